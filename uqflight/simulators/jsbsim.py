@@ -1,0 +1,332 @@
+"""One trimmed, excited JSBSim flight per sample, on an aircraft loaded once and reused.
+
+`JSBSimFlight` is the worker-side object: it loads the aircraft once, then for every sample
+resets the model, sets the sample's properties, trims in unaccelerated level flight, applies
+the elevator excitation and records the outputs. A reused instance gives the same
+trajectories as a freshly loaded one (the reset restores every property the previous sample
+touched and the controls' values at load time).
+"""
+from __future__ import annotations
+
+import hashlib
+import math
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import jsbsim
+import numpy as np
+
+REPO_ROOT = Path(__file__).resolve().parents[2]
+DEFAULT_OUTPUTS = ("alpha_deg", "theta_deg", "h_ft", "q_degps", "vtas_kt")
+
+# Named outputs: (JSBSim property, scale to the output's unit).
+NAMED_OUTPUTS = {
+    "alpha_deg": ("aero/alpha-deg", 1.0),
+    "theta_deg": ("attitude/theta-deg", 1.0),
+    "h_ft": ("position/h-sl-ft", 1.0),
+    "q_degps": ("velocities/q-rad_sec", 180.0 / math.pi),
+    "vtas_kt": ("velocities/vtrue-kts", 1.0),
+}
+UNITS = {"alpha_deg": "deg", "theta_deg": "deg", "h_ft": "ft", "q_degps": "deg/s", "vtas_kt": "kt"}
+
+# Controls the trim writes: restored to their load-time values before every sample.
+TRIM_CONTROLS = (
+    "fcs/throttle-cmd-norm[0]", "fcs/throttle-cmd-norm[1]", "fcs/elevator-cmd-norm",
+    "fcs/pitch-trim-cmd-norm", "fcs/aileron-cmd-norm", "fcs/roll-trim-cmd-norm",
+    "fcs/rudder-cmd-norm", "fcs/yaw-trim-cmd-norm", "fcs/elevator-excitation-deg",
+)
+# Trim acceptance: JSBSim's own tolerances (FGTrim.cpp) with a margin of 10.
+TRIM_TOLERANCES = {
+    "accelerations/udot-ft_sec2": 1e-2,
+    "accelerations/wdot-ft_sec2": 1e-2,
+    "accelerations/qdot-rad_sec2": 1e-3,
+}
+STALL_PROPERTY = "aero/coefficient/CL-stall"  # non-zero past the stall (bacm)
+DIVERGENCE_LIMITS = {"aero/alpha-deg": 30.0, "attitude/phi-deg": 60.0}
+
+
+class FlightError(RuntimeError):
+    """A sample that could not be flown; `status` is its code in the results file."""
+
+    status = 3
+
+
+class TrimError(FlightError):
+    """The trim did not converge or converged to a state outside the aircraft's envelope."""
+
+    status = 1
+
+
+class DivergenceError(FlightError):
+    """The flight left the envelope or produced NaN after the trim."""
+
+    status = 2
+
+
+@dataclass(frozen=True)
+class Excitation:
+    """Elevator excitation added to the trimmed elevator: pulse, step, doublet or none.
+
+    Positive amplitude is trailing edge down (JSBSim's sign: nose-down moment). A doublet is
+    +amplitude for the first half of `duration_s` and -amplitude for the second half.
+    """
+
+    kind: str = "pulse"
+    amplitude_deg: float = 1.0
+    start_s: float = 1.0
+    duration_s: float = 1.0
+
+    KINDS = ("pulse", "step", "doublet", "none")
+
+    def __post_init__(self):
+        if self.kind not in self.KINDS:
+            raise ValueError(f"excitation.kind: expected one of {', '.join(self.KINDS)}, got {self.kind!r}")
+        if self.duration_s < 0 or self.start_s < 0:
+            raise ValueError("excitation.start_s and duration_s must be >= 0")
+
+    def values(self, t: np.ndarray) -> np.ndarray:
+        """Elevator increment [deg] at times `t` [s]."""
+        t = np.asarray(t, dtype=float)
+        after = t >= self.start_s
+        if self.kind == "none":
+            return np.zeros_like(t)
+        if self.kind == "step":
+            return self.amplitude_deg * after
+        end = self.start_s + self.duration_s
+        if self.kind == "pulse":
+            return self.amplitude_deg * (after & (t < end))
+        mid = self.start_s + 0.5 * self.duration_s
+        return self.amplitude_deg * ((after & (t < mid)).astype(float) - ((t >= mid) & (t < end)))
+
+
+@dataclass(frozen=True)
+class FlightSetup:
+    """Everything that is the same for every sample of a campaign."""
+
+    aircraft: str = "bacm"
+    root: Path = REPO_ROOT
+    altitude_ft: float = 15000.0
+    airspeed_ktas: float = 200.0
+    excitation: Excitation = field(default_factory=Excitation)
+    duration_s: float = 50.0
+    rate_hz: float = 120.0
+    output_rate_hz: float = 20.0
+    outputs: tuple[str, ...] = DEFAULT_OUTPUTS
+
+    def __post_init__(self):
+        ratio = self.rate_hz / self.output_rate_hz
+        if self.output_rate_hz <= 0 or abs(ratio - round(ratio)) > 1e-9 or round(ratio) < 1:
+            raise ValueError(
+                f"output_rate_hz: expected a divisor of the integration rate {self.rate_hz:g} Hz, "
+                f"got {self.output_rate_hz:g}")
+        if self.duration_s <= 0:
+            raise ValueError(f"duration_s: expected a positive number, got {self.duration_s:g}")
+
+    @property
+    def steps_per_output(self) -> int:
+        return int(round(self.rate_hz / self.output_rate_hz))
+
+    @property
+    def time(self) -> np.ndarray:
+        """Recorded times [s]: 0 (the trimmed state) to duration_s at the output rate."""
+        n = int(round(self.duration_s * self.output_rate_hz))
+        return np.arange(n + 1) / self.output_rate_hz
+
+    @property
+    def aircraft_file(self) -> Path:
+        return Path(self.root) / "aircraft" / self.aircraft / f"{self.aircraft}.xml"
+
+
+@dataclass
+class TrimResult:
+    """The trimmed state and controls, and the residual accelerations that prove it."""
+
+    alpha_deg: float
+    theta_deg: float
+    throttle: tuple[float, ...]
+    elevator_deg: float
+    residuals: dict[str, float]
+
+    def describe(self) -> str:
+        res = ", ".join(f"{k.split('/')[-1]} = {v:.2e}" for k, v in self.residuals.items())
+        thr = ", ".join(f"{x:.4f}" for x in self.throttle)
+        return (f"trim: alpha = {self.alpha_deg:.4f} deg, theta = {self.theta_deg:.4f} deg, "
+                f"throttle = [{thr}], elevator = {self.elevator_deg:.4f} deg\n"
+                f"residuals: {res}")
+
+
+@dataclass
+class FlightResult:
+    time: np.ndarray
+    outputs: dict[str, np.ndarray]
+    trim: TrimResult
+
+
+def aircraft_hash(setup: FlightSetup) -> str:
+    """sha256 over the aircraft's XML files (airframe, engines, systems), for provenance."""
+    digest = hashlib.sha256()
+    folder = setup.aircraft_file.parent
+    for path in sorted(folder.rglob("*.xml")):
+        digest.update(path.relative_to(folder).as_posix().encode())
+        digest.update(path.read_bytes())
+    return digest.hexdigest()
+
+
+def quiet_jsbsim() -> None:
+    """Silence JSBSim's console messages (trim reports print even at debug level 0)."""
+    jsbsim.set_logger(jsbsim.DefaultLogger(jsbsim.LogLevel.FATAL))
+
+
+class JSBSimFlight:
+    """A loaded aircraft that flies any number of samples: reset, set, trim, excite, record."""
+
+    def __init__(self, setup: FlightSetup = FlightSetup()):
+        if not setup.aircraft_file.is_file():
+            raise FileNotFoundError(f"aircraft {setup.aircraft!r}: no file {setup.aircraft_file}")
+        quiet_jsbsim()
+        self.setup = setup
+        self.fdm = jsbsim.FGFDMExec(str(setup.root))
+        self.fdm.set_debug_level(0)
+        if not self.fdm.load_model(setup.aircraft):
+            raise RuntimeError(f"JSBSim could not load aircraft {setup.aircraft!r} from {setup.root}")
+        self.fdm.set_dt(1.0 / setup.rate_hz)
+        self._pm = self.fdm.get_property_manager()
+        self._nodes: dict[str, object] = {}
+        self._engines = self.fdm.get_propulsion().get_num_engines()
+        self._load_values = {p: self.node(p).get_double_value() for p in TRIM_CONTROLS if self.has_property(p)}
+        self._touched: dict[str, float] = {}
+        self._recorded = [self._output_source(name) for name in setup.outputs]
+
+    # -- properties -------------------------------------------------------------------------
+    def has_property(self, name: str) -> bool:
+        return bool(self._pm.hasNode(name))
+
+    def node(self, name: str):
+        """The cached property node of `name` (KeyError naming it if the aircraft lacks it)."""
+        node = self._nodes.get(name)
+        if node is None:
+            if not self.has_property(name):
+                raise KeyError(f"property {name!r} does not exist in aircraft {self.setup.aircraft!r}")
+            node = self._nodes[name] = self._pm.get_node(name)
+        return node
+
+    def property_value(self, name: str) -> float | None:
+        """The value of `name` as loaded (None when the aircraft has no such property)."""
+        if name in self._touched:
+            return self._touched[name]
+        return self.node(name).get_double_value() if self.has_property(name) else None
+
+    def _output_source(self, name: str):
+        prop, scale = NAMED_OUTPUTS.get(name, (name, 1.0))
+        return self.node(prop), scale
+
+    # -- one sample -------------------------------------------------------------------------
+    def fly(self, settings: dict[str, float] | None = None) -> FlightResult:
+        """Fly one sample with the given property values; raises a FlightError subclass."""
+        trim = self.trim(settings or {})
+        return self.run_trimmed(trim)
+
+    def trim(self, settings: dict[str, float]) -> TrimResult:
+        """Reset, apply `settings`, trim in unaccelerated level flight and settle the engines."""
+        fdm, s = self.fdm, self.setup
+        for name, value in self._load_values.items():
+            self.node(name).set_double_value(value)
+        for name, value in self._touched.items():
+            self.node(name).set_double_value(value)
+        fdm["ic/h-sl-ft"] = s.altitude_ft
+        fdm["ic/vt-kts"] = s.airspeed_ktas
+        for ic in ("ic/gamma-deg", "ic/beta-deg", "ic/phi-deg", "ic/psi-true-deg"):
+            fdm[ic] = 0.0
+        # Initial conditions are read by the reset; every other property must be set after
+        # it, because the reset restores the values declared in the aircraft's XML.
+        initial = {k: v for k, v in settings.items() if k.startswith("ic/")}
+        self._apply(initial)
+        fdm.reset_to_initial_conditions(0)
+        self._apply({k: v for k, v in settings.items() if k not in initial})
+        fdm["propulsion/fuel_freeze"] = 1
+        for i in range(self._engines):
+            fdm[f"fcs/advance-cmd-norm[{i}]"] = 1.0
+        fdm["propulsion/set-running"] = -1
+        try:
+            fdm["simulation/do_simple_trim"] = 1
+        except jsbsim.TrimFailureError as exc:
+            raise TrimError(f"JSBSim trim failed: {str(exc).strip() or 'no convergence'}") from exc
+        fdm.get_propulsion().get_steady_state()
+        return self._checked_trim()
+
+    def _apply(self, settings: dict[str, float]) -> None:
+        for name, value in settings.items():
+            node = self.node(name)
+            self._touched.setdefault(name, node.get_double_value())
+            node.set_double_value(float(value))
+
+    def _checked_trim(self) -> TrimResult:
+        fdm = self.fdm
+        residuals = {name: fdm[name] for name in TRIM_TOLERANCES}
+        result = TrimResult(
+            alpha_deg=fdm["aero/alpha-deg"],
+            theta_deg=fdm["attitude/theta-deg"],
+            throttle=tuple(fdm[f"fcs/throttle-cmd-norm[{i}]"] for i in range(self._engines)),
+            elevator_deg=fdm["fcs/elevator-pos-deg"],
+            residuals=residuals,
+        )
+        bad = [f"{k} = {v:.3g} (tolerance {TRIM_TOLERANCES[k]:g})"
+               for k, v in residuals.items() if not abs(v) <= TRIM_TOLERANCES[k]]
+        if bad:
+            raise TrimError("trim residual too large: " + "; ".join(bad))
+        if not all(0.0 <= x <= 1.0 for x in result.throttle):
+            raise TrimError(f"trim throttle outside [0, 1]: {result.throttle}")
+        if abs(fdm["fcs/pitch-trim-sum"]) >= 1.0:
+            raise TrimError(f"trim elevator saturated at {result.elevator_deg:.2f} deg")
+        if self.has_property(STALL_PROPERTY) and fdm[STALL_PROPERTY] != 0.0:
+            raise TrimError(f"trim angle of attack {result.alpha_deg:.2f} deg is past the stall")
+        return result
+
+    def run_trimmed(self, trim: TrimResult) -> FlightResult:
+        """Excite and integrate from the trimmed state, recording at the output rate."""
+        s = self.setup
+        time = s.time
+        k = s.steps_per_output
+        n_steps = (len(time) - 1) * k
+        step_times = np.arange(n_steps) / s.rate_hz
+        excitation = s.excitation.values(step_times)
+        changes = np.flatnonzero(np.diff(excitation, prepend=0.0))
+        change_at = dict(zip(changes.tolist(), excitation[changes].tolist()))
+        exc_node = self.node("fcs/elevator-excitation-deg")
+        run = self.fdm.run
+        data = np.empty((len(time), len(self._recorded)))
+        data[0] = [node.get_double_value() for node, _ in self._recorded]
+        for i in range(n_steps):
+            if i in change_at:
+                exc_node.set_double_value(change_at[i])
+            run()
+            if (i + 1) % k == 0:
+                data[(i + 1) // k] = [node.get_double_value() for node, _ in self._recorded]
+        exc_node.set_double_value(0.0)
+        data *= np.array([scale for _, scale in self._recorded])
+        self._check_envelope(data)
+        return FlightResult(time=time, outputs=dict(zip(s.outputs, data.T.copy())), trim=trim)
+
+    def _check_envelope(self, data: np.ndarray) -> None:
+        if not np.all(np.isfinite(data)):
+            raise DivergenceError("NaN or infinite value in the recorded outputs")
+        for name, limit in DIVERGENCE_LIMITS.items():
+            value = self.fdm[name]
+            if not abs(value) <= limit:
+                raise DivergenceError(f"{name} = {value:.1f} at the end of the flight (limit {limit:g})")
+
+
+def flight_setup_from(config: dict, root: Path = REPO_ROOT) -> FlightSetup:
+    """A FlightSetup from a campaign's `simulator:` mapping (keys already validated)."""
+    flight = config.get("flight", {})
+    return FlightSetup(
+        aircraft=config.get("aircraft", "bacm"),
+        root=Path(config.get("root", root)),
+        altitude_ft=float(flight.get("altitude_ft", 15000.0)),
+        airspeed_ktas=float(flight.get("airspeed_ktas", 200.0)),
+        excitation=Excitation(**config.get("excitation", {})),
+        duration_s=float(config.get("duration_s", 50.0)),
+        rate_hz=float(config.get("rate_hz", 120.0)),
+        output_rate_hz=float(config.get("output_rate_hz", 20.0)),
+        outputs=tuple(config.get("outputs", DEFAULT_OUTPUTS)),
+    )
