@@ -1,0 +1,67 @@
+"""Designs: the points ξ_j in standard variables and their weights w_j, from a campaign's `design:`.
+
+Kinds (keys in braces):
+- monte_carlo {samples}; sobol {samples, scramble}; halton {samples, scramble};
+  latin_hypercube {samples}: samples mapped to the germs, equal weights.
+- sparse_grid {level, rule, nested, growth}: Smolyak combination technique on 1-D rules.
+- tensor_grid {rule, points}: full tensor product.
+- pick_freeze {samples}: Saltelli's [A; B; AB_1; …; AB_d] for Sobol' index estimators.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .montecarlo import halton_design, latin_hypercube_design, monte_carlo_design, sobol_design
+from .pickfreeze import pick_freeze_design
+from .smolyak import sparse_grid_design
+from .spec import check_germs, is_integer
+from .tensor import tensor_grid_design
+
+_BUILDERS = {
+    "monte_carlo": monte_carlo_design,
+    "sobol": sobol_design,
+    "halton": halton_design,
+    "latin_hypercube": latin_hypercube_design,
+    "sparse_grid": sparse_grid_design,
+    "tensor_grid": tensor_grid_design,
+    "pick_freeze": pick_freeze_design,
+}
+DESIGN_KINDS = tuple(_BUILDERS)
+
+
+@dataclass
+class Design:
+    """Where to run the model and how to weigh each run."""
+
+    kind: str
+    xi: np.ndarray  # (N, d) standard variables, in the order the runs are made
+    weights: np.ndarray  # (N,), summing to 1 for the input distribution; may be negative
+    info: dict = field(default_factory=dict)  # facts for people: level, rule, degree, n_base, ...
+
+
+def build_design(spec: dict, germs: list[str], seed: int) -> Design:
+    """The design a campaign's `design:` mapping asks for, over the given germs."""
+    if not isinstance(spec, dict):
+        raise ValueError(f"design: expected a mapping with a kind key, got {spec!r}")
+    kind = spec.get("kind")
+    if not isinstance(kind, str) or kind not in _BUILDERS:
+        raise ValueError(f"design.kind: expected one of {', '.join(DESIGN_KINDS)}, got {kind!r}")
+    if not is_integer(seed) or seed < 0:
+        raise ValueError(f"seed: expected an integer >= 0, got {seed!r}")
+    xi, weights, info = _BUILDERS[kind](spec, check_germs(germs), int(seed))
+    return Design(kind, xi, weights, info)
+
+
+def describe(design: Design) -> str:
+    """A few lines on the design for `uqflight plan`."""
+    n, d = design.xi.shape
+    lines = [f"{design.kind}: {n} points in {d} dimension{'s' if d > 1 else ''}"]
+    lines += [f"  {key}: {value}" for key, value in design.info.items()]
+    negative = int(np.count_nonzero(design.weights < 0))
+    lines.append(
+        f"  weights: sum {design.weights.sum():.12g}"
+        + (f", {negative} negative" if negative else ", all positive")
+    )
+    return "\n".join(lines)

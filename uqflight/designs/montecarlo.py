@@ -1,0 +1,72 @@
+"""Sampling designs: Monte Carlo and quasi-Monte Carlo points mapped to the germs, equal weights.
+
+Uniform points u in (0, 1)^d become ξ through each germ's inverse CDF (Φ⁻¹ for normal, 2u − 1 for
+uniform), so low-discrepancy structure carries over to ξ.
+"""
+from __future__ import annotations
+
+import numpy as np
+from scipy import special
+from scipy.stats import qmc
+
+from .spec import check_keys, integer, optional_boolean
+
+_OPEN_UNIT = (2.0**-53, 1.0 - 2.0**-53)  # keeps Φ⁻¹ finite at u = 0
+
+
+def germ_quantiles(u: np.ndarray, germs: list[str]) -> np.ndarray:
+    """ξ (N, d) from uniforms u (N, d): column k through the inverse CDF of germ k."""
+    normal = np.array(germs) == "normal"
+    return np.where(normal, special.ndtri(np.clip(u, *_OPEN_UNIT)), 2.0 * u - 1.0)
+
+
+def equal_weights(n: int) -> np.ndarray:
+    return np.full(n, 1.0 / n)
+
+
+def sobol_points(n: int, d: int, scramble: bool, seed: int) -> np.ndarray:
+    """The first n points of a Sobol' sequence in [0, 1)^d.
+
+    Drawn as the next power of 2 and cut, so scipy does not warn about balance. The unscrambled
+    sequence starts at the origin, which has no normal quantile, so it is skipped.
+    """
+    skip = 0 if scramble else 1
+    engine = qmc.Sobol(d, scramble=scramble, rng=seed)
+    return engine.random_base2((n + skip - 1).bit_length())[skip : n + skip]
+
+
+def monte_carlo_design(spec: dict, germs: list[str], seed: int):
+    """`monte_carlo` {samples}: independent draws from numpy's default_rng(seed)."""
+    check_keys(spec, "monte_carlo", ("samples",))
+    n = integer(spec, "samples", "monte_carlo", minimum=1)
+    xi = germ_quantiles(np.random.default_rng(seed).random((n, len(germs))), germs)
+    return xi, equal_weights(n), {"samples": n, "generator": "numpy default_rng", "seed": seed}
+
+
+def sobol_design(spec: dict, germs: list[str], seed: int):
+    """`sobol` {samples, scramble (default true)}: Sobol' points, Owen-scrambled with the seed."""
+    check_keys(spec, "sobol", ("samples", "scramble"))
+    n = integer(spec, "samples", "sobol", minimum=1)
+    scramble = optional_boolean(spec, "scramble", default=True)
+    xi = germ_quantiles(sobol_points(n, len(germs), scramble, seed), germs)
+    return xi, equal_weights(n), {"samples": n, "scramble": scramble, "seed": seed}
+
+
+def halton_design(spec: dict, germs: list[str], seed: int):
+    """`halton` {samples, scramble (default true)}: Halton points; unscrambled, the origin is skipped."""
+    check_keys(spec, "halton", ("samples", "scramble"))
+    n = integer(spec, "samples", "halton", minimum=1)
+    scramble = optional_boolean(spec, "scramble", default=True)
+    engine = qmc.Halton(len(germs), scramble=scramble, rng=seed)
+    if not scramble:
+        engine.fast_forward(1)
+    xi = germ_quantiles(engine.random(n), germs)
+    return xi, equal_weights(n), {"samples": n, "scramble": scramble, "seed": seed}
+
+
+def latin_hypercube_design(spec: dict, germs: list[str], seed: int):
+    """`latin_hypercube` {samples}: one point in each of n equal-probability slices per dimension."""
+    check_keys(spec, "latin_hypercube", ("samples",))
+    n = integer(spec, "samples", "latin_hypercube", minimum=1)
+    xi = germ_quantiles(qmc.LatinHypercube(len(germs), rng=seed).random(n), germs)
+    return xi, equal_weights(n), {"samples": n, "seed": seed}

@@ -1,0 +1,59 @@
+"""Reading a campaign's `design:` mapping: typed values with errors that name the key."""
+from __future__ import annotations
+
+from numbers import Integral
+
+GERMS = ("normal", "uniform")
+
+
+def check_keys(spec: dict, kind: str, accepted: tuple[str, ...]) -> None:
+    """Reject keys that the kind does not know (typos would otherwise be silently ignored)."""
+    allowed = ("kind", *accepted)
+    for key in spec:
+        if key not in allowed:
+            raise ValueError(
+                f"design.{key}: unknown key for kind {kind}; accepted keys: {', '.join(allowed)}"
+            )
+
+
+def is_integer(value) -> bool:
+    return isinstance(value, Integral) and not isinstance(value, bool)
+
+
+def integer(spec: dict, key: str, kind: str, minimum: int) -> int:
+    """The required integer spec[key] >= minimum."""
+    expected = f"an integer >= {minimum}"
+    if key not in spec:
+        raise ValueError(f"design.{key}: missing; kind {kind} expects {expected}")
+    value = spec[key]
+    if not is_integer(value) or value < minimum:
+        raise ValueError(f"design.{key}: expected {expected}, got {value!r}")
+    return int(value)
+
+
+def optional_boolean(spec: dict, key: str, default: bool | None) -> bool | None:
+    if key not in spec:
+        return default
+    value = spec[key]
+    if not isinstance(value, bool):
+        raise ValueError(f"design.{key}: expected true or false, got {value!r}")
+    return value
+
+
+def optional_choice(spec: dict, key: str, choices: tuple[str, ...]) -> str | None:
+    if key not in spec:
+        return None
+    value = spec[key]
+    if value not in choices:
+        raise ValueError(f"design.{key}: expected one of {', '.join(choices)}, got {value!r}")
+    return value
+
+
+def check_germs(germs) -> list[str]:
+    """The germ list of a campaign: non-empty, each "normal" or "uniform"."""
+    germs = list(germs)
+    if not germs or any(germ not in GERMS for germ in germs):
+        raise ValueError(
+            f"germs: expected a non-empty list of {' / '.join(GERMS)}, got {germs!r}"
+        )
+    return germs
