@@ -1,0 +1,95 @@
+"""Weighted moments and quantile bands over time: the one place where Eq. 15–17 are summed.
+
+Y is (N, T) (one row per run, one column per time); the statistics reduce along axis 0.
+Weights are normalised to sum 1, so Monte Carlo rows dropped after failed runs stay 1/N_ok.
+"""
+import numpy as np
+
+
+def as_runs_by_time(Y) -> np.ndarray:
+    """Y as a float (N, T) array; a 1-D array of N scalar outputs becomes (N, 1)."""
+    Y = np.asarray(Y, dtype=float)
+    return Y.reshape(Y.shape[0], -1)
+
+
+def probability_weights(weights, n: int) -> np.ndarray:
+    """Weights (N,) rescaled to sum 1; None means equal weights 1/n."""
+    if weights is None:
+        return np.full(n, 1.0 / n)
+    weights = np.asarray(weights, dtype=float)
+    if weights.shape != (n,):
+        raise ValueError(f"weights have shape {weights.shape}, expected ({n},): one per run")
+    total = weights.sum()
+    if total <= 0:
+        raise ValueError(f"weights sum to {total}; they must sum to a positive number (normally 1)")
+    return weights / total
+
+
+def weighted_mean(Y, weights=None) -> np.ndarray:
+    """Σ_j w_j Y_j (Eq. 17 applied to Eq. 15): (T,)."""
+    Y = np.asarray(Y, dtype=float)
+    return probability_weights(weights, len(Y)) @ Y
+
+
+def weighted_variance(Y, weights=None, unbiased: bool = False) -> np.ndarray:
+    """Σ_j w_j (Y_j − mean)² (Eq. 16), (T,). Centred first to avoid cancellation.
+
+    With ``unbiased`` the result is divided by 1 − Σ w_j² (the reliability-weights correction,
+    N/(N − 1) for equal weights). Signed sparse-grid weights can make the variance negative.
+    """
+    Y = np.asarray(Y, dtype=float)
+    w = probability_weights(weights, len(Y))
+    deviation = Y - w @ Y
+    variance = w @ np.square(deviation, out=deviation)
+    if not unbiased:
+        return variance
+    correction = 1.0 - w @ w
+    if correction <= 0:
+        raise ValueError("an unbiased variance needs at least two runs with positive weight")
+    return variance / correction
+
+
+def weighted_std(Y, weights=None, unbiased: bool = False) -> np.ndarray:
+    """√variance, (T,); a negative variance (possible with signed weights) gives 0."""
+    return np.sqrt(np.clip(weighted_variance(Y, weights, unbiased), 0.0, None))
+
+
+def quantile_band(Y, weights=None, level: float = 0.99) -> tuple[np.ndarray, np.ndarray]:
+    """Central ``level`` band per time: the (1−level)/2 and (1+level)/2 weighted quantiles, each (T,).
+
+    Runs are sorted per time; the j-th sorted run sits at cumulative weight Σ_{i<j} w_i + w_j/2
+    (Hazen positions) and the quantile is interpolated linearly between them. Equal weights
+    (Monte Carlo, the large case) take numpy's selection-based Hazen quantile, which gives the
+    same numbers without a full sort. Needs weights ≥ 0: for a signed sparse grid, sample its
+    PCE instead.
+    """
+    Y = as_runs_by_time(Y)
+    w = probability_weights(weights, len(Y))
+    if (w < 0).any():
+        raise ValueError("quantiles need non-negative weights; sample the PCE for a sparse grid")
+    if len(Y) < 2:
+        raise ValueError("a quantile band needs at least two runs")
+    tails = (0.5 * (1.0 - level), 0.5 * (1.0 + level))
+    if np.ptp(w) == 0:
+        lower, upper = np.quantile(Y, tails, axis=0, method="hazen")
+        return lower, upper
+    order = np.argsort(Y, axis=0)
+    sorted_weights = w[order]
+    positions = np.cumsum(sorted_weights, axis=0)
+    sorted_weights *= 0.5
+    positions -= sorted_weights
+    columns = np.arange(Y.shape[1])
+    bounds = []
+    for probability in tails:
+        upper = np.clip((positions < probability).sum(axis=0), 1, len(Y) - 1)
+        lower = upper - 1
+        gap = positions[upper, columns] - positions[lower, columns]
+        fraction = np.divide(probability - positions[lower, columns], gap, out=np.ones_like(gap), where=gap > 0)
+        below, above = Y[order[lower, columns], columns], Y[order[upper, columns], columns]
+        bounds.append(below + np.clip(fraction, 0.0, 1.0) * (above - below))
+    return bounds[0], bounds[1]
+
+
+def modified_cov(mean, std) -> np.ndarray:
+    """Modified coefficient of variation std(t) / max_t |mean(t)| (the paper's Fig. 8)."""
+    return np.asarray(std, dtype=float) / np.max(np.abs(mean))

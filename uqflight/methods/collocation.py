@@ -1,0 +1,69 @@
+"""Stochastic collocation: interpolation (Eq. 26–34, 41–42), regression (Eq. 35–37) and
+weighted least squares (Eq. 43–48).
+"""
+import numpy as np
+
+from ..analysis.moments import as_runs_by_time, probability_weights
+from ..designs.spec import check_germs
+from .basis import orthonormal_basis, total_degree_indices
+from .galerkin import pseudo_galerkin
+from .integration import direct_integration
+from .pce import PCE
+
+
+def interpolation(xi, weights, Y, germs, order: int = 2, x0=None) -> tuple[np.ndarray, np.ndarray, PCE]:
+    """Lagrange interpolation on the grid: mean, variance (each (T,)) and PCE.
+
+    Because I_j(ξ_k) = δ_jk, the interpolant's moments are the weighted sums of the runs
+    (Eq. 32–34) and its PCE coefficients are the projection Σ_j Y_j Ψ_α(ξ_j) w_j (Eq. 41–42),
+    so no Lagrange polynomial is ever formed. x0 selects the split form of the projection.
+    """
+    mean, variance = direct_integration(Y, weights)
+    return mean, variance, pseudo_galerkin(xi, weights, Y, germs, order, x0)
+
+
+def _basis_matrix(xi, germs, order: int) -> tuple[np.ndarray, np.ndarray]:
+    """Total-degree indices (Z, d) and the Vandermonde-like V = [Ψ_α(ξ_j)] (N, Z) of Eq. 37."""
+    indices = total_degree_indices(len(germs), order)
+    return indices, orthonormal_basis(germs, indices, xi)
+
+
+def _solve(matrix: np.ndarray, rhs: np.ndarray, order: int) -> np.ndarray:
+    """Least-squares solution (Z, T) by SVD (numpy lstsq); refuses an undetermined system."""
+    n_points, n_terms = matrix.shape
+    if n_points < n_terms:
+        raise ValueError(
+            f"N = {n_points} points cannot determine Z = {n_terms} coefficients of a total-degree "
+            f"order-{order} expansion: use N >= Z points or a lower order"
+        )
+    coefficients, _, rank, _ = np.linalg.lstsq(matrix, rhs, rcond=None)
+    if rank < n_terms:
+        raise ValueError(
+            f"the {n_points} points determine only {rank} of the Z = {n_terms} coefficients "
+            f"of the order-{order} expansion (rank-deficient design): lower the order"
+        )
+    return coefficients
+
+
+def regression(xi, Y, germs, order: int = 2) -> PCE:
+    """Solve V c = Y (Eq. 36): interpolation when N = Z, least squares when N > Z; N < Z is a ValueError."""
+    germs = check_germs(germs)
+    indices, matrix = _basis_matrix(xi, germs, order)
+    return PCE(germs, indices, _solve(matrix, as_runs_by_time(Y), order))
+
+
+def least_squares(xi, weights, Y, germs, order: int = 2) -> PCE:
+    """Weighted least squares min Σ_z |w_z| (Y_z − V c)² (Eq. 44), solved through lstsq of √|w|·V.
+
+    Factorising √|w|·V (SVD) never forms the Gram matrix J = VᵀWV of Eq. 47, whose condition
+    number is the square of V's. Signed sparse-grid weights are replaced by |w|: with a negative
+    w_z the objective stops being a sum of squares (it would reward misfit at ξ_z, and √w_z is
+    not real), while |w| keeps a true minimisation that still gives the tails of the law the
+    small influence their weights say. For non-negative weights (MC, Gauss tensor grids) this is
+    exactly Eq. 44; a polynomial in the basis is recovered exactly either way.
+    """
+    germs = check_germs(germs)
+    Y = as_runs_by_time(Y)
+    root_weights = np.sqrt(np.abs(probability_weights(weights, len(Y))))[:, None]
+    indices, matrix = _basis_matrix(xi, germs, order)
+    return PCE(germs, indices, _solve(root_weights * matrix, root_weights * Y, order))
