@@ -1,0 +1,127 @@
+"""The runner: worker-count and executor independence, failure isolation, kill and resume."""
+import os
+import signal
+import subprocess
+import sys
+from pathlib import Path
+
+import h5py
+import numpy as np
+import pytest
+
+from uqflight.campaign import jsbsim_probe, parse_campaign
+from uqflight.execution import run_campaign
+from uqflight.store import ResultStore, Status
+
+UQFLIGHT = str(Path(sys.executable).with_name("uqflight"))
+DATA = Path(__file__).parent / "data"
+
+JSBSIM_CAMPAIGN = """
+name: small-jsbsim
+seed: 7
+simulator:
+  kind: jsbsim
+  duration_s: {duration}
+  output_rate_hz: 10
+parameters:
+  CL0: {{property: aero/uq/CL0, distribution: normal, interval_pct: 23.05}}
+  k2:  {{property: aero/uq/k2, distribution: uniform, interval_pct: 379.74}}
+  V:   {{property: ic/vt-kts, distribution: normal, lower: 195, upper: 205}}
+design: {{kind: monte_carlo, samples: {samples}}}
+execution: {{workers: 1, chunk: 4}}
+"""
+
+
+def jsbsim_campaign(samples=12, duration=5):
+    return parse_campaign(JSBSIM_CAMPAIGN.format(samples=samples, duration=duration), "small.yaml", jsbsim_probe)
+
+
+def read_all(path):
+    with h5py.File(path, "r") as f:
+        return {k: f[k][()] for k in ["samples/xi", "samples/kappa", "samples/status", "time"]} | {
+            f"outputs/{k}": f["outputs"][k][()] for k in f["outputs"]}
+
+
+def assert_same_results(a, b):
+    ra, rb = read_all(a), read_all(b)
+    assert ra.keys() == rb.keys()
+    for key in ra:
+        np.testing.assert_array_equal(ra[key], rb[key], err_msg=key)
+
+
+def test_results_do_not_depend_on_workers_or_executor(tmp_path):
+    campaign = jsbsim_campaign()
+    one = run_campaign(campaign, out=tmp_path / "one.h5", workers=1)
+    two = run_campaign(campaign, out=tmp_path / "two.h5", workers=2)
+    assert one.ran == two.ran == 12 and not one.failures
+    assert_same_results(tmp_path / "one.h5", tmp_path / "two.h5")
+    dask = run_campaign(campaign, out=tmp_path / "dask.h5", workers=2, executor="dask")
+    assert dask.ran == 12
+    assert_same_results(tmp_path / "one.h5", tmp_path / "dask.h5")
+
+
+def test_stored_runs_match_a_fresh_flight(tmp_path):
+    from uqflight.simulators.jsbsim import FlightSetup, JSBSimFlight
+
+    campaign = jsbsim_campaign(samples=3)
+    run_campaign(campaign, out=tmp_path / "r.h5")
+    with ResultStore.open(tmp_path / "r.h5") as store:
+        kappa, theta = store.kappa, store.output_matrix("theta_deg")
+    flight = JSBSimFlight(FlightSetup(duration_s=5, output_rate_hz=10))
+    fresh = flight.fly({"aero/uq/CL0": kappa[2, 0], "aero/uq/k2": kappa[2, 1], "ic/vt-kts": kappa[2, 2]})
+    np.testing.assert_allclose(theta[2], fresh.outputs["theta_deg"], rtol=1e-9)
+
+
+def test_failed_runs_are_recorded_and_the_campaign_goes_on(tmp_path):
+    text = f"""
+name: flaky
+seed: 3
+simulator: {{kind: python, function: "flaky_model.py:flaky"}}
+parameters:
+  x: {{distribution: uniform, lower: -2, upper: 2}}
+design: {{kind: monte_carlo, samples: 200}}
+execution: {{workers: 2, chunk: 8}}
+"""
+    campaign = parse_campaign(text, str(DATA / "flaky.yaml"))
+    summary = run_campaign(campaign, out=tmp_path / "f.h5")
+    with ResultStore.open(tmp_path / "f.h5") as store:
+        x, status, reasons, y = store.kappa[:, 0], store.status, store.reasons, store.output_matrix("y")
+    assert np.all(status[x > 1.5] == Status.SIMULATOR_ERROR)
+    assert all("model blew up" in r for r in np.asarray(reasons)[x > 1.5])
+    assert np.all(status[x < -1.5] == Status.DIVERGED)
+    ok = np.abs(x) <= 1.5
+    assert np.all(status[ok] == Status.OK)
+    np.testing.assert_array_equal(y[ok], np.column_stack([x[ok], x[ok] ** 2]))
+    assert np.all(np.isnan(y[~ok]))
+    assert sum(summary.failures.values()) == int((~ok).sum())
+
+
+def test_a_file_of_another_campaign_is_refused_unless_forced(tmp_path):
+    run_campaign(jsbsim_campaign(samples=2), out=tmp_path / "r.h5")
+    other = jsbsim_campaign(samples=3)
+    with pytest.raises(FileExistsError, match="another campaign"):
+        run_campaign(other, out=tmp_path / "r.h5")
+    assert run_campaign(other, out=tmp_path / "r.h5", force=True).ran == 3
+
+
+def test_resume_after_sigkill_equals_an_uninterrupted_run(tmp_path):
+    text = JSBSIM_CAMPAIGN.format(samples=160, duration=20)
+    (tmp_path / "c.yaml").write_text(text)
+    killed = tmp_path / "killed.h5"
+    proc = subprocess.Popen([UQFLIGHT, "run", str(tmp_path / "c.yaml"), "--out", str(killed)],
+                            stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
+    for line in proc.stderr:  # progress lines: "48/160 runs (30 %), ..."
+        if "/160 runs" in line and int(line.split("/")[0]) >= 40:
+            break
+    os.kill(proc.pid, signal.SIGKILL)
+    proc.wait()
+    with ResultStore.open(killed) as store:
+        remaining = store.pending().size
+    assert 0 < remaining < 160, "the kill should land mid-run"
+    resumed = subprocess.run([UQFLIGHT, "run", str(tmp_path / "c.yaml"), "--out", str(killed)],
+                             capture_output=True, text=True)
+    assert resumed.returncode == 0, resumed.stderr
+    assert f"{160 - remaining} already done" in resumed.stdout
+    campaign = parse_campaign(text, str(tmp_path / "c.yaml"), jsbsim_probe)
+    run_campaign(campaign, out=tmp_path / "whole.h5")
+    assert_same_results(killed, tmp_path / "whole.h5")
