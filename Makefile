@@ -13,8 +13,12 @@ $(STAMP): $(BIN)/python pyproject.toml
 	$(BIN)/pip install --quiet -e '.[test]'
 	touch $(STAMP)
 
+DEMO := paper-pg2-l2
+
 demo: $(STAMP)
-	$(BIN)/uqflight demo
+	$(BIN)/uqflight run campaigns/$(DEMO).yaml
+	$(BIN)/uqflight report results/$(DEMO).h5 --out results/$(DEMO)-report
+	@echo "report: $(CURDIR)/results/$(DEMO)-report/report.html"
 
 test: $(STAMP)
 	$(BIN)/pytest -q

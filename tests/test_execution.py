@@ -125,3 +125,17 @@ def test_resume_after_sigkill_equals_an_uninterrupted_run(tmp_path):
     campaign = parse_campaign(text, str(tmp_path / "c.yaml"), jsbsim_probe)
     run_campaign(campaign, out=tmp_path / "whole.h5")
     assert_same_results(killed, tmp_path / "whole.h5")
+
+
+def test_tsvd_storage_and_property_outputs(tmp_path):
+    text = JSBSIM_CAMPAIGN.format(samples=10, duration=5).replace(
+        "  output_rate_hz: 10\n", "  output_rate_hz: 10\n  outputs: [theta_deg, aero/qbar-psf]\n").replace(
+        "execution:", "storage: {raw: false, tsvd: {tol: 1.0e-12, batch: 4}}\nexecution:")
+    run_campaign(parse_campaign(text, "t.yaml", jsbsim_probe), out=tmp_path / "t.h5")
+    raw_text = text.replace("raw: false", "raw: true")
+    run_campaign(parse_campaign(raw_text, "r.yaml", jsbsim_probe), out=tmp_path / "r.h5")
+    with ResultStore.open(tmp_path / "t.h5") as compressed, ResultStore.open(tmp_path / "r.h5") as raw:
+        assert compressed.output_names == raw.output_names == ["theta_deg", "aero/qbar-psf"]
+        for name in raw.output_names:
+            exact = raw.output_matrix(name)
+            np.testing.assert_allclose(compressed.output_matrix(name), exact, rtol=0, atol=1e-9 * np.abs(exact).max())

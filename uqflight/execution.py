@@ -19,6 +19,7 @@ from multiprocessing import get_context
 from pathlib import Path
 
 import numpy as np
+from threadpoolctl import threadpool_limits
 
 from .campaign import Campaign
 from .designs import Design
@@ -169,13 +170,16 @@ def run_campaign(campaign: Campaign, out: Path | None = None, workers: int | Non
         # A chunk with some samples already stored (impossible with this writer, but a file
         # written elsewhere may have one) is rerun whole; only its pending rows are written.
         tasks = [(spec, c, kappa[c], n_times, outputs) for c in chunks]
-        for indices, status, reasons, values in _execute(tasks, workers, executor, scheduler):
-            keep = store.status[indices] == Status.PENDING
-            store.write_batch(indices[keep], status[keep], np.asarray(reasons, dtype=object)[keep],
-                              {k: v[keep] for k, v in values.items()})
-            summary.ran += int(keep.sum())
-            summary.failures.update(r for r, s in zip(np.asarray(reasons)[keep], status[keep]) if s != 0)
-            progress.advance(int(keep.sum()))
+        # One BLAS thread here: the workers keep every core busy, and a multi-threaded BLAS
+        # competing with them makes the tSVD updates of this process 10-100x slower.
+        with threadpool_limits(limits=1):
+            for indices, status, reasons, values in _execute(tasks, workers, executor, scheduler):
+                keep = store.status[indices] == Status.PENDING
+                store.write_batch(indices[keep], status[keep], np.asarray(reasons, dtype=object)[keep],
+                                  {k: v[keep] for k, v in values.items()})
+                summary.ran += int(keep.sum())
+                summary.failures.update(r for r, s in zip(np.asarray(reasons)[keep], status[keep]) if s != 0)
+                progress.advance(int(keep.sum()))
         progress.close()
     finally:
         store.close()

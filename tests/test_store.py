@@ -1,0 +1,298 @@
+"""The HDF5 results file: fixed layout, design order, tSVD determinism, and resuming after a kill.
+
+Run as a script (`python test_store.py PATH SEED`), this file is the writer that the SIGKILL test kills.
+"""
+import hashlib
+import json
+import os
+import signal
+import subprocess
+import sys
+import time
+
+import h5py
+import numpy as np
+import pytest
+
+import uqflight.store
+from uqflight.store import ResultStore, Status, open_for_campaign
+
+N, T = 240, 400
+XI, TIME = np.random.default_rng(7).standard_normal((N, 2)), np.linspace(0.0, 20.0, T)
+OUTPUTS = ["alpha_deg", "h_ft"]
+CAMPAIGN = "name: store-test\nparameters: {CL0: {distribution: normal}, Cmq: {distribution: normal}}\n"
+
+
+def create_args(raw=True, tsvd=True):
+    return dict(xi=XI, kappa=1.0 + 0.1 * XI, weights=np.full(N, 1.0 / N), parameter_names=["CL0", "Cmq"],
+                outputs=OUTPUTS, time=TIME, raw=raw,
+                tsvd={"tol": 1e-10, "batch": 8} if tsvd else None,
+                attrs={"versions": {"numpy": np.__version__}, "aircraft_hash": "ab12"},
+                units={"alpha_deg": "deg", "h_ft": "ft"})
+
+
+def expected_runs(indices):
+    """Status, reasons and histories of the runs `indices`: a pure function of the index."""
+    status = np.where(indices % 9 == 4, Status.DIVERGED, np.where(indices % 13 == 7, Status.TRIM_FAILURE, Status.OK))
+    reasons = [{Status.OK: "", Status.DIVERGED: "NaN in alpha", Status.TRIM_FAILURE: "udot not trimmable"}[s]
+               for s in status]
+    a, b, t = XI[indices, :1], XI[indices, 1:], TIME
+    outputs = {"alpha_deg": 2.0 + 0.3 * a * np.sin(t) + 0.1 * b * t / 20 + 0.02 * a * b * np.cos(2 * t),
+               "h_ft": 15000.0 + 20.0 * b * (1 - np.cos(t / 3)) + a ** 2 * t}
+    return status, reasons, outputs
+
+
+def write_runs(store, batches):
+    for indices in batches:
+        store.write_batch(indices, *expected_runs(np.asarray(indices)))
+
+
+def shuffled_batches(seed):
+    """All runs in a random order, in batches of random sizes 1..12 (as workers would finish them)."""
+    rng = np.random.default_rng(seed)
+    cuts = np.cumsum(rng.integers(1, 13, size=N))
+    return np.split(rng.permutation(N), cuts[cuts < N])
+
+
+def in_design_order(batch):
+    return np.array_split(np.arange(N), N // batch)
+
+
+def file_contents(path):
+    """Every dataset of a results file, by path."""
+    found = {}
+    with h5py.File(path, "r") as f:
+        f.visititems(lambda key, item: found.update({key: item[()]}) if isinstance(item, h5py.Dataset) else None)
+    return found
+
+
+def assert_same_results(a, b):
+    """Same datasets; identical samples and raw outputs; tSVD factors equal to 1e-12."""
+    ca, cb = file_contents(a), file_contents(b)
+    assert ca.keys() == cb.keys()
+    for key in ca:
+        if key.startswith("tsvd/") and ca[key].dtype.kind == "f":
+            np.testing.assert_allclose(ca[key], cb[key], rtol=0, atol=1e-12, err_msg=key)
+        else:
+            np.testing.assert_array_equal(ca[key], cb[key], err_msg=key)
+
+
+@pytest.fixture
+def reference(tmp_path):
+    """A raw + tSVD file written without interruption, in design order."""
+    path = tmp_path / "reference.h5"
+    with ResultStore.create(path, campaign_text=CAMPAIGN, **create_args()) as store:
+        write_runs(store, in_design_order(8))
+    return path
+
+
+def test_create_writes_the_fixed_layout_and_reopens(tmp_path):
+    path = tmp_path / "r.h5"
+    args = create_args()
+    ResultStore.create(path, campaign_text=CAMPAIGN, **args).close()
+    datasets = set(file_contents(path))
+    with h5py.File(path, "r") as f:
+        assert {"samples/xi", "samples/kappa", "samples/weight", "samples/status", "samples/reason", "time",
+                "outputs/alpha_deg", "outputs/h_ft"} <= datasets
+        assert {f"tsvd/h_ft/{k}" for k in ("U", "s", "V", "columns", "buffer", "buffer_index")} <= datasets
+        assert f["outputs/h_ft"].shape == (N, T) and f["outputs/h_ft"].chunks[1] == T
+        assert f["samples/status"].dtype == np.int8 and np.all(f["samples/status"][()] == -1)
+        assert f.attrs["campaign"] == CAMPAIGN
+        assert f.attrs["campaign_hash"] == hashlib.sha256(CAMPAIGN.encode()).hexdigest()
+        assert json.loads(f.attrs["versions"]) == {"numpy": np.__version__} and f.attrs["aircraft_hash"] == "ab12"
+        assert "created" in f.attrs and f["time"].attrs["units"] == "s"
+        assert list(f["samples/kappa"].attrs["names"]) == ["CL0", "Cmq"]
+        assert f["outputs/alpha_deg"].attrs["units"] == "deg"
+        assert list(f["outputs/alpha_deg"].attrs["dimensions"]) == ["sample", "time"]
+    with ResultStore.open(path) as store:
+        np.testing.assert_array_equal(store.xi, args["xi"])
+        np.testing.assert_array_equal(store.kappa, args["kappa"])
+        np.testing.assert_array_equal(store.weights, args["weights"])
+        np.testing.assert_array_equal(store.time, args["time"])
+        np.testing.assert_array_equal(store.pending(), np.arange(N))
+        assert store.parameter_names == ["CL0", "Cmq"] and store.output_names == OUTPUTS
+        assert store.units == {"alpha_deg": "deg", "h_ft": "ft"} and store.reasons == [""] * N
+        assert store.output_factors("h_ft") is None  # the raw histories are there
+        assert (store.campaign_text, store.storage_description) == (
+            CAMPAIGN, "raw; tsvd tol 1e-10, batch 8, ranks alpha_deg 0, h_ft 0")
+    with pytest.raises(FileExistsError, match="r.h5"):
+        ResultStore.create(path, campaign_text=CAMPAIGN, **args)
+    h5py.File(tmp_path / "other.h5", "w").close()
+    with pytest.raises(ValueError, match="other.h5 is not a uqflight results file"):
+        ResultStore.open(tmp_path / "other.h5")
+
+
+def test_compressed_only_file_has_no_raw_outputs(tmp_path):
+    with ResultStore.create(tmp_path / "c.h5", campaign_text=CAMPAIGN, **create_args(raw=False)) as store:
+        write_runs(store, in_design_order(12))
+        assert store.output_names == OUTPUTS
+    with h5py.File(tmp_path / "c.h5", "r") as f:
+        assert "outputs" not in f
+    with pytest.raises(ValueError, match="nothing would be stored"):
+        ResultStore.create(tmp_path / "n.h5", campaign_text=CAMPAIGN, **create_args(raw=False, tsvd=False))
+
+
+def test_runs_arriving_out_of_order_land_in_design_order(tmp_path):
+    with ResultStore.create(tmp_path / "r.h5", campaign_text=CAMPAIGN, **create_args(tsvd=False)) as store:
+        write_runs(store, shuffled_batches(seed=1))
+        status, reasons, outputs = expected_runs(np.arange(N))
+        ok = status == Status.OK
+        assert store.pending().size == 0 and not ok.all()
+        np.testing.assert_array_equal(store.status, status)
+        assert store.reasons == reasons
+        for name in OUTPUTS:
+            np.testing.assert_array_equal(store.output_matrix(name), np.where(ok[:, None], outputs[name], np.nan))
+            np.testing.assert_array_equal(store.output_matrix(name, rows=[5, 3]), outputs[name][[5, 3]])
+        blocks = list(store.iter_output_blocks("h_ft", block=50))
+        np.testing.assert_array_equal(np.concatenate([rows for rows, _ in blocks]), np.flatnonzero(ok))
+        np.testing.assert_array_equal(np.vstack([v for _, v in blocks]), outputs["h_ft"][ok])
+        with pytest.raises(ValueError, match="already stored"):
+            write_runs(store, [[3]])
+
+
+def test_tsvd_factors_do_not_depend_on_the_arrival_order(tmp_path, reference):
+    for seed in (2, 3):
+        path = tmp_path / f"shuffled{seed}.h5"
+        with ResultStore.create(path, campaign_text=CAMPAIGN, **create_args()) as store:
+            write_runs(store, shuffled_batches(seed))
+        assert_same_results(path, reference)
+    status, _, outputs = expected_runs(np.arange(N))
+    ok = status == Status.OK
+    contents = file_contents(reference)
+    np.testing.assert_array_equal(contents["tsvd/h_ft/columns"], np.flatnonzero(ok))
+    assert contents["tsvd/h_ft/buffer"].shape == (0, T)
+    compressed = tmp_path / "compressed.h5"
+    with ResultStore.create(compressed, campaign_text=CAMPAIGN, **create_args(raw=False)) as store:
+        write_runs(store, shuffled_batches(seed=4))
+        for name in OUTPUTS:
+            rebuilt = store.output_matrix(name)
+            assert np.isnan(rebuilt[~ok]).all()
+            np.testing.assert_allclose(rebuilt[ok], outputs[name][ok], rtol=1e-9)
+
+
+@pytest.mark.parametrize("raw", [True, False])
+def test_moments_equal_numpy_on_the_raw_data(tmp_path, raw):
+    weights = np.random.default_rng(5).uniform(0.5, 1.5, N)
+    with ResultStore.create(tmp_path / "m.h5", campaign_text=CAMPAIGN, **create_args(raw=raw)) as store:
+        write_runs(store, shuffled_batches(seed=6))
+        status, _, outputs = expected_runs(np.arange(N))
+        ok = status == Status.OK
+        w = weights[ok] / weights[ok].sum()
+        for name in OUTPUTS:
+            mean, variance = store.output_moments(name, weights)
+            expected_mean = w @ outputs[name][ok]
+            np.testing.assert_allclose(mean, expected_mean, rtol=1e-12)
+            np.testing.assert_allclose(variance, w @ (outputs[name][ok] - expected_mean) ** 2,
+                                       rtol=1e-7, atol=1e-9 * variance.max())
+
+
+def test_a_partial_compressed_file_reads_its_buffered_runs(tmp_path):
+    with ResultStore.create(tmp_path / "p.h5", campaign_text=CAMPAIGN, **create_args(raw=False)) as store:
+        write_runs(store, [np.arange(0, 30), np.arange(40, 45)])  # a gap: 40..44 wait in the buffer
+        np.testing.assert_array_equal(store.pending(), np.r_[30:40, 45:N])
+        written = np.r_[0:30, 40:45]
+        status, _, outputs = expected_runs(written)
+        ok = status == Status.OK
+        rebuilt = store.output_matrix("alpha_deg", np.r_[written, 35])
+        np.testing.assert_allclose(rebuilt[:-1][ok], outputs["alpha_deg"][ok], rtol=1e-9)
+        assert np.isnan(rebuilt[:-1][~ok]).all() and np.isnan(rebuilt[-1]).all()
+        U, s, V, columns = store.output_factors("alpha_deg")
+        np.testing.assert_array_equal(columns, written[ok])
+        np.testing.assert_allclose((V * s) @ U.T, outputs["alpha_deg"][ok], rtol=1e-9)
+
+
+def kill_writer_midway(path, batches_before_kill, delay):
+    """Run this file as the writer of `path`; SIGKILL it `delay` seconds after it reports that many batches
+    (a batch takes a few milliseconds: the delay moves the kill across the steps of the next one)."""
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join(sys.path))
+    child = subprocess.Popen([sys.executable, __file__, str(path), "8"], stdout=subprocess.PIPE, text=True, env=env)
+    for line in child.stdout:
+        if int(line) + 1 >= batches_before_kill:
+            break
+    time.sleep(delay)
+    os.kill(child.pid, signal.SIGKILL)
+    child.wait()
+    assert child.returncode == -signal.SIGKILL, "the writer finished before the kill"
+
+
+@pytest.mark.parametrize("batches_before_kill, delay", [(2, 0.0), (9, 0.003), (20, 0.006)])
+def test_resume_after_sigkill_equals_an_uninterrupted_file(tmp_path, reference, batches_before_kill, delay):
+    path = tmp_path / "killed.h5"
+    ResultStore.create(path, campaign_text=CAMPAIGN, **create_args()).close()
+    kill_writer_midway(path, batches_before_kill, delay)
+    with ResultStore.open(path, "a") as store:
+        pending, status = store.pending(), store.status
+        assert 0 < pending.size < N
+        reported = np.concatenate(shuffled_batches(8)[:batches_before_kill])
+        assert not np.isin(reported, pending).any()
+        np.testing.assert_array_equal(status[status >= 0], expected_runs(np.flatnonzero(status >= 0))[0])
+        write_runs(store, np.array_split(pending, 5))
+    assert_same_results(path, reference)
+
+
+class Crash(Exception):
+    """Stands for a kill at one step of a write."""
+
+
+def crash_after(step):
+    def crashing(*args):
+        step(*args)
+        raise Crash
+
+    return crashing
+
+
+def crash_before(step):
+    def crashing(*args):
+        raise Crash
+
+    return crashing
+
+
+def crash_halfway(step):
+    def crashing(group):  # _apply_staged moves U in, then dies
+        del group["U"]
+        group.move("next/U", "U")
+        raise Crash
+
+    return crashing
+
+
+@pytest.mark.parametrize("step, crash", [("_append_rows", crash_after), ("_write_state", crash_after),
+                                         ("_apply_staged", crash_before), ("_apply_staged", crash_halfway)])
+def test_a_crash_between_two_steps_is_mended_on_reopening(tmp_path, reference, monkeypatch, step, crash):
+    """Rows in the buffer without their status; factors staged but incomplete; staged but not moved
+    in; moved in half-way."""
+    path = tmp_path / "crashed.h5"
+    with ResultStore.create(path, campaign_text=CAMPAIGN, **create_args()) as store:
+        write_runs(store, [np.arange(0, 6)])
+        monkeypatch.setattr(uqflight.store, step, crash(getattr(uqflight.store, step)))
+        with pytest.raises(Crash):
+            write_runs(store, [np.arange(6, 20)])  # enough runs to fold a batch of 8 columns
+    monkeypatch.undo()
+    with ResultStore.open(path, "a") as store:
+        first_pending = 6 if step == "_append_rows" else 20
+        np.testing.assert_array_equal(store.pending(), np.arange(first_pending, N))
+        write_runs(store, [store.pending()])
+    assert_same_results(path, reference)
+
+
+def test_open_for_campaign_resumes_only_the_same_campaign(tmp_path):
+    path = tmp_path / "r.h5"
+    with open_for_campaign(path, campaign_text=CAMPAIGN, **create_args(tsvd=False)) as store:
+        write_runs(store, [np.arange(10)])
+    with open_for_campaign(path, campaign_text=CAMPAIGN, **create_args(tsvd=False)) as store:
+        np.testing.assert_array_equal(store.pending(), np.arange(10, N))
+    other = CAMPAIGN + "seed: 2\n"
+    with pytest.raises(FileExistsError, match=r"r\.h5 holds the results of another campaign"):
+        open_for_campaign(path, campaign_text=other, **create_args(tsvd=False))
+    with open_for_campaign(path, campaign_text=other, force=True, **create_args(tsvd=False)) as store:
+        assert store.campaign_text == other and store.pending().size == N
+
+
+if __name__ == "__main__":
+    target, seed = sys.argv[1], int(sys.argv[2])
+    with ResultStore.open(target, "a") as writer:
+        for k, batch in enumerate(shuffled_batches(seed)):
+            write_runs(writer, [batch])
+            print(k, flush=True)

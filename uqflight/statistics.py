@@ -1,0 +1,214 @@
+"""Statistics of a results file: the campaign's method applied per output, vectorised over time.
+
+For each output: mean, variance, the 99 % band, PDFs over time, the modified coefficient of
+variation, Sobol' indices, and, against a Monte Carlo reference file, the errors of Eq. 49 and the
+Kullback-Leibler divergence of Eq. 50.
+
+Every method is linear in the runs, so with tSVD storage (Y = V diag(s) Uᵀ) the method is applied
+to V (N × r) and the result multiplied by diag(s) Uᵀ: statistics come from the factors without
+rebuilding the sample matrix. Samples are rebuilt (in blocks, by the store) only for Monte Carlo
+quantiles and PDFs.
+"""
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .analysis.density import pdf_over_time
+from .analysis.divergence import kl_divergence
+from .analysis.errors import error_summary, relative_errors
+from .analysis.moments import modified_cov, quantile_band
+from .analysis.sobol import pick_freeze_indices
+from .methods import PCE, fit
+from .store import ResultStore, Status
+
+SAMPLED_KINDS = ("monte_carlo", "sobol", "halton", "latin_hypercube", "pick_freeze")
+PDF_POINTS = 120
+
+
+@dataclass
+class Options:
+    """How the statistics are computed (from the campaign's `analysis:` mapping, or defaults)."""
+
+    band_samples: int = 20000
+    bootstrap: int = 200
+    pdf_times_s: list[float] = field(default_factory=list)
+    seed: int = 0
+
+
+@dataclass
+class OutputStatistics:
+    name: str
+    units: str
+    time: np.ndarray
+    mean: np.ndarray
+    variance: np.ndarray
+    band99: tuple[np.ndarray, np.ndarray]
+    pdf_support: np.ndarray
+    pdf_density: np.ndarray
+    cov: np.ndarray
+    sobol_first: dict[str, np.ndarray] = field(default_factory=dict)
+    sobol_total: dict[str, np.ndarray] = field(default_factory=dict)
+    sobol_first_ci: dict[str, np.ndarray] = field(default_factory=dict)
+    samples: np.ndarray | None = None  # the runs, or draws of the surrogate, for KLD (M, T)
+    errors: dict = field(default_factory=dict)
+
+    @property
+    def std(self) -> np.ndarray:
+        return np.sqrt(np.maximum(self.variance, 0.0))
+
+
+@dataclass
+class Statistics:
+    path: str
+    campaign_name: str
+    method: dict
+    design_kind: str
+    parameter_names: list[str]
+    runs: int
+    failed: int
+    outputs: dict[str, OutputStatistics]
+    reference: str | None = None
+
+
+def campaign_facts(store: ResultStore) -> tuple[dict, list[str], dict]:
+    """The method, the germs and the analysis options a results file was made with."""
+    attrs = store.attrs
+    return (json.loads(attrs["method"]), json.loads(attrs["germs"]),
+            json.loads(attrs.get("analysis", "{}")))
+
+
+def analyse(path, reference: str | None = None, options: Options | None = None,
+            method: dict | None = None) -> Statistics:
+    """All statistics of the results file `path` (and errors against `reference`, a Monte Carlo file).
+
+    `method` ({"kind", "order", "split"}) overrides the campaign's: the runs of one grid serve
+    every method, so methods and orders are compared on the same runs.
+    """
+    with ResultStore.open(path) as store:
+        stored_method, germs, analysis = campaign_facts(store)
+        method = {**stored_method, **(method or {})}
+        options = options or Options(**{k: analysis[k] for k in ("band_samples", "bootstrap", "pdf_times_s")
+                                        if k in analysis})
+        status = store.status
+        ok = status == Status.OK
+        if not ok.any():
+            raise ValueError(f"{path}: no successful runs to analyse")
+        design_kind = store.attrs.get("design_kind", "")
+        outputs = {name: _output_statistics(store, name, method, germs, design_kind, ok, options)
+                   for name in store.output_names}
+        stats = Statistics(str(path), store.attrs.get("campaign_name", ""), method, design_kind,
+                           store.parameter_names, int(status.size), int((status > 0).sum()), outputs)
+    if reference:
+        add_reference_errors(stats, analyse(reference, options=Options(
+            band_samples=options.band_samples, bootstrap=0, seed=options.seed)))
+    return stats
+
+
+MOMENTS_FROM_WEIGHTS = ("monte_carlo", "integration", "interpolation")
+
+
+def output_basis(store: ResultStore, name: str, ok: np.ndarray) -> tuple[np.ndarray, np.ndarray | None]:
+    """The ok runs of `name` as basis @ scale: raw (Y, None), or tSVD (V rows, diag(s) Uᵀ)."""
+    factors = store.output_factors(name)
+    if factors is None:
+        return store.output_matrix(name, np.flatnonzero(ok)), None
+    U, s, V, columns = factors
+    row_of = np.full(ok.size, -1)
+    row_of[columns] = np.arange(columns.size)
+    return V[row_of[np.flatnonzero(ok)]], s[:, None] * U.T
+
+
+def _output_statistics(store: ResultStore, name: str, method: dict, germs: list[str], design_kind: str,
+                       ok: np.ndarray, options: Options) -> OutputStatistics:
+    xi, weights = store.xi[ok], store.weights[ok]
+    kind, order = method["kind"], method["order"]
+    basis, scale = output_basis(store, name, ok)
+    x0 = None
+    if method.get("split"):  # x = x0 + S with each run's initial value: needs the runs themselves
+        basis = basis if scale is None else basis @ scale
+        scale, x0 = None, basis[:, :1]
+
+    def expand(a):
+        return a if scale is None else a @ scale
+
+    pce = None
+    if kind in ("monte_carlo", "integration") and design_kind in SAMPLED_KINDS:
+        samples = expand(basis)
+        result = fit(kind, xi, weights, samples, germs, order)
+        mean, variance = result.mean, result.variance
+        band = quantile_band(samples, None if kind == "monte_carlo" else weights)
+    else:
+        if kind in MOMENTS_FROM_WEIGHTS:  # quadrature moments; the PCE serves bands, PDFs, Sobol'
+            mean = expand(weights @ basis)
+            variance = _weighted_variance(basis, scale, weights, mean)
+        pce_kind = "pseudo_galerkin" if kind in ("monte_carlo", "integration") else kind
+        fitted = fit(pce_kind, xi, weights, basis, germs, order, x0=x0)
+        pce = PCE(fitted.pce.germs, fitted.pce.indices, expand(fitted.pce.coefficients))
+        if kind not in MOMENTS_FROM_WEIGHTS:
+            mean, variance = pce.mean(), pce.variance()
+        samples = pce.sample(options.band_samples, options.seed)
+        band = quantile_band(samples)
+    support, density = pdf_over_time(samples, PDF_POINTS)
+    std = np.sqrt(np.maximum(variance, 0.0))
+    stats = OutputStatistics(name, store.units.get(name, ""), store.time, mean, variance, band,
+                             support, density, modified_cov(mean, std), samples=samples)
+    names = store.parameter_names
+    if pce is not None:
+        stats.sobol_first = dict(zip(names, pce.sobol_first()))
+        stats.sobol_total = dict(zip(names, pce.sobol_total()))
+    elif design_kind == "pick_freeze" and ok.all():
+        indices = pick_freeze_indices(samples, len(names), n_boot=options.bootstrap, seed=options.seed)
+        stats.sobol_first = dict(zip(names, indices["first"]))
+        stats.sobol_total = dict(zip(names, indices["total"]))
+        stats.sobol_first_ci = dict(zip(names, np.moveaxis(indices["first_ci"], 1, 0)))
+    return stats
+
+
+def _weighted_variance(basis, scale, weights, mean) -> np.ndarray:
+    """Σ w_j (Y_j − mean)² with Y = basis @ scale, from the centred coefficients when Y is
+    given by tSVD factors (Y_j − mean = (b_j − g) @ scale with g = w @ basis): no cancellation
+    for outputs with a large mean and a small spread, such as the altitude."""
+    if scale is None:
+        return weights @ (basis - mean) ** 2
+    centred = basis - weights @ basis
+    moment = centred.T @ (weights[:, None] * centred)
+    return np.einsum("rt,rs,st->t", scale, moment, scale)
+
+
+def add_reference_errors(stats: Statistics, reference: Statistics) -> None:
+    """ε_m, ε_v over time (Eq. 49) and the KLD at the final time (Eq. 50) against the reference."""
+    stats.reference = reference.path
+    for name, out in stats.outputs.items():
+        ref = reference.outputs.get(name)
+        if ref is None or ref.time.shape != out.time.shape or not np.allclose(ref.time, out.time):
+            continue
+        eps_m, eps_v = relative_errors(out.mean, out.variance, ref.mean, ref.variance)
+        kld = kl_divergence(out.samples[:, -1], ref.samples[:, -1])
+        out.errors = {"eps_m": eps_m, "eps_v": eps_v, "eps_m_summary": error_summary(eps_m),
+                      "eps_v_summary": error_summary(eps_v), "kld_final": kld}
+
+
+def summary_json(stats: Statistics) -> dict:
+    """The fixed summary.json schema of DESIGN.md (plus std, cov and errors when present)."""
+    outputs = {}
+    for name, out in stats.outputs.items():
+        entry = {
+            "time": out.time.tolist(), "units": out.units,
+            "mean": out.mean.tolist(), "variance": out.variance.tolist(), "std": out.std.tolist(),
+            "band99": {"lower": out.band99[0].tolist(), "upper": out.band99[1].tolist()},
+            "cov": out.cov.tolist(),
+            "sobol_first": {k: v.tolist() for k, v in out.sobol_first.items()},
+            "sobol_total": {k: v.tolist() for k, v in out.sobol_total.items()},
+        }
+        if out.errors:
+            entry["errors"] = {"eps_m": out.errors["eps_m"].tolist(), "eps_v": out.errors["eps_v"].tolist(),
+                               "eps_m_max": out.errors["eps_m_summary"]["max"],
+                               "eps_v_max": out.errors["eps_v_summary"]["max"],
+                               "kld_final": out.errors["kld_final"]}
+        outputs[name] = entry
+    return {"results": stats.path, "campaign": stats.campaign_name, "method": stats.method,
+            "design": stats.design_kind, "runs": stats.runs, "failed": stats.failed,
+            "parameters": stats.parameter_names, "reference": stats.reference, "outputs": outputs}

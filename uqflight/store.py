@@ -1,0 +1,446 @@
+"""The HDF5 results file of a campaign: the design, the status of every run, and the time histories
+(raw, or compressed on the fly by the incremental thin SVD), appended batch by batch and resumable.
+
+Layout (fixed by DESIGN.md; N runs, d parameters, T recorded times):
+    /samples/xi (N, d)  /samples/kappa (N, d; attr names)  /samples/weight (N)
+    /samples/status (N int8, see Status)  /samples/reason (N str, "" when ok)
+    /time (T)
+    /outputs/<name> (N, T)  raw histories, NaN rows where not run or failed
+    /tsvd/<name>/U (T, r), s (r), V (n, r), columns (n)   A_:c ≈ U diag(s) V_c: is sample columns[c]
+    /tsvd/<name>/buffer (m, T), buffer_index (m)          ok runs not folded into the factors yet
+    root attributes: campaign (YAML text), campaign_hash (its sha256), created, and the caller's
+    (versions, aircraft_hash, ...)
+
+Crash safety: every batch writes its data first and the status last, then flushes, so a killed
+process loses at most the batch in flight and `pending()` tells exactly what to rerun. The factors
+and the buffer of an output are replaced together: written into `/tsvd/<name>/next`, marked complete,
+flushed, then moved in place; reopening with mode "a" finishes or discards such a half-done step.
+
+Determinism: runs complete in any order, but the tSVD ingests the ok runs in design order, `batch`
+columns at a time, folding only the contiguous completed prefix (and the last partial batch once no
+run is pending), so the factors do not depend on the number of workers or on interruptions.
+"""
+from __future__ import annotations
+
+import enum
+import hashlib
+import json
+from collections.abc import Iterator
+from datetime import datetime, timezone
+from pathlib import Path
+
+import h5py
+import numpy as np
+
+from uqflight.tsvd import IncrementalSVD, iter_column_blocks, weighted_mean, weighted_variance
+
+_CHUNK_BYTES = 1 << 20
+
+
+class Status(enum.IntEnum):
+    """Outcome of one run, as stored in /samples/status."""
+
+    PENDING = -1
+    OK = 0
+    TRIM_FAILURE = 1
+    DIVERGED = 2
+    SIMULATOR_ERROR = 3
+
+
+def _key(name: str) -> str:
+    """HDF5 name of an output: JSBSim property outputs contain "/", which HDF5 reads as groups."""
+    return name.replace("/", "|")
+
+
+def _name(key: str) -> str:
+    return key.replace("|", "/")
+
+
+def text_hash(text: str) -> str:
+    """sha256 of a campaign's text, as stored in the campaign_hash attribute."""
+    return hashlib.sha256(text.encode("utf-8")).hexdigest()
+
+
+class ResultStore:
+    """One campaign's results file. Build it with `create`, `open` or `open_for_campaign`."""
+
+    def __init__(self, file: h5py.File):
+        self._file = file
+
+    @classmethod
+    def create(cls, path, *, campaign_text: str, xi, kappa, weights, parameter_names, outputs, time,
+               raw: bool = True, tsvd: dict | None = None, attrs: dict | None = None,
+               units: dict | None = None) -> ResultStore:
+        """A new file (refused if `path` exists) holding the design, with every run pending.
+
+        `tsvd` = {"tol": ..., "batch": ...} turns on compression (batch defaults to the paper's 1000
+        samples); `attrs` become root attributes (dicts as JSON text); `units` maps output name → unit.
+        """
+        xi, kappa = np.atleast_2d(xi).astype(float), np.atleast_2d(kappa).astype(float)
+        weights, time = np.asarray(weights, dtype=float), np.asarray(time, dtype=float)
+        parameter_names, outputs, units = list(parameter_names), list(outputs), units or {}
+        n, d = xi.shape
+        if kappa.shape != (n, d) or weights.shape != (n,) or len(parameter_names) != d:
+            raise ValueError(f"design shapes disagree: xi {xi.shape}, kappa {kappa.shape}, "
+                             f"weights {weights.shape}, {len(parameter_names)} parameter names")
+        if time.ndim != 1 or not outputs or len(set(outputs)) != len(outputs):
+            raise ValueError(f"need a 1-D time and distinct output names, got time {time.shape}, outputs {outputs}")
+        if not raw and tsvd is None:
+            raise ValueError("nothing would be stored: turn on raw storage or tsvd compression")
+        if tsvd is not None:
+            empty = IncrementalSVD.from_factors(np.zeros((time.size, 0)), np.zeros(0), np.zeros((0, 0)),
+                                                float(tsvd["tol"]))
+            batch = int(tsvd.get("batch", 1000))
+
+        f = h5py.File(path, "w-")
+        f.attrs.update({"campaign": campaign_text, "campaign_hash": text_hash(campaign_text),
+                        "created": datetime.now(timezone.utc).isoformat(timespec="seconds")})
+        f.attrs.update({k: json.dumps(v) if isinstance(v, dict) else v for k, v in (attrs or {}).items()})
+        samples = f.create_group("samples")
+        samples.create_dataset("xi", data=xi).attrs["dimensions"] = ["sample", "parameter"]
+        samples.create_dataset("kappa", data=kappa).attrs.update(
+            {"names": parameter_names, "dimensions": ["sample", "parameter"]})
+        samples.create_dataset("weight", data=weights)
+        samples.create_dataset("status", shape=(n,), dtype="i1", fillvalue=Status.PENDING).attrs["codes"] = \
+            json.dumps({s.name.lower(): s.value for s in Status})
+        samples.create_dataset("reason", shape=(n,), dtype=h5py.string_dtype())
+        f.create_dataset("time", data=time).attrs["units"] = "s"
+        if raw:
+            group = f.create_group("outputs", track_order=True)
+            for name in outputs:
+                ds = group.create_dataset(_key(name), shape=(n, time.size), dtype="f8", fillvalue=np.nan,
+                                          chunks=(_chunk_rows(time.size, n), time.size))
+                ds.attrs.update({"units": units.get(name, ""), "dimensions": ["sample", "time"]})
+        if tsvd is not None:
+            group = f.create_group("tsvd", track_order=True)
+            group.attrs.update({"tol": empty.tol, "batch": batch,
+                                "description": "column c of A (run columns[c]) ≈ U diag(s) V[c]; the buffer "
+                                               "rows (runs buffer_index) are not folded in yet"})
+            for name in outputs:
+                out = group.create_group(_key(name))
+                out.attrs["units"] = units.get(name, "")
+                _write_state(out, empty, np.zeros(0, np.int64), np.zeros((0, time.size)), np.zeros(0, np.int64))
+        f.flush()
+        return cls(f)
+
+    @classmethod
+    def open(cls, path, mode: str = "r") -> ResultStore:
+        """An existing file, read-only ("r") or to resume ("a": half-done steps of a killed writer are mended)."""
+        if mode not in ("r", "a"):
+            raise ValueError(f"mode must be 'r' or 'a', got {mode!r}")
+        f = h5py.File(path, "r" if mode == "r" else "r+")
+        if "samples/status" not in f:
+            f.close()
+            raise ValueError(f"{path} is not a uqflight results file (no /samples/status)")
+        store = cls(f)
+        if mode == "a" and "tsvd" in f:
+            status = store.status
+            for name in f["tsvd"]:
+                _apply_staged(f["tsvd"][_key(name)])
+                store._fold_ready(name, status)
+            f.flush()
+        return store
+
+    def close(self) -> None:
+        self._file.close()
+
+    def __enter__(self) -> ResultStore:
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.close()
+
+    # -- the design and the runs ------------------------------------------------------------
+    @property
+    def xi(self) -> np.ndarray:
+        return self._file["samples/xi"][()]
+
+    @property
+    def kappa(self) -> np.ndarray:
+        return self._file["samples/kappa"][()]
+
+    @property
+    def weights(self) -> np.ndarray:
+        return self._file["samples/weight"][()]
+
+    @property
+    def status(self) -> np.ndarray:
+        return self._file["samples/status"][()]
+
+    @property
+    def reasons(self) -> list[str]:
+        return list(self._file["samples/reason"].asstr()[()])
+
+    @property
+    def time(self) -> np.ndarray:
+        return self._file["time"][()]
+
+    @property
+    def parameter_names(self) -> list[str]:
+        return [str(name) for name in self._file["samples/kappa"].attrs["names"]]
+
+    @property
+    def output_names(self) -> list[str]:
+        return [_name(key) for key in self._file["outputs" if self._raw else "tsvd"]]
+
+    @property
+    def units(self) -> dict[str, str]:
+        group = self._file["outputs" if self._raw else "tsvd"]
+        return {_name(key): str(group[key].attrs["units"]) for key in group}
+
+    @property
+    def campaign_text(self) -> str:
+        return str(self._file.attrs["campaign"])
+
+    @property
+    def campaign_hash(self) -> str:
+        return str(self._file.attrs["campaign_hash"])
+
+    @property
+    def attrs(self) -> dict:
+        """All root attributes (campaign, campaign_hash, created, versions, aircraft_hash, ...)."""
+        return dict(self._file.attrs)
+
+    @property
+    def storage_description(self) -> str:
+        """How the outputs are kept, e.g. "raw; tsvd tol 1e-08, batch 1000, ranks alpha_deg 11"."""
+        parts = ["raw"] if self._raw else []
+        if "tsvd" in self._file:
+            group = self._file["tsvd"]
+            ranks = ", ".join(f"{_name(key)} {group[key]['s'].size}" for key in group)
+            parts.append(f"tsvd tol {group.attrs['tol']:g}, batch {group.attrs['batch']}, ranks {ranks}")
+        return "; ".join(parts)
+
+    @property
+    def _raw(self) -> bool:
+        return "outputs" in self._file
+
+    def pending(self) -> np.ndarray:
+        """Indices of the runs not written yet, ascending."""
+        return np.flatnonzero(self.status == Status.PENDING)
+
+    # -- writing ----------------------------------------------------------------------------
+    def write_batch(self, indices, status, reasons, outputs: dict) -> None:
+        """Store finished runs, in any order: outputs[name] is (n, T) for the n `indices`.
+
+        Rows of failed runs are stored as NaN (their values are ignored); ok rows must be finite.
+        Data first, status last, then a flush; then the completed design-order prefix is folded
+        into the tSVD factors.
+        """
+        idx, status, reasons, values = self._checked_batch(indices, status, reasons, outputs)
+        ok = status == Status.OK
+        for name, rows in values.items():
+            if self._raw:
+                self._file["outputs"][_key(name)][idx] = np.where(ok[:, None], rows, np.nan)
+            if "tsvd" in self._file:
+                _append_rows(self._file["tsvd"][_key(name)], rows[ok], idx[ok])
+        self._file["samples/reason"][idx] = reasons
+        self._file["samples/status"][idx] = status
+        self._file.flush()
+        if "tsvd" in self._file:
+            all_status = self.status
+            for name in values:
+                self._fold_ready(name, all_status)
+
+    def _checked_batch(self, indices, status, reasons, outputs):
+        """The batch sorted by index, after checking it against the file."""
+        idx = np.asarray(indices, dtype=np.int64).ravel()
+        order = np.argsort(idx)
+        idx, status = idx[order], np.asarray(status, dtype=np.int8).ravel()[order]
+        reasons = np.asarray(reasons, dtype=object).ravel()[order]
+        stored = self.status
+        n, n_samples, n_times = idx.size, stored.size, self.time.size
+        if status.size != n or reasons.size != n:
+            raise ValueError(f"batch of {n} indices with {status.size} statuses and {reasons.size} reasons")
+        if np.any(np.diff(idx) == 0) or (n and (idx[0] < 0 or idx[-1] >= n_samples)):
+            raise ValueError(f"batch indices must be distinct and in [0, {n_samples}): {idx}")
+        written = idx[stored[idx] != Status.PENDING]
+        if written.size:
+            raise ValueError(f"runs {written} are already stored")
+        if not np.isin(status, [s.value for s in Status if s != Status.PENDING]).all():
+            raise ValueError(f"unknown status codes {np.unique(status)}; see uqflight.store.Status")
+        if set(outputs) != set(self.output_names):
+            raise ValueError(f"batch outputs {sorted(outputs)} differ from the file's {self.output_names}")
+        values = {name: np.asarray(outputs[name], dtype=float)[order] for name in self.output_names}
+        ok = status == Status.OK
+        for name, rows in values.items():
+            if rows.shape != (n, n_times):
+                raise ValueError(f"output {name}: expected shape ({n}, {n_times}), got {rows.shape}")
+            bad = idx[ok & ~np.isfinite(rows).all(axis=1)]
+            if bad.size:
+                raise ValueError(f"output {name} of runs {bad} is not finite but their status is ok")
+        return idx, status, reasons, values
+
+    def _fold_ready(self, name: str, status: np.ndarray) -> None:
+        """Fold the buffered ok runs of the completed design-order prefix into the factors, `batch` at
+        a time (all of them once nothing is pending); drop buffer rows a killed writer left behind."""
+        group = self._file["tsvd"][_key(name)]
+        positions, index, stale = _buffer_rows(group, status)
+        pending = np.flatnonzero(status == Status.PENDING)
+        if pending.size:
+            ready = np.searchsorted(index, pending[0])
+            ready -= ready % self._batch
+        else:
+            ready = index.size
+        if ready == 0 and not stale:
+            return
+        rows = group["buffer"][()][positions]
+        svd, columns = self._stored_factors(group)
+        _ingest(svd, rows[:ready], self._batch)
+        _commit(group, svd, np.concatenate([columns, index[:ready]]), rows[ready:], index[ready:])
+
+    # -- reading ----------------------------------------------------------------------------
+    def output_matrix(self, name: str, rows=None) -> np.ndarray:
+        """The histories of `rows` (default: all runs) as (n, T), NaN where not run or failed;
+        from the raw data when stored, else rebuilt from the tSVD factors."""
+        n_samples = self._file["samples/status"].shape[0]
+        rows = np.arange(n_samples) if rows is None else np.asarray(rows, dtype=np.int64)
+        if self._raw:
+            unique, inverse = np.unique(rows, return_inverse=True)
+            return self._file["outputs"][_key(name)][unique][inverse]
+        U, s, V, columns = self.output_factors(name)
+        column_of = np.full(n_samples, -1)
+        column_of[columns] = np.arange(columns.size)
+        column = column_of[rows]
+        matrix = np.full((rows.size, U.shape[0]), np.nan)
+        matrix[column >= 0] = (V[column[column >= 0]] * s) @ U.T
+        return matrix
+
+    def iter_output_blocks(self, name: str, block: int = 1000) -> Iterator[tuple[np.ndarray, np.ndarray]]:
+        """(indices, histories (n, T)) of the ok runs in design order, at most `block` runs at a time."""
+        if self._raw:
+            status, data = self.status, self._file["outputs"][_key(name)]
+            for start in range(0, status.size, block):
+                ok = np.flatnonzero(status[start:start + block] == Status.OK)
+                if ok.size:
+                    yield start + ok, data[start:start + block][ok]
+        else:
+            U, s, V, columns = self.output_factors(name)
+            for start, histories in zip(range(0, columns.size, block), iter_column_blocks(U, s, V, block)):
+                yield columns[start:start + block], histories
+
+    def output_moments(self, name: str, weights=None) -> tuple[np.ndarray, np.ndarray]:
+        """Weighted mean and variance Σ w_j (A_j − mean)² over the ok runs, each (T,).
+
+        Weights default to the design's and are rescaled to sum 1 over the ok runs, as in
+        analysis.moments (Monte Carlo runs stay 1/N_ok after failures).
+        """
+        w = self.weights if weights is None else np.asarray(weights, dtype=float)
+        w = w / w[self.status == Status.OK].sum()
+        if self._raw:
+            zero = np.zeros(self.time.size)
+            mean = sum((w[rows] @ values for rows, values in self.iter_output_blocks(name)), zero)
+            variance = sum((w[rows] @ (values - mean) ** 2 for rows, values in self.iter_output_blocks(name)), zero)
+            return mean, variance
+        U, s, V, columns = self.output_factors(name)
+        return weighted_mean(U, s, V, w[columns]), weighted_variance(U, s, V, w[columns])
+
+    def output_factors(self, name: str) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray] | None:
+        """(U, s, V, columns) of a compressed output, V row c being run columns[c]; None when the raw
+        histories are stored. Runs still in the buffer are folded in (in memory, not in the file)."""
+        if self._raw:
+            return None
+        group = self._file["tsvd"][_key(name)]
+        positions, index, _ = _buffer_rows(group, self.status)
+        svd, columns = self._stored_factors(group)
+        _ingest(svd, group["buffer"][()][positions], self._batch)
+        return svd.U, svd.s, svd.V, np.concatenate([columns, index])
+
+    def _stored_factors(self, group: h5py.Group) -> tuple[IncrementalSVD, np.ndarray]:
+        """The factors as written in the file (without the buffer), and the run of each V row."""
+        svd = IncrementalSVD.from_factors(group["U"][()], group["s"][()], group["V"][()],
+                                          self._file["tsvd"].attrs["tol"])
+        return svd, group["columns"][()]
+
+    @property
+    def _batch(self) -> int:
+        return int(self._file["tsvd"].attrs["batch"])
+
+
+def open_for_campaign(path, *, campaign_text: str, force: bool = False, **create_args) -> ResultStore:
+    """Resume `path` when it holds this campaign, else create it (see ResultStore.create).
+
+    A file holding another campaign (a different campaign_hash) is refused unless `force`, which
+    deletes and recreates it.
+    """
+    path = Path(path)
+    if path.exists():
+        with h5py.File(path, "r") as f:
+            stored = f.attrs.get("campaign_hash")
+        if stored == text_hash(campaign_text):
+            return ResultStore.open(path, "a")
+        if not force:
+            raise FileExistsError(f"{path} holds the results of another campaign (campaign_hash {stored}); "
+                                  "choose another results file, or force to overwrite it")
+        path.unlink()
+    return ResultStore.create(path, campaign_text=campaign_text, **create_args)
+
+
+def _chunk_rows(n_times: int, n_rows: int) -> int:
+    """Rows per chunk of an (n_rows, n_times) float64 dataset, for chunks of about 1 MiB."""
+    return int(np.clip(_CHUNK_BYTES // (8 * n_times), 1, max(n_rows, 1)))
+
+
+def _ingest(svd: IncrementalSVD, rows: np.ndarray, batch: int) -> None:
+    """Append the runs `rows` (n, T), in their order, `batch` columns per update."""
+    for start in range(0, len(rows), batch):
+        svd.update(rows[start:start + batch].T)
+
+
+def _append_rows(group: h5py.Group, rows: np.ndarray, index: np.ndarray) -> None:
+    """Append ok runs to an output's tSVD buffer (rows first, their indices after)."""
+    n = group["buffer_index"].shape[0]
+    for key, data in (("buffer", rows), ("buffer_index", index)):
+        group[key].resize(n + len(index), axis=0)
+        group[key][n:] = data
+
+
+def _buffer_rows(group: h5py.Group, status: np.ndarray) -> tuple[np.ndarray, np.ndarray, bool]:
+    """Positions of the valid buffer rows sorted by sample, their samples, and whether any row is stale.
+
+    A row is valid when its index was written and its run's status is ok; a writer killed between
+    the buffer and the status leaves stale rows (their runs are still pending and will be rerun).
+    """
+    n_rows = group["buffer"].shape[0]
+    index = group["buffer_index"][:n_rows]
+    valid = index >= 0
+    valid[valid] = status[index[valid]] == Status.OK
+    positions = np.flatnonzero(valid)
+    positions = positions[np.argsort(index[positions], kind="stable")]
+    return positions, index[positions], positions.size < max(n_rows, group["buffer_index"].shape[0])
+
+
+def _write_state(group: h5py.Group, svd: IncrementalSVD, columns, rows, index) -> None:
+    """Create the factor and buffer datasets of one output in `group`."""
+    for key, data in (("U", svd.U), ("s", svd.s), ("V", svd.V), ("columns", columns)):
+        group.create_dataset(key, data=data)
+    n_times = rows.shape[1]
+    chunk = _chunk_rows(n_times, group.file["tsvd"].attrs["batch"])
+    group.create_dataset("buffer", data=rows, maxshape=(None, n_times), chunks=(chunk, n_times))
+    group.create_dataset("buffer_index", data=index.astype(np.int64), maxshape=(None,), chunks=(chunk,),
+                         fillvalue=-1)
+
+
+def _commit(group: h5py.Group, svd: IncrementalSVD, columns, rows, index) -> None:
+    """Replace an output's factors and buffer together: staged in `next`, marked complete, moved in."""
+    if "next" in group:
+        del group["next"]
+    staged = group.create_group("next")
+    _write_state(staged, svd, columns, rows, index)
+    staged.attrs["complete"] = True
+    group.file.flush()
+    _apply_staged(group)
+    group.file.flush()
+
+
+def _apply_staged(group: h5py.Group) -> None:
+    """Move a complete staged state in place (also after a kill half-way through); drop an incomplete one."""
+    staged = group.get("next")
+    if staged is None:
+        return
+    if staged.attrs.get("complete", False):
+        for key in list(staged):
+            if key in group:
+                del group[key]
+            group.move(f"next/{key}", key)
+    del group["next"]
