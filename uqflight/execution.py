@@ -25,7 +25,7 @@ from .campaign import Campaign
 from .designs import Design
 from .parameters import to_physical
 from .simulators import FlightError, make_simulator
-from .store import ResultStore, Status, open_for_campaign
+from .store import ResultStore, Status, compact, open_for_campaign
 
 
 @dataclass(frozen=True)
@@ -181,8 +181,11 @@ def run_campaign(campaign: Campaign, out: Path | None = None, workers: int | Non
                 summary.failures.update(r for r, s in zip(np.asarray(reasons)[keep], status[keep]) if s != 0)
                 progress.advance(int(keep.sum()))
         progress.close()
+        complete = store.pending().size == 0
     finally:
         store.close()
+    if complete and campaign.storage.get("tsvd"):
+        compact(out)
     summary.seconds = time.perf_counter() - started
     return summary
 

@@ -21,7 +21,7 @@ from .analysis.divergence import kl_divergence
 from .analysis.errors import error_summary, relative_errors
 from .analysis.moments import modified_cov, quantile_band
 from .analysis.sobol import pick_freeze_indices
-from .methods import PCE, fit
+from .methods import PCE, SPLIT_FORM_KINDS, fit
 from .store import ResultStore, Status
 
 SAMPLED_KINDS = ("monte_carlo", "sobol", "halton", "latin_hypercube", "pick_freeze")
@@ -126,8 +126,12 @@ def _output_statistics(store: ResultStore, name: str, method: dict, germs: list[
     xi, weights = store.xi[ok], store.weights[ok]
     kind, order = method["kind"], method["order"]
     basis, scale = output_basis(store, name, ok)
+    sampled = kind in ("monte_carlo", "integration") and design_kind in SAMPLED_KINDS
+    pce_kind = "pseudo_galerkin" if kind in ("monte_carlo", "integration") else kind
     x0 = None
-    if method.get("split"):  # x = x0 + S with each run's initial value: needs the runs themselves
+    # x = x0 + S with each run's initial value (needs the runs themselves); only the projections use
+    # it: the other kinds fit the constant term themselves, where the split would change nothing
+    if method.get("split") and not sampled and pce_kind in SPLIT_FORM_KINDS:
         basis = basis if scale is None else basis @ scale
         scale, x0 = None, basis[:, :1]
 
@@ -135,7 +139,7 @@ def _output_statistics(store: ResultStore, name: str, method: dict, germs: list[
         return a if scale is None else a @ scale
 
     pce = None
-    if kind in ("monte_carlo", "integration") and design_kind in SAMPLED_KINDS:
+    if sampled:
         samples = expand(basis)
         result = fit(kind, xi, weights, samples, germs, order)
         mean, variance = result.mean, result.variance
@@ -144,7 +148,6 @@ def _output_statistics(store: ResultStore, name: str, method: dict, germs: list[
         if kind in MOMENTS_FROM_WEIGHTS:  # quadrature moments; the PCE serves bands, PDFs, Sobol'
             mean = expand(weights @ basis)
             variance = _weighted_variance(basis, scale, weights, mean)
-        pce_kind = "pseudo_galerkin" if kind in ("monte_carlo", "integration") else kind
         fitted = fit(pce_kind, xi, weights, basis, germs, order, x0=x0)
         pce = PCE(fitted.pce.germs, fitted.pce.indices, expand(fitted.pce.coefficients))
         if kind not in MOMENTS_FROM_WEIGHTS:

@@ -25,3 +25,24 @@ def exp_decay(p: dict) -> dict:
     """x(t) = exp(-a t) on t in [0, 5] s; with a ~ N(mu, s^2): E = exp(-mu t + s^2 t^2 / 2),
     Var = exp(-2 mu t + 2 s^2 t^2) - E^2."""
     return {"time": DECAY_TIME, "x": np.exp(-p["a"] * DECAY_TIME)}
+
+
+PHUGOID_TIME = np.linspace(0.0, 50.0, 1001)
+
+
+def phugoid(p: dict) -> dict:
+    """Five aircraft-like histories (1001 times over 50 s): a damped phugoid and short-period
+    response whose trim, amplitude, period and damping move with inputs a, b, c (each ~ N(0, 1)).
+    Cheap stand-in for the aircraft where only the data volume matters (runner and memory tests)."""
+    t = PHUGOID_TIME
+    a, b, c = p.get("a", 0.0), p.get("b", 0.0), p.get("c", 0.0)
+    omega = 2 * np.pi / (46.0 * (1 + 0.02 * b))
+    phugoid_wave = np.exp(-0.015 * (1 + 0.1 * c) * t) * np.sin(omega * t)
+    short = np.exp(-1.2 * t) * np.sin(1.6 * t)
+    return {
+        "alpha_deg": 6.3 + 0.2 * a - 1.0 * short,
+        "theta_deg": 6.3 + 0.2 * a + 0.7 * (1 + 0.05 * c) * phugoid_wave - 1.5 * short,
+        "h_ft": 15000.0 - 35.0 * (1 + 0.05 * a) * phugoid_wave,
+        "q_degps": -1.6 * np.exp(-1.2 * t) * np.cos(1.6 * t) + 0.05 * b * np.cos(omega * t),
+        "vtas_kt": 200.0 + 1.7 * (1 + 0.03 * b) * phugoid_wave,
+    }
