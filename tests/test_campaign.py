@@ -179,3 +179,8 @@ design: {kind: monte_carlo, samples: 4}
         parse_campaign(text, "x.yaml")
     campaign = parse_campaign(text.replace("interval_pct: 10", "interval_pct: 10, nominal: 0.2"), "x.yaml")
     assert (campaign.parameters[0].lower, campaign.parameters[0].upper) == pytest.approx((0.18, 0.22))
+
+
+def test_exponents_without_a_dot_are_numbers():
+    text = (DATA / "good_python_ishigami.yaml").read_text() + "storage: {raw: false, tsvd: {tol: 1e-8}}\n"
+    assert parse_campaign(text, "x.yaml").storage["tsvd"]["tol"] == 1e-8

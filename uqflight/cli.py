@@ -182,3 +182,82 @@ def info(results: Path = typer.Argument(..., help="Results file (.h5).")):
         typer.echo(f"versions: {attrs.get('versions', '?')}")
         if "aircraft_hash" in attrs:
             typer.echo(f"aircraft sha256: {attrs['aircraft_hash']}")
+
+
+@app.command()
+def report(
+    results: List[Path] = typer.Argument(..., help="Results files (.h5). The first is the one summary.json, "
+                                                   "the baseline and the single-file plots describe."),
+    out: Path = typer.Option(..., help="Report directory (created if missing)."),
+    reference: Optional[Path] = typer.Option(None, help="Monte Carlo results file: the errors ε_m, ε_v (Eq. 49) "
+                                                        "and KLD (Eq. 50) of every file are taken against it."),
+    times: str = typer.Option("10,25,end", help="Comma-separated times in seconds for the tables at selected times "
+                                                "(the nearest recorded times; 'end' is the final time)."),
+    write_baseline: Optional[Path] = typer.Option(None, help="Also write the first file's statistics to this "
+                                                             "JSON file, the baseline of `uqflight check`."),
+):
+    """Statistics, tables, plots and a report page of one or more results files.
+
+    Several files are compared side by side (labelled campaign: method, runs). OUT gets:
+    summary.json (the first file; schema in DESIGN.md), summaries/<stem>.json (every file, when
+    several), tables/*.csv (statistics over time per file and output, statistics and Sobol' indices
+    at the selected times, errors against the reference, PCE vs Monte Carlo Sobol' indices when a
+    pick_freeze file is given), plots/*.png, report.html (self-contained, plots embedded) and
+    report.md (linking plots/).
+    """
+    from .check import BadInput
+    from .report import write_report
+
+    try:
+        selected = [float("inf") if t.strip() == "end" else float(t) for t in times.split(",")]
+    except ValueError:
+        raise typer.BadParameter(f"expected comma-separated seconds or 'end', got {times!r}", param_hint="--times")
+    try:
+        written = write_report(results, out, reference=reference, times=selected, baseline=write_baseline)
+    except BadInput as exc:
+        typer.echo(f"error: {exc}", err=True)
+        raise typer.Exit(2)
+    except OSError as exc:
+        typer.echo(f"error: cannot write the report: {exc}", err=True)
+        raise typer.Exit(2)
+    typer.echo(f"wrote {len(written)} files to {out}: open {out / 'report.html'}")
+    if write_baseline:
+        typer.echo(f"wrote baseline {write_baseline}")
+
+
+@app.command()
+def check(
+    results: Path = typer.Argument(..., help="Results file (.h5) to recompute the statistics of."),
+    baseline: Path = typer.Option(..., help="Baseline JSON from `uqflight report ... --write-baseline`."),
+    rtol: float = typer.Option(1e-6, help="Relative tolerance."),
+    atol: float = typer.Option(1e-9, help="Absolute tolerance, in each statistic's own unit."),
+):
+    """Recompute a results file's statistics and compare them with a baseline.
+
+    Compares mean, variance, 99 % band and Sobol' indices per output and time: a value drifts when
+    |value - baseline| > atol + rtol * |baseline|. The defaults (rtol 1e-6, atol 1e-9) allow for
+    floating-point noise only: the statistics are deterministic (seeded). Exit 0: no drift; 1: drift
+    (the worst values per statistic are listed); 2: bad input (missing or malformed baseline, other
+    outputs or time grid, unreadable results file).
+    """
+    from .check import BadInput, compare, drift_table, load_baseline, read_statistics
+
+    if rtol < 0 or atol < 0:
+        typer.echo("error: --rtol and --atol must be >= 0", err=True)
+        raise typer.Exit(2)
+    try:
+        expected = load_baseline(baseline)
+        stats, attrs = read_statistics(results)
+        comparison = compare(stats, expected, rtol, atol)
+    except BadInput as exc:
+        typer.echo(f"error: {exc}", err=True)
+        raise typer.Exit(2)
+    if expected.get("campaign_hash") and expected["campaign_hash"] != attrs.get("campaign_hash"):
+        typer.echo(f"note: {results} comes from another campaign (sha256 {str(attrs.get('campaign_hash'))[:12]}) "
+                   f"than the baseline ({str(expected['campaign_hash'])[:12]})")
+    if comparison.drifts:
+        typer.echo(f"drift: {len(comparison.drifts)} of {comparison.compared} values outside "
+                   f"rtol={rtol:g}, atol={atol:g}")
+        typer.echo(drift_table(comparison))
+        raise typer.Exit(1)
+    typer.echo(f"no drift: {comparison.compared} values within rtol={rtol:g}/atol={atol:g}")

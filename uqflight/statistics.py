@@ -52,7 +52,7 @@ class OutputStatistics:
     sobol_first: dict[str, np.ndarray] = field(default_factory=dict)
     sobol_total: dict[str, np.ndarray] = field(default_factory=dict)
     sobol_first_ci: dict[str, np.ndarray] = field(default_factory=dict)
-    samples: np.ndarray | None = None  # the runs, or draws of the surrogate, for KLD (M, T)
+    final_samples: np.ndarray | None = None  # runs or surrogate draws at the final time, for the KLD
     errors: dict = field(default_factory=dict)
 
     @property
@@ -157,7 +157,7 @@ def _output_statistics(store: ResultStore, name: str, method: dict, germs: list[
     support, density = pdf_over_time(samples, PDF_POINTS)
     std = np.sqrt(np.maximum(variance, 0.0))
     stats = OutputStatistics(name, store.units.get(name, ""), store.time, mean, variance, band,
-                             support, density, modified_cov(mean, std), samples=samples)
+                             support, density, modified_cov(mean, std), final_samples=samples[:, -1].copy())
     names = store.parameter_names
     if pce is not None:
         stats.sobol_first = dict(zip(names, pce.sobol_first()))
@@ -189,7 +189,7 @@ def add_reference_errors(stats: Statistics, reference: Statistics) -> None:
         if ref is None or ref.time.shape != out.time.shape or not np.allclose(ref.time, out.time):
             continue
         eps_m, eps_v = relative_errors(out.mean, out.variance, ref.mean, ref.variance)
-        kld = kl_divergence(out.samples[:, -1], ref.samples[:, -1])
+        kld = kl_divergence(out.final_samples, ref.final_samples)
         out.errors = {"eps_m": eps_m, "eps_v": eps_v, "eps_m_summary": error_summary(eps_m),
                       "eps_v_summary": error_summary(eps_v), "kld_final": kld}
 

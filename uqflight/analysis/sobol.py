@@ -52,9 +52,9 @@ def pick_freeze_indices(Y, d: int, n_boot: int = 200, seed=0, confidence: float 
 
     first, total = share(first_sum), share(total_sum)
     tails = [0.5 * (1.0 - confidence), 0.5 * (1.0 + confidence)]
-    return {
-        "first": first[0],
-        "total": total[0],
-        "first_ci": np.quantile(first[1:], tails, axis=0),
-        "total_ci": np.quantile(total[1:], tails, axis=0),
-    }
+
+    def interval(replicates):
+        """Percentile interval; without replicates (n_boot = 0) the estimate itself, twice."""
+        return np.quantile(replicates[1:], tails, axis=0) if n_boot else np.stack([replicates[0]] * 2)
+
+    return {"first": first[0], "total": total[0], "first_ci": interval(first), "total_ci": interval(total)}

@@ -1,0 +1,263 @@
+"""`uqflight report` and `uqflight check` on real results files of closed-form and JSBSim campaigns."""
+import csv
+import json
+import re
+import subprocess
+import sys
+from pathlib import Path
+
+import h5py
+import numpy as np
+import pytest
+
+from uqflight.campaign import jsbsim_probe, parse_campaign
+from uqflight.execution import run_campaign
+from uqflight.report import write_report
+from uqflight.statistics import analyse
+
+UQFLIGHT = str(Path(sys.executable).with_name("uqflight"))
+
+DECAY = """
+name: decay-{name}
+seed: 3
+simulator: {{kind: python, function: "uqflight.simulators.models:exp_decay"}}
+parameters:
+  a: {{distribution: {distribution}, lower: 0.5, upper: 1.5}}
+design: {design}
+method: {method}
+analysis: {{band_samples: 2000, bootstrap: 20}}
+"""
+
+ISHIGAMI = """
+name: ishigami-{name}
+seed: 5
+simulator: {{kind: python, function: "uqflight.simulators.models:ishigami"}}
+parameters:
+  x1: {{distribution: uniform, lower: -3.141592653589793, upper: 3.141592653589793}}
+  x2: {{distribution: uniform, lower: -3.141592653589793, upper: 3.141592653589793}}
+  x3: {{distribution: uniform, lower: -3.141592653589793, upper: 3.141592653589793}}
+design: {design}
+method: {method}
+analysis: {{band_samples: 2000, bootstrap: 20}}
+"""
+
+JSBSIM = """
+name: small-jsbsim-mc
+seed: 7
+simulator: {kind: jsbsim, duration_s: 5, output_rate_hz: 10, outputs: [alpha_deg, h_ft]}
+parameters:
+  CL0: {property: aero/uq/CL0, distribution: normal, interval_pct: 23.05}
+  CLalpha: {property: aero/uq/CLalpha, distribution: normal, interval_pct: 5.27}
+design: {kind: monte_carlo, samples: 16}
+execution: {workers: 1, chunk: 8}
+analysis: {band_samples: 1000}
+"""
+
+
+def run(template: str, path: Path, probe=None, **fields) -> Path:
+    campaign = parse_campaign(template.format(**fields) if fields else template, str(path.with_suffix(".yaml")), probe)
+    run_campaign(campaign, out=path, workers=1)
+    return path
+
+
+@pytest.fixture(scope="module")
+def files(tmp_path_factory) -> dict[str, Path]:
+    root = tmp_path_factory.mktemp("results")
+    grid = "{kind: sparse_grid, rule: gauss_hermite, level: %d}"
+    return {
+        "pg": run(DECAY, root / "pg.h5", name="pg", distribution="normal", design=grid % 3,
+                  method="{kind: pseudo_galerkin, order: 2}"),
+        "int": run(DECAY, root / "int.h5", name="int", distribution="normal", design=grid % 2,
+                   method="{kind: integration, order: 1}"),
+        "mc": run(DECAY, root / "mc.h5", name="mc", distribution="normal", design="{kind: monte_carlo, samples: 1000}",
+                  method="{kind: monte_carlo}"),
+        "mc_uniform": run(DECAY, root / "mc_uniform.h5", name="mc-uniform", distribution="uniform",
+                          design="{kind: monte_carlo, samples: 1000}", method="{kind: monte_carlo}"),
+        "ishigami_pce": run(ISHIGAMI, root / "ishigami_pce.h5", name="pce", method="{kind: regression, order: 6}",
+                            design="{kind: latin_hypercube, samples: 300}"),
+        "ishigami_pf": run(ISHIGAMI, root / "ishigami_pf.h5", name="pick-freeze", method="{kind: monte_carlo}",
+                           design="{kind: pick_freeze, samples: 100}"),
+    }
+
+
+def cli(*args) -> subprocess.CompletedProcess:
+    return subprocess.run([UQFLIGHT, *map(str, args)], capture_output=True, text=True, timeout=120)
+
+
+def read_csv(path: Path) -> list[dict]:
+    with open(path, newline="") as fh:
+        return list(csv.DictReader(fh))
+
+
+def test_report_of_several_files_against_a_reference(files, tmp_path):
+    out = tmp_path / "report"
+    result = cli("report", files["pg"], files["int"], "--reference", files["mc"], "--out", out, "--times", "1,2.5,end")
+    assert result.returncode == 0, result.stderr
+
+    summary = json.loads((out / "summary.json").read_text())
+    entry = summary["outputs"]["x"]
+    n = len(entry["time"])
+    assert n == 51 and entry["time"][-1] == 5.0
+    assert {"time", "mean", "variance", "band99", "sobol_first", "sobol_total"} <= entry.keys()
+    series = [entry["mean"], entry["variance"], entry["band99"]["lower"], entry["band99"]["upper"]]
+    assert [len(values) for values in series] == [n] * 4
+    assert list(entry["sobol_first"]) == list(entry["sobol_total"]) == ["a"] and len(entry["sobol_first"]["a"]) == n
+    assert summary["campaign"] == "decay-pg"
+    assert {p.name for p in (out / "summaries").iterdir()} == {"pg.json", "int.json"}
+
+    errors = read_csv(out / "tables" / "errors.csv")
+    assert [row["file"].split(":")[0] for row in errors] == ["decay-pg", "decay-int"]
+    assert all(float(row["eps_m max"]) < 0.05 for row in errors)
+    over_time = read_csv(out / "tables" / "statistics_pg_x.csv")
+    assert len(over_time) == n and float(over_time[-1]["time [s]"]) == 5.0 and "eps_v [-]" in over_time[0]
+    at_times = read_csv(out / "tables" / "statistics_at_times.csv")
+    assert [float(row["time [s]"]) for row in at_times] == [1.0, 2.5, 5.0] * 2
+    assert len(read_csv(out / "tables" / "sobol_first.csv")) == 6
+
+    page = (out / "report.html").read_text()
+    assert re.findall(r'src="(?!data:)', page) == [] and "<link" not in page
+    plots = sorted(p.name for p in (out / "plots").iterdir())
+    assert {"mean_band.png", "cov.png", "pdf_x.png", "eps_m.png", "eps_v.png", "kld_vs_runs.png",
+            "sobol_pg.png"} <= set(plots)
+    assert page.count('src="data:image/png;base64,') == len(plots)
+    markdown = (out / "report.md").read_text()
+    for name in plots:
+        assert f"plots/{name}" in page and f"](plots/{name})" in markdown
+    assert "Errors against the reference" in page and "decay-int: Int order 1, 3 runs" in page
+
+
+def test_pce_against_pick_freeze_and_two_monte_carlo_files(files, tmp_path):
+    out = tmp_path / "report"
+    write_report([files["ishigami_pce"], files["ishigami_pf"]], out)
+    table = read_csv(out / "tables" / "sobol_pce_vs_mc.csv")
+    assert [row["parameter"] for row in table] == ["x1", "x2", "x3"]
+    pce, pick_freeze = (f"ishigami-{name}: {method}" for name, method in
+                        (("pce", "regression order 6, 300 runs"), ("pick-freeze", "MC, 500 runs")))
+    exact = {"x1": 0.3139, "x2": 0.4424, "x3": 0.0}
+    for row in table:
+        assert float(row[pce]) == pytest.approx(exact[row["parameter"]], abs=0.03)
+        lower, upper = (float(row[f"{pick_freeze} 95 % CI {side}"]) for side in ("lower", "upper"))
+        assert lower <= float(row[pick_freeze]) <= upper
+    assert (out / "plots" / "sobol_ishigami_pf.png").is_file()
+
+    mc = tmp_path / "mc"
+    write_report([files["mc"], files["mc_uniform"]], mc)
+    assert {"mc_bands.png", "mc_pdf_final.png"} <= {p.name for p in (mc / "plots").iterdir()}
+    assert [row["inputs"] for row in read_csv(mc / "tables" / "files.csv")] == ["normal", "uniform"]
+
+
+def test_report_of_a_jsbsim_campaign_and_its_check(tmp_path):
+    results = run(JSBSIM, tmp_path / "jsbsim.h5", probe=jsbsim_probe)
+    baseline = tmp_path / "baseline.json"
+    result = cli("report", results, "--out", tmp_path / "report", "--write-baseline", baseline)
+    assert result.returncode == 0, result.stderr
+    summary = json.loads((tmp_path / "report" / "summary.json").read_text())
+    assert list(summary["outputs"]) == ["alpha_deg", "h_ft"] and len(summary["outputs"]["h_ft"]["time"]) == 51
+    with h5py.File(results, "r") as f:
+        assert json.loads(baseline.read_text())["campaign_hash"] == f.attrs["campaign_hash"]
+    checked = cli("check", results, "--baseline", baseline)
+    assert checked.returncode == 0, checked.stdout + checked.stderr
+    assert checked.stdout.startswith("no drift: ")
+
+
+@pytest.fixture(scope="module")
+def baseline(files, tmp_path_factory) -> Path:
+    path = tmp_path_factory.mktemp("baseline") / "baseline.json"
+    write_report([files["pg"]], path.parent / "report", baseline=path)
+    return path
+
+
+def test_check_passes_on_the_exact_baseline(files, baseline):
+    result = cli("check", files["pg"], "--baseline", baseline)
+    assert result.returncode == 0, result.stdout + result.stderr
+    n = 51 * 6  # mean, variance, two band bounds, first and total index of a
+    assert result.stdout.strip() == f"no drift: {n} values within rtol=1e-06/atol=1e-09"
+
+
+def test_check_reports_a_moved_mean_with_exit_1(files, baseline, tmp_path):
+    data = json.loads(baseline.read_text())
+    data["outputs"]["x"]["mean"][20] += 1e-3
+    moved = tmp_path / "moved.json"
+    moved.write_text(json.dumps(data))
+    result = cli("check", files["pg"], "--baseline", moved)
+    assert result.returncode == 1, result.stdout + result.stderr
+    assert result.stdout.startswith("drift: 1 of 306 values outside rtol=1e-06, atol=1e-09")
+    row = next(line.split() for line in result.stdout.splitlines() if line.startswith("x "))
+    assert row[:3] == ["x", "mean", "2"]
+    assert float(row[4]) == pytest.approx(data["outputs"]["x"]["mean"][20])
+    assert cli("check", files["pg"], "--baseline", moved, "--atol", "0.01").returncode == 0
+
+
+def edited(data: dict, edit) -> str:
+    """The baseline `data` as JSON text after `edit(copy)` changed a copy."""
+    copy = json.loads(json.dumps(data))
+    edit(copy)
+    return json.dumps(copy)
+
+
+def drop_last_time(data: dict) -> None:
+    entry = data["outputs"]["x"]
+    for key in ("time", "mean", "variance"):
+        entry[key].pop()
+    for key in ("band99", "sobol_first", "sobol_total"):
+        for values in entry[key].values():
+            values.pop()
+
+
+def bad_baselines(data: dict) -> dict[str, tuple[str, str]]:
+    """Name: (file text, expected message fragment)."""
+    x = "outputs.x"
+
+    def shift_time(d):
+        d["outputs"]["x"]["time"] = [t + 1 for t in d["outputs"]["x"]["time"]]
+
+    def add_parameter(d):
+        d["outputs"]["x"]["sobol_first"]["b"] = d["outputs"]["x"]["time"]
+
+    return {
+        "bad json": ('{"kind": "uqflight-baseline", "outputs": {', "not a JSON baseline"),
+        "not a baseline": ('{"outputs": {}}', "not a uqflight baseline"),
+        "missing key": (edited(data, lambda d: d["outputs"]["x"].pop("variance")), f"{x}.variance: missing"),
+        "wrong length": (edited(data, lambda d: d["outputs"]["x"]["mean"].append(1.0)),
+                         f"{x}.mean: expected 51 values (one per time), got 52"),
+        "not numbers": (edited(data, lambda d: d["outputs"]["x"]["band99"].update(lower="low")),
+                        f"{x}.band99.lower: expected a list of numbers"),
+        "shorter time grid": (edited(data, drop_last_time), "the baseline's time grid (50 times, 0 to 4.9 s) differs"),
+        "shifted time grid": (edited(data, shift_time), "the baseline's time grid (51 times, 1 to 6 s) differs"),
+        "other outputs": (edited(data, lambda d: d.update(outputs={"y": d["outputs"]["x"]})),
+                          "the baseline is for outputs y; the results have x"),
+        "other parameters": (edited(data, add_parameter),
+                             "the baseline has statistics sobol_first[b] that the results lack"),
+    }
+
+
+def test_check_refuses_bad_input_with_exit_2_and_one_line(files, baseline, tmp_path):
+    cases = bad_baselines(json.loads(baseline.read_text()))
+    for name, (text, message) in cases.items():
+        path = tmp_path / f"{name.replace(' ', '_')}.json"
+        path.write_text(text)
+        result = cli("check", files["pg"], "--baseline", path)
+        assert result.returncode == 2, (name, result.stdout, result.stderr)
+        assert message in result.stderr, (name, result.stderr)
+        assert "Traceback" not in result.stderr and len(result.stderr.strip().splitlines()) == 1, (name, result.stderr)
+    for args, message in (((files["pg"], "--baseline", tmp_path / "missing.json"), "cannot read the baseline"),
+                          ((tmp_path / "missing.h5", "--baseline", baseline), "no such results file"),
+                          ((baseline, "--baseline", baseline), "cannot analyse the results file")):
+        result = cli("check", *args)
+        assert result.returncode == 2 and message in result.stderr and "Traceback" not in result.stderr, result.stderr
+
+
+def test_report_refuses_an_unreadable_results_file(tmp_path):
+    result = cli("report", tmp_path / "missing.h5", "--out", tmp_path / "report")
+    assert result.returncode == 2
+    assert result.stderr.strip() == f"error: {tmp_path / 'missing.h5'}: no such results file"
+
+
+def test_split_form_is_ignored_by_the_kinds_that_fit_their_constant_term(tmp_path):
+    """`split: true` is accepted for every method; least squares fits x0 itself, so nothing changes."""
+    path = run(DECAY, tmp_path / "split.h5", name="split", distribution="normal",
+               design="{kind: sparse_grid, rule: gauss_hermite, level: 3}",
+               method="{kind: least_squares, order: 2, split: true}")
+    split, plain = analyse(path), analyse(path, method={"split": False})
+    np.testing.assert_allclose(split.outputs["x"].mean, plain.outputs["x"].mean, rtol=1e-12)
+    np.testing.assert_allclose(split.outputs["x"].variance, plain.outputs["x"].variance, rtol=1e-12)

@@ -1,0 +1,201 @@
+"""Baselines of a results file's statistics, and the drift of a recomputation against one.
+
+A baseline (written by `uqflight report --write-baseline`) holds, per output and time, the mean,
+variance, 99 % band and Sobol' indices of one results file, with that file's campaign hash.
+`compare` recomputes nothing itself: it takes fresh `Statistics` and lists every value outside
+|value − baseline| <= atol + rtol·|baseline| (NaN matches only NaN).
+"""
+from __future__ import annotations
+
+import json
+import math
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from .statistics import Statistics, analyse
+from .store import ResultStore
+
+BASELINE_KIND = "uqflight-baseline"
+BASELINE_VERSION = 1
+STATISTICS = ("mean", "variance", "band99.lower", "band99.upper", "sobol_first", "sobol_total")
+TIME_ATOL = 1e-9  # seconds: time grids closer than this are the same grid
+
+
+class BadInput(ValueError):
+    """A results file or baseline that cannot be used; the message is one line naming it."""
+
+
+@dataclass
+class Drift:
+    """One value outside its tolerance."""
+
+    output: str
+    statistic: str
+    time: float
+    value: float
+    baseline: float
+    tolerance: float
+
+    @property
+    def excess(self) -> float:
+        """|value − baseline| in units of the tolerance (inf for a NaN on one side only)."""
+        difference = abs(self.value - self.baseline)
+        return difference / self.tolerance if math.isfinite(difference) and self.tolerance > 0 else math.inf
+
+
+@dataclass
+class Comparison:
+    compared: int
+    drifts: list[Drift]
+
+
+def read_statistics(path: Path) -> tuple[Statistics, dict]:
+    """The statistics of a results file and its root attributes (campaign_hash, ...); BadInput if unreadable."""
+    path = Path(path)
+    if not path.is_file():
+        raise BadInput(f"{path}: no such results file")
+    try:
+        with ResultStore.open(path) as store:
+            attrs = store.attrs
+        return analyse(path), attrs
+    except (OSError, ValueError, KeyError) as exc:
+        reason = " ".join(str(exc).split())  # one line, whatever h5py or the analysis said
+        raise BadInput(f"{path}: cannot analyse the results file ({reason})") from exc
+
+
+def _series(entry) -> dict[str, list]:
+    """The compared statistics of one output ({statistic: values}) from a baseline entry (dict)."""
+    series = {"mean": entry["mean"], "variance": entry["variance"],
+              "band99.lower": entry["band99"]["lower"], "band99.upper": entry["band99"]["upper"]}
+    for kind in ("sobol_first", "sobol_total"):
+        series.update({f"{kind}[{parameter}]": values for parameter, values in entry[kind].items()})
+    return series
+
+
+def baseline_json(stats: Statistics, campaign_hash: str) -> dict:
+    """The baseline of `stats`: per output its time grid and compared statistics, and the campaign hash."""
+    outputs = {}
+    for name, out in stats.outputs.items():
+        outputs[name] = {
+            "time": out.time.tolist(), "mean": out.mean.tolist(), "variance": out.variance.tolist(),
+            "band99": {"lower": out.band99[0].tolist(), "upper": out.band99[1].tolist()},
+            "sobol_first": {k: v.tolist() for k, v in out.sobol_first.items()},
+            "sobol_total": {k: v.tolist() for k, v in out.sobol_total.items()},
+        }
+    return {"kind": BASELINE_KIND, "version": BASELINE_VERSION, "results": stats.path,
+            "campaign": stats.campaign_name, "campaign_hash": campaign_hash, "method": stats.method,
+            "outputs": outputs}
+
+
+def write_baseline(stats: Statistics, campaign_hash: str, path: Path) -> Path:
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    path.write_text(json.dumps(baseline_json(stats, campaign_hash), indent=1) + "\n", encoding="utf-8")
+    return path
+
+
+def load_baseline(path: Path) -> dict:
+    """A baseline file, checked for shape: BadInput naming the file and the first bad field."""
+    path = Path(path)
+    try:
+        data = json.loads(path.read_text(encoding="utf-8"))
+    except OSError as exc:
+        raise BadInput(f"{path}: cannot read the baseline ({exc.strerror or exc})") from exc
+    except (UnicodeDecodeError, json.JSONDecodeError) as exc:
+        raise BadInput(f"{path}: not a JSON baseline ({exc})") from exc
+    if not isinstance(data, dict) or data.get("kind") != BASELINE_KIND:
+        raise BadInput(f"{path}: not a uqflight baseline (expected a JSON object with \"kind\": \"{BASELINE_KIND}\"; "
+                       "write one with `uqflight report RESULTS.h5 --out DIR --write-baseline FILE`)")
+    outputs = data.get("outputs")
+    if not isinstance(outputs, dict) or not outputs:
+        raise BadInput(f"{path}: outputs: expected a non-empty mapping of output names to statistics")
+    for name, entry in outputs.items():
+        _check_entry(path, name, entry)
+    return data
+
+
+def _check_entry(path: Path, name: str, entry) -> None:
+    where = f"{path}: outputs.{name}"
+    if not isinstance(entry, dict):
+        raise BadInput(f"{where}: expected a mapping of statistics")
+    for key in ("time", "mean", "variance", "band99", "sobol_first", "sobol_total"):
+        if key not in entry:
+            raise BadInput(f"{where}.{key}: missing")
+    for key in ("band99", "sobol_first", "sobol_total"):
+        if not isinstance(entry[key], dict):
+            raise BadInput(f"{where}.{key}: expected a mapping")
+    for key in ("lower", "upper"):
+        if key not in entry["band99"]:
+            raise BadInput(f"{where}.band99.{key}: missing")
+    length = _numbers(f"{where}.time", entry["time"], None)
+    for statistic, values in _series(entry).items():
+        _numbers(f"{where}.{statistic}", values, length)
+
+
+def _numbers(where: str, values, length: int | None) -> int:
+    """The length of a list of numbers (null stands for NaN), which must be `length` when given."""
+    if not isinstance(values, list) or not all(v is None or (isinstance(v, (int, float)) and not isinstance(v, bool))
+                                               for v in values):
+        raise BadInput(f"{where}: expected a list of numbers")
+    if not values or (length is not None and len(values) != length):
+        raise BadInput(f"{where}: expected {length or 'at least one'} values (one per time), got {len(values)}")
+    return len(values)
+
+
+def compare(stats: Statistics, baseline: dict, rtol: float, atol: float) -> Comparison:
+    """Every value of `stats` against the baseline; BadInput when outputs, time grids or the Sobol'
+    parameters differ (then the two describe different things and nothing is compared)."""
+    fresh = baseline_json(stats, "")["outputs"]
+    expected = baseline["outputs"]
+    if set(fresh) != set(expected):
+        raise BadInput(f"the baseline is for outputs {', '.join(expected)}; the results have {', '.join(fresh)}")
+    compared, drifts = 0, []
+    for name, entry in expected.items():
+        time = np.asarray(fresh[name]["time"])
+        _check_time_grid(name, time, np.asarray(entry["time"], dtype=float))
+        values, reference = _series(fresh[name]), _series(entry)
+        if set(values) != set(reference):
+            only_baseline = ", ".join(sorted(set(reference) - set(values))) or "-"
+            only_results = ", ".join(sorted(set(values) - set(reference))) or "-"
+            raise BadInput(f"output {name}: the baseline has statistics {only_baseline} that the results lack, the "
+                           f"results {only_results} that the baseline lacks (another method or parameters?)")
+        for statistic, baseline_values in reference.items():
+            value = np.asarray(values[statistic], dtype=float)
+            base = np.asarray(baseline_values, dtype=float)
+            tolerance = atol + rtol * np.abs(base)
+            ok = (np.abs(value - base) <= tolerance) | (np.isnan(value) & np.isnan(base))
+            compared += value.size
+            drifts += [Drift(name, statistic, float(time[i]), float(value[i]), float(base[i]), float(tolerance[i]))
+                       for i in np.flatnonzero(~ok)]
+    return Comparison(compared, drifts)
+
+
+def _check_time_grid(name: str, time: np.ndarray, expected: np.ndarray) -> None:
+    if time.shape != expected.shape or not np.allclose(time, expected, rtol=0.0, atol=TIME_ATOL):
+        raise BadInput(f"output {name}: the baseline's time grid ({expected.size} times, {expected[0]:g} to "
+                       f"{expected[-1]:g} s) differs from the results' ({time.size} times, {time[0]:g} to "
+                       f"{time[-1]:g} s)")
+
+
+def drift_table(comparison: Comparison, worst: int = 5) -> str:
+    """The `worst` drifts of each statistic (mean, variance, band99.lower, band99.upper, sobol_first,
+    sobol_total; largest excess over the tolerance first) as a text table, with how many drifted of each."""
+    by_statistic: dict[str, list[Drift]] = {statistic: [] for statistic in STATISTICS}
+    for drift in comparison.drifts:
+        by_statistic[drift.statistic.split("[")[0]].append(drift)
+    by_statistic = {statistic: drifts for statistic, drifts in by_statistic.items() if drifts}
+    header = ("output", "statistic", "time [s]", "value", "baseline", "|difference|", "tolerance")
+    rows = []
+    for statistic, drifts in by_statistic.items():
+        drifts.sort(key=lambda d: d.excess, reverse=True)
+        for d in drifts[:worst]:
+            rows.append((d.output, d.statistic, f"{d.time:g}", f"{d.value:.10g}", f"{d.baseline:.10g}",
+                         f"{abs(d.value - d.baseline):.3g}", f"{d.tolerance:.3g}"))
+        if len(drifts) > worst:
+            rows.append(("", f"... {len(drifts) - worst} more {statistic}", "", "", "", "", ""))
+    widths = [max(len(row[i]) for row in (header, *rows)) for i in range(len(header))]
+    lines = ["  ".join(cell.ljust(width) for cell, width in zip(row, widths)).rstrip() for row in (header, *rows)]
+    counts = ", ".join(f"{statistic} {len(drifts)}" for statistic, drifts in by_statistic.items())
+    return "\n".join([*lines, f"drifted per statistic: {counts}"])
