@@ -261,3 +261,16 @@ def test_split_form_is_ignored_by_the_kinds_that_fit_their_constant_term(tmp_pat
     split, plain = analyse(path), analyse(path, method={"split": False})
     np.testing.assert_allclose(split.outputs["x"].mean, plain.outputs["x"].mean, rtol=1e-12)
     np.testing.assert_allclose(split.outputs["x"].variance, plain.outputs["x"].variance, rtol=1e-12)
+
+
+def test_method_override_reports_another_method_on_the_same_runs(files, tmp_path):
+    result = subprocess.run([UQFLIGHT, "report", str(files["pg"]), "--method", "least_squares", "--order", "3",
+                             "--out", str(tmp_path / "ls")], capture_output=True, text=True)
+    assert result.returncode == 0, result.stderr
+    summary = json.loads((tmp_path / "ls" / "summary.json").read_text())
+    assert summary["method"]["kind"] == "least_squares" and summary["method"]["order"] == 3
+    exact = analyse(files["pg"], method={"kind": "least_squares", "order": 3}).outputs["x"].mean
+    np.testing.assert_allclose(summary["outputs"]["x"]["mean"], exact, rtol=1e-12)
+    bad = subprocess.run([UQFLIGHT, "report", str(files["pg"]), "--method", "galerkin", "--out", str(tmp_path / "b")],
+                         capture_output=True, text=True)
+    assert bad.returncode == 2 and "Traceback" not in bad.stderr

@@ -51,15 +51,16 @@ class Comparison:
     drifts: list[Drift]
 
 
-def read_statistics(path: Path) -> tuple[Statistics, dict]:
-    """The statistics of a results file and its root attributes (campaign_hash, ...); BadInput if unreadable."""
+def read_statistics(path: Path, method: dict | None = None) -> tuple[Statistics, dict]:
+    """The statistics of a results file (with `method` overriding the campaign's) and its root
+    attributes (campaign_hash, ...); BadInput if unreadable."""
     path = Path(path)
     if not path.is_file():
         raise BadInput(f"{path}: no such results file")
     try:
         with ResultStore.open(path) as store:
             attrs = store.attrs
-        return analyse(path), attrs
+        return analyse(path, method=method), attrs
     except (OSError, ValueError, KeyError) as exc:
         reason = " ".join(str(exc).split())  # one line, whatever h5py or the analysis said
         raise BadInput(f"{path}: cannot analyse the results file ({reason})") from exc

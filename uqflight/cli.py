@@ -10,6 +10,7 @@ from typing import List, Optional
 import numpy as np
 import typer
 
+from .methods import METHOD_KINDS
 from .simulators.jsbsim import DEFAULT_OUTPUTS, Excitation, FlightError, FlightSetup, JSBSimFlight
 
 app = typer.Typer(help="Uncertainty quantification campaigns on a JSBSim flight-dynamics model.",
@@ -195,6 +196,10 @@ def report(
                                                 "(the nearest recorded times; 'end' is the final time)."),
     write_baseline: Optional[Path] = typer.Option(None, help="Also write the first file's statistics to this "
                                                              "JSON file, the baseline of `uqflight check`."),
+    method: Optional[str] = typer.Option(None, help="Method for every file instead of its campaign's: integration, "
+                                                    "pseudo_galerkin, interpolation, regression, least_squares, "
+                                                    "monte_carlo (the runs of one grid serve every method)."),
+    order: Optional[int] = typer.Option(None, help="Polynomial order with --method (default: the campaign's)."),
 ):
     """Statistics, tables, plots and a report page of one or more results files.
 
@@ -212,8 +217,14 @@ def report(
         selected = [float("inf") if t.strip() == "end" else float(t) for t in times.split(",")]
     except ValueError:
         raise typer.BadParameter(f"expected comma-separated seconds or 'end', got {times!r}", param_hint="--times")
+    override = {key: value for key, value in (("kind", method), ("order", order)) if value is not None}
+    if method is not None and method not in METHOD_KINDS:
+        raise typer.BadParameter(f"expected one of {', '.join(METHOD_KINDS)}, got {method!r}", param_hint="--method")
+    if order is not None and order < 0:
+        raise typer.BadParameter(f"expected an integer >= 0, got {order}", param_hint="--order")
     try:
-        written = write_report(results, out, reference=reference, times=selected, baseline=write_baseline)
+        written = write_report(results, out, reference=reference, times=selected, baseline=write_baseline,
+                               method=override or None)
     except BadInput as exc:
         typer.echo(f"error: {exc}", err=True)
         raise typer.Exit(2)

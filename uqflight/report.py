@@ -101,14 +101,15 @@ def input_distributions(campaign_text: str) -> str:
     return ", ".join(dict.fromkeys(str(spec.get("distribution", "?")) for spec in parameters.values()))
 
 
-def load_entries(paths: list[Path], reference: Path | None) -> tuple[list[Entry], Entry | None]:
-    """Every file analysed, with errors against the reference unless it is the reference itself,
-    and the reference."""
+def load_entries(paths: list[Path], reference: Path | None,
+                 method: dict | None = None) -> tuple[list[Entry], Entry | None]:
+    """Every file analysed (with `method` overriding the campaigns' methods, the reference
+    excepted), with errors against the reference unless it is the reference itself, and the reference."""
     stems: set[str] = set()
     ref = _entry(reference, *read_statistics(reference), set()) if reference else None
     entries = []
     for path in paths:
-        stats, attrs = read_statistics(path)
+        stats, attrs = read_statistics(path, method)
         if ref is not None and not _same_file(path, reference):
             add_reference_errors(stats, ref.stats)
         entries.append(_entry(path, stats, attrs, stems))
@@ -141,12 +142,12 @@ def _unique(stem: str, taken: set[str]) -> str:
 
 
 def write_report(paths: list[Path], out_dir: Path, reference: Path | None = None,
-                 times=DEFAULT_TIMES, baseline: Path | None = None) -> list[Path]:
+                 times=DEFAULT_TIMES, baseline: Path | None = None, method: dict | None = None) -> list[Path]:
     """Write the whole report of `paths` into `out_dir`; returns the files written."""
     out_dir = Path(out_dir)
     for sub in ("plots", "tables"):
         (out_dir / sub).mkdir(parents=True, exist_ok=True)
-    entries, ref = load_entries(paths, reference)
+    entries, ref = load_entries(paths, reference, method)
     written = write_summaries(entries, out_dir)
     written += write_statistics_tables(entries, out_dir)
     sections = build_sections(entries, ref, times, out_dir)
