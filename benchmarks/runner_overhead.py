@@ -22,6 +22,8 @@ import numpy as np
 
 from uqflight.campaign import jsbsim_probe, parse_campaign
 from uqflight.execution import run_campaign
+from uqflight.paper import table1_parameters_yaml
+from uqflight.parameters import to_physical
 from uqflight.simulators.jsbsim import REPO_ROOT
 
 CAMPAIGN = """
@@ -29,14 +31,7 @@ name: bench-{samples}-{tag}
 seed: 11
 simulator: {{kind: jsbsim, duration_s: 50, output_rate_hz: 20}}
 parameters:
-  CL0:     {{property: aero/uq/CL0,     distribution: normal, interval_pct: 23.05}}
-  CLalpha: {{property: aero/uq/CLalpha, distribution: normal, interval_pct: 5.27}}
-  CD0:     {{property: aero/uq/CD0,     distribution: normal, interval_pct: 12.4}}
-  k1:      {{property: aero/uq/k1,      distribution: normal, interval_pct: 89.16}}
-  k2:      {{property: aero/uq/k2,      distribution: normal, interval_pct: 379.74}}
-  Cm0:     {{property: aero/uq/Cm0,     distribution: normal, interval_pct: 10.46}}
-  Cmq:     {{property: aero/uq/Cmq,     distribution: normal, interval_pct: 0.53}}
-design: {{kind: monte_carlo, samples: {samples}}}
+{parameters}design: {{kind: monte_carlo, samples: {samples}}}
 storage: {{raw: true}}
 """
 RECORDED = ["aero/alpha-deg", "attitude/theta-deg", "position/h-sl-ft", "velocities/q-rad_sec",
@@ -78,7 +73,8 @@ def bare_loop(kappa: np.ndarray, properties: list[str]) -> np.ndarray:
 
 
 def campaign(samples: int, tag: str):
-    return parse_campaign(CAMPAIGN.format(samples=samples, tag=tag), "bench.yaml", jsbsim_probe)
+    text = CAMPAIGN.format(parameters=table1_parameters_yaml(), samples=samples, tag=tag)
+    return parse_campaign(text, "bench.yaml", jsbsim_probe)
 
 
 def timed_run(spec, workers: int, executor: str = "local") -> float:
@@ -98,7 +94,6 @@ def main():
     args = parser.parse_args()
 
     spec = campaign(args.samples, "overhead")
-    from uqflight.parameters import to_physical
     kappa = to_physical(spec.parameters, spec.design().xi)
     properties = [p.property for p in spec.parameters]
     bare, runner = [], []

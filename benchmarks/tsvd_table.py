@@ -21,6 +21,7 @@ import numpy as np
 
 from uqflight.campaign import jsbsim_probe, parse_campaign
 from uqflight.execution import run_campaign
+from uqflight.paper import table1_parameters_yaml
 from uqflight.store import ResultStore, Status
 from uqflight.tsvd import IncrementalSVD, weighted_mean, weighted_variance
 
@@ -29,14 +30,7 @@ name: tsvd-alpha-{samples}
 seed: 2023
 simulator: {{kind: jsbsim, duration_s: 50, output_rate_hz: 20, outputs: [alpha_deg]}}
 parameters:
-  CL0:     {{property: aero/uq/CL0,     distribution: normal, interval_pct: 23.05}}
-  CLalpha: {{property: aero/uq/CLalpha, distribution: normal, interval_pct: 5.27}}
-  CD0:     {{property: aero/uq/CD0,     distribution: normal, interval_pct: 12.4}}
-  k1:      {{property: aero/uq/k1,      distribution: normal, interval_pct: 89.16}}
-  k2:      {{property: aero/uq/k2,      distribution: normal, interval_pct: 379.74}}
-  Cm0:     {{property: aero/uq/Cm0,     distribution: normal, interval_pct: 10.46}}
-  Cmq:     {{property: aero/uq/Cmq,     distribution: normal, interval_pct: 0.53}}
-design: {{kind: monte_carlo, samples: {samples}}}
+{parameters}design: {{kind: monte_carlo, samples: {samples}}}
 execution: {{workers: {workers}}}
 storage: {{raw: true}}
 """
@@ -58,7 +52,7 @@ def main():
     parser.add_argument("--out", type=Path, default=Path("results/tsvd-alpha.h5"))
     args = parser.parse_args()
 
-    spec = parse_campaign(CAMPAIGN.format(samples=args.samples, workers=args.workers), "tsvd.yaml", jsbsim_probe)
+    spec = parse_campaign(CAMPAIGN.format(parameters=table1_parameters_yaml(), samples=args.samples, workers=args.workers), "tsvd.yaml", jsbsim_probe)
     summary = run_campaign(spec, out=args.out)
     with ResultStore.open(args.out) as store:
         ok = store.status == Status.OK

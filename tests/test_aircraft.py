@@ -3,11 +3,12 @@ import jsbsim
 import numpy as np
 import pytest
 
+from uqflight.paper import TABLE1
 from uqflight.simulators.jsbsim import (REPO_ROOT, Excitation, FlightSetup, JSBSimFlight,
                                         TrimError, quiet_jsbsim)
 
-UQ = ["CL0", "CLalpha", "CD0", "k1", "k2", "Cm0", "Cmq"]
-TABLE1_PCT = dict(CL0=23.05, CLalpha=5.27, CD0=12.4, k1=89.16, k2=379.74, Cm0=10.46, Cmq=0.53)
+UQ = list(TABLE1)
+TABLE1_PCT = {name: pct for name, (_, pct) in TABLE1.items()}
 
 
 @pytest.fixture(scope="module")
