@@ -152,6 +152,9 @@ def run(
     except (FileExistsError, ValueError) as exc:
         typer.echo(f"error: {campaign}: {exc}", err=True)
         raise typer.Exit(2)
+    except KeyboardInterrupt:
+        typer.echo(f"\ninterrupted: the finished runs are stored; rerun `uqflight run {campaign}` to resume", err=True)
+        raise typer.Exit(130)
     typer.echo(summary.describe())
 
 
