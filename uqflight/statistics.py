@@ -22,10 +22,12 @@ from .analysis.errors import error_summary, relative_errors
 from .analysis.moments import modified_cov, quantile_band
 from .analysis.sobol import pick_freeze_indices
 from .methods import PCE, SPLIT_FORM_KINDS, fit
+from .methods.basis import draw_germs, orthonormal_basis
 from .store import ResultStore, Status
 
 SAMPLED_KINDS = ("monte_carlo", "sobol", "halton", "latin_hypercube", "pick_freeze")
 PDF_POINTS = 120
+TIME_BLOCK = 100  # recorded times whose runs or surrogate draws are rebuilt at once
 
 
 @dataclass
@@ -139,11 +141,12 @@ def _output_statistics(store: ResultStore, name: str, method: dict, germs: list[
         return a if scale is None else a @ scale
 
     pce = None
-    if sampled:
-        samples = expand(basis)
-        result = fit(kind, xi, weights, samples, germs, order)
-        mean, variance = result.mean, result.variance
-        band = quantile_band(samples, None if kind == "monte_carlo" else weights)
+    if sampled:  # sample moments; bands, PDFs and pick-freeze indices from the runs themselves
+        n = len(basis)
+        w = np.full(n, 1.0 / n) if kind == "monte_carlo" else weights / weights.sum()
+        mean = expand(w @ basis)
+        variance = _weighted_variance(basis, scale, w, mean) * (n / (n - 1) if kind == "monte_carlo" else 1.0)
+        rows, row_scale, band_weights = basis, scale, (None if kind == "monte_carlo" else w)
     else:
         if kind in MOMENTS_FROM_WEIGHTS:  # quadrature moments; the PCE serves bands, PDFs, Sobol'
             mean = expand(weights @ basis)
@@ -152,22 +155,50 @@ def _output_statistics(store: ResultStore, name: str, method: dict, germs: list[
         pce = PCE(fitted.pce.germs, fitted.pce.indices, expand(fitted.pce.coefficients))
         if kind not in MOMENTS_FROM_WEIGHTS:
             mean, variance = pce.mean(), pce.variance()
-        samples = pce.sample(options.band_samples, options.seed)
-        band = quantile_band(samples)
-    support, density = pdf_over_time(samples, PDF_POINTS)
+        draws = draw_germs(germs, options.band_samples, options.seed)
+        rows, row_scale, band_weights = orthonormal_basis(germs, pce.indices, draws), pce.coefficients, None
+    pick_freeze = pce is None and design_kind == "pick_freeze" and ok.all()
+    blocks = _over_time_blocks(rows, row_scale, store.time.size, band_weights,
+                               len(store.parameter_names) if pick_freeze else 0, options)
     std = np.sqrt(np.maximum(variance, 0.0))
-    stats = OutputStatistics(name, store.units.get(name, ""), store.time, mean, variance, band,
-                             support, density, modified_cov(mean, std), final_samples=samples[:, -1].copy())
+    stats = OutputStatistics(name, store.units.get(name, ""), store.time, mean, variance, blocks["band"],
+                             blocks["support"], blocks["density"], modified_cov(mean, std),
+                             final_samples=blocks["final"])
     names = store.parameter_names
     if pce is not None:
         stats.sobol_first = dict(zip(names, pce.sobol_first()))
         stats.sobol_total = dict(zip(names, pce.sobol_total()))
-    elif design_kind == "pick_freeze" and ok.all():
-        indices = pick_freeze_indices(samples, len(names), n_boot=options.bootstrap, seed=options.seed)
-        stats.sobol_first = dict(zip(names, indices["first"]))
-        stats.sobol_total = dict(zip(names, indices["total"]))
-        stats.sobol_first_ci = dict(zip(names, np.moveaxis(indices["first_ci"], 1, 0)))
+    elif pick_freeze:
+        stats.sobol_first = dict(zip(names, blocks["first"]))
+        stats.sobol_total = dict(zip(names, blocks["total"]))
+        stats.sobol_first_ci = dict(zip(names, np.moveaxis(blocks["first_ci"], 1, 0)))
     return stats
+
+
+def _over_time_blocks(rows, scale, n_times: int, weights, pick_freeze_dimensions: int, options: Options) -> dict:
+    """99 % band, PDFs, final-time samples (and pick-freeze indices) of Y = rows @ scale (scale None:
+    Y = rows), rebuilding Y for TIME_BLOCK times at once: the memory stays that of one block
+    whatever the number of runs or draws. Every statistic here is per time, so blocks change nothing."""
+    parts: dict[str, list] = {key: [] for key in ("lower", "upper", "support", "density", "first", "total",
+                                                  "first_ci")}
+    for start in range(0, n_times, TIME_BLOCK):
+        stop = min(start + TIME_BLOCK, n_times)
+        Y = rows[:, start:stop] if scale is None else rows @ scale[:, start:stop]
+        lower, upper = quantile_band(Y, weights)
+        support, density = pdf_over_time(Y, PDF_POINTS)
+        for key, value in (("lower", lower), ("upper", upper), ("support", support), ("density", density)):
+            parts[key].append(value)
+        if pick_freeze_dimensions:
+            indices = pick_freeze_indices(Y, pick_freeze_dimensions, n_boot=options.bootstrap, seed=options.seed)
+            for key in ("first", "total", "first_ci"):
+                parts[key].append(indices[key])
+    joined = {"band": (np.concatenate(parts["lower"]), np.concatenate(parts["upper"])),
+              "support": np.concatenate(parts["support"]), "density": np.concatenate(parts["density"]),
+              "final": Y[:, -1].copy()}
+    if pick_freeze_dimensions:
+        joined.update(first=np.concatenate(parts["first"], axis=-1), total=np.concatenate(parts["total"], axis=-1),
+                      first_ci=np.concatenate(parts["first_ci"], axis=-1))
+    return joined
 
 
 def _weighted_variance(basis, scale, weights, mean) -> np.ndarray:
