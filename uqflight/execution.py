@@ -172,7 +172,8 @@ def _execute_dask(tasks, workers: int, scheduler: str | None):
         client = Client(cluster)
     try:
         queue = list(reversed(tasks))
-        in_flight = 2 * max(workers, len(client.scheduler_info().get("workers", {})) or 1)
+        # a deeper queue than the local pool's: it hides the scheduler round trip of a remote cluster
+        in_flight = 4 * max(workers, len(client.scheduler_info().get("workers", {})) or 1)
         futures = as_completed([client.submit(run_chunk, *queue.pop(), pure=False)
                                 for _ in range(min(in_flight, len(queue)))])
         for future in futures:
