@@ -136,7 +136,7 @@ def run(
     force: bool = typer.Option(False, help="Overwrite a results file made from another campaign."),
 ):
     """Run a campaign into its HDF5 results file; rerunning resumes where it stopped."""
-    from .execution import Progress, run_campaign
+    from .execution import run_campaign
 
     spec = _load(campaign)
     if executor not in (None, "local", "dask"):
@@ -145,10 +145,9 @@ def run(
     if workers is not None and workers < 1:
         typer.echo(f"error: --workers: expected an integer >= 1, got {workers}", err=True)
         raise typer.Exit(2)
-    total = len(spec.design().xi)
     try:
         summary = run_campaign(spec, out=out, workers=workers, executor=executor, scheduler=scheduler,
-                               force=force, progress=Progress(total))
+                               force=force, progress=True)
     except (FileExistsError, ValueError) as exc:
         typer.echo(f"error: {campaign}: {exc}", err=True)
         raise typer.Exit(2)

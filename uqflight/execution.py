@@ -85,18 +85,16 @@ def worker_spec(campaign: Campaign) -> WorkerSpec:
                       base=str(Path(campaign.source).resolve().parent))
 
 
-def pending_chunks(pending: np.ndarray, chunk: int) -> list[np.ndarray]:
-    """The fixed design-order chunks [c*chunk, (c+1)*chunk) that still hold pending samples."""
-    if pending.size == 0:
-        return []
-    ids = pending // chunk
-    return [np.arange(c * chunk, c * chunk + chunk) for c in np.unique(ids)]
+def pending_chunks(pending: np.ndarray, chunk: int, total: int) -> list[np.ndarray]:
+    """The fixed design-order chunks [c*chunk, (c+1)*chunk) ∩ [0, total) that hold pending samples."""
+    return [np.arange(c * chunk, min((c + 1) * chunk, total)) for c in np.unique(pending // chunk)]
 
 
 def run_campaign(campaign: Campaign, out: Path | None = None, workers: int | None = None,
                  executor: str | None = None, scheduler: str | None = None, force: bool = False,
-                 progress: "Progress | None" = None) -> RunSummary:
-    """Run every pending sample of the campaign into its results file; returns a summary."""
+                 progress: bool = False) -> RunSummary:
+    """Run every pending sample of the campaign into its results file; returns a summary.
+    `progress` shows a progress bar (a terminal) or log lines (otherwise) on stderr."""
     execution = campaign.execution
     workers = workers or execution["workers"]
     executor = executor or execution["executor"]
@@ -109,12 +107,12 @@ def run_campaign(campaign: Campaign, out: Path | None = None, workers: int | Non
     try:
         total = len(design.xi)
         pending = store.pending()
-        chunks = [c[c < total] for c in pending_chunks(pending, chunk)]
+        chunks = pending_chunks(pending, chunk, total)
         kappa = store.kappa
         spec = worker_spec(campaign)
         n_times, outputs = store.time.size, store.output_names
         summary = RunSummary(out, total, 0, total - pending.size, 0.0)
-        progress = progress or Progress(pending.size, quiet=True)
+        bar = Progress(pending.size, quiet=not progress)
         # A chunk with some samples already stored (impossible with this writer, but a file
         # written elsewhere may have one) is rerun whole; only its pending rows are written.
         tasks = [(spec, c, kappa[c], n_times, outputs) for c in chunks]
@@ -127,8 +125,8 @@ def run_campaign(campaign: Campaign, out: Path | None = None, workers: int | Non
                                   {k: v[keep] for k, v in values.items()})
                 summary.ran += int(keep.sum())
                 summary.failures.update(r for r, s in zip(np.asarray(reasons)[keep], status[keep]) if s != 0)
-                progress.advance(int(keep.sum()))
-        progress.close()
+                bar.advance(int(keep.sum()))
+        bar.close()
         complete = store.pending().size == 0
     finally:
         store.close()
