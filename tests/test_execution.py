@@ -139,3 +139,11 @@ def test_tsvd_storage_and_property_outputs(tmp_path):
         for name in raw.output_names:
             exact = raw.output_matrix(name)
             np.testing.assert_allclose(compressed.output_matrix(name), exact, rtol=0, atol=1e-9 * np.abs(exact).max())
+
+
+def test_an_unreadable_results_file_is_refused_unless_forced(tmp_path):
+    broken = tmp_path / "r.h5"
+    broken.write_bytes(b"not an HDF5 file")
+    with pytest.raises(FileExistsError, match="not a readable results file"):
+        run_campaign(jsbsim_campaign(samples=2), out=broken)
+    assert run_campaign(jsbsim_campaign(samples=2), out=broken, force=True).ran == 2

@@ -365,8 +365,14 @@ def open_for_campaign(path, *, campaign_text: str, force: bool = False, **create
     """
     path = Path(path)
     if path.exists():
-        with h5py.File(path, "r") as f:
-            stored = f.attrs.get("campaign_hash")
+        try:
+            with h5py.File(path, "r") as f:
+                stored = f.attrs.get("campaign_hash")
+        except OSError as exc:  # e.g. killed while the file was being created: nothing to resume
+            if not force:
+                raise FileExistsError(f"{path} is not a readable results file ({exc}); choose another "
+                                      "results file, or force to overwrite it") from exc
+            stored = None
         if stored == text_hash(campaign_text):
             return ResultStore.open(path, "a")
         if not force:
