@@ -37,9 +37,11 @@ def jsbsim_campaign(samples=12, duration=5):
 
 
 def read_all(path):
+    """Every dataset of a results file (design, status, raw outputs or tSVD factors)."""
+    data = {}
     with h5py.File(path, "r") as f:
-        return {k: f[k][()] for k in ["samples/xi", "samples/kappa", "samples/status", "time"]} | {
-            f"outputs/{k}": f["outputs"][k][()] for k in f["outputs"]}
+        f.visititems(lambda name, obj: data.update({name: obj[()]}) if isinstance(obj, h5py.Dataset) else None)
+    return data
 
 
 def assert_same_results(a, b):
@@ -104,8 +106,11 @@ def test_a_file_of_another_campaign_is_refused_unless_forced(tmp_path):
     assert run_campaign(other, out=tmp_path / "r.h5", force=True).ran == 3
 
 
-def test_resume_after_sigkill_equals_an_uninterrupted_run(tmp_path):
+@pytest.mark.parametrize("storage", ["raw", "tsvd"])
+def test_resume_after_sigkill_equals_an_uninterrupted_run(tmp_path, storage):
     text = JSBSIM_CAMPAIGN.format(samples=160, duration=20)
+    if storage == "tsvd":
+        text += "storage: {raw: false, tsvd: {tol: 1.0e-10, batch: 32}}\n"
     (tmp_path / "c.yaml").write_text(text)
     killed = tmp_path / "killed.h5"
     proc = subprocess.Popen([UQFLIGHT, "run", str(tmp_path / "c.yaml"), "--out", str(killed)],
