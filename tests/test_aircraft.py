@@ -116,3 +116,27 @@ def test_excitation_shapes():
     np.testing.assert_array_equal(Excitation("doublet", 1.0, 1.0, 1.0).values(t), [0, 0, 1, 1, -1, -1, 0, 0])
     with pytest.raises(ValueError, match="excitation.kind"):
         Excitation("ramp")
+
+
+def lateral_response(flight, control: str, seconds: float = 90.0):
+    """phi and beta [deg] once per second after a 1-s pulse of 0.2 on `control` from the trim."""
+    flight.trim({})
+    fdm, steps_per_s = flight.fdm, int(flight.setup.rate_hz)
+    phi, beta = [], []
+    for i in range(int(seconds * steps_per_s)):
+        fdm[control] = 0.2 if steps_per_s <= i < 2 * steps_per_s else 0.0
+        fdm.run()
+        if (i + 1) % steps_per_s == 0:
+            phi.append(fdm["attitude/phi-deg"])
+            beta.append(fdm["aero/beta-deg"])
+    fdm[control] = 0.0
+    return np.array(phi), np.array(beta)
+
+
+def test_lateral_directional_modes_are_stable(flight):
+    # Spiral: the bank left by an aileron pulse decays (slowly) instead of growing.
+    phi, _ = lateral_response(flight, "fcs/aileron-cmd-norm")
+    assert 2.0 < abs(phi[9]) and abs(phi[-1]) < 0.9 * abs(phi[9])
+    # Dutch roll: the sideslip of a rudder pulse is damped within half a minute.
+    _, beta = lateral_response(flight, "fcs/rudder-cmd-norm")
+    assert np.abs(beta).max() > 1.0 and np.abs(beta[29:]).max() < 0.1 * np.abs(beta).max()

@@ -1,7 +1,7 @@
 """CI regression check: a small campaign on the real aircraft against the committed baseline.
 
 If a deliberate change moves the statistics, regenerate the baseline and commit it with the change:
-    uqflight run campaigns/ci-small.yaml --force
+    uqflight run campaigns/ci-small.yaml --force   # starts over when the aircraft files changed
     uqflight report results/ci-small.h5 --out /tmp/ci --write-baseline tests/baselines/ci-small.json
 """
 import subprocess

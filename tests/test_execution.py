@@ -152,3 +152,12 @@ def test_an_unreadable_results_file_is_refused_unless_forced(tmp_path):
     with pytest.raises(FileExistsError, match="not a readable results file"):
         run_campaign(jsbsim_campaign(samples=2), out=broken)
     assert run_campaign(jsbsim_campaign(samples=2), out=broken, force=True).ran == 2
+
+
+def test_resuming_with_changed_aircraft_files_is_refused_unless_forced(tmp_path):
+    run_campaign(jsbsim_campaign(samples=2), out=tmp_path / "r.h5")
+    with h5py.File(tmp_path / "r.h5", "a") as f:
+        f.attrs["aircraft_hash"] = "0" * 64  # as if the file had been made with another aircraft
+    with pytest.raises(FileExistsError, match="other aircraft files"):
+        run_campaign(jsbsim_campaign(samples=2), out=tmp_path / "r.h5")
+    assert run_campaign(jsbsim_campaign(samples=2), out=tmp_path / "r.h5", force=True).ran == 2

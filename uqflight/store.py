@@ -360,22 +360,27 @@ class ResultStore:
 def open_for_campaign(path, *, campaign_text: str, force: bool = False, **create_args) -> ResultStore:
     """Resume `path` when it holds this campaign, else create it (see ResultStore.create).
 
-    A file holding another campaign (a different campaign_hash) is refused unless `force`, which
-    deletes and recreates it.
+    A file holding another campaign (a different campaign_hash), or made with other aircraft files
+    (attrs["aircraft_hash"]), is refused unless `force`, which deletes and recreates it.
     """
     path = Path(path)
+    aircraft = (create_args.get("attrs") or {}).get("aircraft_hash")
     if path.exists():
         try:
             with h5py.File(path, "r") as f:
-                stored = f.attrs.get("campaign_hash")
+                stored, stored_aircraft = f.attrs.get("campaign_hash"), f.attrs.get("aircraft_hash")
         except OSError as exc:  # e.g. killed while the file was being created: nothing to resume
             if not force:
                 raise FileExistsError(f"{path} is not a readable results file ({exc}); choose another "
                                       "results file, or force to overwrite it") from exc
-            stored = None
-        if stored == text_hash(campaign_text):
+            stored = stored_aircraft = None
+        if stored == text_hash(campaign_text) and stored_aircraft == aircraft:
             return ResultStore.open(path, "a")
         if not force:
+            if stored == text_hash(campaign_text):
+                raise FileExistsError(f"{path} was made with other aircraft files (sha256 {stored_aircraft}); "
+                                      "resuming would mix two models: choose another results file, or force "
+                                      "to start over")
             raise FileExistsError(f"{path} holds the results of another campaign (campaign_hash {stored}); "
                                   "choose another results file, or force to overwrite it")
         path.unlink()
