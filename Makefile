@@ -16,7 +16,7 @@ $(STAMP): $(BIN)/python pyproject.toml
 DEMO := paper-pg2-l2
 
 demo: $(STAMP)
-	$(BIN)/uqflight run campaigns/$(DEMO).yaml
+	$(BIN)/uqflight run campaigns/$(DEMO).yaml --force
 	$(BIN)/uqflight report results/$(DEMO).h5 --out results/$(DEMO)-report
 	@echo "report: $(CURDIR)/results/$(DEMO)-report/report.html"
 
