@@ -38,7 +38,7 @@ EXECUTION_KEYS = ("workers", "executor", "scheduler", "chunk")
 STORAGE_KEYS = ("path", "raw", "tsvd")
 TSVD_KEYS = ("tol", "batch")
 SAMPLED_DESIGNS = ("monte_carlo", "sobol", "halton", "latin_hypercube", "pick_freeze")
-ANALYSIS_KEYS = ("band_samples", "pdf_times_s", "bootstrap")
+ANALYSIS_KEYS = ("band_samples", "bootstrap")
 
 
 class CampaignError(ValueError):
@@ -470,8 +470,4 @@ def _analysis(check: _Checker, value) -> dict:
     analysis = dict(check.mapping(value, "analysis", ANALYSIS_KEYS))
     analysis["band_samples"] = check.integer(analysis.get("band_samples", 20000), "analysis.band_samples", 100)
     analysis["bootstrap"] = check.integer(analysis.get("bootstrap", 200), "analysis.bootstrap", 0)
-    times = analysis.get("pdf_times_s", [])
-    if not isinstance(times, list):
-        check.fail("analysis.pdf_times_s", f"expected a list of times in seconds, got {_shown(times)}")
-    analysis["pdf_times_s"] = [check.number(t, f"analysis.pdf_times_s[{i}]", 0.0) for i, t in enumerate(times)]
     return analysis

@@ -36,7 +36,6 @@ class Options:
 
     band_samples: int = 20000
     bootstrap: int = 200
-    pdf_times_s: list[float] = field(default_factory=list)
     seed: int = 0
 
 
@@ -92,7 +91,7 @@ def analyse(path, reference: str | None = None, options: Options | None = None,
     with ResultStore.open(path) as store:
         stored_method, germs, analysis = campaign_facts(store)
         method = {**stored_method, **(method or {})}
-        options = options or Options(**{k: analysis[k] for k in ("band_samples", "bootstrap", "pdf_times_s")
+        options = options or Options(**{k: analysis[k] for k in ("band_samples", "bootstrap")
                                         if k in analysis})
         status = store.status
         ok = status == Status.OK
