@@ -24,7 +24,7 @@ import yaml
 from .designs import Design, build_design
 from .methods import METHOD_KINDS
 from .parameters import DISTRIBUTIONS, Parameter, make_parameter
-from .simulators.jsbsim import NAMED_OUTPUTS, JSBSimFlight, flight_setup_from
+from .simulators.jsbsim import NAMED_OUTPUTS, Excitation, JSBSimFlight, flight_setup_from
 
 SIMULATOR_KINDS = ("jsbsim", "python")
 EXECUTORS = ("local", "dask")
@@ -65,10 +65,6 @@ class Campaign:
     execution: dict
     storage: dict
     analysis: dict = field(default_factory=dict)
-
-    @property
-    def text_hash(self) -> str:
-        return hashlib.sha256(self.text.encode()).hexdigest()
 
     @property
     def germs(self) -> list[str]:
@@ -322,7 +318,7 @@ def _simulator(check: _Checker, value, source: str) -> dict:
     excitation = check.mapping(sim.get("excitation", {}), "simulator.excitation",
                                ("kind", "amplitude_deg", "start_s", "duration_s"))
     if "kind" in excitation:
-        check.string(excitation["kind"], "simulator.excitation.kind", ("pulse", "step", "doublet", "none"))
+        check.string(excitation["kind"], "simulator.excitation.kind", Excitation.KINDS)
     if "amplitude_deg" in excitation:
         check.number(excitation["amplitude_deg"], "simulator.excitation.amplitude_deg")
     for key in ("start_s", "duration_s"):

@@ -24,6 +24,7 @@ from .analysis.sobol import pick_freeze_indices
 from .methods import PCE, SPLIT_FORM_KINDS, fit
 from .methods.basis import draw_germs, orthonormal_basis
 from .store import ResultStore, Status
+from .tsvd import weighted_variance as tsvd_weighted_variance
 
 SAMPLED_KINDS = ("monte_carlo", "sobol", "halton", "latin_hypercube", "pick_freeze")
 PDF_POINTS = 120
@@ -201,14 +202,11 @@ def _over_time_blocks(rows, scale, n_times: int, weights, pick_freeze_dimensions
 
 
 def _weighted_variance(basis, scale, weights, mean) -> np.ndarray:
-    """Σ w_j (Y_j − mean)² with Y = basis @ scale, from the centred coefficients when Y is
-    given by tSVD factors (Y_j − mean = (b_j − g) @ scale with g = w @ basis): no cancellation
-    for outputs with a large mean and a small spread, such as the altitude."""
+    """Σ w_j (Y_j − mean)² with Y = basis @ scale; for tSVD factors (basis = V rows, scale =
+    diag(s) Uᵀ) from the centred coefficients of uqflight.tsvd, without forming Y."""
     if scale is None:
         return weights @ (basis - mean) ** 2
-    centred = basis - weights @ basis
-    moment = centred.T @ (weights[:, None] * centred)
-    return np.einsum("rt,rs,st->t", scale, moment, scale)
+    return tsvd_weighted_variance(scale.T, np.ones(len(scale)), basis, weights)
 
 
 def add_reference_errors(stats: Statistics, reference: Statistics) -> None:
