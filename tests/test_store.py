@@ -201,25 +201,32 @@ def test_a_partial_compressed_file_reads_its_buffered_runs(tmp_path):
         np.testing.assert_allclose((V * s) @ U.T, outputs["alpha_deg"][ok], rtol=1e-9)
 
 
-def kill_writer_midway(path, batches_before_kill, delay):
-    """Run this file as the writer of `path`; SIGKILL it `delay` seconds after it reports that many batches
-    (a batch takes a few milliseconds: the delay moves the kill across the steps of the next one)."""
+def kill_writer_midway(path, batches_before_kill, delay) -> bool:
+    """Run this file as the writer of `path`; SIGKILL it `delay` seconds after it has written that many
+    batches (a batch takes a few milliseconds: the delay moves the kill across the steps of the next one).
+    The writer waits for the go after those batches, so a slow reader cannot let it run ahead; False
+    when it still finished before the kill (an overloaded machine oversleeping the delay)."""
     env = dict(os.environ, PYTHONPATH=os.pathsep.join(sys.path))
-    child = subprocess.Popen([sys.executable, __file__, str(path), "8"], stdout=subprocess.PIPE, text=True, env=env)
-    for line in child.stdout:
-        if int(line) + 1 >= batches_before_kill:
-            break
+    child = subprocess.Popen([sys.executable, __file__, str(path), "8", str(batches_before_kill)],
+                             stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True, env=env)
+    assert child.stdout.readline().strip() == "paused"
+    child.stdin.write("go\n")
+    child.stdin.flush()
     time.sleep(delay)
     os.kill(child.pid, signal.SIGKILL)
     child.wait()
-    assert child.returncode == -signal.SIGKILL, "the writer finished before the kill"
+    return child.returncode == -signal.SIGKILL
 
 
 @pytest.mark.parametrize("batches_before_kill, delay", [(2, 0.0), (9, 0.003), (20, 0.006)])
 def test_resume_after_sigkill_equals_an_uninterrupted_file(tmp_path, reference, batches_before_kill, delay):
-    path = tmp_path / "killed.h5"
-    ResultStore.create(path, campaign_text=CAMPAIGN, **create_args()).close()
-    kill_writer_midway(path, batches_before_kill, delay)
+    for attempt in range(5):
+        path = tmp_path / f"killed-{attempt}.h5"
+        ResultStore.create(path, campaign_text=CAMPAIGN, **create_args()).close()
+        if kill_writer_midway(path, batches_before_kill, delay):
+            break
+    else:
+        pytest.fail("the writer finished before the kill in 5 attempts")
     with ResultStore.open(path, "a") as store:
         pending, status = store.pending(), store.status
         assert 0 < pending.size < N
@@ -291,8 +298,10 @@ def test_open_for_campaign_resumes_only_the_same_campaign(tmp_path):
 
 
 if __name__ == "__main__":
-    target, seed = sys.argv[1], int(sys.argv[2])
+    target, seed, pause_after = sys.argv[1], int(sys.argv[2]), int(sys.argv[3])
     with ResultStore.open(target, "a") as writer:
         for k, batch in enumerate(shuffled_batches(seed)):
+            if k == pause_after:
+                print("paused", flush=True)
+                sys.stdin.readline()
             write_runs(writer, [batch])
-            print(k, flush=True)
