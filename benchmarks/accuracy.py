@@ -22,7 +22,8 @@ from pathlib import Path
 import numpy as np
 
 from uqflight.analysis.errors import relative_errors
-from uqflight.campaign import jsbsim_probe, load_campaign
+from uqflight.campaign import load_campaign
+from uqflight.simulators.jsbsim_probe import jsbsim_probe
 from uqflight.execution import run_campaign
 from uqflight.statistics import Options, analyse
 from uqflight.store import ResultStore, Status

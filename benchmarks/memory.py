@@ -43,7 +43,8 @@ storage: {{raw: false, tsvd: {{tol: 1.0e-8, batch: 1000}}}}
 """
 MEASURE = textwrap.dedent("""
     import resource, sys, time
-    from uqflight.campaign import jsbsim_probe, load_campaign
+    from uqflight.campaign import load_campaign
+from uqflight.simulators.jsbsim_probe import jsbsim_probe
     from uqflight.execution import run_campaign
     t0 = time.perf_counter()
     summary = run_campaign(load_campaign(sys.argv[1], jsbsim_probe), out=sys.argv[2])

@@ -20,7 +20,8 @@ from pathlib import Path
 import jsbsim
 import numpy as np
 
-from uqflight.campaign import jsbsim_probe, parse_campaign
+from uqflight.campaign import parse_campaign
+from uqflight.simulators.jsbsim_probe import jsbsim_probe
 from uqflight.execution import run_campaign
 from uqflight.paper import table1_parameters_yaml
 from uqflight.parameters import to_physical

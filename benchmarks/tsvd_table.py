@@ -19,11 +19,13 @@ from pathlib import Path
 
 import numpy as np
 
-from uqflight.campaign import jsbsim_probe, parse_campaign
+from uqflight.campaign import parse_campaign
+from uqflight.simulators.jsbsim_probe import jsbsim_probe
 from uqflight.execution import run_campaign
 from uqflight.paper import table1_parameters_yaml
 from uqflight.store import ResultStore, Status
-from uqflight.tsvd import IncrementalSVD, weighted_mean, weighted_variance
+from uqflight.analysis.moments import weighted_moments
+from uqflight.tsvd import IncrementalSVD
 
 CAMPAIGN = """
 name: tsvd-alpha-{samples}
@@ -76,8 +78,7 @@ def main():
             t0 = time.perf_counter()
             svd.update(A[:, start:start + args.batch])
             times.append(time.perf_counter() - t0)
-        m = weighted_mean(svd.U, svd.s, svd.V, w)
-        v = weighted_variance(svd.U, svd.s, svd.V, w)
+        m, v = weighted_moments(svd.V, w, svd.s[:, None] * svd.U.T)
         err_m = np.max(np.abs(m - mean)) / np.max(np.abs(mean))
         err_v = np.max(np.abs(v - var)) / np.max(np.abs(var))
         memory = svd.U.nbytes + svd.s.nbytes + svd.V.nbytes

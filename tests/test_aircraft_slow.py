@@ -5,7 +5,8 @@ import numpy as np
 import pytest
 
 from uqflight.paper import TABLE1
-from uqflight.simulators.jsbsim import FlightError, JSBSimFlight
+from uqflight.simulators.base import FlightError
+from uqflight.simulators.jsbsim import JSBSimFlight
 
 pytestmark = pytest.mark.slow
 

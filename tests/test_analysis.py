@@ -16,7 +16,7 @@ from uqflight.analysis import (
     weighted_variance,
 )
 from uqflight.methods import fit
-from uqflight.methods.basis import draw_germs
+from uqflight.parameters.germs import draw_germs
 
 Z_995 = 2.5758293035489
 

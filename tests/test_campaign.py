@@ -6,7 +6,8 @@ from pathlib import Path
 
 import pytest
 
-from uqflight.campaign import CampaignError, jsbsim_probe, load_campaign, parse_campaign
+from uqflight.campaign import CampaignError, load_campaign, parse_campaign
+from uqflight.simulators.jsbsim_probe import jsbsim_probe
 
 ROOT = Path(__file__).resolve().parents[1]
 DATA = Path(__file__).parent / "data" / "campaigns"

@@ -8,7 +8,8 @@ import subprocess
 import sys
 from pathlib import Path
 
-from uqflight.campaign import jsbsim_probe, load_campaign
+from uqflight.campaign import load_campaign
+from uqflight.simulators.jsbsim_probe import jsbsim_probe
 from uqflight.execution import run_campaign
 
 ROOT = Path(__file__).resolve().parents[1]

@@ -163,7 +163,7 @@ def test_tensor_grids_are_exact_to_their_degree(rule, germ, points):
     ],
 )
 def test_one_dimensional_degrees(rule, sizes):
-    germ = rules.RULE_GERMS[rule]
+    germ = rules.RULE_TABLE[rule].germ
     for size in sizes:
         nodes, weights = rules.nodes_weights(rule, size)
         degree = rules.degree(rule, size)

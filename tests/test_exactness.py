@@ -1,9 +1,9 @@
-"""uqflight.designs.exactness: polynomial exactness and design-matrix rank measured on the points."""
+"""uqflight.methods.exactness: polynomial exactness and design-matrix rank measured on the points."""
 import numpy as np
 import pytest
 
 from uqflight.designs import build_design
-from uqflight.designs.exactness import (
+from uqflight.methods.exactness import (
     design_matrix_rank,
     exact_total_degree,
     max_projection_order,

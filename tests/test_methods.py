@@ -7,8 +7,9 @@ import pytest
 from numpy.polynomial.hermite_e import hermegauss
 from numpy.polynomial.legendre import leggauss
 
-from uqflight.methods import METHOD_KINDS, fit, orthonormal_basis, total_degree_indices
-from uqflight.methods.basis import draw_germs
+from uqflight.methods import METHOD_KINDS, fit
+from uqflight.methods.basis import orthonormal_basis, total_degree_indices
+from uqflight.parameters.germs import draw_germs
 from uqflight.methods.galerkin import pseudo_galerkin
 from uqflight.methods.pce import PCE
 
@@ -125,9 +126,12 @@ def test_moment_kinds_and_unknown_kind():
     mc = fit("monte_carlo", None, w, Y, ["normal"])
     np.testing.assert_allclose(mc.mean, Y.mean(axis=0), atol=1e-14)
     np.testing.assert_allclose(mc.variance, Y.var(axis=0, ddof=1), atol=1e-14)
-    integration = fit("integration", None, w, Y, ["normal"])
+    xi = draw_germs(["normal"], 50, seed=6)
+    integration = fit("integration", xi, w, Y, ["normal"])
     np.testing.assert_allclose(integration.mean, w @ Y / w.sum(), atol=1e-14)
-    assert mc.pce is None and integration.pce is None
+    assert mc.pce is None
+    # the PCE that serves bands and Sobol' indices is the projection
+    np.testing.assert_allclose(integration.pce.coefficients, fit("pseudo_galerkin", xi, w, Y, ["normal"]).pce.coefficients)
     with pytest.raises(ValueError, match=", ".join(METHOD_KINDS)):
         fit("kriging", None, w, Y, ["normal"])
 

@@ -134,7 +134,7 @@ def test_vectorised_maps_over_the_table_1_campaign():
 
 def test_germs_follow_distributions():
     params = [example(d, 0.5, 8.0) for d in DISTRIBUTIONS]
-    assert parameters.germs(params) == ["normal", "uniform", "normal", "normal"]
+    assert parameters.germs_of(params) == ["normal", "uniform", "normal", "normal"]
 
 
 def test_absolute_bounds_form():

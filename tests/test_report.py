@@ -10,7 +10,8 @@ import h5py
 import numpy as np
 import pytest
 
-from uqflight.campaign import jsbsim_probe, parse_campaign
+from uqflight.campaign import parse_campaign
+from uqflight.simulators.jsbsim_probe import jsbsim_probe
 from uqflight.execution import run_campaign
 from uqflight.report import write_report
 from uqflight.statistics import analyse

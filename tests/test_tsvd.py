@@ -2,8 +2,18 @@
 import numpy as np
 import pytest
 
-from uqflight.tsvd import (IncrementalSVD, iter_column_blocks, orthogonality_loss, weighted_mean,
-                           weighted_variance)
+from uqflight.analysis.moments import weighted_moments
+from uqflight.tsvd import IncrementalSVD, iter_column_blocks, orthogonality_loss
+
+
+def weighted_mean(U, s, V, w):
+    """The weighted mean of A = U diag(s) Vᵀ's columns, from the factors."""
+    return weighted_moments(V, w, s[:, None] * U.T)[0]
+
+
+def weighted_variance(U, s, V, w):
+    """The weighted variance of A's columns, from the factors."""
+    return weighted_moments(V, w, s[:, None] * U.T)[1]
 
 
 def low_rank_data(n_times=120, n_samples=1000, rank=6, smallest=1e-5, noise=1e-9, seed=0):

@@ -11,7 +11,8 @@ import numpy as np
 import typer
 
 from .methods import METHOD_KINDS
-from .simulators.jsbsim import DEFAULT_OUTPUTS, Excitation, FlightError, FlightSetup, JSBSimFlight
+from .simulators.base import FlightError
+from .simulators.jsbsim import DEFAULT_OUTPUTS, Excitation, FlightSetup, JSBSimFlight
 
 app = typer.Typer(help="Uncertainty quantification campaigns on a JSBSim flight-dynamics model.",
                   no_args_is_help=True, add_completion=False)
@@ -89,7 +90,8 @@ def simulate(
 
 def _load(path: Path):
     """The validated campaign, or exit 2 with the validation message (no traceback)."""
-    from .campaign import CampaignError, jsbsim_probe, load_campaign
+    from .campaign import CampaignError, load_campaign
+    from .simulators.jsbsim_probe import jsbsim_probe
 
     try:
         return load_campaign(path, probe=jsbsim_probe)

@@ -19,14 +19,14 @@ import numpy as np
 from .analysis.density import pdf_over_time
 from .analysis.divergence import kl_divergence
 from .analysis.errors import error_summary, relative_errors
-from .analysis.moments import modified_cov, quantile_band
+from .analysis.moments import modified_cov, quantile_band, weighted_moments
 from .analysis.sobol import pick_freeze_indices
-from .methods import PCE, SPLIT_FORM_KINDS, fit
-from .methods.basis import draw_germs, orthonormal_basis
+from .designs import is_sampled
+from .methods import PCE, method_entry
+from .methods.basis import orthonormal_basis
+from .parameters.germs import draw_germs
 from .store import ResultStore, Status
-from .tsvd import weighted_variance as tsvd_weighted_variance
 
-SAMPLED_KINDS = ("monte_carlo", "sobol", "halton", "latin_hypercube", "pick_freeze")
 PDF_POINTS = 120
 TIME_BLOCK = 100  # recorded times whose runs or surrogate draws are rebuilt at once
 
@@ -109,9 +109,6 @@ def analyse(path, reference: str | None = None, options: Options | None = None,
     return stats
 
 
-MOMENTS_FROM_WEIGHTS = ("monte_carlo", "integration", "interpolation")
-
-
 def output_basis(store: ResultStore, name: str, ok: np.ndarray) -> tuple[np.ndarray, np.ndarray | None]:
     """The ok runs of `name` as basis @ scale: raw (Y, None), or tSVD (V rows, diag(s) Uᵀ)."""
     factors = store.output_factors(name)
@@ -127,13 +124,13 @@ def _output_statistics(store: ResultStore, name: str, method: dict, germs: list[
                        ok: np.ndarray, options: Options) -> OutputStatistics:
     xi, weights = store.xi[ok], store.weights[ok]
     kind, order = method["kind"], method["order"]
+    entry = method_entry(kind)
     basis, scale = output_basis(store, name, ok)
-    sampled = kind in ("monte_carlo", "integration") and design_kind in SAMPLED_KINDS
-    pce_kind = "pseudo_galerkin" if kind in ("monte_carlo", "integration") else kind
+    from_runs = entry.runs_on_sampled and is_sampled(design_kind)
     x0 = None
     # x = x0 + S with each run's initial value (needs the runs themselves); only the projections use
     # it: the other kinds fit the constant term themselves, where the split would change nothing
-    if method.get("split") and not sampled and pce_kind in SPLIT_FORM_KINDS:
+    if method.get("split") and not from_runs and entry.split:
         basis = basis if scale is None else basis @ scale
         scale, x0 = None, basis[:, :1]
 
@@ -141,19 +138,16 @@ def _output_statistics(store: ResultStore, name: str, method: dict, germs: list[
         return a if scale is None else a @ scale
 
     pce = None
-    if sampled:  # sample moments; bands, PDFs and pick-freeze indices from the runs themselves
-        n = len(basis)
-        w = np.full(n, 1.0 / n) if kind == "monte_carlo" else weights / weights.sum()
-        mean = expand(w @ basis)
-        variance = _weighted_variance(basis, scale, w, mean) * (n / (n - 1) if kind == "monte_carlo" else 1.0)
-        rows, row_scale, band_weights = basis, scale, (None if kind == "monte_carlo" else w)
+    if from_runs:  # sample moments; bands, PDFs and pick-freeze indices from the runs themselves
+        sample = entry.moments == "sample"
+        mean, variance = weighted_moments(basis, None if sample else weights, scale, unbiased=sample)
+        rows, row_scale, band_weights = basis, scale, (None if sample else weights / weights.sum())
     else:
-        if kind in MOMENTS_FROM_WEIGHTS:  # quadrature moments; the PCE serves bands, PDFs, Sobol'
-            mean = expand(weights @ basis)
-            variance = _weighted_variance(basis, scale, weights, mean)
-        fitted = fit(pce_kind, xi, weights, basis, germs, order, x0=x0)
-        pce = PCE(fitted.pce.germs, fitted.pce.indices, expand(fitted.pce.coefficients))
-        if kind not in MOMENTS_FROM_WEIGHTS:
+        fitted = entry.pce(xi, weights, basis, germs, order, x0)
+        pce = PCE(fitted.germs, fitted.indices, expand(fitted.coefficients))
+        if entry.moments == "weights":  # quadrature moments; the PCE serves bands, PDFs, Sobol'
+            mean, variance = weighted_moments(basis, weights, scale)
+        else:
             mean, variance = pce.mean(), pce.variance()
         draws = draw_germs(germs, options.band_samples, options.seed)
         rows, row_scale, band_weights = orthonormal_basis(germs, pce.indices, draws), pce.coefficients, None
@@ -199,14 +193,6 @@ def _over_time_blocks(rows, scale, n_times: int, weights, pick_freeze_dimensions
         joined.update(first=np.concatenate(parts["first"], axis=-1), total=np.concatenate(parts["total"], axis=-1),
                       first_ci=np.concatenate(parts["first_ci"], axis=-1))
     return joined
-
-
-def _weighted_variance(basis, scale, weights, mean) -> np.ndarray:
-    """Σ w_j (Y_j − mean)² with Y = basis @ scale; for tSVD factors (basis = V rows, scale =
-    diag(s) Uᵀ) from the centred coefficients of uqflight.tsvd, without forming Y."""
-    if scale is None:
-        return weights @ (basis - mean) ** 2
-    return tsvd_weighted_variance(scale.T, np.ones(len(scale)), basis, weights)
 
 
 def add_reference_errors(stats: Statistics, reference: Statistics) -> None:

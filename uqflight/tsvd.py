@@ -2,8 +2,9 @@
 
 The paper (section 4.1.1, Table 2) compresses the time histories of a campaign on the fly: a thin SVD
 of the first group of samples, then an update with each new group (Brand, "Fast low-rank modifications
-of the thin singular value decomposition", 2006). Means and variances come straight from the factors;
-samples are rebuilt block by block only where a quantile or a PDF needs them.
+of the thin singular value decomposition", 2006). Means and variances come straight from the factors
+(`uqflight.analysis.moments.weighted_moments`); samples are rebuilt block by block only where a
+quantile or a PDF needs them.
 """
 from __future__ import annotations
 
@@ -88,25 +89,6 @@ class IncrementalSVD:
 def orthogonality_loss(Q: np.ndarray) -> float:
     """‖QᵀQ − I‖_F: how far the columns of Q are from orthonormal."""
     return float(np.linalg.norm(Q.T @ Q - np.eye(Q.shape[1])))
-
-
-def weighted_mean(U, s, V, w) -> np.ndarray:
-    """Σ_j w_j A_:j = U diag(s) Vᵀ w, shape (T,)."""
-    return U @ (s * (V.T @ w))
-
-
-def weighted_variance(U, s, V, w) -> np.ndarray:
-    """Σ_j w_j (A_tj − m_t)² with m the weighted mean, shape (T,).
-
-    Column j of A is U c_j with c_j = diag(s) V_j:. Centring the coefficients before squaring,
-    M = Σ_j w_j (c_j − c̄)(c_j − c̄)ᵀ = diag(s) (V − 1gᵀ)ᵀ diag(w) (V − 1gᵀ) diag(s) with g = Vᵀw,
-    avoids the cancellation of E[A²] − m² on outputs with a large mean and a small spread;
-    the variance is then the diagonal of U M Uᵀ.
-    """
-    coefficients = V * s
-    centred = coefficients - w @ coefficients
-    M = centred.T @ (w[:, None] * centred)
-    return ((U @ M) * U).sum(axis=1)
 
 
 def iter_column_blocks(U, s, V, block: int = 1000) -> Iterator[np.ndarray]:

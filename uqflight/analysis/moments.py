@@ -25,6 +25,36 @@ def probability_weights(weights, n: int) -> np.ndarray:
     return weights / total
 
 
+def weighted_moments(basis, weights=None, scale=None, unbiased: bool = False) -> tuple[np.ndarray, np.ndarray]:
+    """Mean Σ_j w_j Y_j and variance Σ_j w_j (Y_j − mean)² (Eq. 15–17), each (T,), of Y = basis @ scale
+    (scale None: Y = basis, (N, T)); the one place where weighted moments are summed.
+
+    Weights are rescaled to sum 1 (None: 1/N). With tSVD factors (basis = V rows (N, r), scale =
+    diag(s) Uᵀ (r, T)) Y is never formed: run j is Uc_j with c_j = diag(s) V_j, and centring the
+    coefficients before squaring, M = Σ_j w_j (c_j − c̄)(c_j − c̄)ᵀ, avoids the cancellation of
+    E[Y²] − mean² on outputs with a large mean and a small spread; the variance is diag(U M Uᵀ).
+    With ``unbiased`` the variance is divided by 1 − Σ w_j² (the reliability-weights correction,
+    N/(N − 1) for equal weights). Signed sparse-grid weights can make the variance negative.
+    """
+    basis = np.asarray(basis, dtype=float)
+    w = probability_weights(weights, len(basis))
+    centre = w @ basis
+    deviation = basis - centre
+    if scale is None:
+        mean = centre
+        variance = w @ np.square(deviation, out=deviation)
+    else:
+        mean = centre @ scale
+        spread = deviation.T @ (w[:, None] * deviation)
+        variance = ((scale.T @ spread) * scale.T).sum(axis=1)
+    if unbiased:
+        correction = 1.0 - w @ w
+        if correction <= 0:
+            raise ValueError("an unbiased variance needs at least two runs with positive weight")
+        variance = variance / correction
+    return mean, variance
+
+
 def weighted_mean(Y, weights=None) -> np.ndarray:
     """Σ_j w_j Y_j (Eq. 17 applied to Eq. 15): (T,)."""
     Y = np.asarray(Y, dtype=float)
@@ -32,21 +62,8 @@ def weighted_mean(Y, weights=None) -> np.ndarray:
 
 
 def weighted_variance(Y, weights=None, unbiased: bool = False) -> np.ndarray:
-    """Σ_j w_j (Y_j − mean)² (Eq. 16), (T,). Centred first to avoid cancellation.
-
-    With ``unbiased`` the result is divided by 1 − Σ w_j² (the reliability-weights correction,
-    N/(N − 1) for equal weights). Signed sparse-grid weights can make the variance negative.
-    """
-    Y = np.asarray(Y, dtype=float)
-    w = probability_weights(weights, len(Y))
-    deviation = Y - w @ Y
-    variance = w @ np.square(deviation, out=deviation)
-    if not unbiased:
-        return variance
-    correction = 1.0 - w @ w
-    if correction <= 0:
-        raise ValueError("an unbiased variance needs at least two runs with positive weight")
-    return variance / correction
+    """Σ_j w_j (Y_j − mean)² (Eq. 16), (T,); see weighted_moments."""
+    return weighted_moments(Y, weights, unbiased=unbiased)[1]
 
 
 def weighted_std(Y, weights=None, unbiased: bool = False) -> np.ndarray:

@@ -10,25 +10,44 @@ Kinds (keys in braces):
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import Callable
 
 import numpy as np
 
+from ..parameters.germs import check_germs
 from .montecarlo import halton_design, latin_hypercube_design, monte_carlo_design, sobol_design
 from .pickfreeze import pick_freeze_design
 from .smolyak import sparse_grid_design
-from .spec import check_germs, is_integer
+from .spec import is_integer
 from .tensor import tensor_grid_design
 
-_BUILDERS = {
-    "monte_carlo": monte_carlo_design,
-    "sobol": sobol_design,
-    "halton": halton_design,
-    "latin_hypercube": latin_hypercube_design,
-    "sparse_grid": sparse_grid_design,
-    "tensor_grid": tensor_grid_design,
-    "pick_freeze": pick_freeze_design,
+
+@dataclass(frozen=True)
+class DesignKind:
+    """A registered design: its builder (spec, germs, seed) -> (xi, weights, info), and whether its
+    points are random draws (`sampled`: moments are sample averages, valid on any subset of runs)
+    or a quadrature grid (its weights are valid only all together)."""
+
+    build: Callable
+    sampled: bool
+
+
+REGISTRY: dict[str, DesignKind] = {
+    "monte_carlo": DesignKind(monte_carlo_design, sampled=True),
+    "sobol": DesignKind(sobol_design, sampled=True),
+    "halton": DesignKind(halton_design, sampled=True),
+    "latin_hypercube": DesignKind(latin_hypercube_design, sampled=True),
+    "sparse_grid": DesignKind(sparse_grid_design, sampled=False),
+    "tensor_grid": DesignKind(tensor_grid_design, sampled=False),
+    "pick_freeze": DesignKind(pick_freeze_design, sampled=True),
 }
-DESIGN_KINDS = tuple(_BUILDERS)
+DESIGN_KINDS = tuple(REGISTRY)
+SAMPLED_DESIGNS = tuple(kind for kind, entry in REGISTRY.items() if entry.sampled)
+
+
+def is_sampled(kind: str) -> bool:
+    """Whether the design kind draws random points (see DesignKind)."""
+    return REGISTRY[kind].sampled
 
 
 @dataclass
@@ -46,11 +65,11 @@ def build_design(spec: dict, germs: list[str], seed: int) -> Design:
     if not isinstance(spec, dict):
         raise ValueError(f"design: expected a mapping with a kind key, got {spec!r}")
     kind = spec.get("kind")
-    if not isinstance(kind, str) or kind not in _BUILDERS:
+    if not isinstance(kind, str) or kind not in REGISTRY:
         raise ValueError(f"design.kind: expected one of {', '.join(DESIGN_KINDS)}, got {kind!r}")
     if not is_integer(seed) or seed < 0:
         raise ValueError(f"seed: expected an integer >= 0, got {seed!r}")
-    xi, weights, info = _BUILDERS[kind](spec, check_germs(germs), int(seed))
+    xi, weights, info = REGISTRY[kind].build(spec, check_germs(germs), int(seed))
     return Design(kind, xi, weights, info)
 
 

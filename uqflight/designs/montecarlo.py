@@ -6,18 +6,9 @@ uniform), so low-discrepancy structure carries over to ξ.
 from __future__ import annotations
 
 import numpy as np
-from scipy import special
-from scipy.stats import qmc
 
+from ..parameters.germs import draw_germs, germ_quantiles
 from .spec import check_keys, integer, optional_boolean
-
-_OPEN_UNIT = (2.0**-53, 1.0 - 2.0**-53)  # keeps Φ⁻¹ finite at u = 0
-
-
-def germ_quantiles(u: np.ndarray, germs: list[str]) -> np.ndarray:
-    """ξ (N, d) from uniforms u (N, d): column k through the inverse CDF of germ k."""
-    normal = np.array(germs) == "normal"
-    return np.where(normal, special.ndtri(np.clip(u, *_OPEN_UNIT)), 2.0 * u - 1.0)
 
 
 def equal_weights(n: int) -> np.ndarray:
@@ -30,6 +21,8 @@ def sobol_points(n: int, d: int, scramble: bool, seed: int) -> np.ndarray:
     Drawn as the next power of 2 and cut, so scipy does not warn about balance. The unscrambled
     sequence starts at the origin, which has no normal quantile, so it is skipped.
     """
+    from scipy.stats import qmc
+
     skip = 0 if scramble else 1
     engine = qmc.Sobol(d, scramble=scramble, rng=seed)
     return engine.random_base2((n + skip - 1).bit_length())[skip : n + skip]
@@ -39,8 +32,7 @@ def monte_carlo_design(spec: dict, germs: list[str], seed: int):
     """`monte_carlo` {samples}: independent draws from numpy's default_rng(seed)."""
     check_keys(spec, "monte_carlo", ("samples",))
     n = integer(spec, "samples", "monte_carlo", minimum=1)
-    xi = germ_quantiles(np.random.default_rng(seed).random((n, len(germs))), germs)
-    return xi, equal_weights(n), {"samples": n, "generator": "numpy default_rng", "seed": seed}
+    return draw_germs(germs, n, seed), equal_weights(n), {"samples": n, "generator": "numpy default_rng", "seed": seed}
 
 
 def sobol_design(spec: dict, germs: list[str], seed: int):
@@ -56,6 +48,8 @@ def halton_design(spec: dict, germs: list[str], seed: int):
     """`halton` {samples, scramble (default true)}: Halton points; unscrambled, the origin is skipped."""
     check_keys(spec, "halton", ("samples", "scramble"))
     n = integer(spec, "samples", "halton", minimum=1)
+    from scipy.stats import qmc
+
     scramble = optional_boolean(spec, "scramble", default=True)
     engine = qmc.Halton(len(germs), scramble=scramble, rng=seed)
     if not scramble:
@@ -67,6 +61,8 @@ def halton_design(spec: dict, germs: list[str], seed: int):
 def latin_hypercube_design(spec: dict, germs: list[str], seed: int):
     """`latin_hypercube` {samples}: one point in each of n equal-probability slices per dimension."""
     check_keys(spec, "latin_hypercube", ("samples",))
+    from scipy.stats import qmc
+
     n = integer(spec, "samples", "latin_hypercube", minimum=1)
     xi = germ_quantiles(qmc.LatinHypercube(len(germs), rng=seed).random(n), germs)
     return xi, equal_weights(n), {"samples": n, "seed": seed}

@@ -3,7 +3,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from .montecarlo import equal_weights, germ_quantiles, sobol_points
+from ..parameters.germs import germ_quantiles
+from .montecarlo import equal_weights, sobol_points
 from .spec import check_keys, integer
 
 

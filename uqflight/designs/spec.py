@@ -3,8 +3,6 @@ from __future__ import annotations
 
 from numbers import Integral
 
-GERMS = ("normal", "uniform")
-
 
 def check_keys(spec: dict, kind: str, accepted: tuple[str, ...]) -> None:
     """Reject keys that the kind does not know (typos would otherwise be silently ignored)."""
@@ -47,13 +45,3 @@ def optional_choice(spec: dict, key: str, choices: tuple[str, ...]) -> str | Non
     if value not in choices:
         raise ValueError(f"design.{key}: expected one of {', '.join(choices)}, got {value!r}")
     return value
-
-
-def check_germs(germs) -> list[str]:
-    """The germ list of a campaign: non-empty, each "normal" or "uniform"."""
-    germs = list(germs)
-    if not germs or any(germ not in GERMS for germ in germs):
-        raise ValueError(
-            f"germs: expected a non-empty list of {' / '.join(GERMS)}, got {germs!r}"
-        )
-    return germs

@@ -1,17 +1,70 @@
-"""Non-intrusive UQ methods (paper section 4): one entry point, ``fit``, for every kind."""
+"""Non-intrusive UQ methods (paper section 4): the registry every other part reads.
+
+A method is one module plus one entry in METHODS, which says which designs it accepts, how its PCE
+is built, the rule its points must satisfy before it runs, and how its mean and variance follow:
+
+* ``monte_carlo``: sample mean and unbiased variance of the runs, no PCE; sampled designs only;
+* ``integration``: weighted sums (Eq. 17); on a grid the PCE for bands, PDFs and Sobol' indices is the
+  projection (Eq. 21);
+* ``pseudo_galerkin``: projection (Eq. 21), split form (Eq. 24) with x0; moments from the PCE;
+* ``interpolation``: moments from the weights (Eq. 32–34), PCE by projection (Eq. 41–42);
+* ``regression``: V c = Y by least squares (Eq. 36), the weights ignored; moments from the PCE;
+* ``least_squares``: weighted least squares (Eq. 44) with |w|; moments from the PCE.
+
+Rules before anything runs (`validity.method_problem`): a projection of total order p needs a grid
+exact to degree 2p; a fit needs a design matrix of full rank Z on the actual points.
+"""
+from __future__ import annotations
+
 from dataclasses import dataclass
+from typing import Callable
 
 import numpy as np
 
-from ..analysis.moments import as_runs_by_time
-from .basis import orthonormal_basis, total_degree_indices
-from .collocation import interpolation, least_squares, regression
+from .collocation import least_squares, regression
 from .galerkin import pseudo_galerkin
-from .integration import direct_integration, monte_carlo
 from .pce import PCE
 
-METHOD_KINDS = ("integration", "pseudo_galerkin", "interpolation", "regression", "least_squares", "monte_carlo")
-SPLIT_FORM_KINDS = ("pseudo_galerkin", "interpolation")
+
+@dataclass(frozen=True)
+class Method:
+    """One registered method.
+
+    label: its name in the paper's legends. pce: how its PCE is built from (xi, weights, Y, germs,
+    order, x0) -> PCE, or None (no PCE). moments: "sample" (sample moments of the runs, unbiased),
+    "weights" (weighted sums of the runs) or "pce" (the expansion's). sampled_only: refuses grids.
+    runs_on_sampled: on a sampled design its statistics are those of the runs themselves (no PCE).
+    rule: "projection" (needs exactness 2p), "fit" (needs rank Z) or None. split: accepts x0.
+    partial: valid on a subset of a design's runs (failed or pending runs left out).
+    """
+
+    label: str
+    pce: Callable | None
+    moments: str
+    rule: str | None
+    sampled_only: bool = False
+    runs_on_sampled: bool = False
+    split: bool = False
+    partial: bool = False
+
+
+def _regression(xi, weights, Y, germs, order, x0=None) -> PCE:
+    return regression(xi, Y, germs, order)
+
+
+def _least_squares(xi, weights, Y, germs, order, x0=None) -> PCE:
+    return least_squares(xi, weights, Y, germs, order)
+
+
+METHODS: dict[str, Method] = {
+    "integration": Method("Int", pseudo_galerkin, "weights", "projection", runs_on_sampled=True, split=True),
+    "pseudo_galerkin": Method("PG", pseudo_galerkin, "pce", "projection", split=True),
+    "interpolation": Method("interpolation", pseudo_galerkin, "weights", "projection", split=True),
+    "regression": Method("regression", _regression, "pce", "fit", partial=True),
+    "least_squares": Method("least squares", _least_squares, "pce", "fit", partial=True),
+    "monte_carlo": Method("MC", None, "sample", None, sampled_only=True, runs_on_sampled=True, partial=True),
+}
+METHOD_KINDS = tuple(METHODS)
 
 
 @dataclass
@@ -26,42 +79,30 @@ class Result:
 def fit(kind: str, xi, weights, Y, germs, order: int = 2, x0=None) -> Result:
     """Apply method ``kind`` to the runs Y (N, T) at points xi (N, d) with weights (N,).
 
-    * ``integration``: weighted sums (Eq. 17), no PCE;
-    * ``monte_carlo``: sample mean and unbiased variance, the weights ignored, no PCE;
-    * ``pseudo_galerkin``: projection (Eq. 21), split form (Eq. 24) when x0 is given;
-    * ``interpolation``: moments from the weights, PCE by projection (Eq. 34, 42);
-    * ``regression``: V c = Y by least squares (Eq. 36), the weights ignored;
-    * ``least_squares``: weighted least squares (Eq. 44) with |w|.
-    ``order`` is the total degree of the PCE; x0 ((T,) or (N, 1)) applies to the projections only.
+    ``order`` is the total degree of the PCE; x0 ((T,) or (N, 1)) selects the split form of the
+    projections (see galerkin). Moments follow the method's entry in METHODS.
     """
-    if kind not in METHOD_KINDS:
-        raise ValueError(f"unknown method kind {kind!r}: expected one of {', '.join(METHOD_KINDS)}")
-    if x0 is not None and kind not in SPLIT_FORM_KINDS:
-        raise ValueError(
-            f"x0 (the split form x = x0 + S) applies to {' and '.join(SPLIT_FORM_KINDS)}; {kind!r} "
-            "either builds no PCE or fits the constant term itself, so the split would change nothing"
-        )
+    from ..analysis.moments import as_runs_by_time, weighted_moments
+
+    method = method_entry(kind)
+    if x0 is not None and not method.split:
+        split = " and ".join(k for k, m in METHODS.items() if m.split)
+        raise ValueError(f"x0 (the split form x = x0 + S) applies to {split}; {kind!r} either builds no "
+                         "PCE or fits the constant term itself, so the split would change nothing")
     Y = as_runs_by_time(Y)
-    if kind == "monte_carlo":
-        return Result(*monte_carlo(Y), None)
-    if kind == "integration":
-        return Result(*direct_integration(Y, weights), None)
-    if kind == "interpolation":
-        return Result(*interpolation(xi, weights, Y, germs, order, x0))
-    if kind == "pseudo_galerkin":
-        pce = pseudo_galerkin(xi, weights, Y, germs, order, x0)
-    elif kind == "regression":
-        pce = regression(xi, Y, germs, order)
-    else:
-        pce = least_squares(xi, weights, Y, germs, order)
-    return Result(pce.mean(), pce.variance(), pce)
+    pce = method.pce(xi, weights, Y, germs, order, x0) if method.pce and method.moments != "sample" else None
+    if method.moments == "pce":
+        return Result(pce.mean(), pce.variance(), pce)
+    mean, variance = weighted_moments(Y, None if method.moments == "sample" else weights,
+                                      unbiased=method.moments == "sample")
+    return Result(mean, variance, pce)
 
 
-__all__ = [
-    "METHOD_KINDS",
-    "PCE",
-    "Result",
-    "fit",
-    "orthonormal_basis",
-    "total_degree_indices",
-]
+def method_entry(kind: str) -> Method:
+    """The registry entry of `kind`; an unknown kind is a ValueError listing the kinds."""
+    if kind not in METHODS:
+        raise ValueError(f"unknown method kind {kind!r}: expected one of {', '.join(METHOD_KINDS)}")
+    return METHODS[kind]
+
+
+__all__ = ["METHODS", "METHOD_KINDS", "PCE", "Method", "Result", "fit", "method_entry"]

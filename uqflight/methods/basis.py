@@ -1,22 +1,14 @@
 """Orthonormal polynomial chaos basis: total-degree multi-indices and their polynomials.
 
-Each input is driven by a standard variable ξ_k with germ ``"normal"`` (N(0, 1)) or
-``"uniform"`` (U(−1, 1)). The 1-D polynomials are orthonormal under the germ's law
-(He_n/√n! and √(2n+1)·P_n), so the products satisfy E[Ψ_α Ψ_β] = δ_αβ.
+Each input is driven by a standard variable ξ_k, its germ (`uqflight.parameters.germs`), whose
+three-term recurrence gives 1-D polynomials orthonormal under its law (He_n/√n! for N(0, 1),
+√(2n+1)·P_n for U(−1, 1)), so the products satisfy E[Ψ_α Ψ_β] = δ_αβ.
 """
 from itertools import combinations_with_replacement
 
 import numpy as np
 
-from ..designs.montecarlo import germ_quantiles
-from ..designs.spec import check_germs
-
-
-def _recurrence_beta(germ: str, n: np.ndarray) -> np.ndarray:
-    """β_n of the orthonormal three-term recurrence x p_n = β_{n+1} p_{n+1} + β_n p_{n−1}."""
-    if germ == "normal":
-        return np.sqrt(n)
-    return n / np.sqrt(4.0 * n**2 - 1.0)
+from ..parameters.germs import GERMS, check_germs
 
 
 def total_degree_indices(dim: int, order: int) -> np.ndarray:
@@ -39,7 +31,7 @@ def orthonormal_polynomials(germ: str, x: np.ndarray, order: int) -> np.ndarray:
     values = np.empty((x.size, order + 1))
     values[:, 0] = 1.0
     if order >= 1:
-        beta = _recurrence_beta(germ, np.arange(1, order + 1, dtype=float))
+        beta = GERMS[germ].recurrence_beta(np.arange(1, order + 1, dtype=float))
         values[:, 1] = x / beta[0]
         for n in range(1, order):
             values[:, n + 1] = (x * values[:, n] - beta[n - 1] * values[:, n - 1]) / beta[n]
@@ -56,9 +48,3 @@ def orthonormal_basis(germs, indices: np.ndarray, xi: np.ndarray) -> np.ndarray:
         table = orthonormal_polynomials(germ, xi[:, k], int(indices[:, k].max(initial=0)))
         basis *= table[:, indices[:, k]]
     return basis
-
-
-def draw_germs(germs, n: int, seed) -> np.ndarray:
-    """n seeded independent draws of the standard variables, (n, d): the Monte Carlo design's points."""
-    germs = check_germs(germs)
-    return germ_quantiles(np.random.default_rng(seed).random((n, len(germs))), germs)

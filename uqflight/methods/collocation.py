@@ -1,25 +1,14 @@
-"""Stochastic collocation: interpolation (Eq. 26–34, 41–42), regression (Eq. 35–37) and
-weighted least squares (Eq. 43–48).
+"""Stochastic collocation by fitting: regression (Eq. 35–37) and weighted least squares (Eq. 43–48).
+
+Interpolation (Eq. 26–34, 41–42) needs no fit: its moments are the weighted sums of the runs and its
+PCE the projection, because I_j(ξ_k) = δ_jk (see the registry in `uqflight.methods`).
 """
 import numpy as np
 
 from ..analysis.moments import as_runs_by_time, probability_weights
-from ..designs.spec import check_germs
+from ..parameters.germs import check_germs
 from .basis import orthonormal_basis, total_degree_indices
-from .galerkin import pseudo_galerkin
-from .integration import direct_integration
 from .pce import PCE
-
-
-def interpolation(xi, weights, Y, germs, order: int = 2, x0=None) -> tuple[np.ndarray, np.ndarray, PCE]:
-    """Lagrange interpolation on the grid: mean, variance (each (T,)) and PCE.
-
-    Because I_j(ξ_k) = δ_jk, the interpolant's moments are the weighted sums of the runs
-    (Eq. 32–34) and its PCE coefficients are the projection Σ_j Y_j Ψ_α(ξ_j) w_j (Eq. 41–42),
-    so no Lagrange polynomial is ever formed. x0 selects the split form of the projection.
-    """
-    mean, variance = direct_integration(Y, weights)
-    return mean, variance, pseudo_galerkin(xi, weights, Y, germs, order, x0)
 
 
 def _basis_matrix(xi, germs, order: int) -> tuple[np.ndarray, np.ndarray]:

@@ -15,7 +15,7 @@ nothing, since projection is linear. It matters in two cases:
 import numpy as np
 
 from ..analysis.moments import as_runs_by_time, probability_weights
-from ..designs.spec import check_germs
+from ..parameters.germs import check_germs
 from .basis import orthonormal_basis, total_degree_indices
 from .pce import PCE
 

@@ -3,7 +3,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .basis import draw_germs, orthonormal_basis
+from ..parameters.germs import draw_germs
+from .basis import orthonormal_basis
 
 # Variances below this fraction of the largest over time are rounding noise (e.g. the spread of
 # a trimmed state at t = 0): their Sobol' shares would be ratios of noise, so they count as 0.

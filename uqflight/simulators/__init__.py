@@ -9,7 +9,8 @@ from pathlib import Path
 
 import numpy as np
 
-from .jsbsim import UNITS, FlightError, FlightSetup, JSBSimFlight, flight_setup_from
+from .base import FlightError
+from .jsbsim import UNITS, FlightSetup, JSBSimFlight, flight_setup_from
 from .python import PythonSimulator
 
 

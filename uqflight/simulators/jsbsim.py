@@ -16,6 +16,8 @@ from pathlib import Path
 import jsbsim
 import numpy as np
 
+from .base import DivergenceError, FlightError, TrimError
+
 REPO_ROOT = Path(__file__).resolve().parents[2]
 DEFAULT_OUTPUTS = ("alpha_deg", "theta_deg", "h_ft", "q_degps", "vtas_kt")
 
@@ -43,24 +45,6 @@ TRIM_TOLERANCES = {
 }
 STALL_PROPERTY = "aero/coefficient/CL-stall"  # non-zero past the stall (bacm)
 DIVERGENCE_LIMITS = {"aero/alpha-deg": 30.0, "attitude/phi-deg": 60.0}
-
-
-class FlightError(RuntimeError):
-    """A sample that could not be flown; `status` is its code in the results file."""
-
-    status = 3
-
-
-class TrimError(FlightError):
-    """The trim did not converge or converged to a state outside the aircraft's envelope."""
-
-    status = 1
-
-
-class DivergenceError(FlightError):
-    """The flight left the envelope or produced NaN after the trim."""
-
-    status = 2
 
 
 @dataclass(frozen=True)

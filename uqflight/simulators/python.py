@@ -6,19 +6,57 @@ numbered 0, 1, 2, ...). A scalar output has one time point.
 """
 from __future__ import annotations
 
+import hashlib
+import importlib
+import importlib.util
+import sys
 from pathlib import Path
+from typing import Callable
 
 import numpy as np
 
-from .jsbsim import DivergenceError, FlightError
+from .base import DivergenceError, FlightError
+
+
+class PluginError(ValueError):
+    """A `simulator.function` that cannot be loaded; the message says what was expected."""
+
+
+def load_function(spec: str, base: Path) -> Callable:
+    """The callable named `module:attribute` or `path/to/file.py:attribute` (relative to base)."""
+    if not isinstance(spec, str) or spec.count(":") != 1:
+        shown = repr(spec) if isinstance(spec, str) and len(repr(spec)) <= 60 else type(spec).__name__
+        raise PluginError(f"expected 'package.module:callable' or 'file.py:callable', got {shown}")
+    module_name, attribute = spec.split(":")
+    try:
+        if module_name.endswith(".py"):
+            file = (base / module_name) if not Path(module_name).is_absolute() else Path(module_name)
+            if not file.is_file():
+                raise PluginError(f"expected an existing Python file, got {str(file)!r} "
+                                  "(a relative path is read from the campaign's folder)")
+            unique = "uqflight_user_" + hashlib.sha256(str(file.resolve()).encode()).hexdigest()[:12]
+            module = sys.modules.get(unique)
+            if module is None:
+                module_spec = importlib.util.spec_from_file_location(unique, file)
+                module = importlib.util.module_from_spec(module_spec)
+                module_spec.loader.exec_module(module)
+                sys.modules[unique] = module
+        else:
+            module = importlib.import_module(module_name)
+    except PluginError:
+        raise
+    except Exception as exc:  # the user's module failed to import: say which and why
+        raise PluginError(f"cannot import {module_name!r}: {type(exc).__name__}: {exc}") from exc
+    function = getattr(module, attribute, None)
+    if not callable(function):
+        raise PluginError(f"{module_name!r} has no callable {attribute!r}")
+    return function
 
 
 class PythonSimulator:
     """Calls `function` once per sample and checks what it returns."""
 
     def __init__(self, config: dict, parameter_names: list[str], base: Path):
-        from ..campaign import load_function
-
         self.function = load_function(config["function"], base)
         self.names = list(parameter_names)
         self.outputs = config.get("outputs")

@@ -1,30 +1,20 @@
-"""Campaign files (YAML): read, validate, and turn into parameters, a design and settings.
-
-Validation happens before anything runs. Every problem is a `CampaignError` whose message
-names the file, the field and what was expected, e.g.
-`campaigns/x.yaml: parameters.CL0.interval_pct: expected a number > 0, got -3`.
-"""
+"""The campaign schema: the keys a campaign file may hold, and the typed checks that raise
+CampaignError naming the file, the field and what was expected."""
 from __future__ import annotations
 
 import difflib
-import hashlib
-import importlib
-import importlib.util
 import math
 import re
-import sys
 from collections.abc import Hashable
-from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Callable
 
-import jsbsim
 import yaml
 
-from .designs import Design, build_design
-from .methods import METHOD_KINDS
-from .parameters import DISTRIBUTIONS, Parameter, make_parameter
-from .simulators.jsbsim import NAMED_OUTPUTS, Excitation, JSBSimFlight, flight_setup_from
+from ..designs import SAMPLED_DESIGNS, Design
+from ..methods import METHOD_KINDS
+from ..parameters import DISTRIBUTIONS, Parameter, make_parameter
+from ..simulators.jsbsim import NAMED_OUTPUTS, Excitation
+from ..simulators.python import PluginError, load_function
 
 SIMULATOR_KINDS = ("jsbsim", "python")
 EXECUTORS = ("local", "dask")
@@ -37,7 +27,6 @@ METHOD_KEYS = ("kind", "order", "split")
 EXECUTION_KEYS = ("workers", "executor", "scheduler", "chunk")
 STORAGE_KEYS = ("path", "raw", "tsvd")
 TSVD_KEYS = ("tol", "batch")
-SAMPLED_DESIGNS = ("monte_carlo", "sobol", "halton", "latin_hypercube", "pick_freeze")
 ANALYSIS_KEYS = ("band_samples", "bootstrap")
 
 
@@ -50,31 +39,7 @@ class CampaignError(ValueError):
         super().__init__(where + message)
 
 
-@dataclass
-class Campaign:
-    """A validated campaign. `text` is the file's exact text (its hash identifies results)."""
-
-    source: str
-    text: str
-    name: str
-    seed: int
-    simulator: dict
-    parameters: list[Parameter]
-    design_spec: dict
-    method: dict
-    execution: dict
-    storage: dict
-    analysis: dict = field(default_factory=dict)
-
-    @property
-    def germs(self) -> list[str]:
-        return [p.germ for p in self.parameters]
-
-    def design(self) -> Design:
-        return build_design(self.design_spec, self.germs, self.seed)
-
-
-def _shown(value) -> str:
+def shown(value) -> str:
     """A value as an error message quotes it: short, and readable for people who wrote YAML."""
     if value is None:
         return "nothing"
@@ -86,7 +51,7 @@ def _shown(value) -> str:
     return text if len(text) <= 60 else text[:57] + "..."
 
 
-class _Checker:
+class Checker:
     """Typed access to a YAML mapping that raises CampaignError with the field's path."""
 
     def __init__(self, source: str):
@@ -97,7 +62,7 @@ class _Checker:
 
     def mapping(self, value, path: str, allowed: tuple[str, ...], required=()) -> dict:
         if not isinstance(value, dict):
-            self.fail(path, f"expected a mapping with the keys {', '.join(allowed)}, got {_shown(value)}")
+            self.fail(path, f"expected a mapping with the keys {', '.join(allowed)}, got {shown(value)}")
         for key in value:
             if key not in allowed:
                 close = difflib.get_close_matches(str(key), allowed, n=1)
@@ -111,29 +76,29 @@ class _Checker:
 
     def number(self, value, path: str, minimum: float | None = None, strict=False) -> float:
         if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
-            self.fail(path, f"expected a finite number, got {_shown(value)}")
+            self.fail(path, f"expected a finite number, got {shown(value)}")
         if minimum is not None and (value <= minimum if strict else value < minimum):
             self.fail(path, f"expected a number {'>' if strict else '>='} {minimum:g}, got {value!r}")
         return float(value)
 
     def integer(self, value, path: str, minimum: int) -> int:
         if isinstance(value, bool) or not isinstance(value, int) or value < minimum:
-            self.fail(path, f"expected an integer >= {minimum}, got {_shown(value)}")
+            self.fail(path, f"expected an integer >= {minimum}, got {shown(value)}")
         return value
 
     def string(self, value, path: str, choices: tuple[str, ...] | None = None) -> str:
         expected = f"one of {', '.join(choices)}" if choices else "a non-empty string"
         if not isinstance(value, str) or not value or (choices and value not in choices):
-            self.fail(path, f"expected {expected}, got {_shown(value)}")
+            self.fail(path, f"expected {expected}, got {shown(value)}")
         return value
 
     def boolean(self, value, path: str) -> bool:
         if not isinstance(value, bool):
-            self.fail(path, f"expected true or false, got {_shown(value)}")
+            self.fail(path, f"expected true or false, got {shown(value)}")
         return value
 
 
-class _CampaignLoader(yaml.SafeLoader):
+class CampaignLoader(yaml.SafeLoader):
     """YAML's safe loader, except that a key given twice in one mapping is an error (plain YAML
     keeps the last one silently, so a parameter pasted twice would vanish)."""
 
@@ -153,9 +118,9 @@ class _CampaignLoader(yaml.SafeLoader):
 
 
 # YAML 1.1 (PyYAML) reads 1e-8 as a string: accept exponents without a dot, as YAML 1.2 does.
-_CampaignLoader.yaml_implicit_resolvers = {
+CampaignLoader.yaml_implicit_resolvers = {
     key: list(value) for key, value in yaml.SafeLoader.yaml_implicit_resolvers.items()}
-_CampaignLoader.add_implicit_resolver(
+CampaignLoader.add_implicit_resolver(
     "tag:yaml.org,2002:float",
     re.compile(r"""^(?:[-+]?(?:[0-9][0-9_]*)\.[0-9_]*(?:[eE][-+]?[0-9]+)?
                   |[-+]?(?:[0-9][0-9_]*)(?:[eE][-+]?[0-9]+)
@@ -165,7 +130,7 @@ _CampaignLoader.add_implicit_resolver(
     list("-+0123456789."))
 
 
-def _yaml_error(exc: yaml.YAMLError) -> str:
+def yaml_error(exc: yaml.YAMLError) -> str:
     """'YAML syntax error at line L, column C: problem (context at line L', column C')'."""
     def at(mark) -> str:
         return f"line {mark.line + 1}, column {mark.column + 1}"
@@ -179,108 +144,7 @@ def _yaml_error(exc: yaml.YAMLError) -> str:
     return message
 
 
-class AircraftProperties:
-    """The campaign's aircraft as a sample finds it before the trim: loaded, with the flight
-    condition's initial conditions set (so `ic/vt-kts` reads the campaign's airspeed and
-    `ic/vc-kts` the matching calibrated airspeed). Validation reads nominal values here."""
-
-    def __init__(self, simulator: dict):
-        setup = flight_setup_from({**simulator, "outputs": []})
-        if not setup.aircraft_file.is_file():
-            folder = Path(setup.root) / "aircraft"
-            known = sorted(p.parent.name for p in folder.glob("*/*.xml") if p.stem == p.parent.name)
-            raise FileNotFoundError(f"expected one of {', '.join(known)} (the aircraft in {folder}), "
-                                    f"got {setup.aircraft!r}")
-        self.aircraft = setup.aircraft
-        self._flight = JSBSimFlight(setup)
-        fdm = self._flight.fdm
-        fdm["ic/h-sl-ft"] = setup.altitude_ft  # as JSBSimFlight.trim sets them
-        fdm["ic/vt-kts"] = setup.airspeed_ktas
-        names = [line.rsplit(" (", 1)[0] for line in fdm.query_property_catalog("").splitlines()]  # "name (RW)"
-        self._names = {name.lower(): name for name in names}  # for hints, whatever the case typed
-
-    def value(self, name: str) -> float | None:
-        """The property's value (None when the aircraft has no such property)."""
-        return self._flight.property_value(name)
-
-    def writable(self, name: str) -> bool:
-        return self._flight.node(name).get_attribute(jsbsim.Attribute.WRITE)
-
-    def hint(self, name: str) -> str:
-        """'; did you mean ...?' with the aircraft's properties closest to `name`, or ''."""
-        close = difflib.get_close_matches(name.lower(), self._names, n=3, cutoff=0.8)
-        return f"; did you mean {' or '.join(self._names[c] for c in close)}?" if close else ""
-
-
-def jsbsim_probe(simulator: dict) -> AircraftProperties:
-    """The campaign aircraft's properties, for `load_campaign(..., probe=jsbsim_probe)`."""
-    return AircraftProperties(simulator)
-
-
-PropertyProbe = Callable[[dict], AircraftProperties]
-
-
-def load_campaign(path: str | Path, probe: PropertyProbe | None = None) -> Campaign:
-    """Read and validate a campaign file.
-
-    `probe(simulator_config)` gives the aircraft's properties (`jsbsim_probe`); it is used for
-    JSBSim campaigns to check property and output names and to read nominal values from the
-    aircraft. Without it, those checks are skipped and nominal values must be given.
-    """
-    source = str(path)
-    try:
-        text = Path(path).read_text(encoding="utf-8")
-    except OSError as exc:
-        raise CampaignError(source, "", f"cannot read the file ({exc.strerror})") from exc
-    except UnicodeDecodeError as exc:
-        raise CampaignError(source, "", f"expected UTF-8 text, got byte {exc.object[exc.start]:#04x} "
-                                        f"at position {exc.start}") from exc
-    return parse_campaign(text, source, probe)
-
-
-def parse_campaign(text: str, source: str = "<campaign>", probe: PropertyProbe | None = None) -> Campaign:
-    """Validate campaign text; see `load_campaign`."""
-    check = _Checker(source)
-    try:
-        data = yaml.load(text, Loader=_CampaignLoader)
-    except yaml.YAMLError as exc:
-        raise CampaignError(source, "", _yaml_error(exc)) from exc
-    data = check.mapping(data, "", TOP_KEYS, required=("name", "simulator", "parameters", "design"))
-    name = check.string(data["name"], "name")
-    seed = check.integer(data.get("seed", 0), "seed", 0)
-    simulator = _simulator(check, data["simulator"], source)
-    aircraft = None
-    if probe and simulator["kind"] == "jsbsim":
-        try:
-            aircraft = probe(simulator)
-        except (FileNotFoundError, RuntimeError) as exc:  # no such aircraft, or JSBSim cannot load it
-            check.fail("simulator.aircraft", str(exc))
-        for i, output in enumerate(simulator.get("outputs", ())):
-            if output not in NAMED_OUTPUTS and aircraft.value(output) is None:
-                check.fail(f"simulator.outputs[{i}]", f"expected one of {', '.join(NAMED_OUTPUTS)} or a JSBSim "
-                           f"property of aircraft {aircraft.aircraft!r}, got {output!r}{aircraft.hint(output)}")
-    parameters = _parameters(check, data["parameters"], simulator["kind"], aircraft)
-    design_kind = data["design"].get("kind") if isinstance(data["design"], dict) else None
-    default_method = "monte_carlo" if design_kind in SAMPLED_DESIGNS else "integration"
-    method = _method(check, data.get("method", {"kind": default_method}))
-    execution = _execution(check, data.get("execution", {}))
-    storage = _storage(check, data.get("storage", {}), name)
-    analysis = _analysis(check, data.get("analysis", {}))
-    campaign = Campaign(source, text, name, seed, simulator, parameters, data["design"], method,
-                        execution, storage, analysis)
-    try:
-        design = campaign.design()
-    except ValueError as exc:
-        message = str(exc)
-        field_path, sep, rest = message.partition(": ")
-        if sep and (field_path.startswith("design") or field_path == "seed"):
-            raise CampaignError(source, field_path, rest) from exc
-        raise CampaignError(source, "design", message) from exc
-    _check_method_fits_design(check, method, design, len(parameters))
-    return campaign
-
-
-def _check_method_fits_design(check: _Checker, method: dict, design: Design, dimensions: int) -> None:
+def check_method_fits_design(check: Checker, method: dict, design: Design, dimensions: int) -> None:
     if method["kind"] == "monte_carlo" and design.kind not in SAMPLED_DESIGNS:
         check.fail("method.kind", f"monte_carlo needs a sampled design ({', '.join(SAMPLED_DESIGNS)}); "
                    f"a {design.kind} needs its weights: use integration, pseudo_galerkin, interpolation, "
@@ -295,17 +159,20 @@ def _check_method_fits_design(check: _Checker, method: dict, design: Design, dim
                        f"only {points} points")
 
 
-def _simulator(check: _Checker, value, source: str) -> dict:
+def simulator(check: Checker, value, source: str) -> dict:
     if not isinstance(value, dict):
-        check.fail("simulator", f"expected a mapping with a kind key, got {_shown(value)}")
+        check.fail("simulator", f"expected a mapping with a kind key, got {shown(value)}")
     if "kind" not in value:
         check.fail("simulator.kind", f"is required; expected one of {', '.join(SIMULATOR_KINDS)}")
     kind = check.string(value["kind"], "simulator.kind", SIMULATOR_KINDS)
     if kind == "python":
         sim = check.mapping(value, "simulator", PYTHON_KEYS, required=("function",))
-        load_function(sim["function"], Path(source).parent, check)
+        try:
+            load_function(sim["function"], Path(source).parent)
+        except PluginError as exc:
+            check.fail("simulator.function", str(exc))
         if "outputs" in sim:
-            _outputs(check, sim["outputs"])
+            outputs(check, sim["outputs"])
         return dict(sim)
     sim = dict(check.mapping(value, "simulator", JSBSIM_KEYS))
     sim.setdefault("aircraft", "bacm")
@@ -332,13 +199,13 @@ def _simulator(check: _Checker, value, source: str) -> dict:
             check.fail("simulator.output_rate_hz",
                        f"expected a divisor of the 120 Hz integration rate (120, 60, 40, 30, 24, 20, ...), got {rate:g}")
     if "outputs" in sim:
-        _outputs(check, sim["outputs"])
+        outputs(check, sim["outputs"])
     return sim
 
 
-def _outputs(check: _Checker, value) -> list[str]:
+def outputs(check: Checker, value) -> list[str]:
     if not isinstance(value, list) or not value:
-        check.fail("simulator.outputs", f"expected a non-empty list of output names, got {_shown(value)}")
+        check.fail("simulator.outputs", f"expected a non-empty list of output names, got {shown(value)}")
     for i, item in enumerate(value):
         check.string(item, f"simulator.outputs[{i}]")
     if len(set(value)) != len(value):
@@ -346,41 +213,9 @@ def _outputs(check: _Checker, value) -> list[str]:
     return value
 
 
-def load_function(spec: str, base: Path, check: _Checker | None = None) -> Callable:
-    """The callable named `module:attribute` or `path/to/file.py:attribute` (relative to base)."""
-    check = check or _Checker("<campaign>")
-    if not isinstance(spec, str) or spec.count(":") != 1:
-        check.fail("simulator.function",
-                   f"expected 'package.module:callable' or 'file.py:callable', got {_shown(spec)}")
-    module_name, attribute = spec.split(":")
-    try:
-        if module_name.endswith(".py"):
-            file = (base / module_name) if not Path(module_name).is_absolute() else Path(module_name)
-            if not file.is_file():
-                check.fail("simulator.function", f"expected an existing Python file, got {str(file)!r} "
-                                                 "(a relative path is read from the campaign's folder)")
-            unique = "uqflight_user_" + hashlib.sha256(str(file.resolve()).encode()).hexdigest()[:12]
-            module = sys.modules.get(unique)
-            if module is None:
-                module_spec = importlib.util.spec_from_file_location(unique, file)
-                module = importlib.util.module_from_spec(module_spec)
-                module_spec.loader.exec_module(module)
-                sys.modules[unique] = module
-        else:
-            module = importlib.import_module(module_name)
-    except CampaignError:
-        raise
-    except Exception as exc:  # the user's module failed to import: say which and why
-        check.fail("simulator.function", f"cannot import {module_name!r}: {type(exc).__name__}: {exc}")
-    function = getattr(module, attribute, None)
-    if not callable(function):
-        check.fail("simulator.function", f"{module_name!r} has no callable {attribute!r}")
-    return function
-
-
-def _parameters(check: _Checker, value, kind: str, aircraft: AircraftProperties | None) -> list[Parameter]:
+def parameters(check: Checker, value, kind: str, aircraft) -> list[Parameter]:
     if not isinstance(value, dict) or not value:
-        check.fail("parameters", f"expected a mapping of parameter names to their definitions, got {_shown(value)}")
+        check.fail("parameters", f"expected a mapping of parameter names to their definitions, got {shown(value)}")
     parameters = []
     owners: dict[str, str] = {}  # property -> the parameter that sets it
     for name, spec in value.items():
@@ -427,7 +262,7 @@ def _parameters(check: _Checker, value, kind: str, aircraft: AircraftProperties 
     return parameters
 
 
-def _method(check: _Checker, value) -> dict:
+def method(check: Checker, value) -> dict:
     method = dict(check.mapping(value, "method", METHOD_KEYS, required=("kind",)))
     check.string(method["kind"], "method.kind", METHOD_KINDS)
     method["order"] = check.integer(method.get("order", 2), "method.order", 0)
@@ -435,7 +270,7 @@ def _method(check: _Checker, value) -> dict:
     return method
 
 
-def _execution(check: _Checker, value) -> dict:
+def execution(check: Checker, value) -> dict:
     execution = dict(check.mapping(value, "execution", EXECUTION_KEYS))
     execution["workers"] = check.integer(execution.get("workers", 1), "execution.workers", 1)
     execution["executor"] = check.string(execution.get("executor", "local"), "execution.executor", EXECUTORS)
@@ -445,7 +280,7 @@ def _execution(check: _Checker, value) -> dict:
     return execution
 
 
-def _storage(check: _Checker, value, name: str) -> dict:
+def storage(check: Checker, value, name: str) -> dict:
     storage = dict(check.mapping(value, "storage", STORAGE_KEYS))
     storage["path"] = check.string(storage.get("path", f"results/{name}.h5"), "storage.path")
     storage["raw"] = check.boolean(storage.get("raw", True), "storage.raw")
@@ -462,7 +297,7 @@ def _storage(check: _Checker, value, name: str) -> dict:
     return storage
 
 
-def _analysis(check: _Checker, value) -> dict:
+def analysis(check: Checker, value) -> dict:
     analysis = dict(check.mapping(value, "analysis", ANALYSIS_KEYS))
     analysis["band_samples"] = check.integer(analysis.get("band_samples", 20000), "analysis.band_samples", 100)
     analysis["bootstrap"] = check.integer(analysis.get("bootstrap", 200), "analysis.bootstrap", 0)

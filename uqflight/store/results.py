@@ -22,29 +22,17 @@ run is pending), so the factors do not depend on the number of workers or on int
 """
 from __future__ import annotations
 
-import enum
 import hashlib
 import json
 from collections.abc import Iterator
 from datetime import datetime, timezone
-from pathlib import Path
 
 import h5py
 import numpy as np
 
-from uqflight.tsvd import IncrementalSVD, iter_column_blocks, weighted_mean, weighted_variance
-
-_CHUNK_BYTES = 1 << 20
-
-
-class Status(enum.IntEnum):
-    """Outcome of one run, as stored in /samples/status."""
-
-    PENDING = -1
-    OK = 0
-    TRIM_FAILURE = 1
-    DIVERGED = 2
-    SIMULATOR_ERROR = 3
+from ..simulators.base import Status
+from ..tsvd import IncrementalSVD, iter_column_blocks
+from .compressed import append_rows, apply_staged, buffer_rows, chunk_rows, commit, ingest, write_state
 
 
 def _key(name: str) -> str:
@@ -109,7 +97,7 @@ class ResultStore:
             group = f.create_group("outputs", track_order=True)
             for name in outputs:
                 ds = group.create_dataset(_key(name), shape=(n, time.size), dtype="f8", fillvalue=np.nan,
-                                          chunks=(_chunk_rows(time.size, n), time.size))
+                                          chunks=(chunk_rows(time.size, n), time.size))
                 ds.attrs.update({"units": units.get(name, ""), "dimensions": ["sample", "time"]})
         if tsvd is not None:
             group = f.create_group("tsvd", track_order=True)
@@ -119,7 +107,7 @@ class ResultStore:
             for name in outputs:
                 out = group.create_group(_key(name))
                 out.attrs["units"] = units.get(name, "")
-                _write_state(out, empty, np.zeros(0, np.int64), np.zeros((0, time.size)), np.zeros(0, np.int64))
+                write_state(out, empty, np.zeros(0, np.int64), np.zeros((0, time.size)), np.zeros(0, np.int64))
         f.flush()
         return cls(f)
 
@@ -136,7 +124,7 @@ class ResultStore:
         if mode == "a" and "tsvd" in f:
             status = store.status
             for name in f["tsvd"]:
-                _apply_staged(f["tsvd"][_key(name)])
+                apply_staged(f["tsvd"][_key(name)])
                 store._fold_ready(name, status)
             f.flush()
         return store
@@ -233,7 +221,7 @@ class ResultStore:
             if self._raw:
                 self._file["outputs"][_key(name)][idx] = np.where(ok[:, None], rows, np.nan)
             if "tsvd" in self._file:
-                _append_rows(self._file["tsvd"][_key(name)], rows[ok], idx[ok])
+                append_rows(self._file["tsvd"][_key(name)], rows[ok], idx[ok])
         self._file["samples/reason"][idx] = reasons
         self._file["samples/status"][idx] = status
         self._file.flush()
@@ -258,7 +246,7 @@ class ResultStore:
         if written.size:
             raise ValueError(f"runs {written} are already stored")
         if not np.isin(status, [s.value for s in Status if s != Status.PENDING]).all():
-            raise ValueError(f"unknown status codes {np.unique(status)}; see uqflight.store.Status")
+            raise ValueError(f"unknown status codes {np.unique(status)}; see uqflight.simulators.base.Status")
         if set(outputs) != set(self.output_names):
             raise ValueError(f"batch outputs {sorted(outputs)} differ from the file's {self.output_names}")
         values = {name: np.asarray(outputs[name], dtype=float)[order] for name in self.output_names}
@@ -275,7 +263,7 @@ class ResultStore:
         """Fold the buffered ok runs of the completed design-order prefix into the factors, `batch` at
         a time (all of them once nothing is pending); drop buffer rows a killed writer left behind."""
         group = self._file["tsvd"][_key(name)]
-        positions, index, stale = _buffer_rows(group, status)
+        positions, index, stale = buffer_rows(group, status)
         pending = np.flatnonzero(status == Status.PENDING)
         if pending.size:
             ready = np.searchsorted(index, pending[0])
@@ -286,8 +274,8 @@ class ResultStore:
             return
         rows = group["buffer"][()][positions]
         svd, columns = self._stored_factors(group)
-        _ingest(svd, rows[:ready], self._batch)
-        _commit(group, svd, np.concatenate([columns, index[:ready]]), rows[ready:], index[ready:])
+        ingest(svd, rows[:ready], self._batch)
+        commit(group, svd, np.concatenate([columns, index[:ready]]), rows[ready:], index[ready:])
 
     # -- reading ----------------------------------------------------------------------------
     def output_matrix(self, name: str, rows=None) -> np.ndarray:
@@ -319,31 +307,15 @@ class ResultStore:
             for start, histories in zip(range(0, columns.size, block), iter_column_blocks(U, s, V, block)):
                 yield columns[start:start + block], histories
 
-    def output_moments(self, name: str, weights=None) -> tuple[np.ndarray, np.ndarray]:
-        """Weighted mean and variance Σ w_j (A_j − mean)² over the ok runs, each (T,).
-
-        Weights default to the design's and are rescaled to sum 1 over the ok runs, as in
-        analysis.moments (Monte Carlo runs stay 1/N_ok after failures).
-        """
-        w = self.weights if weights is None else np.asarray(weights, dtype=float)
-        w = w / w[self.status == Status.OK].sum()
-        if self._raw:
-            zero = np.zeros(self.time.size)
-            mean = sum((w[rows] @ values for rows, values in self.iter_output_blocks(name)), zero)
-            variance = sum((w[rows] @ (values - mean) ** 2 for rows, values in self.iter_output_blocks(name)), zero)
-            return mean, variance
-        U, s, V, columns = self.output_factors(name)
-        return weighted_mean(U, s, V, w[columns]), weighted_variance(U, s, V, w[columns])
-
     def output_factors(self, name: str) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray] | None:
         """(U, s, V, columns) of a compressed output, V row c being run columns[c]; None when the raw
         histories are stored. Runs still in the buffer are folded in (in memory, not in the file)."""
         if self._raw:
             return None
         group = self._file["tsvd"][_key(name)]
-        positions, index, _ = _buffer_rows(group, self.status)
+        positions, index, _ = buffer_rows(group, self.status)
         svd, columns = self._stored_factors(group)
-        _ingest(svd, group["buffer"][()][positions], self._batch)
+        ingest(svd, group["buffer"][()][positions], self._batch)
         return svd.U, svd.s, svd.V, np.concatenate([columns, index])
 
     def _stored_factors(self, group: h5py.Group) -> tuple[IncrementalSVD, np.ndarray]:
@@ -355,116 +327,3 @@ class ResultStore:
     @property
     def _batch(self) -> int:
         return int(self._file["tsvd"].attrs["batch"])
-
-
-def open_for_campaign(path, *, campaign_text: str, force: bool = False, **create_args) -> ResultStore:
-    """Resume `path` when it holds this campaign, else create it (see ResultStore.create).
-
-    A file holding another campaign (a different campaign_hash), or made with other aircraft files
-    (attrs["aircraft_hash"]), is refused unless `force`, which deletes and recreates it.
-    """
-    path = Path(path)
-    aircraft = (create_args.get("attrs") or {}).get("aircraft_hash")
-    if path.exists():
-        try:
-            with h5py.File(path, "r") as f:
-                stored, stored_aircraft = f.attrs.get("campaign_hash"), f.attrs.get("aircraft_hash")
-        except OSError as exc:  # e.g. killed while the file was being created: nothing to resume
-            if not force:
-                raise FileExistsError(f"{path} is not a readable results file ({exc}); choose another "
-                                      "results file, or force to overwrite it") from exc
-            stored = stored_aircraft = None
-        if stored == text_hash(campaign_text) and stored_aircraft == aircraft:
-            return ResultStore.open(path, "a")
-        if not force:
-            if stored == text_hash(campaign_text):
-                raise FileExistsError(f"{path} was made with other aircraft files (sha256 {stored_aircraft}); "
-                                      "resuming would mix two models: choose another results file, or force "
-                                      "to start over")
-            raise FileExistsError(f"{path} holds the results of another campaign (campaign_hash {stored}); "
-                                  "choose another results file, or force to overwrite it")
-        path.unlink()
-    return ResultStore.create(path, campaign_text=campaign_text, **create_args)
-
-
-def compact(path) -> None:
-    """Rewrite a file without the free space its replaced tSVD factors left behind (HDF5 does not
-    reclaim it: a 10^4-run file shrinks about tenfold). Written to a temporary file, then renamed
-    over the original, so a kill leaves one complete file."""
-    path = Path(path)
-    scratch = path.with_name(path.name + ".compacting")
-    with h5py.File(path, "r") as src, h5py.File(scratch, "w") as dst:
-        dst.attrs.update(dict(src.attrs))
-        for key in src:
-            src.copy(src[key], dst, name=key)
-    scratch.replace(path)
-
-
-def _chunk_rows(n_times: int, n_rows: int) -> int:
-    """Rows per chunk of an (n_rows, n_times) float64 dataset, for chunks of about 1 MiB."""
-    return int(np.clip(_CHUNK_BYTES // (8 * n_times), 1, max(n_rows, 1)))
-
-
-def _ingest(svd: IncrementalSVD, rows: np.ndarray, batch: int) -> None:
-    """Append the runs `rows` (n, T), in their order, `batch` columns per update."""
-    for start in range(0, len(rows), batch):
-        svd.update(rows[start:start + batch].T)
-
-
-def _append_rows(group: h5py.Group, rows: np.ndarray, index: np.ndarray) -> None:
-    """Append ok runs to an output's tSVD buffer (rows first, their indices after)."""
-    n = group["buffer_index"].shape[0]
-    for key, data in (("buffer", rows), ("buffer_index", index)):
-        group[key].resize(n + len(index), axis=0)
-        group[key][n:] = data
-
-
-def _buffer_rows(group: h5py.Group, status: np.ndarray) -> tuple[np.ndarray, np.ndarray, bool]:
-    """Positions of the valid buffer rows sorted by sample, their samples, and whether any row is stale.
-
-    A row is valid when its index was written and its run's status is ok; a writer killed between
-    the buffer and the status leaves stale rows (their runs are still pending and will be rerun).
-    """
-    n_rows = group["buffer"].shape[0]
-    index = group["buffer_index"][:n_rows]
-    valid = index >= 0
-    valid[valid] = status[index[valid]] == Status.OK
-    positions = np.flatnonzero(valid)
-    positions = positions[np.argsort(index[positions], kind="stable")]
-    return positions, index[positions], positions.size < max(n_rows, group["buffer_index"].shape[0])
-
-
-def _write_state(group: h5py.Group, svd: IncrementalSVD, columns, rows, index) -> None:
-    """Create the factor and buffer datasets of one output in `group`."""
-    for key, data in (("U", svd.U), ("s", svd.s), ("V", svd.V), ("columns", columns)):
-        group.create_dataset(key, data=data)
-    n_times = rows.shape[1]
-    chunk = _chunk_rows(n_times, group.file["tsvd"].attrs["batch"])
-    group.create_dataset("buffer", data=rows, maxshape=(None, n_times), chunks=(chunk, n_times))
-    group.create_dataset("buffer_index", data=index.astype(np.int64), maxshape=(None,), chunks=(chunk,),
-                         fillvalue=-1)
-
-
-def _commit(group: h5py.Group, svd: IncrementalSVD, columns, rows, index) -> None:
-    """Replace an output's factors and buffer together: staged in `next`, marked complete, moved in."""
-    if "next" in group:
-        del group["next"]
-    staged = group.create_group("next")
-    _write_state(staged, svd, columns, rows, index)
-    staged.attrs["complete"] = True
-    group.file.flush()
-    _apply_staged(group)
-    group.file.flush()
-
-
-def _apply_staged(group: h5py.Group) -> None:
-    """Move a complete staged state in place (also after a kill half-way through); drop an incomplete one."""
-    staged = group.get("next")
-    if staged is None:
-        return
-    if staged.attrs.get("complete", False):
-        for key in list(staged):
-            if key in group:
-                del group[key]
-            group.move(f"next/{key}", key)
-    del group["next"]

@@ -1,0 +1,107 @@
+"""Campaign files (YAML): read, validate (against `schema`), and turn into parameters, a design and settings.
+
+Validation happens before anything runs. Every problem is a `CampaignError` whose message
+names the file, the field and what was expected, e.g.
+`campaigns/x.yaml: parameters.CL0.interval_pct: expected a number > 0, got -3`.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Callable
+
+import yaml
+
+from ..designs import SAMPLED_DESIGNS, Design, build_design
+from ..parameters import Parameter
+from ..simulators.jsbsim import NAMED_OUTPUTS
+from . import schema
+from .schema import TOP_KEYS, CampaignError, CampaignLoader, Checker, yaml_error
+
+PropertyProbe = Callable[[dict], object]  # simulator config -> its aircraft's properties (see jsbsim_probe)
+
+@dataclass
+class Campaign:
+    """A validated campaign. `text` is the file's exact text (its hash identifies results)."""
+
+    source: str
+    text: str
+    name: str
+    seed: int
+    simulator: dict
+    parameters: list[Parameter]
+    design_spec: dict
+    method: dict
+    execution: dict
+    storage: dict
+    analysis: dict = field(default_factory=dict)
+
+    @property
+    def germs(self) -> list[str]:
+        return [p.germ for p in self.parameters]
+
+    def design(self) -> Design:
+        return build_design(self.design_spec, self.germs, self.seed)
+
+
+def load_campaign(path: str | Path, probe: PropertyProbe | None = None) -> Campaign:
+    """Read and validate a campaign file.
+
+    `probe(simulator_config)` gives the aircraft's properties
+    (`uqflight.simulators.jsbsim_probe.jsbsim_probe`); it is used for
+    JSBSim campaigns to check property and output names and to read nominal values from the
+    aircraft. Without it, those checks are skipped and nominal values must be given.
+    """
+    source = str(path)
+    try:
+        text = Path(path).read_text(encoding="utf-8")
+    except OSError as exc:
+        raise CampaignError(source, "", f"cannot read the file ({exc.strerror})") from exc
+    except UnicodeDecodeError as exc:
+        raise CampaignError(source, "", f"expected UTF-8 text, got byte {exc.object[exc.start]:#04x} "
+                                        f"at position {exc.start}") from exc
+    return parse_campaign(text, source, probe)
+
+
+def parse_campaign(text: str, source: str = "<campaign>", probe: PropertyProbe | None = None) -> Campaign:
+    """Validate campaign text; see `load_campaign`."""
+    check = Checker(source)
+    try:
+        data = yaml.load(text, Loader=CampaignLoader)
+    except yaml.YAMLError as exc:
+        raise CampaignError(source, "", yaml_error(exc)) from exc
+    data = check.mapping(data, "", TOP_KEYS, required=("name", "simulator", "parameters", "design"))
+    name = check.string(data["name"], "name")
+    seed = check.integer(data.get("seed", 0), "seed", 0)
+    simulator = schema.simulator(check, data["simulator"], source)
+    aircraft = None
+    if probe and simulator["kind"] == "jsbsim":
+        try:
+            aircraft = probe(simulator)
+        except (FileNotFoundError, RuntimeError) as exc:  # no such aircraft, or JSBSim cannot load it
+            check.fail("simulator.aircraft", str(exc))
+        for i, output in enumerate(simulator.get("outputs", ())):
+            if output not in NAMED_OUTPUTS and aircraft.value(output) is None:
+                check.fail(f"simulator.outputs[{i}]", f"expected one of {', '.join(NAMED_OUTPUTS)} or a JSBSim "
+                           f"property of aircraft {aircraft.aircraft!r}, got {output!r}{aircraft.hint(output)}")
+    parameters = schema.parameters(check, data["parameters"], simulator["kind"], aircraft)
+    design_kind = data["design"].get("kind") if isinstance(data["design"], dict) else None
+    default_method = "monte_carlo" if design_kind in SAMPLED_DESIGNS else "integration"
+    method = schema.method(check, data.get("method", {"kind": default_method}))
+    execution = schema.execution(check, data.get("execution", {}))
+    storage = schema.storage(check, data.get("storage", {}), name)
+    analysis = schema.analysis(check, data.get("analysis", {}))
+    campaign = Campaign(source, text, name, seed, simulator, parameters, data["design"], method,
+                        execution, storage, analysis)
+    try:
+        design = campaign.design()
+    except ValueError as exc:
+        message = str(exc)
+        field_path, sep, rest = message.partition(": ")
+        if sep and (field_path.startswith("design") or field_path == "seed"):
+            raise CampaignError(source, field_path, rest) from exc
+        raise CampaignError(source, "design", message) from exc
+    schema.check_method_fits_design(check, method, design, len(parameters))
+    return campaign
+
+

@@ -1,0 +1,54 @@
+"""What every simulator shares: the run status codes, the errors of a failed sample, the protocol.
+
+The status codes are stored per run in `/samples/status` of a results file; they are defined here
+once, and each error class carries its own code.
+"""
+from __future__ import annotations
+
+import enum
+from typing import Protocol
+
+import numpy as np
+
+
+class Status(enum.IntEnum):
+    """Outcome of one run, as stored in /samples/status."""
+
+    PENDING = -1
+    OK = 0
+    TRIM_FAILURE = 1
+    DIVERGED = 2
+    SIMULATOR_ERROR = 3
+
+
+class FlightError(RuntimeError):
+    """A sample that could not be flown; `status` is its code in the results file."""
+
+    status = Status.SIMULATOR_ERROR
+
+
+class TrimError(FlightError):
+    """The trim did not converge or converged to a state outside the aircraft's envelope."""
+
+    status = Status.TRIM_FAILURE
+
+
+class DivergenceError(FlightError):
+    """The flight left the envelope or produced NaN after the trim."""
+
+    status = Status.DIVERGED
+
+
+class Simulator(Protocol):
+    """One object per worker that turns a row of physical values κ into outputs."""
+
+    units: dict[str, str]
+
+    def probe(self, kappa: np.ndarray) -> tuple[np.ndarray, list[str]]:
+        """The recorded times and the output names (one call at the nominal point, if needed)."""
+
+    def evaluate(self, kappa: np.ndarray) -> dict[str, np.ndarray]:
+        """{output name: (T,)} for one sample; raises a FlightError subclass for a failed one."""
+
+    def restart(self) -> None:
+        """Forget what earlier samples left behind (called at the start of every chunk)."""

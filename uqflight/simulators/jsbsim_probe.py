@@ -1,0 +1,47 @@
+"""The aircraft as campaign validation sees it: property names, values and writability, with hints."""
+from __future__ import annotations
+
+import difflib
+from pathlib import Path
+
+import jsbsim
+
+from .jsbsim import JSBSimFlight, flight_setup_from
+
+
+class AircraftProperties:
+    """The campaign's aircraft as a sample finds it before the trim: loaded, with the flight
+    condition's initial conditions set (so `ic/vt-kts` reads the campaign's airspeed and
+    `ic/vc-kts` the matching calibrated airspeed). Validation reads nominal values here."""
+
+    def __init__(self, simulator: dict):
+        setup = flight_setup_from({**simulator, "outputs": []})
+        if not setup.aircraft_file.is_file():
+            folder = Path(setup.root) / "aircraft"
+            known = sorted(p.parent.name for p in folder.glob("*/*.xml") if p.stem == p.parent.name)
+            raise FileNotFoundError(f"expected one of {', '.join(known)} (the aircraft in {folder}), "
+                                    f"got {setup.aircraft!r}")
+        self.aircraft = setup.aircraft
+        self._flight = JSBSimFlight(setup)
+        fdm = self._flight.fdm
+        fdm["ic/h-sl-ft"] = setup.altitude_ft  # as JSBSimFlight.trim sets them
+        fdm["ic/vt-kts"] = setup.airspeed_ktas
+        names = [line.rsplit(" (", 1)[0] for line in fdm.query_property_catalog("").splitlines()]  # "name (RW)"
+        self._names = {name.lower(): name for name in names}  # for hints, whatever the case typed
+
+    def value(self, name: str) -> float | None:
+        """The property's value (None when the aircraft has no such property)."""
+        return self._flight.property_value(name)
+
+    def writable(self, name: str) -> bool:
+        return self._flight.node(name).get_attribute(jsbsim.Attribute.WRITE)
+
+    def hint(self, name: str) -> str:
+        """'; did you mean ...?' with the aircraft's properties closest to `name`, or ''."""
+        close = difflib.get_close_matches(name.lower(), self._names, n=3, cutoff=0.8)
+        return f"; did you mean {' or '.join(self._names[c] for c in close)}?" if close else ""
+
+
+def jsbsim_probe(simulator: dict) -> AircraftProperties:
+    """The campaign aircraft's properties, for `load_campaign(..., probe=jsbsim_probe)`."""
+    return AircraftProperties(simulator)

@@ -1,0 +1,52 @@
+"""Resume policy: reopen a campaign's results file when it holds the same campaign and aircraft,
+create it otherwise, and compact a finished tSVD file."""
+from __future__ import annotations
+
+from pathlib import Path
+
+import h5py
+
+from .results import ResultStore, text_hash
+
+
+def open_for_campaign(path, *, campaign_text: str, force: bool = False, **create_args) -> ResultStore:
+    """Resume `path` when it holds this campaign, else create it (see ResultStore.create).
+
+    A file holding another campaign (a different campaign_hash), or made with other aircraft files
+    (attrs["aircraft_hash"]), is refused unless `force`, which deletes and recreates it.
+    """
+    path = Path(path)
+    aircraft = (create_args.get("attrs") or {}).get("aircraft_hash")
+    if path.exists():
+        try:
+            with h5py.File(path, "r") as f:
+                stored, stored_aircraft = f.attrs.get("campaign_hash"), f.attrs.get("aircraft_hash")
+        except OSError as exc:  # e.g. killed while the file was being created: nothing to resume
+            if not force:
+                raise FileExistsError(f"{path} is not a readable results file ({exc}); choose another "
+                                      "results file, or force to overwrite it") from exc
+            stored = stored_aircraft = None
+        if stored == text_hash(campaign_text) and stored_aircraft == aircraft:
+            return ResultStore.open(path, "a")
+        if not force:
+            if stored == text_hash(campaign_text):
+                raise FileExistsError(f"{path} was made with other aircraft files (sha256 {stored_aircraft}); "
+                                      "resuming would mix two models: choose another results file, or force "
+                                      "to start over")
+            raise FileExistsError(f"{path} holds the results of another campaign (campaign_hash {stored}); "
+                                  "choose another results file, or force to overwrite it")
+        path.unlink()
+    return ResultStore.create(path, campaign_text=campaign_text, **create_args)
+
+
+def compact(path) -> None:
+    """Rewrite a file without the free space its replaced tSVD factors left behind (HDF5 does not
+    reclaim it: a 10^4-run file shrinks about tenfold). Written to a temporary file, then renamed
+    over the original, so a kill leaves one complete file."""
+    path = Path(path)
+    scratch = path.with_name(path.name + ".compacting")
+    with h5py.File(path, "r") as src, h5py.File(scratch, "w") as dst:
+        dst.attrs.update(dict(src.attrs))
+        for key in src:
+            src.copy(src[key], dst, name=key)
+    scratch.replace(path)
