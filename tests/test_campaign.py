@@ -58,7 +58,7 @@ BAD = {
     "bad_samples_string.yaml": ("design.samples", "expected an integer >= 1, got '100'"),
     "bad_method_kind.yaml": ("method.kind", "expected one of integration, pseudo_galerkin"),
     "bad_method_for_design.yaml": ("method.kind", "monte_carlo needs a sampled design"),
-    "bad_regression_order.yaml": ("method.order", "expected at most 1 for this design"),
+    "bad_regression_order.yaml": ("method.order", "the largest order with full rank is 1"),
     "bad_workers_zero.yaml": ("execution.workers", "expected an integer >= 1, got 0"),
     "bad_executor.yaml": ("execution.executor", "expected one of local, dask, got 'slurm'"),
     "bad_tsvd_tol.yaml": ("storage.tsvd.tol", "expected a relative tolerance in (0, 1), got 1.5"),

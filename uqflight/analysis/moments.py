@@ -48,10 +48,11 @@ def weighted_moments(basis, weights=None, scale=None, unbiased: bool = False) ->
         spread = deviation.T @ (w[:, None] * deviation)
         variance = ((scale.T @ spread) * scale.T).sum(axis=1)
     if unbiased:
+        n = len(basis)
         correction = 1.0 - w @ w
         if correction <= 0:
             raise ValueError("an unbiased variance needs at least two runs with positive weight")
-        variance = variance / correction
+        variance = variance * (n / (n - 1)) if weights is None else variance / correction
     return mean, variance
 
 

@@ -101,7 +101,7 @@ def parse_campaign(text: str, source: str = "<campaign>", probe: PropertyProbe |
         if sep and (field_path.startswith("design") or field_path == "seed"):
             raise CampaignError(source, field_path, rest) from exc
         raise CampaignError(source, "design", message) from exc
-    schema.check_method_fits_design(check, method, design, len(parameters))
+    schema.check_method_fits_design(check, method, design, campaign.germs)
     return campaign
 
 

@@ -10,8 +10,10 @@ from pathlib import Path
 
 import yaml
 
-from ..designs import SAMPLED_DESIGNS, Design
-from ..methods import METHOD_KINDS
+from ..designs import Design, is_sampled
+from ..methods import METHOD_KINDS, method_entry
+from ..methods.exactness import exact_total_degree, max_projection_order
+from ..methods.validity import method_problem
 from ..parameters import DISTRIBUTIONS, Parameter, make_parameter
 from ..simulators.jsbsim import NAMED_OUTPUTS, Excitation
 from ..simulators.python import PluginError, load_function
@@ -23,10 +25,11 @@ TOP_KEYS = ("name", "description", "seed", "simulator", "parameters", "design", 
 JSBSIM_KEYS = ("kind", "aircraft", "flight", "excitation", "duration_s", "output_rate_hz", "outputs")
 PYTHON_KEYS = ("kind", "function", "outputs")
 PARAMETER_KEYS = ("property", "distribution", "nominal", "interval_pct", "lower", "upper")
-METHOD_KEYS = ("kind", "order", "split")
+METHOD_KEYS = ("kind", "order", "split", "allow_aliasing")
 EXECUTION_KEYS = ("workers", "executor", "scheduler", "chunk")
 STORAGE_KEYS = ("path", "raw", "tsvd")
 TSVD_KEYS = ("tol", "batch")
+DEFAULT_ORDER = 2
 ANALYSIS_KEYS = ("band_samples", "bootstrap")
 
 
@@ -144,19 +147,19 @@ def yaml_error(exc: yaml.YAMLError) -> str:
     return message
 
 
-def check_method_fits_design(check: Checker, method: dict, design: Design, dimensions: int) -> None:
-    if method["kind"] == "monte_carlo" and design.kind not in SAMPLED_DESIGNS:
-        check.fail("method.kind", f"monte_carlo needs a sampled design ({', '.join(SAMPLED_DESIGNS)}); "
-                   f"a {design.kind} needs its weights: use integration, pseudo_galerkin, interpolation, "
-                   "regression or least_squares")
-    if method["kind"] in ("regression", "least_squares"):
-        order, points = method["order"], len(design.xi)
-        terms = math.comb(dimensions + order, order)
-        if points < terms:
-            fitting = max((o for o in range(order) if math.comb(dimensions + o, o) <= points), default=0)
-            check.fail("method.order", f"expected at most {fitting} for this design: {method['kind']} of "
-                       f"order {order} in {dimensions} dimensions fits {terms} terms, but the design has "
-                       f"only {points} points")
+def check_method_fits_design(check: Checker, method: dict, design: Design, germs: list[str]) -> None:
+    """Refuse, before anything runs, a method the design's points cannot carry (methods.validity).
+    Without `order`, the order is 2, or the largest a grid's projection allows when that is lower."""
+    sampled = is_sampled(design.kind)
+    if "order" not in method:
+        method["order"] = DEFAULT_ORDER
+        if method_entry(method["kind"]).rule == "projection" and not sampled:
+            degree = exact_total_degree(design.xi, design.weights, germs, max_degree=2 * DEFAULT_ORDER)
+            method["order"] = max(0, min(DEFAULT_ORDER, max_projection_order(degree)))
+    problem = method_problem(method["kind"], method["order"], design.xi, design.weights, germs, sampled,
+                             allow_aliasing=method.get("allow_aliasing", False))
+    if problem:
+        check.fail("method.order" if method["kind"] != "monte_carlo" else "method.kind", problem)
 
 
 def simulator(check: Checker, value, source: str) -> dict:
@@ -265,8 +268,11 @@ def parameters(check: Checker, value, kind: str, aircraft) -> list[Parameter]:
 def method(check: Checker, value) -> dict:
     method = dict(check.mapping(value, "method", METHOD_KEYS, required=("kind",)))
     check.string(method["kind"], "method.kind", METHOD_KINDS)
-    method["order"] = check.integer(method.get("order", 2), "method.order", 0)
+    if "order" in method:
+        check.integer(method["order"], "method.order", 0)
     method["split"] = check.boolean(method.get("split", False), "method.split")
+    if "allow_aliasing" in method:  # kept only when given, so that files of older campaigns stay identical
+        check.boolean(method["allow_aliasing"], "method.allow_aliasing")
     return method
 
 

@@ -5,8 +5,8 @@ quadrature errors of the orthonormal basis, E[Ψ_α] = δ_{α,0}, not taken from
 """
 import numpy as np
 
-from .basis import orthonormal_basis, total_degree_indices
 from ..parameters.germs import check_germs
+from .basis import orthonormal_basis, total_degree_indices
 
 EXACTNESS_RTOL = np.sqrt(np.finfo(float).eps)  # ~1.5e-8; see exact_total_degree
 
