@@ -14,17 +14,12 @@ from pathlib import Path
 
 import numpy as np
 
-from .statistics import Statistics, analyse
-from .store import ResultStore
+from .statistics import BadInput, Statistics, json_ready, read_statistics
 
 BASELINE_KIND = "uqflight-baseline"
 BASELINE_VERSION = 1
 STATISTICS = ("mean", "variance", "band99.lower", "band99.upper", "sobol_first", "sobol_total")
 TIME_ATOL = 1e-9  # seconds: time grids closer than this are the same grid
-
-
-class BadInput(ValueError):
-    """A results file or baseline that cannot be used; the message is one line naming it."""
 
 
 @dataclass
@@ -51,21 +46,6 @@ class Comparison:
     drifts: list[Drift]
 
 
-def read_statistics(path: Path, method: dict | None = None) -> tuple[Statistics, dict]:
-    """The statistics of a results file (with `method` overriding the campaign's) and its root
-    attributes (campaign_hash, ...); BadInput if unreadable."""
-    path = Path(path)
-    if not path.is_file():
-        raise BadInput(f"{path}: no such results file")
-    try:
-        with ResultStore.open(path) as store:
-            attrs = store.attrs
-        return analyse(path, method=method), attrs
-    except (OSError, ValueError, KeyError) as exc:
-        reason = " ".join(str(exc).split())  # one line, whatever h5py or the analysis said
-        raise BadInput(f"{path}: cannot analyse the results file ({reason})") from exc
-
-
 def _series(entry) -> dict[str, list]:
     """The compared statistics of one output ({statistic: values}) from a baseline entry (dict)."""
     series = {"mean": entry["mean"], "variance": entry["variance"],
@@ -79,12 +59,11 @@ def baseline_json(stats: Statistics, campaign_hash: str) -> dict:
     """The baseline of `stats`: per output its time grid and compared statistics, and the campaign hash."""
     outputs = {}
     for name, out in stats.outputs.items():
-        outputs[name] = {
-            "time": out.time.tolist(), "mean": out.mean.tolist(), "variance": out.variance.tolist(),
-            "band99": {"lower": out.band99[0].tolist(), "upper": out.band99[1].tolist()},
-            "sobol_first": {k: v.tolist() for k, v in out.sobol_first.items()},
-            "sobol_total": {k: v.tolist() for k, v in out.sobol_total.items()},
-        }
+        outputs[name] = json_ready({
+            "time": out.time, "mean": out.mean, "variance": out.variance,
+            "band99": {"lower": out.band99[0], "upper": out.band99[1]},
+            "sobol_first": out.sobol_first, "sobol_total": out.sobol_total,
+        })
     return {"kind": BASELINE_KIND, "version": BASELINE_VERSION, "results": stats.path,
             "campaign": stats.campaign_name, "campaign_hash": campaign_hash, "method": stats.method,
             "outputs": outputs}
@@ -93,7 +72,7 @@ def baseline_json(stats: Statistics, campaign_hash: str) -> dict:
 def write_baseline(stats: Statistics, campaign_hash: str, path: Path) -> Path:
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    path.write_text(json.dumps(baseline_json(stats, campaign_hash), indent=1) + "\n", encoding="utf-8")
+    path.write_text(json.dumps(baseline_json(stats, campaign_hash), indent=1, allow_nan=False) + "\n", encoding="utf-8")
     return path
 
 

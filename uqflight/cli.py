@@ -204,6 +204,10 @@ def report(
                                                     "pseudo_galerkin, interpolation, regression, least_squares, "
                                                     "monte_carlo (the runs of one grid serve every method)."),
     order: Optional[int] = typer.Option(None, help="Polynomial order with --method (default: the campaign's)."),
+    partial: bool = typer.Option(False, help="Analyse a file with pending runs on its completed runs, where that "
+                                             "is valid (Monte Carlo, QMC, least squares, regression); labelled partial."),
+    allow_aliasing: bool = typer.Option(False, help="Let a projection's order exceed what the grid integrates "
+                                                    "exactly (refused otherwise); the report says so."),
 ):
     """Statistics, tables, plots and a report page of one or more results files.
 
@@ -214,8 +218,8 @@ def report(
     pick_freeze file is given), plots/*.png, report.html (self-contained, plots embedded) and
     report.md (linking plots/).
     """
-    from .check import BadInput
     from .report import write_report
+    from .statistics import BadInput
 
     try:
         selected = [float("inf") if t.strip() == "end" else float(t) for t in times.split(",")]
@@ -228,7 +232,7 @@ def report(
         raise typer.BadParameter(f"expected an integer >= 0, got {order}", param_hint="--order")
     try:
         written = write_report(results, out, reference=reference, times=selected, baseline=write_baseline,
-                               method=override or None)
+                               method=override or None, partial=partial, allow_aliasing=allow_aliasing)
     except BadInput as exc:
         typer.echo(f"error: {exc}", err=True)
         raise typer.Exit(2)
@@ -246,6 +250,7 @@ def check(
     baseline: Path = typer.Option(..., help="Baseline JSON from `uqflight report ... --write-baseline`."),
     rtol: float = typer.Option(1e-6, help="Relative tolerance."),
     atol: float = typer.Option(1e-9, help="Absolute tolerance, in each statistic's own unit."),
+    partial: bool = typer.Option(False, help="Check a file with pending runs on its completed runs (see report)."),
 ):
     """Recompute a results file's statistics and compare them with a baseline.
 
@@ -255,14 +260,15 @@ def check(
     (the worst values per statistic are listed); 2: bad input (missing or malformed baseline, other
     outputs or time grid, unreadable results file).
     """
-    from .check import BadInput, compare, drift_table, load_baseline, read_statistics
+    from .check import compare, drift_table, load_baseline
+    from .statistics import BadInput, read_statistics
 
     if rtol < 0 or atol < 0:
         typer.echo("error: --rtol and --atol must be >= 0", err=True)
         raise typer.Exit(2)
     try:
         expected = load_baseline(baseline)
-        stats, attrs = read_statistics(results)
+        stats, attrs = read_statistics(results, partial=partial)
         comparison = compare(stats, expected, rtol, atol)
     except BadInput as exc:
         typer.echo(f"error: {exc}", err=True)

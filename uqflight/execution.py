@@ -64,6 +64,7 @@ def prepare_store(campaign: Campaign, design: Design, out: Path, force: bool) ->
     simulator = spec.build()
     time_grid, outputs = simulator.probe(to_physical(campaign.parameters, np.zeros((1, len(campaign.parameters))))[0])
     attrs = {"versions": json.dumps(versions()), "campaign_name": campaign.name,
+             "campaign_path": str(Path(campaign.source).resolve()),
              "method": json.dumps(campaign.method), "germs": json.dumps(campaign.germs),
              "analysis": json.dumps(campaign.analysis),
              "design_kind": design.kind, "design_info": json.dumps(design.info, default=str)}

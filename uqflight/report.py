@@ -25,8 +25,8 @@ import numpy as np
 import yaml
 
 from . import plots
-from .check import read_statistics, write_baseline
-from .statistics import Statistics, add_reference_errors, summary_json
+from .check import write_baseline
+from .statistics import Statistics, add_reference_errors, read_statistics, summary_json
 
 METHOD_NAMES = {"integration": "Int", "pseudo_galerkin": "PG", "interpolation": "interpolation",
                 "regression": "regression", "least_squares": "least squares", "monte_carlo": "MC"}
@@ -101,15 +101,15 @@ def input_distributions(campaign_text: str) -> str:
     return ", ".join(dict.fromkeys(str(spec.get("distribution", "?")) for spec in parameters.values()))
 
 
-def load_entries(paths: list[Path], reference: Path | None,
-                 method: dict | None = None) -> tuple[list[Entry], Entry | None]:
+def load_entries(paths: list[Path], reference: Path | None, method: dict | None = None,
+                 partial: bool = False, allow_aliasing: bool = False) -> tuple[list[Entry], Entry | None]:
     """Every file analysed (with `method` overriding the campaigns' methods, the reference
     excepted), with errors against the reference unless it is the reference itself, and the reference."""
     stems: set[str] = set()
     ref = _entry(reference, *read_statistics(reference), set()) if reference else None
     entries = []
     for path in paths:
-        stats, attrs = read_statistics(path, method)
+        stats, attrs = read_statistics(path, method, partial=partial, allow_aliasing=allow_aliasing)
         if ref is not None and not _same_file(path, reference):
             add_reference_errors(stats, ref.stats)
         entries.append(_entry(path, stats, attrs, stems))
@@ -118,7 +118,8 @@ def load_entries(paths: list[Path], reference: Path | None,
 
 def _entry(path: Path, stats: Statistics, attrs: dict, stems: set[str]) -> Entry:
     stem = _unique(file_name(Path(path).stem), stems)
-    label = f"{stats.campaign_name or stem}: {method_label(stats.method)}, {stats.runs} runs"
+    runs = f"partial: {stats.completed} of {stats.runs} runs" if stats.partial else f"{stats.runs} runs"
+    label = f"{stats.campaign_name or stem}: {method_label(stats.method)}, {runs}"
     return Entry(stats, stem, label, str(attrs.get("campaign_hash", "")),
                  input_distributions(str(attrs.get("campaign", ""))))
 
@@ -142,12 +143,14 @@ def _unique(stem: str, taken: set[str]) -> str:
 
 
 def write_report(paths: list[Path], out_dir: Path, reference: Path | None = None,
-                 times=DEFAULT_TIMES, baseline: Path | None = None, method: dict | None = None) -> list[Path]:
-    """Write the whole report of `paths` into `out_dir`; returns the files written."""
+                 times=DEFAULT_TIMES, baseline: Path | None = None, method: dict | None = None,
+                 partial: bool = False, allow_aliasing: bool = False) -> list[Path]:
+    """Write the whole report of `paths` into `out_dir`; returns the files written. Nothing is written
+    when a file is refused (statistics.BadInput)."""
     out_dir = Path(out_dir)
+    entries, ref = load_entries(paths, reference, method, partial, allow_aliasing)
     for sub in ("plots", "tables"):
         (out_dir / sub).mkdir(parents=True, exist_ok=True)
-    entries, ref = load_entries(paths, reference, method)
     written = write_summaries(entries, out_dir)
     written += write_statistics_tables(entries, out_dir)
     sections = build_sections(entries, ref, times, out_dir)
@@ -421,7 +424,7 @@ def write_csv(path: Path, header: list[str], rows: list[list]) -> Path:
 
 
 def _write_json(path: Path, data: dict) -> Path:
-    path.write_text(json.dumps(data, indent=1) + "\n", encoding="utf-8")
+    path.write_text(json.dumps(data, indent=1, allow_nan=False) + "\n", encoding="utf-8")
     return path
 
 

@@ -1,34 +1,57 @@
-"""Statistics of a results file: the campaign's method applied per output, vectorised over time.
+"""Statistics of a results file: the method registry applied per output, vectorised over time.
 
-For each output: mean, variance, the 99 % band, PDFs over time, the modified coefficient of
-variation, Sobol' indices, and, against a Monte Carlo reference file, the errors of Eq. 49 and the
-Kullback-Leibler divergence of Eq. 50.
+For each output: mean, variance, quantiles and the 99 % band, skewness and kurtosis, PDFs over time,
+the modified coefficient of variation, Sobol' indices, a leave-one-out error for the fits, the
+difference to the next lower order for the projections, and, against a reference file, the errors of
+Eq. 49 with the reference's own noise floor and the Kullback-Leibler divergence of Eq. 50.
 
-Every method is linear in the runs, so with tSVD storage (Y = V diag(s) Uᵀ) the method is applied
-to V (N × r) and the result multiplied by diag(s) Uᵀ: statistics come from the factors without
-rebuilding the sample matrix. Samples are rebuilt (in blocks, by the store) only for Monte Carlo
-quantiles and PDFs.
+A number here is right, refused (`BadInput` naming the file, the count or the order and what to do)
+or flagged (`Statistics.notes`, `null` in summary.json):
+* pending runs are refused unless `partial`, and then only where a subset of the runs is valid;
+* failed runs: sampled designs give statistics conditional on success (noted); grids refuse the
+  projections and weighted sums, and the fits are made on the successful runs after a rank check;
+* a method the points cannot carry is refused (`methods.validity`), aliasing only when allowed;
+* Sobol' indices of a variance at rounding noise, and an undefined CoV, are NaN here and null in JSON.
+
+Every method is linear in the runs, so with tSVD storage (Y = V diag(s) Uᵀ) the method is applied to V
+(N × r) and the result multiplied by diag(s) Uᵀ: statistics come from the factors without rebuilding
+the sample matrix. Samples are rebuilt (in blocks of times) only for quantiles, PDFs and KLDs.
 """
 from __future__ import annotations
 
 import json
+import math
 from dataclasses import dataclass, field
+from pathlib import Path
 
 import numpy as np
 
 from .analysis.density import pdf_over_time
 from .analysis.divergence import kl_divergence
 from .analysis.errors import error_summary, relative_errors
-from .analysis.moments import modified_cov, quantile_band, weighted_moments
+from .analysis.failures import failure_probability
+from .analysis.floors import central_moments, floors_from_moments, kld_floor
+from .analysis.moments import modified_cov, standardised_moments, weighted_moments, weighted_quantiles
+from .analysis.resolution import resolved_variance
 from .analysis.sobol import pick_freeze_indices
+from .designs import REGISTRY as DESIGNS
 from .designs import is_sampled
-from .methods import PCE, method_entry
+from .methods import PCE, METHODS, method_entry
 from .methods.basis import orthonormal_basis
+from .methods.loo import relative_loo_error
+from .methods.validity import method_problem
 from .parameters.germs import draw_germs
 from .store import ResultStore, Status
 
 PDF_POINTS = 120
 TIME_BLOCK = 100  # recorded times whose runs or surrogate draws are rebuilt at once
+BAND_LEVEL = 0.99
+DEFAULT_QUANTILES = (0.005, 0.995)
+
+
+class BadInput(ValueError):
+    """A results file, baseline or request that cannot give right numbers; the message is one line that
+    names the file and says what to do."""
 
 
 @dataclass
@@ -38,6 +61,7 @@ class Options:
     band_samples: int = 20000
     bootstrap: int = 200
     seed: int = 0
+    quantiles: tuple[float, ...] = DEFAULT_QUANTILES
 
 
 @dataclass
@@ -50,11 +74,20 @@ class OutputStatistics:
     band99: tuple[np.ndarray, np.ndarray]
     pdf_support: np.ndarray
     pdf_density: np.ndarray
-    cov: np.ndarray
-    sobol_first: dict[str, np.ndarray] = field(default_factory=dict)
+    cov: np.ndarray  # NaN where undefined (a mean that is zero at every time)
+    resolved: np.ndarray  # bool (T,): the variance is above rounding noise (analysis.resolution)
+    quantiles: dict[float, np.ndarray] = field(default_factory=dict)
+    skewness: np.ndarray | None = None
+    kurtosis: np.ndarray | None = None
+    sobol_first: dict[str, np.ndarray] = field(default_factory=dict)  # NaN where unresolved
     sobol_total: dict[str, np.ndarray] = field(default_factory=dict)
-    sobol_first_ci: dict[str, np.ndarray] = field(default_factory=dict)
+    sobol_first_ci: dict[str, np.ndarray] = field(default_factory=dict)  # (2, T) per parameter
+    sobol_total_ci: dict[str, np.ndarray] = field(default_factory=dict)
+    loo_error: np.ndarray | None = None  # relative leave-one-out error of a fit, (T,)
+    convergence: dict | None = None  # difference to the next lower order of a projection
+    coefficient_decay: dict[int, np.ndarray] | None = None  # degree -> RSS of its PCE coefficients (T,)
     final_samples: np.ndarray | None = None  # runs or surrogate draws at the final time, for the KLD
+    fourth_central: np.ndarray | None = None  # of the runs, for a sampled reference's noise floor
     errors: dict = field(default_factory=dict)
 
     @property
@@ -69,10 +102,17 @@ class Statistics:
     method: dict
     design_kind: str
     parameter_names: list[str]
-    runs: int
+    runs: int  # the design's runs
+    completed: int
     failed: int
+    pending: int
     outputs: dict[str, OutputStatistics]
+    failure_probability: dict | None = None
+    failures: list[dict] = field(default_factory=list)
+    partial: bool = False
+    notes: list[str] = field(default_factory=list)
     reference: str | None = None
+    from_runs: bool = False  # statistics of the runs themselves (a sampled design), not of a PCE
 
 
 def campaign_facts(store: ResultStore) -> tuple[dict, list[str], dict]:
@@ -82,31 +122,102 @@ def campaign_facts(store: ResultStore) -> tuple[dict, list[str], dict]:
             json.loads(attrs.get("analysis", "{}")))
 
 
-def analyse(path, reference: str | None = None, options: Options | None = None,
-            method: dict | None = None) -> Statistics:
-    """All statistics of the results file `path` (and errors against `reference`, a Monte Carlo file).
+def read_statistics(path, method: dict | None = None, partial: bool = False,
+                    allow_aliasing: bool = False) -> tuple[Statistics, dict]:
+    """The statistics of a results file (`method` overriding the campaign's) and its root attributes;
+    BadInput, one line naming the file, when it cannot give right numbers."""
+    path = Path(path)
+    if not path.is_file():
+        raise BadInput(f"{path}: no such results file")
+    try:
+        with ResultStore.open(path) as store:
+            attrs = store.attrs
+        return analyse(path, method=method, partial=partial, allow_aliasing=allow_aliasing), attrs
+    except BadInput:
+        raise
+    except (OSError, ValueError, KeyError) as exc:
+        reason = " ".join(str(exc).split())  # one line, whatever h5py or the analysis said
+        raise BadInput(f"{path}: cannot analyse the results file ({reason})") from exc
 
-    `method` ({"kind", "order", "split"}) overrides the campaign's: the runs of one grid serve
-    every method, so methods and orders are compared on the same runs.
+
+def analyse(path, reference: str | None = None, options: Options | None = None, method: dict | None = None,
+            partial: bool = False, allow_aliasing: bool = False) -> Statistics:
+    """All statistics of the results file `path` (and errors against `reference`).
+
+    `method` ({"kind", "order", "split"}) overrides the campaign's: the runs of one grid serve every
+    method, so methods and orders are compared on the same runs. `partial` analyses a file with pending
+    runs where a subset of the runs is valid; `allow_aliasing` lets a projection exceed the grid's degree.
     """
     with ResultStore.open(path) as store:
         stored_method, germs, analysis = campaign_facts(store)
-        method = {**stored_method, **(method or {})}
-        options = options or Options(**{k: analysis[k] for k in ("band_samples", "bootstrap")
-                                        if k in analysis})
+        method = {"order": 2, **stored_method, **(method or {})}
+        allow_aliasing = allow_aliasing or bool(method.get("allow_aliasing"))
+        options = options or Options(**{k: (tuple(v) if k == "quantiles" else v) for k, v in analysis.items()
+                                        if k in ("band_samples", "bootstrap", "quantiles")})
         status = store.status
-        ok = status == Status.OK
-        if not ok.any():
-            raise ValueError(f"{path}: no successful runs to analyse")
         design_kind = store.attrs.get("design_kind", "")
-        outputs = {name: _output_statistics(store, name, method, germs, design_kind, ok, options)
-                   for name in store.output_names}
+        if design_kind not in DESIGNS:
+            raise BadInput(f"{path}: unknown design kind {design_kind!r} in the file")
+        if method["kind"] not in METHODS:
+            raise BadInput(f"{path}: unknown method {method['kind']!r}: expected one of {', '.join(METHODS)}")
+        sampled = is_sampled(design_kind)
+        ok = status == Status.OK
+        pending = int(np.sum(status == Status.PENDING))
         stats = Statistics(str(path), store.attrs.get("campaign_name", ""), method, design_kind,
-                           store.parameter_names, int(status.size), int((status > 0).sum()), outputs)
+                           store.parameter_names, int(status.size), int(ok.sum()), int(np.sum(status > 0)),
+                           pending, {}, partial=pending > 0)
+        _check_runs(store, stats, sampled, partial)
+        problem = method_problem(method["kind"], method["order"], store.xi[ok], store.weights[ok], germs, sampled,
+                                 missing=int(status.size - ok.sum()), allow_aliasing=allow_aliasing)
+        if problem:
+            raise BadInput(f"{path}: method {method['kind']} order {method['order']}: {problem}")
+        _note_runs(store, stats, sampled, allow_aliasing)
+        stats.from_runs = method_entry(method["kind"]).runs_on_sampled and sampled
+        for name in store.output_names:
+            stats.outputs[name] = _output_statistics(store, name, method, germs, design_kind, ok, options)
     if reference:
         add_reference_errors(stats, analyse(reference, options=Options(
-            band_samples=options.band_samples, bootstrap=0, seed=options.seed)))
+            band_samples=options.band_samples, bootstrap=0, seed=options.seed, quantiles=options.quantiles)))
     return stats
+
+
+def _check_runs(store: ResultStore, stats: Statistics, sampled: bool, partial: bool) -> None:
+    """Refuse pending runs (unless partial, and then where a subset is valid) and a file with no run done."""
+    path, n = stats.path, stats.runs
+    if stats.pending and not partial:
+        campaign = store.attrs.get("campaign_path") or "CAMPAIGN.yaml"
+        raise BadInput(f"{path}: {stats.pending} of {n} runs are pending (interrupted, or still running): resume "
+                       f"them with `uqflight run {campaign} --out {path}`, or add --partial to analyse the "
+                       f"{stats.completed} completed runs (Monte Carlo, QMC, least squares and regression only)")
+    if stats.pending and not sampled and not method_entry(stats.method["kind"]).partial:
+        raise BadInput(f"{path}: --partial: {stats.method['kind']} on a {stats.design_kind} needs every run of "
+                       f"the grid ({stats.pending} of {n} pending); use --method least_squares or regression, "
+                       f"or resume the campaign")
+    if stats.completed == 0:
+        raise BadInput(f"{path}: no successful runs to analyse ({stats.failed} failed, {stats.pending} pending)")
+
+
+def _note_runs(store: ResultStore, stats: Statistics, sampled: bool, allow_aliasing: bool) -> None:
+    """Failure probability, the failed runs, and the notes a reader must see."""
+    status = store.status
+    done = status != Status.PENDING
+    failed = status[done] > 0
+    stats.failure_probability = failure_probability(failed, None if sampled else store.weights[done])
+    if stats.failed:
+        kappa, reasons, names = store.kappa, store.reasons, store.parameter_names
+        stats.failures = [{"run": int(i), "status": Status(int(status[i])).name.lower(), "reason": reasons[i],
+                           "parameters": dict(zip(names, map(float, kappa[i])))}
+                          for i in np.flatnonzero(status > 0)]
+        if sampled:
+            stats.notes.append(f"{stats.failed} of {stats.runs - stats.pending} runs failed: the statistics are "
+                               "conditional on success (the failure probability is given apart)")
+        else:
+            stats.notes.append(f"{stats.failed} grid runs failed: {stats.method['kind']} is fitted on the "
+                               f"{stats.completed} successful runs")
+    if stats.pending:
+        stats.notes.append(f"partial: {stats.completed} of {stats.runs} runs")
+    if allow_aliasing and not sampled and method_entry(stats.method["kind"]).rule == "projection":
+        stats.notes.append("aliasing allowed: the projection's order may exceed what the grid integrates exactly")
 
 
 def output_basis(store: ResultStore, name: str, ok: np.ndarray) -> tuple[np.ndarray, np.ndarray | None]:
@@ -126,6 +237,7 @@ def _output_statistics(store: ResultStore, name: str, method: dict, germs: list[
     kind, order = method["kind"], method["order"]
     entry = method_entry(kind)
     basis, scale = output_basis(store, name, ok)
+    truncation = _tsvd_resolution(store, scale, int(ok.sum()))
     from_runs = entry.runs_on_sampled and is_sampled(design_kind)
     x0 = None
     # x = x0 + S with each run's initial value (needs the runs themselves); only the projections use
@@ -153,50 +265,108 @@ def _output_statistics(store: ResultStore, name: str, method: dict, germs: list[
         rows, row_scale, band_weights = orthonormal_basis(germs, pce.indices, draws), pce.coefficients, None
     pick_freeze = pce is None and design_kind == "pick_freeze" and ok.all()
     blocks = _over_time_blocks(rows, row_scale, store.time.size, band_weights,
-                               len(store.parameter_names) if pick_freeze else 0, options)
-    std = np.sqrt(np.maximum(variance, 0.0))
+                               len(store.parameter_names) if pick_freeze else 0, options, from_runs)
+    resolved = resolved_variance(variance, mean, n=int(ok.sum()), weights=None if from_runs else weights,
+                                 atol=truncation)
     stats = OutputStatistics(name, store.units.get(name, ""), store.time, mean, variance, blocks["band"],
-                             blocks["support"], blocks["density"], modified_cov(mean, std),
-                             final_samples=blocks["final"])
+                             blocks["support"], blocks["density"], modified_cov(mean, np.sqrt(np.maximum(variance, 0))),
+                             resolved, quantiles=dict(zip(options.quantiles, blocks["quantiles"])),
+                             skewness=blocks["skewness"], kurtosis=blocks["kurtosis"],
+                             final_samples=blocks["final"], fourth_central=blocks.get("fourth"))
     names = store.parameter_names
+
+    def masked(indices):
+        return np.where(resolved, indices, np.nan)
+
     if pce is not None:
-        stats.sobol_first = dict(zip(names, pce.sobol_first()))
-        stats.sobol_total = dict(zip(names, pce.sobol_total()))
+        stats.sobol_first = dict(zip(names, masked(pce.sobol_first())))
+        stats.sobol_total = dict(zip(names, masked(pce.sobol_total())))
+        stats.coefficient_decay = _coefficient_decay(pce)
+        if entry.rule == "fit":
+            stats.loo_error = _loo_error(kind, xi, weights, expand(basis) if scale is not None else basis,
+                                         germs, pce.indices)
+        elif entry.moments == "pce" and order >= 1:
+            stats.convergence = _lower_order_difference(entry, xi, weights, basis, scale, germs, order, x0, pce)
     elif pick_freeze:
-        stats.sobol_first = dict(zip(names, blocks["first"]))
-        stats.sobol_total = dict(zip(names, blocks["total"]))
+        stats.sobol_first = dict(zip(names, masked(blocks["first"])))
+        stats.sobol_total = dict(zip(names, masked(blocks["total"])))
         stats.sobol_first_ci = dict(zip(names, np.moveaxis(blocks["first_ci"], 1, 0)))
+        stats.sobol_total_ci = dict(zip(names, np.moveaxis(blocks["total_ci"], 1, 0)))
     return stats
 
 
-def _over_time_blocks(rows, scale, n_times: int, weights, pick_freeze_dimensions: int, options: Options) -> dict:
-    """99 % band, PDFs, final-time samples (and pick-freeze indices) of Y = rows @ scale (scale None:
-    Y = rows), rebuilding Y for TIME_BLOCK times at once: the memory stays that of one block
-    whatever the number of runs or draws. Every statistic here is per time, so blocks change nothing."""
-    parts: dict[str, list] = {key: [] for key in ("lower", "upper", "support", "density", "first", "total",
-                                                  "first_ci")}
+def _tsvd_resolution(store: ResultStore, scale: np.ndarray | None, n: int) -> float:
+    """The std a tSVD truncation can hide: tol·σ₁/√n per run, σ₁ the norm of scale = diag(s) Uᵀ's first
+    row (0 for raw storage)."""
+    if scale is None or not len(scale):
+        return 0.0
+    return float(store.tsvd_tolerance * np.linalg.norm(scale[0]) / math.sqrt(max(n, 1)))
+
+
+def _coefficient_decay(pce: PCE) -> dict[int, np.ndarray]:
+    """Root-sum-square of the PCE coefficients of each total degree, over time: how fast they decay."""
+    degrees = np.asarray(pce.indices).sum(axis=1)
+    return {int(p): np.sqrt((pce.coefficients[degrees == p] ** 2).sum(axis=0)) for p in np.unique(degrees)}
+
+
+def _loo_error(kind, xi, weights, Y, germs, indices) -> np.ndarray:
+    """The relative leave-one-out error of the fit over time (methods.loo), weighted as the fit is."""
+    matrix = orthonormal_basis(germs, indices, xi)
+    try:
+        return relative_loo_error(matrix, Y, None if kind == "regression" else np.abs(weights))
+    except ValueError:  # a point the fit interpolates: leaving it out is undefined
+        return np.full(Y.shape[1], np.nan)
+
+
+def _lower_order_difference(entry, xi, weights, basis, scale, germs, order, x0, pce: PCE) -> dict:
+    """ε_m, ε_v (Eq. 49's normalisation) between this projection and the one of order − 1 on the same
+    runs: a cheap estimate of the truncation error, with no reference needed."""
+    lower = entry.pce(xi, weights, basis, germs, order - 1, x0)
+    coefficients = lower.coefficients if scale is None else lower.coefficients @ scale
+    lower = PCE(lower.germs, lower.indices, coefficients)
+    eps_m, eps_v = relative_errors(lower.mean(), lower.variance(), pce.mean(), pce.variance())
+    return {"against": f"order {order - 1}", "eps_m": eps_m, "eps_v": eps_v}
+
+
+def _over_time_blocks(rows, scale, n_times: int, weights, pick_freeze_dimensions: int, options: Options,
+                      from_runs: bool) -> dict:
+    """Quantiles, 99 % band, skewness and kurtosis, PDFs, final-time samples (the runs' fourth central
+    moments, pick-freeze indices) of Y = rows @ scale (scale None: Y = rows), rebuilding Y for
+    TIME_BLOCK times at once: the memory stays that of one block whatever the number of runs or draws.
+    Every statistic here is per time, so blocks change nothing."""
+    probabilities = (0.5 * (1 - BAND_LEVEL), 0.5 * (1 + BAND_LEVEL), *options.quantiles)
+    parts: dict[str, list] = {key: [] for key in ("quantiles", "support", "density", "skewness", "kurtosis",
+                                                  "fourth", "first", "total", "first_ci", "total_ci")}
     for start in range(0, n_times, TIME_BLOCK):
         stop = min(start + TIME_BLOCK, n_times)
         Y = rows[:, start:stop] if scale is None else rows @ scale[:, start:stop]
-        lower, upper = quantile_band(Y, weights)
+        parts["quantiles"].append(weighted_quantiles(Y, probabilities, weights))
         support, density = pdf_over_time(Y, PDF_POINTS)
-        for key, value in (("lower", lower), ("upper", upper), ("support", support), ("density", density)):
+        skewness, kurtosis = standardised_moments(Y, weights)
+        for key, value in (("support", support), ("density", density), ("skewness", skewness),
+                           ("kurtosis", kurtosis)):
             parts[key].append(value)
+        if from_runs and weights is None:
+            parts["fourth"].append(central_moments(Y)[2])
         if pick_freeze_dimensions:
             indices = pick_freeze_indices(Y, pick_freeze_dimensions, n_boot=options.bootstrap, seed=options.seed)
-            for key in ("first", "total", "first_ci"):
+            for key in ("first", "total", "first_ci", "total_ci"):
                 parts[key].append(indices[key])
-    joined = {"band": (np.concatenate(parts["lower"]), np.concatenate(parts["upper"])),
+    quantiles = np.concatenate(parts["quantiles"], axis=1)
+    joined = {"band": (quantiles[0], quantiles[1]), "quantiles": list(quantiles[2:]),
               "support": np.concatenate(parts["support"]), "density": np.concatenate(parts["density"]),
+              "skewness": np.concatenate(parts["skewness"]), "kurtosis": np.concatenate(parts["kurtosis"]),
               "final": Y[:, -1].copy()}
+    if parts["fourth"]:
+        joined["fourth"] = np.concatenate(parts["fourth"])
     if pick_freeze_dimensions:
-        joined.update(first=np.concatenate(parts["first"], axis=-1), total=np.concatenate(parts["total"], axis=-1),
-                      first_ci=np.concatenate(parts["first_ci"], axis=-1))
+        joined.update({key: np.concatenate(parts[key], axis=-1) for key in ("first", "total", "first_ci", "total_ci")})
     return joined
 
 
 def add_reference_errors(stats: Statistics, reference: Statistics) -> None:
-    """ε_m, ε_v over time (Eq. 49) and the KLD at the final time (Eq. 50) against the reference."""
+    """ε_m, ε_v over time (Eq. 49) and the KLD at the final time (Eq. 50) against the reference, with the
+    reference's own noise floor in the same normalisation (analysis.floors)."""
     stats.reference = reference.path
     for name, out in stats.outputs.items():
         ref = reference.outputs.get(name)
@@ -205,27 +375,73 @@ def add_reference_errors(stats: Statistics, reference: Statistics) -> None:
         eps_m, eps_v = relative_errors(out.mean, out.variance, ref.mean, ref.variance)
         kld = kl_divergence(out.final_samples, ref.final_samples)
         out.errors = {"eps_m": eps_m, "eps_v": eps_v, "eps_m_summary": error_summary(eps_m),
-                      "eps_v_summary": error_summary(eps_v), "kld_final": kld}
+                      "eps_v_summary": error_summary(eps_v), "kld_final": kld, **_reference_floor(reference, ref, out)}
+
+
+def _reference_floor(reference: Statistics, ref: OutputStatistics, out: OutputStatistics) -> dict:
+    """The errors a reference's own noise alone would show, and which floor that is."""
+    if reference.from_runs and ref.fourth_central is not None:
+        floors = floors_from_moments(ref.mean, ref.variance, ref.fourth_central, reference.completed)
+        qmc = reference.design_kind != "monte_carlo"
+        note = (f"reference: {reference.completed} {reference.design_kind} runs; floor = its standard errors "
+                "(σ/√N for the mean, the distribution-free s.e. of the variance)"
+                + ("; QMC converges faster than this Monte Carlo floor, so it is an upper bound" if qmc else ""))
+        return {"eps_m_floor": floors["eps_m_floor"], "eps_v_floor": floors["eps_v_floor"],
+                "kld_floor": float(kld_floor(ref.final_samples, n_method=len(out.final_samples))), "floor_note": note}
+    note = (f"reference: {reference.method['kind']} on a {reference.design_kind}, deterministic: it has no sampling "
+            "floor; its own truncation error is not included (see its convergence estimate)")
+    return {"eps_m_floor": None, "eps_v_floor": None, "kld_floor": None, "floor_note": note}
+
+
+def json_ready(value):
+    """`value` with numpy arrays as lists and NaN or infinite floats as None: strict JSON."""
+    if isinstance(value, dict):
+        return {str(k): json_ready(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [json_ready(v) for v in value]
+    if isinstance(value, np.ndarray):
+        return json_ready(value.tolist())
+    if isinstance(value, (np.bool_, bool)):
+        return bool(value)
+    if isinstance(value, (np.integer, int)):
+        return int(value)
+    if isinstance(value, (np.floating, float)):
+        return float(value) if math.isfinite(value) else None
+    return value
 
 
 def summary_json(stats: Statistics) -> dict:
-    """The fixed summary.json schema of DESIGN.md (plus std, cov and errors when present)."""
+    """summary.json: the fixed schema of DESIGN.md plus the run counts, the failure probability, the
+    notes, and per output std, CoV, quantiles, skewness, kurtosis, resolution, the fits' leave-one-out
+    error, the projections' convergence estimate, and the errors against a reference with their floors.
+    Undefined values are None (null): the result dumps as strict JSON."""
     outputs = {}
     for name, out in stats.outputs.items():
         entry = {
-            "time": out.time.tolist(), "units": out.units,
-            "mean": out.mean.tolist(), "variance": out.variance.tolist(), "std": out.std.tolist(),
-            "band99": {"lower": out.band99[0].tolist(), "upper": out.band99[1].tolist()},
-            "cov": out.cov.tolist(),
-            "sobol_first": {k: v.tolist() for k, v in out.sobol_first.items()},
-            "sobol_total": {k: v.tolist() for k, v in out.sobol_total.items()},
+            "time": out.time, "units": out.units, "mean": out.mean, "variance": out.variance, "std": out.std,
+            "band99": {"lower": out.band99[0], "upper": out.band99[1]},
+            "quantiles": {f"{p:g}": values for p, values in out.quantiles.items()},
+            "skewness": out.skewness, "kurtosis": out.kurtosis, "cov": out.cov, "resolved": out.resolved,
+            "sobol_first": out.sobol_first, "sobol_total": out.sobol_total,
         }
+        if out.sobol_first_ci:
+            entry["sobol_first_ci"] = {k: {"lower": v[0], "upper": v[1]} for k, v in out.sobol_first_ci.items()}
+            entry["sobol_total_ci"] = {k: {"lower": v[0], "upper": v[1]} for k, v in out.sobol_total_ci.items()}
+        if out.loo_error is not None:
+            entry["loo_error"] = out.loo_error
+        if out.convergence is not None:
+            entry["convergence"] = out.convergence
         if out.errors:
-            entry["errors"] = {"eps_m": out.errors["eps_m"].tolist(), "eps_v": out.errors["eps_v"].tolist(),
-                               "eps_m_max": out.errors["eps_m_summary"]["max"],
-                               "eps_v_max": out.errors["eps_v_summary"]["max"],
-                               "kld_final": out.errors["kld_final"]}
+            errors = out.errors
+            entry["errors"] = {"eps_m": errors["eps_m"], "eps_v": errors["eps_v"],
+                               "eps_m_max": errors["eps_m_summary"]["max"], "eps_v_max": errors["eps_v_summary"]["max"],
+                               "kld_final": errors["kld_final"], "eps_m_floor": errors["eps_m_floor"],
+                               "eps_v_floor": errors["eps_v_floor"], "kld_floor": errors["kld_floor"],
+                               "floor_note": errors["floor_note"]}
         outputs[name] = entry
-    return {"results": stats.path, "campaign": stats.campaign_name, "method": stats.method,
-            "design": stats.design_kind, "runs": stats.runs, "failed": stats.failed,
-            "parameters": stats.parameter_names, "reference": stats.reference, "outputs": outputs}
+    return json_ready({
+        "results": stats.path, "campaign": stats.campaign_name, "method": stats.method, "design": stats.design_kind,
+        "runs": stats.runs, "completed": stats.completed, "failed": stats.failed, "pending": stats.pending,
+        "failure_probability": stats.failure_probability, "partial": stats.partial, "notes": stats.notes,
+        "failures": stats.failures, "parameters": stats.parameter_names, "reference": stats.reference,
+        "outputs": outputs})

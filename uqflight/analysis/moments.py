@@ -72,8 +72,8 @@ def weighted_std(Y, weights=None, unbiased: bool = False) -> np.ndarray:
     return np.sqrt(np.clip(weighted_variance(Y, weights, unbiased), 0.0, None))
 
 
-def quantile_band(Y, weights=None, level: float = 0.99) -> tuple[np.ndarray, np.ndarray]:
-    """Central ``level`` band per time: the (1−level)/2 and (1+level)/2 weighted quantiles, each (T,).
+def weighted_quantiles(Y, probabilities, weights=None) -> np.ndarray:
+    """The weighted quantiles of each column of Y (N, T) at `probabilities` (P,): (P, T).
 
     Runs are sorted per time; the j-th sorted run sits at cumulative weight Σ_{i<j} w_i + w_j/2
     (Hazen positions) and the quantile is interpolated linearly between them. Equal weights
@@ -86,11 +86,10 @@ def quantile_band(Y, weights=None, level: float = 0.99) -> tuple[np.ndarray, np.
     if (w < 0).any():
         raise ValueError("quantiles need non-negative weights; sample the PCE for a sparse grid")
     if len(Y) < 2:
-        raise ValueError("a quantile band needs at least two runs")
-    tails = (0.5 * (1.0 - level), 0.5 * (1.0 + level))
+        raise ValueError("quantiles need at least two runs")
+    probabilities = np.asarray(probabilities, dtype=float)
     if np.ptp(w) == 0:
-        lower, upper = np.quantile(Y, tails, axis=0, method="hazen")
-        return lower, upper
+        return np.quantile(Y, probabilities, axis=0, method="hazen")
     order = np.argsort(Y, axis=0)
     sorted_weights = w[order]
     positions = np.cumsum(sorted_weights, axis=0)
@@ -98,16 +97,38 @@ def quantile_band(Y, weights=None, level: float = 0.99) -> tuple[np.ndarray, np.
     positions -= sorted_weights
     columns = np.arange(Y.shape[1])
     bounds = []
-    for probability in tails:
+    for probability in probabilities:
         upper = np.clip((positions < probability).sum(axis=0), 1, len(Y) - 1)
         lower = upper - 1
         gap = positions[upper, columns] - positions[lower, columns]
         fraction = np.divide(probability - positions[lower, columns], gap, out=np.ones_like(gap), where=gap > 0)
         below, above = Y[order[lower, columns], columns], Y[order[upper, columns], columns]
         bounds.append(below + np.clip(fraction, 0.0, 1.0) * (above - below))
-    return bounds[0], bounds[1]
+    return np.array(bounds)
+
+
+def quantile_band(Y, weights=None, level: float = 0.99) -> tuple[np.ndarray, np.ndarray]:
+    """Central ``level`` band per time: the (1−level)/2 and (1+level)/2 weighted quantiles, each (T,)."""
+    lower, upper = weighted_quantiles(Y, (0.5 * (1.0 - level), 0.5 * (1.0 + level)), weights)
+    return lower, upper
+
+
+def standardised_moments(Y, weights=None) -> tuple[np.ndarray, np.ndarray]:
+    """Skewness E[(Y − μ)³]/σ³ and kurtosis E[(Y − μ)⁴]/σ⁴ (Pearson's, 3 for a normal law) of each
+    column of Y (N, T) under the weights: each (T,), NaN where σ = 0."""
+    Y = as_runs_by_time(Y)
+    w = probability_weights(weights, len(Y))
+    deviation = Y - w @ Y
+    variance = w @ deviation**2
+    with np.errstate(invalid="ignore", divide="ignore"):
+        skewness = np.where(variance > 0, (w @ deviation**3) / variance**1.5, np.nan)
+        kurtosis = np.where(variance > 0, (w @ deviation**4) / variance**2, np.nan)
+    return skewness, kurtosis
 
 
 def modified_cov(mean, std) -> np.ndarray:
-    """Modified coefficient of variation std(t) / max_t |mean(t)| (the paper's Fig. 8)."""
-    return np.asarray(std, dtype=float) / np.max(np.abs(mean))
+    """Modified coefficient of variation std(t) / max_t |mean(t)| (the paper's Fig. 8); NaN (undefined)
+    where the mean is zero at every time, up to rounding (see analysis.resolution.cov_or_none)."""
+    from .resolution import cov_or_none
+
+    return np.array([np.nan if v is None else v for v in cov_or_none(std, mean)], dtype=float)

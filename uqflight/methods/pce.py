@@ -6,11 +6,6 @@ import numpy as np
 from ..parameters.germs import draw_germs
 from .basis import orthonormal_basis
 
-# Variances below this fraction of the largest over time are rounding noise (e.g. the spread of
-# a trimmed state at t = 0): their Sobol' shares would be ratios of noise, so they count as 0.
-RESOLVED_VARIANCE = 1e-20
-
-
 @dataclass
 class PCE:
     """Coefficients (Z, T) of the orthonormal basis named by ``indices`` (Z, d) over ``germs``.
@@ -46,14 +41,14 @@ class PCE:
         """Σ c_α² over the terms of each row of ``terms`` (d, Z), divided by the variance: (d, T)."""
         partial = terms.astype(float) @ self.coefficients**2
         variance = self.variance()
-        resolved = variance > RESOLVED_VARIANCE * variance.max(initial=0.0)
-        return np.divide(partial, variance, out=np.zeros_like(partial), where=resolved)
+        return np.divide(partial, variance, out=np.full_like(partial, np.nan), where=variance > 0)
 
     def sobol_first(self) -> np.ndarray:
-        """First-order Sobol' indices (Eq. 53), (d, T): terms in ξ_i alone; 0 where var is unresolved."""
+        """First-order Sobol' indices (Eq. 53), (d, T): terms in ξ_i alone; NaN where the variance is 0
+        (whether a variance is above rounding noise is judged by the caller: analysis.resolution)."""
         involved = np.asarray(self.indices).T > 0
         return self._variance_share(involved & (involved.sum(axis=0) == 1))
 
     def sobol_total(self) -> np.ndarray:
-        """Total Sobol' indices, (d, T): every term involving ξ_i; 0 where var is unresolved."""
+        """Total Sobol' indices, (d, T): every term involving ξ_i; NaN where the variance is 0."""
         return self._variance_share(np.asarray(self.indices).T > 0)

@@ -200,6 +200,11 @@ class ResultStore:
         return "; ".join(parts)
 
     @property
+    def tsvd_tolerance(self) -> float:
+        """The relative truncation tolerance of the tSVD factors (0 without compression)."""
+        return float(self._file["tsvd"].attrs["tol"]) if "tsvd" in self._file else 0.0
+
+    @property
     def _raw(self) -> bool:
         return "outputs" in self._file
 
