@@ -81,7 +81,7 @@ def simulate(
                 writer.writerow([f"{t:g}", *(repr(float(v[i])) for v in result.outputs.values())])
         typer.echo(f"wrote {out}")
     if plot:
-        from .plots import plot_flight
+        from .report.plots import plot_flight
 
         plot_flight(result.time, result.outputs, plot,
                     title=f"{aircraft}: {excitation} {amplitude_deg:g} deg at {altitude_ft:g} ft, {airspeed_ktas:g} KTAS")
