@@ -1,8 +1,9 @@
 """Analysed results files → report entries: statistics, labels, the campaign's parameters and the file's facts."""
 from __future__ import annotations
 
+import json
 import re
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import yaml
@@ -13,6 +14,7 @@ from ..statistics import Statistics, add_reference_errors
 METHOD_NAMES = {"integration": "Int", "pseudo_galerkin": "PG", "interpolation": "interpolation",
                 "regression": "regression", "least_squares": "least squares", "monte_carlo": "MC"}
 
+
 @dataclass
 class Entry:
     """One analysed results file and how the report names it."""
@@ -22,6 +24,8 @@ class Entry:
     label: str
     campaign_hash: str
     inputs: str
+    attrs: dict = field(default_factory=dict)  # the results file's root attributes
+    path: str = ""  # the results file (several entries share one with several --method)
 
     @property
     def outputs(self) -> dict:
@@ -60,26 +64,97 @@ def input_distributions(campaign_text: str) -> str:
     return ", ".join(dict.fromkeys(str(spec.get("distribution", "?")) for spec in parameters.values()))
 
 
-def load_entries(paths: list[Path], reference: Path | None,
-                 method: dict | None = None) -> tuple[list[Entry], Entry | None]:
-    """Every file analysed (with `method` overriding the campaigns' methods, the reference
-    excepted), with errors against the reference unless it is the reference itself, and the reference."""
+def campaign_parameters(campaign_text: str) -> list[dict] | None:
+    """The campaign's parameters as dicts (name, property, distribution, lower, upper, nominal), read
+    through the campaign parser (nominal values from the aircraft when the campaign leaves them to
+    it); None when the text cannot be parsed."""
+    from ..campaign import parse_campaign
+
+    for probe in (None, "jsbsim"):
+        try:
+            if probe == "jsbsim":
+                from ..simulators.jsbsim_probe import jsbsim_probe as probe
+            campaign = parse_campaign(campaign_text, "<results file>", probe)
+        except Exception:  # noqa: BLE001 - a report describes what it can; the table says "not readable"
+            continue
+        return [{"name": p.name, "property": p.property, "distribution": p.distribution, "lower": p.lower,
+                 "upper": p.upper, "nominal": p.nominal} for p in campaign.parameters]
+    return None
+
+
+def campaign_settings(campaign_text: str) -> dict:
+    """The campaign's mapping as written (YAML), {} when unreadable."""
+    try:
+        data = yaml.safe_load(campaign_text)
+    except yaml.YAMLError:
+        return {}
+    return data if isinstance(data, dict) else {}
+
+
+def parse_methods(methods: list[str], order: int | None = None) -> list[dict]:
+    """`KIND[:ORDER]` strings into method overrides; a bare KIND takes `order` (when given).
+    ValueError naming the bad item."""
+    from ..methods import METHOD_KINDS
+
+    parsed = []
+    for text in methods:
+        kind, sep, number = text.partition(":")
+        kind = kind.strip()
+        if kind not in METHOD_KINDS:
+            raise ValueError(f"expected KIND[:ORDER] with KIND one of {', '.join(METHOD_KINDS)}, got {text!r}")
+        method = {"kind": kind}
+        if sep:
+            try:
+                method["order"] = int(number)
+            except ValueError:
+                raise ValueError(f"expected an integer ORDER >= 0 after {kind}:, got {text!r}") from None
+            if method["order"] < 0:
+                raise ValueError(f"expected an integer ORDER >= 0 after {kind}:, got {text!r}")
+        elif order is not None:
+            method["order"] = order
+        parsed.append(method)
+    return parsed
+
+
+def load_entries(paths: list[Path], reference: Path | None, method: dict | list[dict] | None = None,
+                 progress=None) -> tuple[list[Entry], Entry | None]:
+    """Every file analysed once per method (`method`: one override, several, or None for the
+    campaigns' own; the reference keeps its own), with errors against the reference unless it is
+    the reference itself, and the reference. `progress(text)` is told each stage."""
+    methods = method if isinstance(method, list) else [method]
+    methods = methods or [None]
     stems: set[str] = set()
-    ref = _entry(reference, *read_statistics(reference), set()) if reference else None
+    tell = progress or (lambda text: None)
+    ref = None
+    if reference:
+        tell(f"analysing the reference {reference}")
+        ref = _entry(reference, *read_statistics(reference), set())
     entries = []
     for path in paths:
-        stats, attrs = read_statistics(path, method)
-        if ref is not None and not _same_file(path, reference):
-            add_reference_errors(stats, ref.stats)
-        entries.append(_entry(path, stats, attrs, stems))
+        for override in methods:
+            tell(f"analysing {path}" + (f" ({method_label({'order': '?', **override})})" if override else ""))
+            stats, attrs = read_statistics(path, override)
+            if ref is not None and not _same_file(path, reference):
+                add_reference_errors(stats, ref.stats)
+            entries.append(_entry(path, stats, attrs, stems, with_method=len(methods) > 1))
     return entries, ref
 
 
-def _entry(path: Path, stats: Statistics, attrs: dict, stems: set[str]) -> Entry:
-    stem = _unique(file_name(Path(path).stem), stems)
+def _entry(path: Path, stats: Statistics, attrs: dict, stems: set[str], with_method: bool = False) -> Entry:
+    name = Path(path).stem + (f"_{stats.method['kind']}{stats.method.get('order', '')}" if with_method else "")
+    stem = _unique(file_name(name), stems)
     label = f"{stats.campaign_name or stem}: {method_label(stats.method)}, {stats.runs} runs"
     return Entry(stats, stem, label, str(attrs.get("campaign_hash", "")),
-                 input_distributions(str(attrs.get("campaign", ""))))
+                 input_distributions(str(attrs.get("campaign", ""))), dict(attrs), str(path))
+
+
+def design_info(attrs: dict) -> dict:
+    """The design's facts (level, rule, ...) from the results file, {} when absent."""
+    try:
+        info = json.loads(attrs.get("design_info", "{}"))
+    except (TypeError, ValueError):
+        return {}
+    return info if isinstance(info, dict) else {}
 
 
 def file_name(name: str) -> str:

@@ -14,7 +14,9 @@ STYLE = """body{font-family:sans-serif;max-width:1200px;margin:2em auto;padding:
 table{border-collapse:collapse;margin:.5em 0 1.5em;font-size:.85em;display:block;overflow-x:auto}
 th,td{border:1px solid #ccc;padding:.2em .5em;text-align:right}th{background:#eee}
 td:first-child,td:nth-child(2){text-align:left}img{max-width:100%}figure{margin:1em 0 2em}
-figcaption{font-size:.9em;color:#444}pre{background:#f6f6f6;padding:.5em}"""
+figcaption{font-size:.9em;color:#444}pre{background:#f6f6f6;padding:.5em;overflow-x:auto}
+.notes{border:2px solid #c60;background:#fff4e5;padding:.5em 1em;margin:1em 0}
+.notes h2{margin:.2em 0;color:#a40}"""
 
 
 def render_html(title: str, sections: list[Section], out_dir: Path) -> str:
@@ -22,6 +24,10 @@ def render_html(title: str, sections: list[Section], out_dir: Path) -> str:
     toc, body = [], []
     for s in sections:
         toc.append(f'<li><a href="#{s.anchor}">{html.escape(s.title)}</a>' + _html_toc(s) + "</li>")
+        if s.notes:
+            items = "".join(f"<li>{html.escape(line.removeprefix('- '))}</li>" for line in s.text.splitlines())
+            body.append(f'<div class="notes"><h2 id="{s.anchor}">{html.escape(s.title)}</h2><ul>{items}</ul></div>')
+            continue
         body.append(f'<h2 id="{s.anchor}">{html.escape(s.title)}</h2>')
         body.append(f"<pre>{html.escape(s.text)}</pre>" if "\n" in s.text else f"<p>{html.escape(s.text)}</p>")
         body += [_html_block(s.anchor, n, block, out_dir) for n, block in enumerate(s.blocks)]
@@ -57,7 +63,10 @@ def render_markdown(title: str, sections: list[Section]) -> str:
     lines = [f"# {title}", "", "## Contents", ""]
     lines += [f"- [{s.title}](#{s.anchor})" for s in sections]
     for s in sections:
-        lines += ["", f'<a id="{s.anchor}"></a>', f"## {s.title}", "", s.text]
+        text = f"```yaml\n{s.text}\n```" if s.preformatted else s.text
+        if s.notes:
+            text = "\n".join(f"> **{line}**" for line in s.text.splitlines())
+        lines += ["", f'<a id="{s.anchor}"></a>', f"## {s.title}", "", text]
         for block in s.blocks:
             if isinstance(block, Figure):
                 lines += ["", f"![{block.caption}]({block.file})", "", f"*{block.caption}* ({block.file})"]
