@@ -344,14 +344,16 @@ def plot_band_comparison(entries: list[tuple[str, dict]], path: Path, title: str
     panels = _band_panels(first)
     fig, axes = _panels(len(panels), title)
     for ax, (name, about_mean) in zip(axes, panels):
-        for color, (_, outputs) in zip(COLORS, entries):
+        for k, (color, (_, outputs)) in enumerate(zip(COLORS, entries)):
             out = outputs.get(name)
             if out is None:
                 continue
+            # earlier files drawn wider, so that coinciding methods stay visible under later ones
+            widen = 1.0 + 0.9 * (len(entries) - 1 - k)
             offset = np.interp(out.time, first[name].time, first[name].mean) if about_mean else 0.0
-            _line(ax, out.time, out.mean - offset, color=color, lw=1.3)
+            _line(ax, out.time, out.mean - offset, color=color, lw=1.3 * widen)
             for bound in out.band99:
-                _line(ax, out.time, bound - offset, color=color, lw=0.9, ls="--")
+                _line(ax, out.time, bound - offset, color=color, lw=0.9 * widen, ls="--")
         _style_band_panel(ax, first[name], about_mean)
     return _save(fig, path, _file_legend(entries), legend_columns=2)
 
@@ -390,7 +392,8 @@ def plot_sobol_compared(entries: list[tuple[str, dict]], path: Path, title: str)
                 if parameter not in parameters:
                     parameters.append(parameter)
                 color = COLORS[parameters.index(parameter) % len(COLORS)]
-                ax.plot(out.time, index, color=color, lw=1.1, ls=style)
+                ax.plot(out.time, index, color=color, lw=1.1 + 0.8 * (len(entries) - 1 - entries.index(
+                    next(e for e in entries if e[1] is outputs))), ls=style)
                 finite = np.asarray(index, dtype=float)[np.isfinite(index)]
                 if finite.size:
                     low, high = min(low, finite.min() - 0.05), max(high, finite.max() + 0.05)

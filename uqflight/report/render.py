@@ -29,6 +29,10 @@ def render_html(title: str, sections: list[Section], out_dir: Path) -> str:
             body.append(f'<div class="notes"><h2 id="{s.anchor}">{html.escape(s.title)}</h2><ul>{items}</ul></div>')
             continue
         body.append(f'<h2 id="{s.anchor}">{html.escape(s.title)}</h2>')
+        if s.preformatted:  # the campaign text, folded below the tables and figures
+            body += [_html_block(s.anchor, n, block, out_dir) for n, block in enumerate(s.blocks)]
+            body.append(f"<details><summary>Campaign text</summary><pre>{html.escape(s.text)}</pre></details>")
+            continue
         body.append(f"<pre>{html.escape(s.text)}</pre>" if "\n" in s.text else f"<p>{html.escape(s.text)}</p>")
         body += [_html_block(s.anchor, n, block, out_dir) for n, block in enumerate(s.blocks)]
     stamp = datetime.now(timezone.utc).isoformat(timespec="seconds")
