@@ -428,6 +428,10 @@ def plot_convergence(points: list[tuple[str, int, dict]], path: Path, title: str
                 floors = True
             ax.set_xscale("log")
             ax.set_yscale("log")
+            low, high = ax.get_ylim()
+            if low > 0 and high / low < 10:  # at least a decade, so that log ticks stay readable
+                middle = np.sqrt(low * high)
+                ax.set_ylim(middle / np.sqrt(10), middle * np.sqrt(10))
             ax.set_title(f"{short_label(name)}: {symbol.split(' [')[0]}", fontsize=10)
             ax.set_xlabel("runs (simulator calls)", fontsize=8)
             ax.set_ylabel(symbol, fontsize=8)
