@@ -118,7 +118,8 @@ def test_report_of_several_files_against_a_reference(files, tmp_path):
     page = (out / "report.html").read_text()
     assert re.findall(r'src="(?!data:)', page) == [] and "<link" not in page
     plots = sorted(p.name for p in (out / "plots").iterdir())
-    assert {"mean_band.png", "cov.png", "pdf_x.png", "eps_m.png", "eps_v.png", "kld_vs_runs.png",
+    assert {"mean_band_pg.png", "cov_pg.png", "pdf_pg_x.png", "mean_band_int.png", "cov_int.png", "pdf_int_x.png",
+            "eps_m.png", "eps_v.png", "kld_vs_runs.png", "convergence.png", "bands_compared.png",
             "sobol_pg.png"} <= set(plots)
     assert page.count('src="data:image/png;base64,') == len(plots)
     markdown = (out / "report.md").read_text()

@@ -14,12 +14,27 @@ from .methods import METHOD_KINDS
 from .simulators.base import FlightError
 from .simulators.jsbsim import DEFAULT_OUTPUTS, Excitation, FlightSetup, JSBSimFlight
 
+CONTEXT = {"help_option_names": ["-h", "--help"]}
+# rich_markup_mode=None: help text is shown as written, so units such as [ft], [kt], [deg], [s] are
+# not swallowed as rich markup
 app = typer.Typer(help="Uncertainty quantification campaigns on a JSBSim flight-dynamics model.",
-                  no_args_is_help=True, add_completion=False)
+                  no_args_is_help=True, add_completion=False, context_settings=CONTEXT, rich_markup_mode=None)
+surrogate_app = typer.Typer(help="The PCE surrogate of a results file: export it as JSON.", no_args_is_help=True,
+                            context_settings=CONTEXT, rich_markup_mode=None)
+app.add_typer(surrogate_app, name="surrogate")
+
+
+def _version(value: bool):
+    if value:
+        from . import __version__
+
+        typer.echo(f"uqflight {__version__}")
+        raise typer.Exit(0)
 
 
 @app.callback()
-def cli():
+def cli(version: bool = typer.Option(False, "--version", callback=_version, is_eager=True,
+                                     help="Print the version and exit.")):
     """Uncertainty quantification campaigns on a JSBSim flight-dynamics model."""
 
 
@@ -39,7 +54,7 @@ def parse_settings(pairs: list[str]) -> dict[str, float]:
 
 @app.command()
 def simulate(
-    set_: List[str] = typer.Option([], "--set", help="PROPERTY=VALUE set before the trim, e.g. aero/uq/CL0=0.25 (repeatable)."),
+    set_: List[str] = typer.Option([], "--set", metavar="PROPERTY=VALUE", help="PROPERTY=VALUE set before the trim, e.g. aero/uq/CL0=0.25 (repeatable)."),
     altitude_ft: float = typer.Option(15000.0, help="Trim altitude [ft]."),
     airspeed_ktas: float = typer.Option(200.0, help="Trim true airspeed [kt]."),
     excitation: str = typer.Option("pulse", help="Elevator excitation: pulse, step, doublet or none."),
@@ -48,7 +63,7 @@ def simulate(
     pulse_duration_s: float = typer.Option(1.0, help="Excitation duration [s] (pulse, doublet)."),
     duration_s: float = typer.Option(50.0, help="Flight time after the trim [s]."),
     output_rate_hz: float = typer.Option(20.0, help="Recording rate [Hz]; divides the 120 Hz integration rate."),
-    output: List[str] = typer.Option([], "--output", help="Extra JSBSim property to record (repeatable)."),
+    output: List[str] = typer.Option([], "--output", metavar="PROPERTY", help="Extra JSBSim property to record (repeatable)."),
     aircraft: str = typer.Option("bacm", help="Aircraft folder under aircraft/."),
     out: Optional[Path] = typer.Option(None, help="Write the time histories to this CSV file."),
     plot: Optional[Path] = typer.Option(None, help="Write a PNG plot of the outputs."),
@@ -81,7 +96,7 @@ def simulate(
                 writer.writerow([f"{t:g}", *(repr(float(v[i])) for v in result.outputs.values())])
         typer.echo(f"wrote {out}")
     if plot:
-        from .plots import plot_flight
+        from .report.plots import plot_flight
 
         plot_flight(result.time, result.outputs, plot,
                     title=f"{aircraft}: {excitation} {amplitude_deg:g} deg at {altitude_ft:g} ft, {airspeed_ktas:g} KTAS")
@@ -192,18 +207,22 @@ def info(results: Path = typer.Argument(..., help="Results file (.h5).")):
 @app.command()
 def report(
     results: List[Path] = typer.Argument(..., help="Results files (.h5). The first is the one summary.json, "
-                                                   "the baseline and the single-file plots describe."),
-    out: Path = typer.Option(..., help="Report directory (created if missing)."),
+                                                   "the baseline and the default folder describe."),
+    out: Optional[Path] = typer.Option(None, help="Report directory (default: RESULTS-report/ next to the first "
+                                                  "results file). Replaced only when the new report is complete."),
     reference: Optional[Path] = typer.Option(None, help="Monte Carlo results file: the errors ε_m, ε_v (Eq. 49) "
                                                         "and KLD (Eq. 50) of every file are taken against it."),
     times: str = typer.Option("10,25,end", help="Comma-separated times in seconds for the tables at selected times "
                                                 "(the nearest recorded times; 'end' is the final time)."),
     write_baseline: Optional[Path] = typer.Option(None, help="Also write the first file's statistics to this "
                                                              "JSON file, the baseline of `uqflight check`."),
-    method: Optional[str] = typer.Option(None, help="Method for every file instead of its campaign's: integration, "
-                                                    "pseudo_galerkin, interpolation, regression, least_squares, "
-                                                    "monte_carlo (the runs of one grid serve every method)."),
-    order: Optional[int] = typer.Option(None, help="Polynomial order with --method (default: the campaign's)."),
+    method: List[str] = typer.Option([], metavar="KIND[:ORDER]", help="KIND[:ORDER], repeatable: analyse every file with each method "
+                                              "instead of its campaign's, overlaid in the plots, e.g. --method "
+                                              "pseudo_galerkin:2 --method least_squares:3. KIND: "
+                                              + ", ".join(METHOD_KINDS) + " (the runs of one grid serve every "
+                                              "method)."),
+    order: Optional[int] = typer.Option(None, help="Polynomial order for a --method given without :ORDER "
+                                                   "(default: the campaign's)."),
     partial: bool = typer.Option(False, help="Analyse a file with pending runs on its completed runs, where that "
                                              "is valid (Monte Carlo, QMC, least squares, regression); labelled partial."),
     allow_aliasing: bool = typer.Option(False, help="Let a projection's order exceed what the grid integrates "
@@ -211,37 +230,136 @@ def report(
 ):
     """Statistics, tables, plots and a report page of one or more results files.
 
-    Several files are compared side by side (labelled campaign: method, runs). OUT gets:
+    Several files (and methods) are compared side by side (labelled campaign: method, runs). OUT gets:
     summary.json (the first file; schema in DESIGN.md), summaries/<stem>.json (every file, when
-    several), tables/*.csv (statistics over time per file and output, statistics and Sobol' indices
-    at the selected times, errors against the reference, PCE vs Monte Carlo Sobol' indices when a
-    pick_freeze file is given), plots/*.png, report.html (self-contained, plots embedded) and
-    report.md (linking plots/).
+    several), tables/*.csv (campaign, parameters, statistics over time per file and output,
+    statistics and Sobol' indices at the selected times, errors against the reference),
+    plots/*.png, report.html (self-contained, plots embedded) and report.md (linking plots/).
+    The report is written to a temporary folder and moved into place when complete.
     """
-    from .report import write_report
+    from .report import default_out_dir, parse_methods, write_report
     from .statistics import BadInput
 
     try:
         selected = [float("inf") if t.strip() == "end" else float(t) for t in times.split(",")]
     except ValueError:
         raise typer.BadParameter(f"expected comma-separated seconds or 'end', got {times!r}", param_hint="--times")
-    override = {key: value for key, value in (("kind", method), ("order", order)) if value is not None}
-    if method is not None and method not in METHOD_KINDS:
-        raise typer.BadParameter(f"expected one of {', '.join(METHOD_KINDS)}, got {method!r}", param_hint="--method")
     if order is not None and order < 0:
         raise typer.BadParameter(f"expected an integer >= 0, got {order}", param_hint="--order")
+    if order is not None and not method:
+        raise typer.BadParameter("--order needs --method KIND", param_hint="--order")
     try:
-        written = write_report(results, out, reference=reference, times=selected, baseline=write_baseline,
-                               method=override or None, partial=partial, allow_aliasing=allow_aliasing)
+        overrides = parse_methods(method, order)
+    except ValueError as exc:
+        raise typer.BadParameter(str(exc), param_hint="--method")
+    out = out if out is not None else default_out_dir(results[0])
+    try:
+        with _status("report") as tell:
+            written = write_report(results, out, reference=reference, times=selected, baseline=write_baseline,
+                                   method=overrides or None, progress=tell, partial=partial,
+                                   allow_aliasing=allow_aliasing)
     except BadInput as exc:
         typer.echo(f"error: {exc}", err=True)
         raise typer.Exit(2)
     except OSError as exc:
         typer.echo(f"error: cannot write the report: {exc}", err=True)
         raise typer.Exit(2)
-    typer.echo(f"wrote {len(written)} files to {out}: open {out / 'report.html'}")
+    except KeyboardInterrupt:
+        typer.echo(f"\ninterrupted: no report written ({out} unchanged)", err=True)
+        raise typer.Exit(130)
+    in_report = [p for p in written if out in p.parents]
+    typer.echo(f"wrote {len(in_report)} files to {out}: open {out / 'report.html'}")
     if write_baseline:
         typer.echo(f"wrote baseline {write_baseline}")
+
+
+class _status:
+    """A rich status line on stderr when it is a terminal (each stage of a long command), else silent."""
+
+    def __init__(self, what: str):
+        self.what, self._status = what, None
+
+    def __enter__(self):
+        import sys
+
+        if sys.stderr.isatty():
+            from rich.console import Console
+
+            self._status = Console(stderr=True).status(f"{self.what}: starting")
+            self._status.start()
+        return self.tell
+
+    def tell(self, text: str) -> None:
+        if self._status is not None:
+            self._status.update(f"{self.what}: {text}")
+
+    def __exit__(self, *exc):
+        if self._status is not None:
+            self._status.stop()
+        return False
+
+
+@app.command()
+def design(
+    campaign: Path = typer.Argument(..., help="Campaign YAML file."),
+    csv_path: Path = typer.Option(..., "--csv", help="Write the design to this CSV file: one row per run, columns "
+                                                     "xi_<name> (standard variables), <name> (physical values "
+                                                     "kappa) and weight."),
+):
+    """Write a campaign's design (the points and weights the runs would use) as CSV, without running it."""
+    from .parameters import to_physical
+
+    spec = _load(campaign)
+    points = spec.design()
+    kappa = to_physical(spec.parameters, points.xi)
+    names = [p.name for p in spec.parameters]
+    try:
+        with open(csv_path, "w", newline="") as fh:
+            writer = csv.writer(fh)
+            writer.writerow(["run", *(f"xi_{n}" for n in names), *names, "weight"])
+            for j, (x, k, w) in enumerate(zip(points.xi, kappa, points.weights)):
+                writer.writerow([j, *map(repr, map(float, x)), *map(repr, map(float, k)), repr(float(w))])
+    except OSError as exc:
+        typer.echo(f"error: cannot write {csv_path}: {exc.strerror}", err=True)
+        raise typer.Exit(2)
+    typer.echo(f"wrote {csv_path}: {len(points.xi)} points of a {points.kind} design in {len(names)} parameters "
+               f"({', '.join(names)})")
+
+
+@surrogate_app.command("export")
+def surrogate_export(
+    results: Path = typer.Argument(..., help="Results file (.h5)."),
+    out: Path = typer.Option(..., help="JSON file to write (strict JSON)."),
+    method: Optional[str] = typer.Option(None, help="KIND[:ORDER] instead of the campaign's method, "
+                                                    "e.g. least_squares:3 (a PCE method)."),
+):
+    """Export the PCE of every output over time as JSON: germs, multi-indices, coefficients per output
+    and time, the parameters' distributions (name, distribution, lower, upper, nominal), the time
+    grid, method and order. Load it in Python with uqflight.surrogate.load(path).evaluate(kappa)."""
+    from .surrogate import SurrogateError, export
+
+    try:
+        override = parse_method_option(method)
+    except ValueError as exc:
+        raise typer.BadParameter(str(exc), param_hint="--method")
+    if not results.is_file():
+        typer.echo(f"error: {results}: no such results file", err=True)
+        raise typer.Exit(2)
+    try:
+        export(results, out, override)
+    except SurrogateError as exc:
+        typer.echo(f"error: {exc}", err=True)
+        raise typer.Exit(2)
+    except (OSError, KeyError, ValueError) as exc:
+        typer.echo(f"error: {results}: cannot export the surrogate ({' '.join(str(exc).split())})", err=True)
+        raise typer.Exit(2)
+    typer.echo(f"wrote {out}")
+
+
+def parse_method_option(method: str | None) -> dict | None:
+    from .report.loading import parse_methods
+
+    return parse_methods([method])[0] if method else None
 
 
 @app.command()

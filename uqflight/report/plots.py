@@ -236,18 +236,28 @@ def plot_errors(curves: list[tuple[str, dict]], key: str, path: Path, title: str
     names = list(dict.fromkeys(name for _, outputs in curves for name, out in outputs.items() if out.errors))
     symbol = {"eps_m": "ε_m (error of the mean)", "eps_v": "ε_v (error of the variance)"}[key]
     fig, axes = _panels(len(names), title)
+    floors = any(out.errors.get(f"{key}_floor") is not None for _, outputs in curves
+                 for out in outputs.values() if out.errors)
     for ax, name in zip(axes, names):
-        errors = []
+        errors, drawn_floor = [], False
         for color, (_, outputs) in zip(COLORS, curves):
             out = outputs.get(name)
             if out is not None and out.errors:
                 errors.append(out.errors[key])
                 _line(ax, out.time, np.where(errors[-1] > 0, errors[-1], np.nan), color=color, lw=1.1)
+                floor = out.errors.get(f"{key}_floor")
+                if floor is not None and not drawn_floor:
+                    floor = np.broadcast_to(np.asarray(floor, dtype=float), out.time.shape)
+                    ax.plot(out.time, np.where(floor > 0, floor, np.nan), color="gray", lw=1.0, ls="--")
+                    drawn_floor = True
                 shown = out
         ax.set_yscale("log")
         _floor_log_axis(ax, errors, ERROR_DECADES)
         _style(ax, shown, ylabel=f"{symbol} [-]")
-    return _save(fig, path, _file_legend(curves), legend_columns=2)
+    handles, labels = _file_legend(curves)
+    if floors:
+        handles, labels = handles + [Line2D([], [], color="gray", ls="--")], labels + ["reference floor"]
+    return _save(fig, path, (handles, labels), legend_columns=2)
 
 
 def _file_legend(entries: list[tuple[str, dict]], **style) -> tuple[list, list[str]]:
@@ -292,12 +302,24 @@ def plot_sobol(outputs: dict, path: Path, title: str) -> Path:
             _sobol_bars(ax, out)
             continue
         handles = []
+        low, high = -0.05, 1.05
         for color, (parameter, index) in zip(COLORS, out.sobol_first.items()):
-            handles.append(_line(ax, out.time, index, color=color, lw=1.2, label=parameter))
-            if parameter in out.sobol_first_ci:
-                _band(ax, out.time, *out.sobol_first_ci[parameter], color, alpha=0.2)
+            text = parameter
+            ci = out.sobol_first_ci.get(parameter) if out.sobol_first_ci else None
+            if ci is not None:
+                _band(ax, out.time, *ci, color, alpha=0.2)
+                text = f"{parameter} (95 % CI shaded)"
+            handles.append(_line(ax, out.time, index, color=color, lw=1.2, label=text))
+            finite = np.asarray(index, dtype=float)[np.isfinite(index)]
+            if ci is not None:
+                finite = np.concatenate([finite, *(np.asarray(b, dtype=float)[np.isfinite(b)] for b in ci)])
+            if finite.size:  # values above 1 or below 0 (estimator noise) are shown, not clipped
+                low, high = min(low, finite.min() - 0.05), max(high, finite.max() + 0.05)
         _style(ax, out, ylabel="first-order Sobol' index S_i [-]")
-        ax.set_ylim(-0.05, 1.05)
+        ax.set_ylim(low, high)
+        if high > 1.05 or low < -0.05:
+            ax.axhspan(1.0, high, color="0.9", zorder=0)
+            ax.axhspan(low, min(0.0, high), color="0.9", zorder=0)
     return _save(fig, path, (handles, [h.get_label() for h in handles]) if handles else None, legend_columns=7)
 
 
@@ -322,14 +344,16 @@ def plot_band_comparison(entries: list[tuple[str, dict]], path: Path, title: str
     panels = _band_panels(first)
     fig, axes = _panels(len(panels), title)
     for ax, (name, about_mean) in zip(axes, panels):
-        for color, (_, outputs) in zip(COLORS, entries):
+        for k, (color, (_, outputs)) in enumerate(zip(COLORS, entries)):
             out = outputs.get(name)
             if out is None:
                 continue
+            # earlier files drawn wider, so that coinciding methods stay visible under later ones
+            widen = 1.0 + 0.9 * (len(entries) - 1 - k)
             offset = np.interp(out.time, first[name].time, first[name].mean) if about_mean else 0.0
-            _line(ax, out.time, out.mean - offset, color=color, lw=1.3)
+            _line(ax, out.time, out.mean - offset, color=color, lw=1.3 * widen)
             for bound in out.band99:
-                _line(ax, out.time, bound - offset, color=color, lw=0.9, ls="--")
+                _line(ax, out.time, bound - offset, color=color, lw=0.9 * widen, ls="--")
         _style_band_panel(ax, first[name], about_mean)
     return _save(fig, path, _file_legend(entries), legend_columns=2)
 
@@ -348,3 +372,138 @@ def plot_final_pdfs(entries: list[tuple[str, dict]], path: Path, title: str) -> 
         ax.tick_params(labelsize=8)
         ax.grid(alpha=0.3)
     return _save(fig, path, _file_legend(entries), legend_columns=2)
+
+
+def plot_sobol_compared(entries: list[tuple[str, dict]], path: Path, title: str) -> Path:
+    """First-order indices of several files or methods overlaid: one colour per parameter, one line
+    style per file (NaN where unresolved: gaps)."""
+    names = list(dict.fromkeys(n for _, outputs in entries for n, o in outputs.items()
+                               if o.sobol_first and o.time.size > 1))
+    styles = ["-", "--", ":", "-."]
+    fig, axes = _panels(max(len(names), 1), title)
+    parameters: list[str] = []
+    for ax, name in zip(axes, names):
+        low, high = -0.05, 1.05
+        for style, (_, outputs) in zip(styles * 3, entries):
+            out = outputs.get(name)
+            if out is None:
+                continue
+            for parameter, index in out.sobol_first.items():
+                if parameter not in parameters:
+                    parameters.append(parameter)
+                color = COLORS[parameters.index(parameter) % len(COLORS)]
+                ax.plot(out.time, index, color=color, lw=1.1 + 0.8 * (len(entries) - 1 - entries.index(
+                    next(e for e in entries if e[1] is outputs))), ls=style)
+                finite = np.asarray(index, dtype=float)[np.isfinite(index)]
+                if finite.size:
+                    low, high = min(low, finite.min() - 0.05), max(high, finite.max() + 0.05)
+        ax.set_ylim(low, high)
+        _style(ax, next(o[name] for _, o in entries if name in o), ylabel="first-order Sobol' index S_i [-]")
+    handles = [Line2D([], [], color=COLORS[k % len(COLORS)]) for k in range(len(parameters))]
+    handles += [Line2D([], [], color="black", ls=style) for style, _ in zip(styles * 3, entries)]
+    labels = parameters + [file_label for file_label, _ in entries]
+    return _save(fig, path, (handles, labels), legend_columns=4)
+
+
+def plot_convergence(points: list[tuple[str, int, dict]], path: Path, title: str) -> Path:
+    """max over time of ε_m (left) and ε_v (right) against the number of runs, log-log, one row per
+    output and one line per method; `points` are (method label, runs, {output: (eps_m max, eps_v max,
+    eps_m floor, eps_v floor)}); the reference's floor dashed when known."""
+    names = list(dict.fromkeys(name for _, _, values in points for name in values))
+    methods = list(dict.fromkeys(method for method, _, _ in points))
+    style = {"ms": 6, "mfc": "none", "mew": 1.4}
+    fig, axes = plt.subplots(len(names), 2, figsize=(11, 2.6 * len(names) + 0.9), squeeze=False)
+    floors = False
+    for row, name in zip(axes, names):
+        for column, (ax, symbol) in enumerate(zip(row, ("max ε_m [-]", "max ε_v [-]"))):
+            for color, marker, method in zip(COLORS, MARKERS, methods):
+                found = sorted((n, values[name][column]) for m, n, values in points
+                               if m == method and name in values and values[name][column] > 0)
+                if found:
+                    ax.plot(*zip(*found), marker=marker, color=color, **style)
+            floor = [values[name][column + 2] for _, _, values in points
+                     if name in values and values[name][column + 2] is not None]
+            if floor:
+                ax.axhline(max(floor), color="gray", ls="--", lw=1.0)
+                floors = True
+            ax.set_xscale("log")
+            ax.set_yscale("log")
+            low, high = ax.get_ylim()
+            if low > 0 and high / low < 10:  # at least a decade, so that log ticks stay readable
+                middle = np.sqrt(low * high)
+                ax.set_ylim(middle / np.sqrt(10), middle * np.sqrt(10))
+            ax.set_title(f"{short_label(name)}: {symbol.split(' [')[0]}", fontsize=10)
+            ax.set_xlabel("runs (simulator calls)", fontsize=8)
+            ax.set_ylabel(symbol, fontsize=8)
+            ax.tick_params(labelsize=8)
+            ax.grid(alpha=0.3, which="both")
+    fig.suptitle(title, fontsize=12)
+    handles = [Line2D([], [], color=c, marker=m, **style) for c, m, _ in zip(COLORS, MARKERS, methods)]
+    labels = list(methods)
+    if floors:
+        handles.append(Line2D([], [], color="gray", ls="--"))
+        labels.append("reference floor")
+    return _save(fig, path, (handles, labels), legend_columns=3)
+
+
+def plot_coefficient_decay(outputs: dict, path: Path, title: str) -> Path:
+    """Root-sum-square of the PCE coefficients of each total degree over time, log y, one panel per
+    output (`OutputStatistics.coefficient_decay`: {degree: array over time})."""
+    names = [n for n, o in outputs.items() if getattr(o, "coefficient_decay", None)]
+    fig, axes = _panels(max(len(names), 1), title)
+    degrees: list = []
+    for ax, name in zip(axes, names):
+        out = outputs[name]
+        for degree, values in sorted(out.coefficient_decay.items(), key=lambda kv: int(kv[0])):
+            if degree not in degrees:
+                degrees.append(degree)
+            values = np.asarray(values, dtype=float)
+            _line(ax, out.time, np.where(values > 0, values, np.nan), color=COLORS[degrees.index(degree) % 10], lw=1.1)
+        ax.set_yscale("log")
+        _style(ax, out, ylabel=f"RSS of coefficients [{out.units}]" if out.units else "RSS of coefficients")
+    handles = [Line2D([], [], color=COLORS[k % 10]) for k in range(len(degrees))]
+    return _save(fig, path, (handles, [f"degree {d}" for d in degrees]), legend_columns=6)
+
+
+MAX_PAIRS = 8  # parameters drawn in the design scatter (the first ones)
+
+
+def plot_design_pairs(results, path: Path, title: str) -> Path | None:
+    """The design points on every pair of inputs (lower triangle), in standard variables ξ (paper
+    Fig. 9), marker size by |weight| for a grid; failed runs as red crosses. None for one input."""
+    from ..store import ResultStore
+
+    with ResultStore.open(results) as store:
+        xi, weights, status, names = store.xi, store.weights, store.status, store.parameter_names
+    d = min(xi.shape[1], MAX_PAIRS)
+    if d < 2:
+        return None
+    failed = status > 0
+    sizes = 8.0 if np.allclose(weights, weights[0]) else 6 + 40 * np.abs(weights) / np.abs(weights).max()
+    fig, axes = plt.subplots(d - 1, d - 1, figsize=(1.7 * (d - 1) + 1.2, 1.7 * (d - 1) + 1.0), squeeze=False)
+    alpha = 0.8 if xi.shape[0] <= 500 else 0.25
+    for i in range(1, d):
+        for j in range(d - 1):
+            ax = axes[i - 1, j]
+            if j >= i:
+                ax.set_visible(False)
+                continue
+            ax.scatter(xi[~failed, j], xi[~failed, i], s=sizes if np.ndim(sizes) == 0 else sizes[~failed],
+                       color=COLORS[0], alpha=alpha, lw=0)
+            if failed.any():
+                ax.scatter(xi[failed, j], xi[failed, i], s=18, color="red", marker="x", lw=1)
+            ax.tick_params(labelsize=6)
+            if j == 0:
+                ax.set_ylabel(f"ξ {names[i]}", fontsize=8)
+            else:
+                ax.set_yticklabels([])
+            if i == d - 1:
+                ax.set_xlabel(f"ξ {names[j]}", fontsize=8)
+            else:
+                ax.set_xticklabels([])
+            ax.grid(alpha=0.3)
+    fig.suptitle(title, fontsize=11)
+    fig.tight_layout()
+    fig.savefig(path, dpi=DPI)
+    plt.close(fig)
+    return Path(path)

@@ -1,0 +1,169 @@
+"""The CLI and report for people (issue 14): --version, -h, units in --help, the report's default
+folder and its temp-dir-then-move, repeatable --method, `design --csv`, `surrogate export`."""
+import csv
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import uqflight
+from uqflight.campaign import parse_campaign
+from uqflight.execution import run_campaign
+from uqflight.methods.basis import orthonormal_basis
+from uqflight.report import write_report
+from uqflight.statistics import analyse
+from uqflight.surrogate import fit_surrogate, load
+
+UQFLIGHT = str(Path(sys.executable).with_name("uqflight"))
+
+DECAY = """
+name: decay-people
+seed: 3
+simulator: {kind: python, function: "uqflight.simulators.models:exp_decay"}
+parameters:
+  a: {distribution: normal, lower: 0.5, upper: 1.5}
+  b: {distribution: uniform, lower: 1.0, upper: 2.0, nominal: 1.4}
+design: {kind: sparse_grid, level: 3}
+method: {kind: pseudo_galerkin, order: 2}
+analysis: {band_samples: 500, bootstrap: 0}
+"""
+
+
+def cli(*args) -> subprocess.CompletedProcess:
+    return subprocess.run([UQFLIGHT, *map(str, args)], capture_output=True, text=True, timeout=300)
+
+
+@pytest.fixture(scope="module")
+def results(tmp_path_factory) -> Path:
+    root = tmp_path_factory.mktemp("people")
+    (root / "decay.yaml").write_text(DECAY)
+    path = root / "decay.h5"
+    run_campaign(parse_campaign(DECAY, str(root / "decay.yaml")), out=path, workers=1)
+    return path
+
+
+def test_version_and_short_help():
+    result = cli("--version")
+    assert result.returncode == 0 and result.stdout.strip() == f"uqflight {uqflight.__version__}"
+    short, long = cli("-h"), cli("--help")
+    assert short.returncode == 0 and short.stdout == long.stdout and "-h, --help" in short.stdout
+    for command in ("report", "design", "simulate"):
+        assert cli(command, "-h").returncode == 0
+    assert "surrogate" in short.stdout and "design" in short.stdout
+
+
+def test_units_are_visible_in_simulate_help():
+    text = " ".join(cli("simulate", "--help").stdout.split())
+    for unit in ("altitude [ft]", "airspeed [kt]", "amplitude [deg]", "start [s]", "[Hz]"):
+        assert unit in text, (unit, text)
+
+
+def test_report_writes_next_to_the_results_file_by_default(results):
+    result = cli("report", results)
+    assert result.returncode == 0, result.stderr
+    out = results.with_name("decay-report")
+    files = [p for p in out.rglob("*") if p.is_file()]
+    assert result.stdout.strip() == f"wrote {len(files)} files to {out}: open {out / 'report.html'}"
+    assert (out / "summary.json").is_file() and (out / "tables" / "parameters.csv").is_file()
+    parameters = list(csv.DictReader(open(out / "tables" / "parameters.csv")))
+    assert [(r["parameter"], r["distribution"], float(r["nominal"])) for r in parameters] == \
+        [("a", "normal", 1.0), ("b", "uniform", 1.4)]
+    page = (out / "report.html").read_text()
+    assert "What was run" in page and "design_decay.png" in page and "name: decay-people" in page
+    assert not [p for p in results.parent.iterdir() if p.name.startswith(".decay-report")]
+
+
+def test_a_report_that_fails_midway_leaves_nothing(results, tmp_path, monkeypatch):
+    import uqflight.report as report
+
+    def broken(*args, **kwargs):
+        raise RuntimeError("disk on fire")
+
+    out = tmp_path / "nested" / "report"
+    monkeypatch.setattr(report, "render_markdown", broken)  # after the plots and tables are written
+    with pytest.raises(RuntimeError, match="disk on fire"):
+        write_report([results], out)
+    assert list(out.parent.iterdir()) == []
+    old = tmp_path / "old"
+    old.mkdir()
+    (old / "keep.txt").write_text("previous report")
+    with pytest.raises(RuntimeError):
+        write_report([results], old)
+    assert [p.name for p in old.iterdir()] == ["keep.txt"] and len(list(tmp_path.iterdir())) == 2
+    monkeypatch.undo()
+    written = write_report([results], old)
+    assert not (old / "keep.txt").exists() and (old / "report.html") in written
+
+
+def test_several_methods_over_the_same_runs(results, tmp_path):
+    out = tmp_path / "methods"
+    result = cli("report", results, "--method", "pseudo_galerkin:2", "--method", "least_squares:1",
+                 "--method", "regression", "--order", "2", "--out", out)
+    assert result.returncode == 0, result.stderr
+    labels = [row["label"] for row in csv.DictReader(open(out / "tables" / "files.csv"))]
+    assert [label.split(": ")[1].split(",")[0] for label in labels] == \
+        ["PG order 2", "least squares order 1", "regression order 2"]
+    plots = {p.name for p in (out / "plots").iterdir()}
+    assert {"sobol_compared.png", "bands_compared.png", "mean_band_decay_least_squares1.png"} <= plots
+    summaries = {p.name: json.loads(p.read_text()) for p in (out / "summaries").iterdir()}
+    least = summaries["decay_least_squares1.json"]
+    assert least["method"]["kind"] == "least_squares" and least["method"]["order"] == 1
+    exact = analyse(results, method={"kind": "least_squares", "order": 1}).outputs["x"].mean
+    np.testing.assert_allclose(least["outputs"]["x"]["mean"], exact, rtol=1e-12)
+    for bad, message in ((["--method", "galerkin:2"], "expected KIND[:ORDER]"),
+                         (["--method", "least_squares:two"], "integer ORDER"),
+                         (["--order", "2"], "--order needs --method")):
+        refused = cli("report", results, *bad, "--out", tmp_path / "bad")
+        assert refused.returncode == 2 and message in refused.stderr and "Traceback" not in refused.stderr, bad
+        assert not (tmp_path / "bad").exists()
+
+
+def test_design_csv(tmp_path):
+    campaign = tmp_path / "decay.yaml"
+    campaign.write_text(DECAY)
+    out = tmp_path / "design.csv"
+    result = cli("design", campaign, "--csv", out)
+    assert result.returncode == 0, result.stderr
+    rows = list(csv.DictReader(open(out)))
+    design = parse_campaign(DECAY, str(campaign)).design()
+    assert result.stdout.strip() == (f"wrote {out}: {len(design.xi)} points of a sparse_grid design in 2 "
+                                     "parameters (a, b)")
+    assert list(rows[0]) == ["run", "xi_a", "xi_b", "a", "b", "weight"] and len(rows) == len(design.xi)
+    xi = np.array([[float(r["xi_a"]), float(r["xi_b"])] for r in rows])
+    np.testing.assert_array_equal(xi, design.xi)
+    np.testing.assert_array_equal([float(r["weight"]) for r in rows], design.weights)
+    kappa = np.array([[float(r["a"]), float(r["b"])] for r in rows])
+    np.testing.assert_allclose(kappa[:, 0], 1.0 + xi[:, 0] / 6, rtol=1e-14)  # normal: ±3σ on [0.5, 1.5]
+    np.testing.assert_allclose(kappa[:, 1], 1.5 + 0.5 * xi[:, 1], rtol=1e-14)  # uniform on [1, 2]
+    missing = cli("design", tmp_path / "missing.yaml", "--csv", out)
+    assert missing.returncode == 2 and "Traceback" not in missing.stderr
+
+
+def test_surrogate_export_round_trip(results, tmp_path):
+    out = tmp_path / "pce.json"
+    result = cli("surrogate", "export", results, "--out", out)
+    assert result.returncode == 0, result.stderr
+    assert result.stdout.strip() == f"wrote {out}"
+    data = json.loads(out.read_text(), parse_constant=lambda c: pytest.fail(f"not strict JSON: {c}"))
+    assert data["method"] == "pseudo_galerkin" and data["order"] == 2 and len(data["germs"]) == 2
+    assert [p["name"] for p in data["parameters"]] == ["a", "b"] and data["parameters"][1]["nominal"] == 1.4
+    surrogate = load(out)
+    stats = analyse(results)
+    np.testing.assert_allclose(surrogate.mean()["x"], stats.outputs["x"].mean, rtol=1e-12, atol=1e-15)
+    np.testing.assert_allclose(surrogate.variance()["x"], stats.outputs["x"].variance, rtol=1e-10, atol=1e-15)
+    rng = np.random.default_rng(1)
+    xi = np.column_stack([rng.standard_normal(50), rng.uniform(-1, 1, 50)])
+    fitted = fit_surrogate(results)
+    expected = orthonormal_basis(fitted.germs, fitted.indices, xi) @ fitted.coefficients["x"]
+    np.testing.assert_allclose(surrogate.evaluate(xi=xi)["x"], expected, rtol=1e-12, atol=1e-14)
+    kappa = np.column_stack([1.0 + xi[:, 0] / 6, 1.5 + 0.5 * xi[:, 1]])
+    np.testing.assert_allclose(surrogate.evaluate(kappa)["x"], expected, rtol=1e-12, atol=1e-14)
+    # a quadratic PCE of exp(-a t) · b is close to the model itself at the nominal point
+    time = np.asarray(data["time"])
+    near = surrogate.evaluate([[1.0, 1.5]])["x"][0]
+    assert near.shape == time.shape
+    mc = cli("surrogate", "export", results, "--out", tmp_path / "mc.json", "--method", "monte_carlo")
+    assert mc.returncode == 2 and "builds no PCE" in mc.stderr and not (tmp_path / "mc.json").exists()

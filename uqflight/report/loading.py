@@ -1,0 +1,176 @@
+"""Analysed results files → report entries: statistics, labels, the campaign's parameters and the file's facts."""
+from __future__ import annotations
+
+import json
+import re
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import yaml
+
+from ..statistics import Statistics, add_reference_errors, read_statistics
+
+METHOD_NAMES = {"integration": "Int", "pseudo_galerkin": "PG", "interpolation": "interpolation",
+                "regression": "regression", "least_squares": "least squares", "monte_carlo": "MC"}
+
+
+@dataclass
+class Entry:
+    """One analysed results file and how the report names it."""
+
+    stats: Statistics
+    stem: str
+    label: str
+    campaign_hash: str
+    inputs: str
+    attrs: dict = field(default_factory=dict)  # the results file's root attributes
+    path: str = ""  # the results file (several entries share one with several --method)
+
+    @property
+    def outputs(self) -> dict:
+        return self.stats.outputs
+
+    @property
+    def monte_carlo(self) -> bool:
+        return self.stats.method["kind"] == "monte_carlo"
+
+    @property
+    def pick_freeze(self) -> bool:
+        return self.stats.design_kind == "pick_freeze"
+
+    @property
+    def has_sobol(self) -> bool:
+        return any(out.sobol_first for out in self.outputs.values())
+
+    @property
+    def has_errors(self) -> bool:
+        return any(out.errors for out in self.outputs.values())
+
+
+
+def method_label(method: dict) -> str:
+    """A method as in the paper's legends, e.g. "PG order 2", "MC"."""
+    kind = method["kind"]
+    name = METHOD_NAMES.get(kind, kind)
+    if kind == "monte_carlo":
+        return name
+    return f"{name} order {method['order']}" + (" split" if method.get("split") else "")
+
+
+def input_distributions(campaign_text: str) -> str:
+    """The campaign's input distribution(s), e.g. "normal" or "normal, uniform"."""
+    parameters = (yaml.safe_load(campaign_text) or {}).get("parameters") or {}
+    return ", ".join(dict.fromkeys(str(spec.get("distribution", "?")) for spec in parameters.values()))
+
+
+def campaign_parameters(campaign_text: str) -> list[dict] | None:
+    """The campaign's parameters as dicts (name, property, distribution, lower, upper, nominal), read
+    through the campaign parser (nominal values from the aircraft when the campaign leaves them to
+    it); None when the text cannot be parsed."""
+    from ..campaign import parse_campaign
+
+    for probe in (None, "jsbsim"):
+        try:
+            if probe == "jsbsim":
+                from ..simulators.jsbsim_probe import jsbsim_probe as probe
+            campaign = parse_campaign(campaign_text, "<results file>", probe)
+        except Exception:  # noqa: BLE001 - a report describes what it can; the table says "not readable"
+            continue
+        return [{"name": p.name, "property": p.property, "distribution": p.distribution, "lower": p.lower,
+                 "upper": p.upper, "nominal": p.nominal} for p in campaign.parameters]
+    return None
+
+
+def campaign_settings(campaign_text: str) -> dict:
+    """The campaign's mapping as written (YAML), {} when unreadable."""
+    try:
+        data = yaml.safe_load(campaign_text)
+    except yaml.YAMLError:
+        return {}
+    return data if isinstance(data, dict) else {}
+
+
+def parse_methods(methods: list[str], order: int | None = None) -> list[dict]:
+    """`KIND[:ORDER]` strings into method overrides; a bare KIND takes `order` (when given).
+    ValueError naming the bad item."""
+    from ..methods import METHOD_KINDS
+
+    parsed = []
+    for text in methods:
+        kind, sep, number = text.partition(":")
+        kind = kind.strip()
+        if kind not in METHOD_KINDS:
+            raise ValueError(f"expected KIND[:ORDER] with KIND one of {', '.join(METHOD_KINDS)}, got {text!r}")
+        method = {"kind": kind}
+        if sep:
+            try:
+                method["order"] = int(number)
+            except ValueError:
+                raise ValueError(f"expected an integer ORDER >= 0 after {kind}:, got {text!r}") from None
+            if method["order"] < 0:
+                raise ValueError(f"expected an integer ORDER >= 0 after {kind}:, got {text!r}")
+        elif order is not None:
+            method["order"] = order
+        parsed.append(method)
+    return parsed
+
+
+def load_entries(paths: list[Path], reference: Path | None, method: dict | list[dict] | None = None,
+                 progress=None, partial: bool = False, allow_aliasing: bool = False) -> tuple[list[Entry], Entry | None]:
+    """Every file analysed once per method (`method`: one override, several, or None for the
+    campaigns' own; the reference keeps its own), with errors against the reference unless it is
+    the reference itself, and the reference. `progress(text)` is told each stage."""
+    methods = method if isinstance(method, list) else [method]
+    methods = methods or [None]
+    stems: set[str] = set()
+    tell = progress or (lambda text: None)
+    ref = None
+    if reference:
+        tell(f"analysing the reference {reference}")
+        ref = _entry(reference, *read_statistics(reference), set())
+    entries = []
+    for path in paths:
+        for override in methods:
+            tell(f"analysing {path}" + (f" ({method_label({'order': '?', **override})})" if override else ""))
+            stats, attrs = read_statistics(path, override, partial=partial, allow_aliasing=allow_aliasing)
+            if ref is not None and not _same_file(path, reference):
+                add_reference_errors(stats, ref.stats)
+            entries.append(_entry(path, stats, attrs, stems, with_method=len(methods) > 1))
+    return entries, ref
+
+
+def _entry(path: Path, stats: Statistics, attrs: dict, stems: set[str], with_method: bool = False) -> Entry:
+    name = Path(path).stem + (f"_{stats.method['kind']}{stats.method.get('order', '')}" if with_method else "")
+    stem = _unique(file_name(name), stems)
+    runs = f"partial: {stats.completed} of {stats.runs} runs" if stats.partial else f"{stats.runs} runs"
+    label = f"{stats.campaign_name or stem}: {method_label(stats.method)}, {runs}"
+    return Entry(stats, stem, label, str(attrs.get("campaign_hash", "")),
+                 input_distributions(str(attrs.get("campaign", ""))), dict(attrs), str(path))
+
+
+def design_info(attrs: dict) -> dict:
+    """The design's facts (level, rule, ...) from the results file, {} when absent."""
+    try:
+        info = json.loads(attrs.get("design_info", "{}"))
+    except (TypeError, ValueError):
+        return {}
+    return info if isinstance(info, dict) else {}
+
+
+def file_name(name: str) -> str:
+    """An output or file name made safe for a file name: "velocities/vc-kts" → "velocities_vc-kts"."""
+    return re.sub(r"[^A-Za-z0-9_.-]", "_", name)
+
+
+def _same_file(a, b) -> bool:
+    return Path(a).resolve() == Path(b).resolve()
+
+
+def _unique(stem: str, taken: set[str]) -> str:
+    name, n = stem, 1
+    while name in taken:
+        n += 1
+        name = f"{stem}-{n}"
+    taken.add(name)
+    return name
+

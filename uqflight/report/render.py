@@ -1,0 +1,91 @@
+"""The report page as self-contained HTML (plots embedded) and as Markdown (linking plots/)."""
+from __future__ import annotations
+
+import base64
+import html
+from datetime import datetime, timezone
+from pathlib import Path
+
+import numpy as np
+
+from .sections import Figure, Section
+
+STYLE = """body{font-family:sans-serif;max-width:1200px;margin:2em auto;padding:0 1em;color:#222}
+table{border-collapse:collapse;margin:.5em 0 1.5em;font-size:.85em;display:block;overflow-x:auto}
+th,td{border:1px solid #ccc;padding:.2em .5em;text-align:right}th{background:#eee}
+td:first-child,td:nth-child(2){text-align:left}img{max-width:100%}figure{margin:1em 0 2em}
+figcaption{font-size:.9em;color:#444}pre{background:#f6f6f6;padding:.5em;overflow-x:auto}
+.notes{border:2px solid #c60;background:#fff4e5;padding:.5em 1em;margin:1em 0}
+.notes h2{margin:.2em 0;color:#a40}"""
+
+
+def render_html(title: str, sections: list[Section], out_dir: Path) -> str:
+    """One self-contained page: the plots as base64 PNG data URIs, a table of contents, the tables."""
+    toc, body = [], []
+    for s in sections:
+        toc.append(f'<li><a href="#{s.anchor}">{html.escape(s.title)}</a>' + _html_toc(s) + "</li>")
+        if s.notes:
+            items = "".join(f"<li>{html.escape(line.removeprefix('- '))}</li>" for line in s.text.splitlines())
+            body.append(f'<div class="notes"><h2 id="{s.anchor}">{html.escape(s.title)}</h2><ul>{items}</ul></div>')
+            continue
+        body.append(f'<h2 id="{s.anchor}">{html.escape(s.title)}</h2>')
+        if s.preformatted:  # the campaign text, folded below the tables and figures
+            body += [_html_block(s.anchor, n, block, out_dir) for n, block in enumerate(s.blocks)]
+            body.append(f"<details><summary>Campaign text</summary><pre>{html.escape(s.text)}</pre></details>")
+            continue
+        body.append(f"<pre>{html.escape(s.text)}</pre>" if "\n" in s.text else f"<p>{html.escape(s.text)}</p>")
+        body += [_html_block(s.anchor, n, block, out_dir) for n, block in enumerate(s.blocks)]
+    stamp = datetime.now(timezone.utc).isoformat(timespec="seconds")
+    return (f'<!DOCTYPE html>\n<html lang="en"><head><meta charset="utf-8"><title>{html.escape(title)}</title>'
+            f"<style>{STYLE}</style></head><body>\n<h1>{html.escape(title)}</h1>\n<p>Written {stamp} by uqflight.</p>\n"
+            f"<h2>Contents</h2><ul>{''.join(toc)}</ul>\n" + "\n".join(body) + "\n</body></html>\n")
+
+
+def _html_toc(section: Section) -> str:
+    items = [f'<li><a href="#{section.anchor}-{n}">{html.escape(_block_title(b))}</a></li>'
+             for n, b in enumerate(section.blocks)]
+    return f"<ul>{''.join(items)}</ul>" if items else ""
+
+
+def _block_title(block) -> str:
+    return f"{block.file}: {block.caption}" if isinstance(block, Figure) else f"Table: {block.caption}"
+
+
+def _html_block(anchor: str, n: int, block, out_dir: Path) -> str:
+    if isinstance(block, Figure):
+        data = base64.b64encode((out_dir / block.file).read_bytes()).decode("ascii")
+        return (f'<figure id="{anchor}-{n}"><img src="data:image/png;base64,{data}" alt="{html.escape(block.file)}">'
+                f"<figcaption>{html.escape(block.caption)} ({html.escape(block.file)})</figcaption></figure>")
+    head = "".join(f"<th>{html.escape(h)}</th>" for h in block.header)
+    rows = "".join("<tr>" + "".join(f"<td>{html.escape(_cell(v))}</td>" for v in row) + "</tr>" for row in block.rows)
+    return (f'<h3 id="{anchor}-{n}">{html.escape(block.caption)}</h3><p>({html.escape(block.file)})</p>'
+            f"<table><tr>{head}</tr>{rows}</table>")
+
+
+def render_markdown(title: str, sections: list[Section]) -> str:
+    """The same page in Markdown, linking the PNGs in plots/."""
+    lines = [f"# {title}", "", "## Contents", ""]
+    lines += [f"- [{s.title}](#{s.anchor})" for s in sections]
+    for s in sections:
+        text = f"```yaml\n{s.text}\n```" if s.preformatted else s.text
+        if s.notes:
+            text = "\n".join(f"> **{line}**" for line in s.text.splitlines())
+        lines += ["", f'<a id="{s.anchor}"></a>', f"## {s.title}", "", text]
+        for block in s.blocks:
+            if isinstance(block, Figure):
+                lines += ["", f"![{block.caption}]({block.file})", "", f"*{block.caption}* ({block.file})"]
+            else:
+                lines += ["", f"### {block.caption}", "", f"({block.file})", "",
+                          "| " + " | ".join(block.header) + " |", "|" + "---|" * len(block.header)]
+                lines += ["| " + " | ".join(_cell(v).replace("|", "\\|") for v in row) + " |" for row in block.rows]
+    return "\n".join(lines) + "\n"
+
+
+def _cell(value) -> str:
+    """A table cell for reading: 4 significant digits, one decimal from 1000 on (an altitude of
+    14966.1 ft, not 1.497e+04); the CSVs keep full precision."""
+    if isinstance(value, (float, np.floating)):
+        return f"{value:.1f}" if 1e3 <= abs(value) < 1e7 else f"{value:.4g}"
+    return str(value)
+
+

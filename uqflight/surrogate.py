@@ -1,0 +1,169 @@
+"""The PCE surrogate of a results file: export it as strict JSON, load it back and evaluate it.
+
+    uqflight surrogate export RESULTS.h5 --out pce.json
+    >>> from uqflight.surrogate import load
+    >>> pce = load("pce.json")
+    >>> pce.evaluate(kappa=[[0.25, 5.1, ...]])["theta_deg"]     # (points, times)
+
+The file holds everything needed to evaluate the expansion without uqflight's results file:
+the germs (standard variables), the multi-indices (total degree, one row per basis polynomial),
+the coefficients of the orthonormal basis per output and time, the parameters' distributions
+(name, distribution, lower, upper, nominal: κ ↔ ξ), the time grid, the method and its order.
+The PCE is fitted exactly as the statistics fit it (same runs, same method, same order).
+"""
+from __future__ import annotations
+
+import json
+import math
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+FORMAT = "uqflight-pce"
+VERSION = 1
+
+
+class SurrogateError(ValueError):
+    """A results file that has no PCE (e.g. Monte Carlo) or a malformed surrogate file."""
+
+
+@dataclass
+class Surrogate:
+    """A PCE over time per output; evaluate it at physical values κ or standard variables ξ."""
+
+    parameters: list[dict]
+    germs: list[str]
+    indices: np.ndarray  # (Z, d) multi-indices
+    time: np.ndarray  # (T,)
+    coefficients: dict[str, np.ndarray]  # output -> (Z, T)
+    units: dict[str, str]
+    method: dict
+    campaign: str = ""
+
+    @property
+    def outputs(self) -> list[str]:
+        return list(self.coefficients)
+
+    def to_standard(self, kappa) -> np.ndarray:
+        """ξ (M, d) from physical values κ (M, d), column by column through each parameter's law."""
+        from .parameters import Parameter
+
+        kappa = np.atleast_2d(np.asarray(kappa, dtype=float))
+        if kappa.shape[1] != len(self.parameters):
+            raise ValueError(f"expected {len(self.parameters)} values per point "
+                             f"({', '.join(p['name'] for p in self.parameters)}), got {kappa.shape[1]}")
+        laws = [Parameter(p["name"], p.get("property", p["name"]), p["distribution"], p["nominal"], p["lower"],
+                          p["upper"]) for p in self.parameters]
+        return np.column_stack([law.to_standard(kappa[:, j]) for j, law in enumerate(laws)])
+
+    def evaluate(self, kappa=None, *, xi=None) -> dict[str, np.ndarray]:
+        """{output: (M, T)} at M points given as physical values κ (M, d) or standard variables ξ."""
+        from .methods.basis import orthonormal_basis
+
+        if (kappa is None) == (xi is None):
+            raise ValueError("give exactly one of kappa (physical values) or xi (standard variables)")
+        points = self.to_standard(kappa) if xi is None else np.atleast_2d(np.asarray(xi, dtype=float))
+        if points.shape[1] != len(self.germs):
+            raise ValueError(f"expected {len(self.germs)} standard variables per point, got {points.shape[1]}")
+        basis = orthonormal_basis(self.germs, self.indices, points)
+        return {name: basis @ c for name, c in self.coefficients.items()}
+
+    def mean(self) -> dict[str, np.ndarray]:
+        constant = ~self.indices.any(axis=1)
+        return {name: c[constant].sum(axis=0) for name, c in self.coefficients.items()}
+
+    def variance(self) -> dict[str, np.ndarray]:
+        constant = ~self.indices.any(axis=1)
+        return {name: (c[~constant] ** 2).sum(axis=0) for name, c in self.coefficients.items()}
+
+
+def fit_surrogate(path, method: dict | None = None) -> Surrogate:
+    """The PCE of every output of the results file `path`, fitted as `uqflight.statistics.analyse`
+    fits it (with `method` overriding the campaign's). SurrogateError when the method builds none."""
+    from .designs import is_sampled
+    from .methods import PCE, method_entry
+    from .statistics import campaign_facts, output_basis
+    from .store import ResultStore, Status
+
+    with ResultStore.open(path) as store:
+        stored_method, germs, _ = campaign_facts(store)
+        method = {**stored_method, **(method or {})}
+        entry = method_entry(method["kind"])
+        design_kind = store.attrs.get("design_kind", "")
+        if entry.pce is None or entry.moments == "sample" or (entry.runs_on_sampled and is_sampled(design_kind)):
+            raise SurrogateError(f"{path}: method {method['kind']} on a {design_kind} design builds no PCE; "
+                                 "give a PCE method, e.g. --method least_squares:2")
+        ok = store.status == Status.OK
+        if not ok.any():
+            raise SurrogateError(f"{path}: no successful runs")
+        xi, weights = store.xi[ok], store.weights[ok]
+        coefficients, indices = {}, None
+        for name in store.output_names:
+            basis, scale = output_basis(store, name, ok)
+            x0 = None
+            if method.get("split") and entry.split:  # as statistics: x = x0 + S with each run's x(0)
+                basis = basis if scale is None else basis @ scale
+                scale, x0 = None, basis[:, :1]
+            fitted = entry.pce(xi, weights, basis, germs, method["order"], x0)
+            pce = PCE(fitted.germs, fitted.indices, fitted.coefficients if scale is None
+                      else fitted.coefficients @ scale)
+            coefficients[name] = np.asarray(pce.coefficients, dtype=float)
+            indices = np.asarray(pce.indices, dtype=int)
+        return Surrogate(_parameters(store), list(germs), indices, np.asarray(store.time, dtype=float),
+                         coefficients, dict(store.units), method, str(store.attrs.get("campaign_name", "")))
+
+
+def _parameters(store) -> list[dict]:
+    """The parameters' laws from the stored campaign text (κ ↔ ξ), via the campaign parser."""
+    from .report.loading import campaign_parameters
+
+    found = campaign_parameters(store.campaign_text)
+    names = store.parameter_names
+    if found is None or [p["name"] for p in found] != names:
+        raise SurrogateError("cannot read the parameters' distributions from the campaign text in the results file")
+    return found
+
+
+def surrogate_json(surrogate: Surrogate, results: str = "") -> dict:
+    """The strict-JSON form (non-finite numbers as null)."""
+    def numbers(a):
+        return [[v if math.isfinite(v) else None for v in row] for row in np.asarray(a, dtype=float).tolist()]
+
+    return {
+        "format": FORMAT, "version": VERSION, "campaign": surrogate.campaign, "results": results,
+        "method": surrogate.method["kind"], "order": surrogate.method["order"],
+        "split": bool(surrogate.method.get("split", False)),
+        "basis": "orthonormal polynomials of the germs (Hermite for normal, Legendre for uniform), total degree",
+        "parameters": surrogate.parameters, "germs": surrogate.germs,
+        "multi_indices": surrogate.indices.tolist(), "time": surrogate.time.tolist(),
+        "outputs": {name: {"units": surrogate.units.get(name, ""), "coefficients": numbers(c)}
+                    for name, c in surrogate.coefficients.items()},
+    }
+
+
+def export(results, out, method: dict | None = None) -> Path:
+    """Fit the PCE of `results` and write it to `out` as strict JSON; returns `out`."""
+    data = surrogate_json(fit_surrogate(results, method), str(results))
+    out = Path(out)
+    out.parent.mkdir(parents=True, exist_ok=True)
+    tmp = out.with_name(out.name + ".part")
+    tmp.write_text(json.dumps(data, allow_nan=False) + "\n", encoding="utf-8")
+    tmp.replace(out)
+    return out
+
+
+def load(path) -> Surrogate:
+    """The surrogate written by `export` (or `uqflight surrogate export`)."""
+    try:
+        data = json.loads(Path(path).read_text(encoding="utf-8"))
+    except (OSError, ValueError) as exc:
+        raise SurrogateError(f"{path}: cannot read the surrogate ({exc})") from exc
+    if not isinstance(data, dict) or data.get("format") != FORMAT:
+        raise SurrogateError(f"{path}: not a uqflight PCE surrogate (format {FORMAT!r})")
+    coefficients = {name: np.array([[np.nan if v is None else v for v in row] for row in o["coefficients"]],
+                                   dtype=float) for name, o in data["outputs"].items()}
+    return Surrogate(data["parameters"], data["germs"], np.array(data["multi_indices"], dtype=int).reshape(
+        -1, len(data["germs"])), np.array(data["time"], dtype=float), coefficients,
+        {name: o.get("units", "") for name, o in data["outputs"].items()},
+        {"kind": data["method"], "order": data["order"], "split": data.get("split", False)}, data.get("campaign", ""))
