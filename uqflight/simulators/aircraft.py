@@ -244,6 +244,9 @@ def safe_name(text: str) -> str:
 # aircraft's envelope (measured: trims and holds level flight, see docs/own-aircraft.md).
 DEFAULT_CONDITIONS = {
     "bacm": {"altitude_ft": 15000.0, "airspeed_ktas": 200.0},
+    "c172p": {"altitude_ft": 4000.0, "airspeed_ktas": 100.0},
+    "737": {"altitude_ft": 10000.0, "airspeed_ktas": 280.0},
+    "f16": {"altitude_ft": 15000.0, "airspeed_ktas": 400.0},
 }
 FALLBACK_CONDITION = {"altitude_ft": 15000.0, "airspeed_ktas": 200.0}
 
