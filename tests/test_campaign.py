@@ -29,7 +29,7 @@ BAD = {
     "bad_seed.yaml": ("seed", "expected an integer >= 0, got -1"),
     "bad_simulator_kind.yaml": ("simulator.kind", "expected one of jsbsim, python, got 'xplane'"),
     "bad_missing_simulator_kind.yaml": ("simulator.kind", "is required; expected one of jsbsim, python"),
-    "bad_unknown_aircraft.yaml": ("simulator.aircraft", "expected one of bacm"),
+    "bad_unknown_aircraft.yaml": ("simulator.aircraft", "no aircraft 'concorde'"),
     "bad_unknown_output.yaml": ("simulator.outputs[1]", "or a JSBSim property of aircraft 'bacm', got 'aero/not-a-property'"),
     "bad_excitation_kind.yaml": ("simulator.excitation.kind", "expected one of pulse, step, doublet, none"),
     "bad_duration.yaml": ("simulator.duration_s", "expected a number > 0, got -5"),

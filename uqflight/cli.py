@@ -12,6 +12,7 @@ import typer
 
 from .methods import METHOD_KINDS
 from .simulators.base import FlightError
+from .simulators.aircraft import default_condition
 from .simulators.jsbsim import DEFAULT_OUTPUTS, Excitation, FlightSetup, JSBSimFlight
 
 CONTEXT = {"help_option_names": ["-h", "--help"]}
@@ -55,8 +56,11 @@ def parse_settings(pairs: list[str]) -> dict[str, float]:
 @app.command()
 def simulate(
     set_: List[str] = typer.Option([], "--set", metavar="PROPERTY=VALUE", help="PROPERTY=VALUE set before the trim, e.g. aero/uq/CL0=0.25 (repeatable)."),
-    altitude_ft: float = typer.Option(15000.0, help="Trim altitude [ft]."),
-    airspeed_ktas: float = typer.Option(200.0, help="Trim true airspeed [kt]."),
+    scale: List[str] = typer.Option([], "--scale", metavar="FUNCTION=FACTOR", help="FUNCTION=FACTOR: multiply an aerodynamic function of the "
+                                                        "aircraft, e.g. aero/coefficient/CLwbh=1.1 (repeatable)."),
+    offset: List[str] = typer.Option([], "--offset", metavar="FUNCTION=VALUE", help="FUNCTION=VALUE: add to an aerodynamic function (repeatable)."),
+    altitude_ft: Optional[float] = typer.Option(None, help="Trim altitude [ft] (default: the aircraft's, 15000 for bacm)."),
+    airspeed_ktas: Optional[float] = typer.Option(None, help="Trim true airspeed [kt] (default: the aircraft's, 200 for bacm)."),
     excitation: str = typer.Option("pulse", help="Elevator excitation: pulse, step, doublet or none."),
     amplitude_deg: float = typer.Option(1.0, help="Excitation amplitude [deg], positive trailing edge down."),
     start_s: float = typer.Option(1.0, help="Excitation start [s]."),
@@ -64,15 +68,21 @@ def simulate(
     duration_s: float = typer.Option(50.0, help="Flight time after the trim [s]."),
     output_rate_hz: float = typer.Option(20.0, help="Recording rate [Hz]; divides the 120 Hz integration rate."),
     output: List[str] = typer.Option([], "--output", metavar="PROPERTY", help="Extra JSBSim property to record (repeatable)."),
-    aircraft: str = typer.Option("bacm", help="Aircraft folder under aircraft/."),
+    aircraft: str = typer.Option("bacm", help="Aircraft: a name in the project's aircraft/ or JSBSim's, or a "
+                                              "path to an aircraft folder (`uqflight aircraft --list`)."),
     out: Optional[Path] = typer.Option(None, help="Write the time histories to this CSV file."),
     plot: Optional[Path] = typer.Option(None, help="Write a PNG plot of the outputs."),
 ):
     """Trim one flight in level flight, excite the elevator and record the outputs."""
     settings = parse_settings(set_)
     try:
+        located = _prepared(aircraft, scale, offset)
+        settings.update(located.settings)
+        condition = default_condition(located.name)
+        altitude_ft = condition["altitude_ft"] if altitude_ft is None else altitude_ft
+        airspeed_ktas = condition["airspeed_ktas"] if airspeed_ktas is None else airspeed_ktas
         setup = FlightSetup(
-            aircraft=aircraft, altitude_ft=altitude_ft, airspeed_ktas=airspeed_ktas,
+            aircraft=located.name, root=located.root, altitude_ft=altitude_ft, airspeed_ktas=airspeed_ktas,
             excitation=Excitation(kind=excitation, amplitude_deg=amplitude_deg, start_s=start_s,
                                   duration_s=pulse_duration_s),
             duration_s=duration_s, output_rate_hz=output_rate_hz,
@@ -99,8 +109,24 @@ def simulate(
         from .report.plots import plot_flight
 
         plot_flight(result.time, result.outputs, plot,
-                    title=f"{aircraft}: {excitation} {amplitude_deg:g} deg at {altitude_ft:g} ft, {airspeed_ktas:g} KTAS")
+                    title=f"{setup.aircraft}: {excitation} {amplitude_deg:g} deg at {altitude_ft:g} ft, {airspeed_ktas:g} KTAS")
         typer.echo(f"wrote {plot}")
+
+
+def _prepared(aircraft: str, scale: list[str], offset: list[str]):
+    """The aircraft of `simulate`/`aircraft`, patched for --scale/--offset; `.settings` holds the
+    patch properties' values. Raises ValueError (a bad pair or function) or FileNotFoundError."""
+    from .simulators.patch import PreparedAircraft, patch_property, resolve_function
+
+    plain = PreparedAircraft(aircraft, Path.cwd())
+    pairs = []
+    for kind, items in (("scale", scale), ("offset", offset)):
+        for name, value in parse_settings(items).items():
+            function = resolve_function(name, plain.functions)
+            pairs.append((function, kind, patch_property(function, kind, plain.functions), value))
+    prepared = PreparedAircraft(aircraft, Path.cwd(), patches=[(f, k) for f, k, _, _ in pairs]) if pairs else plain
+    prepared.settings = {prop: value for _, _, prop, value in pairs}
+    return prepared
 
 
 def _load(path: Path):
@@ -400,3 +426,52 @@ def check(
         typer.echo(drift_table(comparison))
         raise typer.Exit(1)
     typer.echo(f"no drift: {comparison.compared} values within rtol={rtol:g}/atol={atol:g}")
+
+
+@app.command("aircraft")
+def aircraft_command(
+    aircraft: Optional[str] = typer.Argument(None, help="Aircraft: a name in the project's aircraft/ or JSBSim's, "
+                                                        "or a path to an aircraft folder."),
+    altitude_ft: Optional[float] = typer.Option(None, help="Trim altitude [ft] (default: the aircraft's)."),
+    airspeed_ktas: Optional[float] = typer.Option(None, help="Trim true airspeed [kt] (default: the aircraft's)."),
+    list_: bool = typer.Option(False, "--list", help="List the project's and JSBSim's aircraft."),
+):
+    """An aircraft's aerodynamic functions (axis, name, description), engines and nominal trim."""
+    from .simulators.aircraft import AircraftFiles, aero_functions, known_aircraft
+    from .simulators.engines import engine_kinds
+
+    if list_ or aircraft is None:
+        for origin, names in known_aircraft().items():
+            typer.echo(f"{origin}: {' '.join(names)}")
+        return
+    try:
+        located = _prepared(aircraft, [], [])
+    except (ValueError, FileNotFoundError) as exc:
+        typer.echo(f"error: {exc}", err=True)
+        raise typer.Exit(2)
+    files = AircraftFiles.read(located.location)
+    typer.echo(f"aircraft: {located.name} ({located.location.origin}: {located.location.folder})")
+    typer.echo(f"files: {len(files.files)} XML, sha256 {files.hash()}")
+    functions = aero_functions(files.main)
+    typer.echo(f"aerodynamic functions ({len(functions)}; perturb with function: NAME, perturbation: scale|offset):")
+    for f in functions:
+        typer.echo(f"  {f.axis or '-':<6} {f.name:<40} {f.description[:70]}")
+    condition = default_condition(located.name)
+    condition.update({k: v for k, v in (("altitude_ft", altitude_ft), ("airspeed_ktas", airspeed_ktas)) if v is not None})
+    setup = FlightSetup(aircraft=located.name, root=located.root, excitation=Excitation(kind="none"), **condition)
+    try:
+        flight = JSBSimFlight(setup)
+    except (RuntimeError, FileNotFoundError) as exc:
+        typer.echo(f"error: {exc}", err=True)
+        raise typer.Exit(2)
+    typer.echo("engines:")
+    for i, (name, kind, thruster) in enumerate(engine_kinds(flight.fdm)):
+        typer.echo(f"  {i}: {name:<24} {kind:<10} thruster: {thruster}")
+    typer.echo(f"elevator travel: {flight.elevator_travel_deg[0]:.1f} deg down, {flight.elevator_travel_deg[1]:.1f} deg up"
+               + ("" if not flight.has_property("fcs/elevator-excitation-deg") else " (fcs/elevator-excitation-deg used)"))
+    typer.echo(f"nominal trim at {setup.altitude_ft:g} ft, {setup.airspeed_ktas:g} KTAS:")
+    try:
+        typer.echo(flight.trim({}).describe())
+    except FlightError as exc:
+        typer.echo(f"trim failed: {exc}")
+        raise typer.Exit(1)

@@ -80,10 +80,14 @@ def prepare_store(campaign: Campaign, design: Design, out: Path, force: bool) ->
 
 
 def worker_spec(campaign: Campaign) -> WorkerSpec:
+    from .simulators.bundle import make_bundle
+
+    properties = tuple(p.property for p in campaign.parameters)
+    base = str(Path(campaign.source).resolve().parent)
     return WorkerSpec(simulator=campaign.simulator,
                       parameter_names=tuple(p.name for p in campaign.parameters),
-                      properties=tuple(p.property for p in campaign.parameters),
-                      base=str(Path(campaign.source).resolve().parent))
+                      properties=properties, base=base,
+                      bundle=make_bundle(campaign.simulator, properties, base))  # files travel with the task
 
 
 def pending_chunks(pending: np.ndarray, chunk: int, total: int) -> list[np.ndarray]:

@@ -12,6 +12,7 @@ from pathlib import Path
 import numpy as np
 
 from .simulators import FlightError, make_simulator
+from .simulators.bundle import localized
 
 
 @dataclass(frozen=True)
@@ -22,6 +23,7 @@ class WorkerSpec:
     parameter_names: tuple[str, ...]
     properties: tuple[str, ...]
     base: str
+    bundle: dict | None = None  # the aircraft's (or file.py's) files as bytes + hash (simulators/bundle.py)
 
     @property
     def key(self) -> str:
@@ -36,6 +38,7 @@ _WORKER_CACHE: dict[str, object] = {}
 
 def worker_simulator(spec: WorkerSpec):
     """This process's simulator for `spec`, built on first use and kept (one load per worker)."""
+    spec = localized(spec)  # unpack the files that travel with the task; refuse other aircraft files
     simulator = _WORKER_CACHE.get(spec.key)
     if simulator is None:
         simulator = _WORKER_CACHE[spec.key] = spec.build()

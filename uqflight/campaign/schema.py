@@ -24,7 +24,8 @@ TOP_KEYS = ("name", "description", "seed", "simulator", "parameters", "design", 
             "execution", "storage", "analysis")
 JSBSIM_KEYS = ("kind", "aircraft", "flight", "excitation", "duration_s", "output_rate_hz", "outputs")
 PYTHON_KEYS = ("kind", "function", "outputs")
-PARAMETER_KEYS = ("property", "distribution", "nominal", "interval_pct", "lower", "upper")
+PARAMETER_KEYS = ("property", "function", "perturbation", "distribution", "nominal", "interval_pct", "lower", "upper")
+PERTURBATIONS = ("scale", "offset")
 METHOD_KEYS = ("kind", "order", "split", "allow_aliasing")
 EXECUTION_KEYS = ("workers", "executor", "scheduler", "chunk")
 STORAGE_KEYS = ("path", "raw", "tsvd")
@@ -180,6 +181,12 @@ def simulator(check: Checker, value, source: str) -> dict:
     sim = dict(check.mapping(value, "simulator", JSBSIM_KEYS))
     sim.setdefault("aircraft", "bacm")
     check.string(sim["aircraft"], "simulator.aircraft")
+    from ..simulators.aircraft import AircraftNotFound, locate
+
+    try:  # a path is relative to the campaign file; the resolved folder travels with the simulator
+        sim["aircraft_path"] = str(locate(sim["aircraft"], Path(source).resolve().parent).folder)
+    except AircraftNotFound as exc:
+        check.fail("simulator.aircraft", str(exc))
     flight = check.mapping(sim.get("flight", {}), "simulator.flight", ("altitude_ft", "airspeed_ktas"))
     if "altitude_ft" in flight:
         check.number(flight["altitude_ft"], "simulator.flight.altitude_ft", 0.0)
@@ -225,9 +232,13 @@ def parameters(check: Checker, value, kind: str, aircraft) -> list[Parameter]:
         path = f"parameters.{name}"
         spec = check.mapping(spec, path, PARAMETER_KEYS, required=("distribution",))
         distribution = check.string(spec["distribution"], f"{path}.distribution", DISTRIBUTIONS)
-        if kind == "jsbsim" and "property" not in spec:
-            check.fail(f"{path}.property", "is required: the JSBSim property the parameter sets, e.g. aero/uq/CL0")
-        prop = check.string(spec.get("property", str(name)), f"{path}.property")
+        function = None
+        if "function" in spec or "perturbation" in spec:
+            function = function_property(check, spec, path, kind, aircraft)
+        if kind == "jsbsim" and "property" not in spec and function is None:
+            check.fail(f"{path}.property", "is required: the JSBSim property the parameter sets, e.g. aero/uq/CL0 "
+                                           "(or function: and perturbation: to scale or offset an aerodynamic function)")
+        prop = function or check.string(spec.get("property", str(name)), f"{path}.property")
         if prop in owners:
             check.fail(f"{path}.property", f"expected each property once, but {prop!r} is already set by "
                                            f"parameters.{owners[prop]}")
@@ -244,7 +255,11 @@ def parameters(check: Checker, value, kind: str, aircraft) -> list[Parameter]:
         if "lower" in spec and not spec["lower"] < spec["upper"]:
             check.fail(f"{path}.lower", f"expected lower < upper, got {spec['lower']!r} >= {spec['upper']!r}")
         nominal = spec.get("nominal")
-        if aircraft is not None:
+        if function is not None:
+            from ..simulators.patch import NOMINAL
+
+            nominal = NOMINAL[spec["perturbation"]] if nominal is None else nominal
+        elif aircraft is not None:
             known = aircraft.value(prop)
             if known is None:
                 check.fail(f"{path}.property", f"expected a JSBSim property of aircraft {aircraft.aircraft!r}, "
@@ -263,6 +278,34 @@ def parameters(check: Checker, value, kind: str, aircraft) -> list[Parameter]:
         except ValueError as exc:
             check.fail(path, str(exc).removeprefix(f"parameter {str(name)!r}: "))
     return parameters
+
+
+def function_property(check: Checker, spec: dict, path: str, kind: str, aircraft) -> str:
+    """The property that scales or offsets `spec["function"]` (aero/uq/scale/NAME), checked
+    against the aircraft's aerodynamic functions when the aircraft is known."""
+    from ..simulators.patch import PatchError, patch_property, resolve_function
+
+    if kind != "jsbsim":
+        check.fail(f"{path}.function", "is for JSBSim aircraft; a python simulator's parameters have no functions")
+    if "property" in spec:
+        check.fail(path, "give either property or function (with perturbation), not both")
+    if "function" not in spec:
+        check.fail(f"{path}.function", "is required with perturbation: the aerodynamic function to perturb, "
+                                       "e.g. aero/coefficient/CLwbh")
+    function = check.string(spec["function"], f"{path}.function")
+    if "perturbation" not in spec:
+        check.fail(f"{path}.perturbation", f"is required with function: expected one of {', '.join(PERTURBATIONS)}")
+    perturbation = check.string(spec["perturbation"], f"{path}.perturbation", PERTURBATIONS)
+    if "interval_pct" in spec and perturbation == "offset":
+        check.fail(f"{path}.interval_pct", "has no meaning for an offset (nominal 0): give lower and upper")
+    functions = getattr(aircraft, "functions", None)
+    if functions is None:
+        return patch_property(function, perturbation)
+    try:
+        full = resolve_function(function, functions)
+    except PatchError as exc:
+        check.fail(f"{path}.function", f"{exc} (aircraft {aircraft.aircraft!r})")
+    return patch_property(full, perturbation, functions)
 
 
 def method(check: Checker, value) -> dict:

@@ -17,8 +17,10 @@ from .python import PythonSimulator
 class JSBSimSimulator:
     """The campaign's aircraft and flight; parameters map to JSBSim properties."""
 
-    def __init__(self, config: dict, properties: list[str]):
-        self.setup: FlightSetup = flight_setup_from(config)
+    def __init__(self, config: dict, properties: list[str], base: Path | None = None):
+        # the aircraft is located (a path relative to the campaign's folder) and, when parameters
+        # set aero/uq/scale/... or aero/uq/offset/... properties, patched (see patch.py)
+        self.setup: FlightSetup = flight_setup_from(config, base=base, properties=properties)
         self.properties = list(properties)
         self.flight = JSBSimFlight(self.setup)
         self._flown = False
@@ -45,7 +47,7 @@ def make_simulator(config: dict, parameter_names: list[str], properties: list[st
     """The simulator a campaign's `simulator:` mapping describes."""
     if config["kind"] == "python":
         return PythonSimulator(config, parameter_names, base)
-    return JSBSimSimulator(config, properties)
+    return JSBSimSimulator(config, properties, base)
 
 
 __all__ = ["FlightError", "JSBSimSimulator", "PythonSimulator", "make_simulator"]

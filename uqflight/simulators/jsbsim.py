@@ -8,7 +8,6 @@ touched and the controls' values at load time).
 """
 from __future__ import annotations
 
-import hashlib
 import math
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -17,8 +16,17 @@ import jsbsim
 import numpy as np
 
 from .base import DivergenceError, FlightError, TrimError
+from .engines import prepare_engines
 
-REPO_ROOT = Path(__file__).resolve().parents[2]
+REPO_ROOT = Path(__file__).resolve().parents[2]  # the source tree (aircraft/bacm)
+
+
+def default_root() -> Path:
+    """The root holding the project's aircraft: the source tree, else the installed package data."""
+    from .aircraft import project_roots
+
+    roots = project_roots()
+    return roots[0] if roots else REPO_ROOT
 DEFAULT_OUTPUTS = ("alpha_deg", "theta_deg", "h_ft", "q_degps", "vtas_kt")
 
 # Named outputs: (JSBSim property, scale to the output's unit).
@@ -88,7 +96,7 @@ class FlightSetup:
     """Everything that is the same for every sample of a campaign."""
 
     aircraft: str = "bacm"
-    root: Path = REPO_ROOT
+    root: Path = field(default_factory=default_root)
     altitude_ft: float = 15000.0
     airspeed_ktas: float = 200.0
     excitation: Excitation = field(default_factory=Excitation)
@@ -148,12 +156,10 @@ class FlightResult:
 
 def aircraft_hash(setup: FlightSetup) -> str:
     """sha256 over the aircraft's XML files (airframe, engines, systems), for provenance."""
-    digest = hashlib.sha256()
-    folder = setup.aircraft_file.parent
-    for path in sorted(folder.rglob("*.xml")):
-        digest.update(path.relative_to(folder).as_posix().encode())
-        digest.update(path.read_bytes())
-    return digest.hexdigest()
+    from .aircraft import AircraftFiles, AircraftLocation
+
+    location = AircraftLocation(setup.aircraft, setup.aircraft_file.parent, Path(setup.root), "root")
+    return AircraftFiles.read(location).hash()
 
 
 def quiet_jsbsim() -> None:
@@ -227,16 +233,26 @@ class JSBSimFlight:
         self._apply(initial)
         fdm.reset_to_initial_conditions(0)
         self._apply({k: v for k, v in settings.items() if k not in initial})
-        fdm["propulsion/fuel_freeze"] = 1
-        for i in range(self._engines):
-            fdm[f"fcs/advance-cmd-norm[{i}]"] = 1.0
-        fdm["propulsion/set-running"] = -1
+        prepare_engines(fdm)  # per engine kind: fuel frozen, running, mixture, propeller (engines.py)
         try:
             fdm["simulation/do_simple_trim"] = 1
         except jsbsim.TrimFailureError as exc:
-            raise TrimError(f"JSBSim trim failed: {str(exc).strip() or 'no convergence'}") from exc
+            raise TrimError(self._trim_failure(exc)) from exc
         fdm.get_propulsion().get_steady_state()
         return self._checked_trim()
+
+    def _trim_failure(self, exc) -> str:
+        """Why the trim failed: the axis furthest outside its tolerance, and the state and
+        controls JSBSim leaves after the failure (it restores the pre-trim controls)."""
+        fdm = self.fdm
+        ratios = {name: abs(fdm[name]) / tol for name, tol in TRIM_TOLERANCES.items()}
+        worst = max(ratios, key=ratios.get)
+        acc = ", ".join(f"{k.split('/')[-1].split('-')[0]} = {fdm[k]:.3g}" for k in TRIM_TOLERANCES)
+        thr = ", ".join(f"{fdm[f'fcs/throttle-cmd-norm[{i}]']:.3f}" for i in range(self._engines))
+        return (f"JSBSim trim failed ({str(exc).strip() or 'no convergence'}) at {self.setup.altitude_ft:g} ft, "
+                f"{self.setup.airspeed_ktas:g} KTAS: {worst.split('/')[-1].split('-')[0]} not trimmable "
+                f"({acc}; alpha = {fdm['aero/alpha-deg']:.2f} deg, throttle = [{thr}], "
+                f"pitch trim = {fdm['fcs/pitch-trim-cmd-norm']:.3f}, elevator = {fdm['fcs/elevator-pos-deg']:.2f} deg)")
 
     def _apply(self, settings: dict[str, float]) -> None:
         for name, value in settings.items():
@@ -260,7 +276,7 @@ class JSBSimFlight:
             raise TrimError("trim residual too large: " + "; ".join(bad))
         if not all(0.0 <= x <= 1.0 for x in result.throttle):
             raise TrimError(f"trim throttle outside [0, 1]: {result.throttle}")
-        if abs(fdm["fcs/pitch-trim-sum"]) >= 1.0:
+        if self.has_property("fcs/pitch-trim-sum") and abs(fdm["fcs/pitch-trim-sum"]) >= 1.0:
             raise TrimError(f"trim elevator saturated at {result.elevator_deg:.2f} deg")
         if self.has_property(STALL_PROPERTY) and fdm[STALL_PROPERTY] != 0.0:
             raise TrimError(f"trim angle of attack {result.alpha_deg:.2f} deg is past the stall")
@@ -276,20 +292,42 @@ class JSBSimFlight:
         excitation = s.excitation.values(step_times)
         changes = np.flatnonzero(np.diff(excitation, prepend=0.0))
         change_at = dict(zip(changes.tolist(), excitation[changes].tolist()))
-        exc_node = self.node("fcs/elevator-excitation-deg")
+        exc_node, exc_base, exc_per_deg = self._excitation_input()
         run = self.fdm.run
         data = np.empty((len(time), len(self._recorded)))
         data[0] = [node.get_double_value() for node, _ in self._recorded]
         for i in range(n_steps):
             if i in change_at:
-                exc_node.set_double_value(change_at[i])
+                exc_node.set_double_value(exc_base + exc_per_deg * change_at[i])
             run()
             if (i + 1) % k == 0:
                 data[(i + 1) // k] = [node.get_double_value() for node, _ in self._recorded]
-        exc_node.set_double_value(0.0)
+        exc_node.set_double_value(exc_base)
         data *= np.array([scale for _, scale in self._recorded])
         self._check_envelope(data)
         return FlightResult(time=time, outputs=dict(zip(s.outputs, data.T.copy())), trim=trim)
+
+    def _excitation_input(self):
+        """(node, trimmed value, command per degree) of the elevator excitation: the aircraft's
+        `fcs/elevator-excitation-deg` (degrees added to the elevator) when it has one; otherwise
+        `fcs/elevator-cmd-norm` (added to the pitch command, which the trim leaves at its value and
+        trims with fcs/pitch-trim-cmd-norm), converted by the elevator's travel read from the
+        aircraft's flight controls (its down travel for a positive amplitude, up travel for a negative one)."""
+        if self.has_property("fcs/elevator-excitation-deg"):
+            return self.node("fcs/elevator-excitation-deg"), 0.0, 1.0
+        node = self.node("fcs/elevator-cmd-norm")
+        travel = self.elevator_travel_deg
+        per_deg = 1.0 / (travel[0] if self.setup.excitation.amplitude_deg >= 0 else travel[1])
+        return node, node.get_double_value(), per_deg
+
+    @property
+    def elevator_travel_deg(self) -> tuple[float, float]:
+        """(down, up) elevator travel [deg] from the aircraft's flight controls (20 deg if not found)."""
+        if not hasattr(self, "_travel"):
+            from .aircraft import elevator_travel_deg
+
+            self._travel = elevator_travel_deg(self.setup.aircraft_file.read_bytes()) or (20.0, 20.0)
+        return self._travel
 
     def _check_envelope(self, data: np.ndarray) -> None:
         if not np.all(np.isfinite(data)):
@@ -300,14 +338,25 @@ class JSBSimFlight:
                 raise DivergenceError(f"{name} = {value:.1f} at the end of the flight (limit {limit:g})")
 
 
-def flight_setup_from(config: dict, root: Path = REPO_ROOT) -> FlightSetup:
-    """A FlightSetup from a campaign's `simulator:` mapping (keys already validated)."""
-    flight = config.get("flight", {})
+def flight_setup_from(config: dict, root: Path | None = None, base: Path | None = None,
+                      properties=()) -> FlightSetup:
+    """A FlightSetup from a campaign's `simulator:` mapping (keys already validated). The aircraft
+    is located (a path relative to `base`, the project's, JSBSim's; see `aircraft.locate`) and
+    patched when `properties` scale or offset its functions, unless `root` or config["root"] is given."""
+    from .aircraft import default_condition
+    from .patch import PreparedAircraft
+
+    name = config.get("aircraft", "bacm")
+    root = config.get("root", root)
+    if root is None:
+        prepared = PreparedAircraft(config.get("aircraft_path", name), base, properties)
+        name, root = prepared.name, prepared.root
+    flight = {**default_condition(name), **config.get("flight", {})}
     return FlightSetup(
-        aircraft=config.get("aircraft", "bacm"),
-        root=Path(config.get("root", root)),
-        altitude_ft=float(flight.get("altitude_ft", 15000.0)),
-        airspeed_ktas=float(flight.get("airspeed_ktas", 200.0)),
+        aircraft=name,
+        root=Path(root),
+        altitude_ft=float(flight["altitude_ft"]),
+        airspeed_ktas=float(flight["airspeed_ktas"]),
         excitation=Excitation(**config.get("excitation", {})),
         duration_s=float(config.get("duration_s", 50.0)),
         rate_hz=float(config.get("rate_hz", 120.0)),

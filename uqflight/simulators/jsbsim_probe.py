@@ -15,13 +15,11 @@ class AircraftProperties:
     `ic/vc-kts` the matching calibrated airspeed). Validation reads nominal values here."""
 
     def __init__(self, simulator: dict):
-        setup = flight_setup_from({**simulator, "outputs": []})
-        if not setup.aircraft_file.is_file():
-            folder = Path(setup.root) / "aircraft"
-            known = sorted(p.parent.name for p in folder.glob("*/*.xml") if p.stem == p.parent.name)
-            raise FileNotFoundError(f"expected one of {', '.join(known)} (the aircraft in {folder}), "
-                                    f"got {setup.aircraft!r}")
+        from .aircraft import AircraftFiles, aero_functions
+
+        setup = flight_setup_from({**simulator, "outputs": []})  # raises AircraftNotFound (a FileNotFoundError)
         self.aircraft = setup.aircraft
+        self.functions = [f.name for f in aero_functions(setup.aircraft_file.read_bytes())]
         self._flight = JSBSimFlight(setup)
         fdm = self._flight.fdm
         fdm["ic/h-sl-ft"] = setup.altitude_ft  # as JSBSimFlight.trim sets them

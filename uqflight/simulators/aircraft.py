@@ -1,0 +1,276 @@
+"""Where an aircraft's files are, what they are, and a JSBSim root directory that flies them.
+
+`simulator.aircraft` (and `uqflight simulate --aircraft`) names either
+1. a path to an aircraft folder `X/NAME/` holding `NAME.xml` (relative to the campaign file's
+   folder, or to the working directory on the command line); tried first when it exists;
+2. an aircraft of this project: `aircraft/NAME/` in the source tree, or the copy shipped as
+   package data (`uqflight/aircraft/NAME/`) in an installed uqflight;
+3. one of JSBSim's own aircraft (`jsbsim.get_default_root_dir()/aircraft/NAME/`).
+
+An aircraft is flown from a *root*: a folder with `aircraft/NAME/NAME.xml`, and `engine/` and
+`systems/` for the shared files it names. The aircraft's files are its folder's XML files plus
+the engines, thrusters and systems it names that live in the root's shared folders:
+`AircraftFiles` holds them as bytes (keyed by path), hashes them, and writes them out as a root
+of their own (the patched copies and the copies on remote workers are such roots).
+"""
+from __future__ import annotations
+
+import hashlib
+import os
+import re
+import xml.etree.ElementTree as ET
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import jsbsim
+
+PACKAGE_ROOT = Path(__file__).resolve().parents[1]  # uqflight/: holds aircraft/bacm as package data
+SOURCE_ROOT = Path(__file__).resolve().parents[2]   # the repository, when run from the source tree
+SHARED = "@root/"  # key prefix of files from the root's shared engine/ and systems/ folders
+
+
+class AircraftNotFound(FileNotFoundError):
+    """No aircraft of that name or path; the message lists where it looked and close names."""
+
+
+def cache_dir(*parts: str) -> Path:
+    """uqflight's cache: $UQFLIGHT_CACHE, else $XDG_CACHE_HOME/uqflight, else ~/.cache/uqflight."""
+    base = os.environ.get("UQFLIGHT_CACHE")
+    if not base:
+        base = str(Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache") / "uqflight")
+    return Path(base, *parts)
+
+
+def project_roots() -> list[Path]:
+    """Roots holding this project's aircraft: the source tree first, then the package data."""
+    return [root for root in (SOURCE_ROOT, PACKAGE_ROOT) if (root / "aircraft").is_dir()]
+
+
+def jsbsim_root() -> Path:
+    return Path(jsbsim.get_default_root_dir())
+
+
+@dataclass(frozen=True)
+class AircraftLocation:
+    """An aircraft found on disk: its name, its folder, and the root JSBSim loads it from."""
+
+    name: str
+    folder: Path
+    root: Path
+    origin: str  # "path", "project" or "jsbsim"
+
+    @property
+    def file(self) -> Path:
+        return self.folder / f"{self.name}.xml"
+
+    @property
+    def loadable_from_root(self) -> bool:
+        """True when `FGFDMExec(root).load_model(name)` finds exactly this folder."""
+        return (self.root / "aircraft" / self.name).resolve() == self.folder.resolve()
+
+
+def _is_aircraft_folder(folder: Path) -> bool:
+    return (folder / f"{folder.name}.xml").is_file()
+
+
+def known_aircraft() -> dict[str, list[str]]:
+    """Names of the project's and JSBSim's aircraft, for messages and `uqflight aircraft`."""
+    found = {"project": set(), "jsbsim": set()}
+    for origin, roots in (("project", project_roots()), ("jsbsim", [jsbsim_root()])):
+        for root in roots:
+            found[origin].update(p.name for p in (root / "aircraft").iterdir() if _is_aircraft_folder(p))
+    return {k: sorted(v) for k, v in found.items()}
+
+
+def locate(aircraft: str | os.PathLike, base: Path | None = None) -> AircraftLocation:
+    """The aircraft named by `aircraft` (a path, a project aircraft or a JSBSim aircraft)."""
+    text = str(aircraft)
+    candidate = Path(text).expanduser()
+    if not candidate.is_absolute():
+        candidate = Path(base or Path.cwd()) / candidate
+    if candidate.is_file() and candidate.suffix == ".xml":
+        candidate = candidate.parent
+    if candidate.is_dir() and _is_aircraft_folder(candidate):
+        folder = candidate.resolve()
+        parent = folder.parent
+        # A folder inside a root's aircraft/ keeps that root (its shared engines and systems).
+        root = parent.parent if parent.name == "aircraft" else jsbsim_root()
+        return AircraftLocation(folder.name, folder, root, "path")
+    if "/" not in text and os.sep not in text:
+        for root in project_roots():
+            if _is_aircraft_folder(root / "aircraft" / text):
+                return AircraftLocation(text, (root / "aircraft" / text).resolve(), root, "project")
+        if _is_aircraft_folder(jsbsim_root() / "aircraft" / text):
+            return AircraftLocation(text, (jsbsim_root() / "aircraft" / text).resolve(), jsbsim_root(), "jsbsim")
+    import difflib
+
+    names = known_aircraft()
+    everything = names["project"] + names["jsbsim"]
+    close = difflib.get_close_matches(text, everything, n=3, cutoff=0.6)
+    hint = f"; did you mean {' or '.join(close)}?" if close else ""
+    raise AircraftNotFound(
+        f"no aircraft {text!r}: expected a folder X/NAME/ holding NAME.xml (relative to "
+        f"{base or Path.cwd()}), or one of the project's aircraft ({', '.join(names['project'])}) or of "
+        f"JSBSim's ({len(names['jsbsim'])}, e.g. c172p, 737, f16; `uqflight aircraft --list`){hint}")
+
+
+# -- the files an aircraft consists of -----------------------------------------------------
+def _referenced(xml: bytes) -> dict[str, list[str]]:
+    """File names the aircraft XML refers to: engines/thrusters and systems."""
+    try:
+        tree = ET.fromstring(xml)
+    except ET.ParseError:
+        return {"engine": [], "systems": []}
+    engines = [e.get("file") for tag in ("engine", "thruster") for e in tree.iter(tag) if e.get("file")]
+    systems = [e.get("file") for tag in ("system", "flight_control", "autopilot") for e in tree.iter(tag)
+               if e.get("file")]
+    return {"engine": engines, "systems": systems}
+
+
+@dataclass
+class AircraftFiles:
+    """An aircraft's XML files as bytes: `files[key]`, where a key is a path relative to the
+    aircraft's folder, or `@root/engine/...` / `@root/systems/...` for shared files."""
+
+    name: str
+    files: dict[str, bytes] = field(default_factory=dict)
+
+    @classmethod
+    def read(cls, location: AircraftLocation) -> "AircraftFiles":
+        folder = location.folder
+        files = {p.relative_to(folder).as_posix(): p.read_bytes()
+                 for p in sorted(folder.rglob("*.xml")) if p.is_file()}
+        refs = _referenced(files.get(f"{location.name}.xml", b""))
+        for kind, subfolder in (("engine", "Engines"), ("systems", "Systems")):
+            for name in refs[kind]:
+                file = name if name.endswith(".xml") else name + ".xml"
+                if f"{subfolder}/{file}" in files or file in files:
+                    continue
+                shared = location.root / kind / file
+                if shared.is_file():
+                    files[f"{SHARED}{kind}/{file}"] = shared.read_bytes()
+        return cls(location.name, files)
+
+    @property
+    def main(self) -> bytes:
+        return self.files[f"{self.name}.xml"]
+
+    def hash(self) -> str:
+        """sha256 over the files, each as its key then its bytes, keys sorted (for the project's
+        aircraft, the same value as before shared files were counted: they have none)."""
+        digest = hashlib.sha256()
+        for key in sorted(self.files):
+            digest.update(key.encode())
+            digest.update(self.files[key])
+        return digest.hexdigest()
+
+    def with_main(self, xml: bytes) -> "AircraftFiles":
+        return AircraftFiles(self.name, {**self.files, f"{self.name}.xml": xml})
+
+    def write_root(self, root: Path) -> Path:
+        """Write the files as a JSBSim root (`aircraft/NAME/...`, `engine/`, `systems/`); returns root.
+        Written into a temporary folder then renamed, so concurrent writers never see half a root."""
+        root = Path(root)
+        if (root / "aircraft" / self.name / f"{self.name}.xml").is_file():
+            return root
+        root.parent.mkdir(parents=True, exist_ok=True)
+        tmp = root.parent / f".{root.name}.{os.getpid()}.tmp"
+        for key, data in self.files.items():
+            rel = key[len(SHARED):] if key.startswith(SHARED) else f"aircraft/{self.name}/{key}"
+            path = tmp / rel
+            path.parent.mkdir(parents=True, exist_ok=True)
+            path.write_bytes(data)
+        for shared in ("engine", "systems"):
+            (tmp / shared).mkdir(exist_ok=True)
+        try:
+            tmp.rename(root)
+        except OSError:  # another process wrote it first
+            import shutil
+
+            shutil.rmtree(tmp, ignore_errors=True)
+        return root
+
+    def cached_root(self) -> Path:
+        """The files written once as a root in the cache, under their hash."""
+        return self.write_root(cache_dir("aircraft", self.hash()[:24]))
+
+
+def files_hash(location: AircraftLocation) -> str:
+    return AircraftFiles.read(location).hash()
+
+
+# -- what the aircraft holds: aerodynamic functions and engines ----------------------------
+@dataclass(frozen=True)
+class AeroFunction:
+    axis: str         # LIFT, DRAG, PITCH, ... or "" for a function outside the axes
+    name: str         # the JSBSim property it defines, e.g. aero/coefficient/CLwbh
+    description: str
+
+
+def aero_functions(xml: bytes) -> list[AeroFunction]:
+    """The named functions of the <aerodynamics> section, in file order, with their axis."""
+    tree = ET.fromstring(xml)
+    aero = tree.find("aerodynamics")
+    if aero is None:
+        return []
+    found = []
+
+    def walk(element, axis):
+        for child in element:
+            if child.tag == "axis":
+                walk(child, child.get("name", ""))
+            elif child.tag == "function" and child.get("name"):
+                desc = child.findtext("description") or ""
+                found.append(AeroFunction(axis, child.get("name").strip(), " ".join(desc.split())))
+    walk(aero, "")
+    return found
+
+
+def engines(xml: bytes) -> list[tuple[str, str]]:
+    """(engine file, thruster file) per engine of the aircraft, in order."""
+    tree = ET.fromstring(xml)
+    result = []
+    for engine in tree.iter("engine"):
+        thruster = engine.find("thruster")
+        result.append((engine.get("file", ""), thruster.get("file", "") if thruster is not None else ""))
+    return result
+
+
+def safe_name(text: str) -> str:
+    return re.sub(r"[^A-Za-z0-9_.-]+", "_", text)
+
+
+# Flight condition used when a campaign or the command line states none: inside each tested
+# aircraft's envelope (measured: trims and holds level flight, see docs/own-aircraft.md).
+DEFAULT_CONDITIONS = {
+    "bacm": {"altitude_ft": 15000.0, "airspeed_ktas": 200.0},
+    "c172p": {"altitude_ft": 4000.0, "airspeed_ktas": 100.0},
+    "737": {"altitude_ft": 10000.0, "airspeed_ktas": 280.0},
+    "f16": {"altitude_ft": 15000.0, "airspeed_ktas": 400.0},
+}
+FALLBACK_CONDITION = {"altitude_ft": 15000.0, "airspeed_ktas": 200.0}
+
+
+def default_condition(name: str) -> dict[str, float]:
+    """The aircraft's default trim condition (altitude_ft, airspeed_ktas)."""
+    return dict(DEFAULT_CONDITIONS.get(name, FALLBACK_CONDITION))
+
+
+def elevator_travel_deg(xml: bytes) -> tuple[float, float] | None:
+    """(down, up) elevator travel [deg] at command +1 and -1: from the flight control component
+    whose output is fcs/elevator-pos-rad (or -deg), its <range> times its <gain>. None if absent."""
+    import math
+
+    tree = ET.fromstring(xml)
+    for component in tree.iter():
+        output = (component.findtext("output") or "").strip()
+        if output not in ("fcs/elevator-pos-rad", "fcs/elevator-pos-deg"):
+            continue
+        rng = component.find("range")
+        if rng is None:
+            continue
+        gain = float(component.findtext("gain") or 1.0)
+        lo, hi = float(rng.findtext("min")) * gain, float(rng.findtext("max")) * gain
+        to_deg = 180.0 / math.pi if output.endswith("-rad") else 1.0
+        return abs(hi) * to_deg, abs(lo) * to_deg
+    return None

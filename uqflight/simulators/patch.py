@@ -1,0 +1,157 @@
+"""Perturb any aerodynamic function of an aircraft without editing the aircraft.
+
+A patch `(function, kind)` rewrites the aircraft's `<function name="FUNCTION">BODY</function>` as
+
+    scale:  <product> <property> aero/uq/scale/NAME </property> BODY </product>
+    offset: <sum> <property> aero/uq/offset/NAME </property> BODY </sum>
+
+(both: the sum around the product), and declares the new properties in `<aerodynamics>` with
+their nominal values (scale 1, offset 0). NAME is the function's last path component
+(`aero/coefficient/CLwbh` -> `aero/uq/scale/CLwbh`), or the whole function name when two
+functions share it. JSBSim's product and sum evaluate their arguments left to right, so the
+patched function is s * f and o + f in floating point: exactly what the parameter says.
+
+The patched aircraft is written as a copy (a JSBSim root) in uqflight's cache, keyed by the
+hash of its files; the user's folder is never written.
+"""
+from __future__ import annotations
+
+import difflib
+import xml.etree.ElementTree as ET
+
+from .aircraft import AircraftFiles, aero_functions
+
+KINDS = ("scale", "offset")
+NOMINAL = {"scale": 1.0, "offset": 0.0}
+PREFIX = "aero/uq/"
+
+
+class PatchError(ValueError):
+    """An unknown function or kind; the message suggests the closest function names."""
+
+
+def patch_property(function: str, kind: str, functions: list[str] | None = None) -> str:
+    """The property that scales or offsets `function` (`aero/uq/scale/CLwbh`)."""
+    short = function.rsplit("/", 1)[-1]
+    if functions is not None and sum(f.rsplit("/", 1)[-1] == short for f in functions) > 1:
+        short = function
+    return f"{PREFIX}{kind}/{short}"
+
+
+def function_hint(name: str, functions: list[str]) -> str:
+    """'; did you mean X or Y?' from the aircraft's function names (full or last component)."""
+    by_short = {f.rsplit("/", 1)[-1].lower(): f for f in functions}
+    close = difflib.get_close_matches(name.lower(), [f.lower() for f in functions], n=3, cutoff=0.6)
+    lowered = {f.lower(): f for f in functions}
+    picks = [lowered[c] for c in close]
+    if not picks:
+        picks = [by_short[c] for c in difflib.get_close_matches(name.rsplit("/", 1)[-1].lower(), by_short, n=3, cutoff=0.6)]
+    return f"; did you mean {' or '.join(picks)}?" if picks else ""
+
+
+def resolve_function(name: str, functions: list[str]) -> str:
+    """The aircraft's function `name` names: its full name, or a unique last component."""
+    if name in functions:
+        return name
+    matches = [f for f in functions if f.rsplit("/", 1)[-1] == name]
+    if len(matches) == 1:
+        return matches[0]
+    if len(matches) > 1:
+        raise PatchError(f"{name!r} names several functions ({', '.join(matches)}): give the full name")
+    raise PatchError(f"expected one of the aircraft's aerodynamic functions (`uqflight aircraft` lists them), "
+                     f"got {name!r}{function_hint(name, functions)}")
+
+
+def patch_xml(xml: bytes, patches: list[tuple[str, str]]) -> bytes:
+    """The aircraft XML with every (function, kind) patch applied (see the module doc)."""
+    tree = ET.ElementTree(ET.fromstring(xml))
+    root = tree.getroot()
+    aero = root.find("aerodynamics")
+    names = [f.name for f in aero_functions(xml)]
+    wanted: dict[str, set[str]] = {}
+    for function, kind in patches:
+        if kind not in KINDS:
+            raise PatchError(f"perturbation: expected one of {', '.join(KINDS)}, got {kind!r}")
+        wanted.setdefault(resolve_function(function, names), set()).add(kind)
+    declared = []
+    for element in aero.iter("function"):
+        name = (element.get("name") or "").strip()
+        if name not in wanted:
+            continue
+        keep = [c for c in element if c.tag == "description"]
+        body = [c for c in element if c.tag != "description"]
+        if len(body) != 1:
+            raise PatchError(f"function {name!r} has {len(body)} top-level elements, expected 1")
+        node = body[0]
+        for kind in ("scale", "offset"):  # the product inside the sum: o + s * f
+            if kind in wanted[name]:
+                prop = patch_property(name, kind, names)
+                wrapper = ET.Element("product" if kind == "scale" else "sum")
+                ref = ET.SubElement(wrapper, "property")
+                ref.text = f" {prop} "
+                wrapper.append(node)
+                node = wrapper
+                declared.append((prop, NOMINAL[kind]))
+        tail = element[-1].tail if len(element) else None
+        for child in list(element):
+            element.remove(child)
+        for child in keep:
+            element.append(child)
+        node.tail = tail
+        element.append(node)
+    for i, (prop, value) in enumerate(declared):
+        decl = ET.Element("property", value=repr(value))
+        decl.text = f" {prop} "
+        decl.tail = "\n    "
+        aero.insert(i, decl)
+    return ET.tostring(root, encoding="utf-8", xml_declaration=True)
+
+
+def patched_files(files: AircraftFiles, patches: list[tuple[str, str]]) -> AircraftFiles:
+    """The aircraft's files with its main XML patched (the files themselves when no patch)."""
+    if not patches:
+        return files
+    return files.with_main(patch_xml(files.main, sorted(set(patches))))
+
+
+def patches_from_properties(properties, functions: list[str], existing=lambda p: False) -> list[tuple[str, str]]:
+    """The patches that the properties `aero/uq/scale/NAME` and `aero/uq/offset/NAME` ask for
+    (properties the aircraft already defines are its own and ask for nothing)."""
+    patches = []
+    for prop in properties:
+        for kind in KINDS:
+            head = f"{PREFIX}{kind}/"
+            if prop.startswith(head) and not existing(prop):
+                patches.append((resolve_function(prop[len(head):], functions), kind))
+    return patches
+
+
+def declared_properties(xml: bytes) -> set[str]:
+    """Properties the aircraft declares itself (`<property>` elements anywhere)."""
+    return {(e.text or "").strip() for e in ET.fromstring(xml).iter("property") if e.get("value") is not None}
+
+
+class PreparedAircraft:
+    """The aircraft a simulator flies: its name, the root JSBSim loads it from, its files (patched
+    when parameters scale or offset its functions) and their hash."""
+
+    def __init__(self, aircraft: str, base=None, properties=(), patches=()):
+        from .aircraft import locate
+
+        self.location = locate(aircraft, base)
+        original = AircraftFiles.read(self.location)
+        self.functions = [f.name for f in aero_functions(original.main)]
+        own = declared_properties(original.main)
+        self.patches = sorted(set(patches) | set(patches_from_properties(
+            properties, self.functions, existing=lambda p: p in own)))
+        self.original_hash = original.hash()
+        self.files = patched_files(original, self.patches)
+        self.name = self.location.name
+        if self.patches or not self.location.loadable_from_root:
+            self.root = self.files.cached_root()
+        else:
+            self.root = self.location.root
+
+    @property
+    def hash(self) -> str:
+        return self.files.hash()
