@@ -112,8 +112,13 @@ class FlightSetup:
     rate_hz: float = 120.0
     output_rate_hz: float = 20.0
     outputs: tuple[str, ...] = DEFAULT_OUTPUTS
+    trim: str = "newton"
+
+    TRIMS = ("newton", "jsbsim")
 
     def __post_init__(self):
+        if self.trim not in self.TRIMS:
+            raise ValueError(f"trim: expected one of {', '.join(self.TRIMS)}, got {self.trim!r}")
         ratio = self.rate_hz / self.output_rate_hz
         if self.output_rate_hz <= 0 or abs(ratio - round(ratio)) > 1e-9 or round(ratio) < 1:
             raise ValueError(
@@ -227,7 +232,43 @@ class JSBSimFlight:
         return self.run_trimmed(trim)
 
     def trim(self, settings: dict[str, float]) -> TrimResult:
-        """Reset, apply `settings`, trim in unaccelerated level flight and settle the engines."""
+        """Reset, apply `settings`, trim in unaccelerated level flight and settle the engines.
+
+        `setup.trim` chooses the trim: "newton" (uqflight.simulators.trim, falling back to
+        JSBSim's when it does not converge) or "jsbsim" (`simulation/do_simple_trim`).
+        """
+        if self.setup.trim == "newton":
+            level = self._level_trim()
+            self._reset(settings, settle_engines=False)
+            if level.solve(level.nominal) is not None:
+                return self._checked_trim()
+            level.fallbacks += 1
+        return self._jsbsim_trim(settings)
+
+    def _level_trim(self):
+        """The Newton trim, its nominal computed on first use (right after the load: deterministic)."""
+        level = getattr(self, "_level", None)
+        if level is None:
+            from .trim import LevelTrim
+            level = LevelTrim(self)
+            level.prepare(lambda: self._jsbsim_trim({}))
+            self._level = level
+        return level
+
+    def _jsbsim_trim(self, settings: dict[str, float]) -> TrimResult:
+        fdm = self.fdm
+        self._reset(settings)
+        try:
+            fdm["simulation/do_simple_trim"] = 1
+        except jsbsim.TrimFailureError as exc:
+            raise TrimError(f"JSBSim trim failed: {str(exc).strip() or 'no convergence'}") from exc
+        fdm.get_propulsion().get_steady_state()
+        return self._checked_trim()
+
+    def _reset(self, settings: dict[str, float], settle_engines: bool = True) -> None:
+        """Controls as loaded, the flight condition's ICs, reset, `settings`, engines running
+        (and at their steady state at full throttle, unless `settle_engines` is false: the
+        Newton trim runs its own steady states)."""
         fdm, s = self.fdm, self.setup
         for name, value in self._load_values.items():
             self.node(name).set_double_value(value)
@@ -235,7 +276,8 @@ class JSBSimFlight:
             self.node(name).set_double_value(value)
         fdm["ic/h-sl-ft"] = s.altitude_ft
         fdm["ic/vt-kts"] = s.airspeed_ktas
-        for ic in ("ic/gamma-deg", "ic/beta-deg", "ic/phi-deg", "ic/psi-true-deg"):
+        # ic/alpha-deg first: the Newton trim leaves its alpha there, the reset must not see it.
+        for ic in ("ic/alpha-deg", "ic/gamma-deg", "ic/beta-deg", "ic/phi-deg", "ic/psi-true-deg"):
             fdm[ic] = 0.0
         # Initial conditions are read by the reset; every other property must be set after
         # it, because the reset restores the values declared in the aircraft's XML.
@@ -246,13 +288,11 @@ class JSBSimFlight:
         fdm["propulsion/fuel_freeze"] = 1
         for i in range(self._engines):
             fdm[f"fcs/advance-cmd-norm[{i}]"] = 1.0
-        fdm["propulsion/set-running"] = -1
-        try:
-            fdm["simulation/do_simple_trim"] = 1
-        except jsbsim.TrimFailureError as exc:
-            raise TrimError(f"JSBSim trim failed: {str(exc).strip() or 'no convergence'}") from exc
-        fdm.get_propulsion().get_steady_state()
-        return self._checked_trim()
+        if settle_engines:
+            fdm["propulsion/set-running"] = -1
+        else:
+            for i in range(self._engines):
+                fdm[f"propulsion/engine[{i}]/set-running"] = 1
 
     def _apply(self, settings: dict[str, float]) -> None:
         for name, value in settings.items():
@@ -329,4 +369,5 @@ def flight_setup_from(config: dict, root: Path = REPO_ROOT) -> FlightSetup:
         rate_hz=float(config.get("rate_hz", 120.0)),
         output_rate_hz=float(config.get("output_rate_hz", 20.0)),
         outputs=tuple(config.get("outputs", DEFAULT_OUTPUTS)),
+        trim=config.get("trim", "newton"),
     )

@@ -1,0 +1,190 @@
+"""A trim of our own for unaccelerated, wings-level flight: Newton against JSBSim's accelerations.
+
+JSBSim's `simulation/do_simple_trim` costs ~15 ms a sample on bacm. This trim solves the same
+three equations (u̇ = ẇ = q̇ = 0 in body axes, γ = 0 so θ = α) for the same three unknowns
+(α, the throttle of all engines together, `fcs/pitch-trim-cmd-norm`, the control FGTrim's
+tQdot axis uses), with JSBSim's own accelerations, evaluated without advancing time:
+`run_ic()` suspends the integration, initialises the state from the IC (`ic/alpha-rad`) and
+runs every model once with dt = 0, like FGTrimAxis::Run (fdmex->Initialize(fgic); Run()).
+
+The engines. During a dt = 0 run the turboprop is in its trim phase and makes no power: the
+propeller keeps the rpm and blade angle it had and gives the thrust of that frozen state
+(FGTurboProp::Calculate, FGPropeller::Calculate). Its thrust only follows the throttle through
+`get_propulsion().get_steady_state()` (time marching at 0.5 s), which JSBSim's trim calls on
+every throttle change (FGTrimAxis::setThrottlesPct) and uqflight calls once after it, and
+which costs ~0.4 ms here (N1 restarts from idle after every dt = 0 run). So:
+
+* the inner Newton works on (α, pitch trim, total thrust T) with the propellers frozen: the
+  residual is JSBSim's (u̇, ẇ, q̇) plus B (T − T_frozen), where B is the acceleration per
+  pound of thrust (body-axis thrust line: measured once at the nominal trim). Jacobian
+  columns for α and pitch trim by finite differences (one dt = 0 run each, ~10 µs);
+* the throttle giving T is read off T_ss(throttle), the steady-state thrust tabulated once at
+  the nominal trim, then corrected by secant steps on the steady states actually run;
+* the outer loop runs the engines' steady state at the new throttle and re-evaluates JSBSim's
+  full residual; it stops when that residual is within 1/100 of JSBSim's own tolerances
+  (FGTrim.cpp: 1e-3 ft/s² on u̇, ẇ; 1e-4 rad/s² on q̇), usually after one or two steady states.
+
+The final state is the one uqflight flies today after JSBSim's trim: the trimmed IC evaluated
+at dt = 0, then one `get_steady_state()` that leaves the turboprops in their run phase.
+
+Warm start: every sample starts from the nominal trim (all properties as loaded), computed once
+per `LevelTrim` by JSBSim's trim refined by this one, so a sample's result does not depend on
+the samples flown before it on the same instance. When this trim does not converge the caller
+falls back to JSBSim's trim (`fallbacks` counts them).
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+RESIDUALS = ("accelerations/udot-ft_sec2", "accelerations/wdot-ft_sec2", "accelerations/qdot-rad_sec2")
+LATERAL = ("accelerations/vdot-ft_sec2", "accelerations/pdot-rad_sec2", "accelerations/rdot-rad_sec2")
+# JSBSim's trim tolerances (FGTrim.cpp: Tolerance 1e-3, A_Tolerance 1e-4).
+JSBSIM_TOLERANCE = np.array([1e-3, 1e-3, 1e-4])
+# Converged when every residual is below this fraction of JSBSim's tolerance. The engines'
+# steady state stops at 1e-4 lbf thrust change a 0.5-s step, ~1e-5 ft/s² of u̇ at most:
+# 1/100 of JSBSim's tolerance is reachable and 100 times tighter than JSBSim's trim.
+FRACTION = 1e-2
+INNER_FRACTION = 1e-3      # the frozen-propeller model is solved tighter than the outer loop
+MAX_INNER = 8
+MAX_OUTER = 6
+FD_STEP = (1e-6, 1e-6)     # α [rad], pitch trim [-]: forward differences of a smooth model
+THROTTLE_GRID = np.linspace(0.0, 1.0, 41)
+ALPHA_LIMITS = (math.radians(-10.0), math.radians(20.0))
+
+
+class LevelTrim:
+    """Newton trim in wings-level, unaccelerated flight for one JSBSimFlight (see module doc)."""
+
+    def __init__(self, flight):
+        self.flight = flight
+        self.fdm = flight.fdm
+        self._prop = self.fdm.get_propulsion()
+        n = flight.node
+        self._alpha = n("ic/alpha-rad")
+        self._pitch = n("fcs/pitch-trim-cmd-norm")
+        self._throttles = [n(f"fcs/throttle-cmd-norm[{i}]") for i in range(flight._engines)]
+        self._thrusts = [n(f"propulsion/engine[{i}]/thrust-lbs") for i in range(flight._engines)]
+        self._res = [n(p) for p in RESIDUALS]
+        self.nominal: np.ndarray | None = None     # (α [rad], throttle, pitch trim)
+        self.thrust_grid: np.ndarray | None = None  # steady-state total thrust at THROTTLE_GRID
+        self.B: np.ndarray | None = None            # d(u̇, ẇ, q̇)/dT [per lbf]
+        self.nominal_alpha = 0.0                    # alpha [rad] of the thrust table
+        self.dthrust_dalpha = 0.0                   # its steady thrust's slope in alpha [lbf/rad]
+        self.fallbacks = 0
+        self.last_steady_states = 0
+
+    # -- evaluations at dt = 0 ---------------------------------------------------------------
+    def _set(self, alpha: float, pitch: float, throttle: float | None = None) -> None:
+        self._alpha.set_double_value(alpha)
+        self._pitch.set_double_value(pitch)
+        if throttle is not None:
+            for node in self._throttles:
+                node.set_double_value(throttle)
+
+    def _evaluate(self) -> tuple[np.ndarray, float]:
+        """JSBSim's (u̇, ẇ, q̇) and total thrust of the state set, time not advanced."""
+        self.fdm.run_ic()
+        return (np.array([node.get_double_value() for node in self._res]),
+                sum(node.get_double_value() for node in self._thrusts))
+
+    def _steady(self, alpha: float, pitch: float, throttle: float) -> tuple[np.ndarray, float]:
+        """Engines at their steady state for this state and throttle, then the full residual."""
+        self._set(alpha, pitch, throttle)
+        self.fdm.run_ic()                   # the throttle and the air data reach the engines
+        self._prop.get_steady_state()
+        self.last_steady_states += 1
+        return self._evaluate()
+
+    def _model(self, alpha: float, pitch: float, thrust: float) -> np.ndarray:
+        """Residual with the propellers frozen plus the thrust increment to `thrust`."""
+        self._set(alpha, pitch)
+        r, frozen = self._evaluate()
+        return r + self.B * (thrust - frozen)
+
+    # -- the solve ---------------------------------------------------------------------------
+    def _inner(self, y: np.ndarray) -> np.ndarray | None:
+        """Newton on y = (α, pitch trim, T) with the propellers frozen."""
+        tol = JSBSIM_TOLERANCE * INNER_FRACTION
+        for _ in range(MAX_INNER):
+            r = self._model(*y)
+            if not np.all(np.isfinite(r)):
+                return None
+            if np.all(np.abs(r) <= tol):
+                return y
+            jac = np.empty((3, 3))
+            for j, h in enumerate(FD_STEP):
+                z = y.copy()
+                z[j] += h
+                jac[:, j] = (self._model(*z) - r) / h
+            jac[:, 2] = self.B
+            try:
+                y = y - np.linalg.solve(jac, r)
+            except np.linalg.LinAlgError:
+                return None
+            if not (ALPHA_LIMITS[0] < y[0] < ALPHA_LIMITS[1]) or abs(y[1]) > 2.0:
+                return None
+        return y if np.all(np.abs(self._model(*y)) <= tol) else None
+
+    def solve(self, start: np.ndarray) -> np.ndarray | None:
+        """(α, throttle, pitch trim) trimmed from `start`; None if not converged.
+
+        The first Newton step uses the propellers as the reset and `set-running` left them
+        (any frozen state will do: the model adds B (T − T_frozen)). The aircraft is left in
+        the trimmed state, evaluated at dt = 0, and the engines run once more to their steady
+        state, as after JSBSim's trim.
+        """
+        self.last_steady_states = 0
+        alpha, throttle, pitch = (float(v) for v in start)
+        # Propellers at the steady state of the start: the frozen state the Newton model starts
+        # from. Its thrust is close to the trimmed one, which matters beyond the B (T − T_frozen)
+        # term: JSBSim's alpha-dot (in CL, Cm) is computed from the accelerations of the
+        # previous dt = 0 run, so a frozen thrust far from the trimmed one biases alpha and the
+        # pitch trim of the first Newton step.
+        r, wanted = self._steady(alpha, pitch, throttle)
+        tol = JSBSIM_TOLERANCE * FRACTION
+        offset = None                 # steady thrust minus the nominal table's, at this sample's state
+        for _ in range(MAX_OUTER):
+            y = self._inner(np.array([alpha, pitch, wanted]))
+            if y is None:
+                return None
+            alpha, pitch, wanted = (float(v) for v in y)
+            if offset is None:        # before any steady state: the table's slope in alpha
+                offset = self.dthrust_dalpha * (alpha - self.nominal_alpha)
+            shifted = wanted - offset
+            if not self.thrust_grid[0] <= shifted <= self.thrust_grid[-1]:
+                return None
+            throttle = float(np.interp(shifted, self.thrust_grid, THROTTLE_GRID))
+            r, thrust = self._steady(alpha, pitch, throttle)
+            if not np.all(np.isfinite(r)):
+                return None
+            if np.all(np.abs(r) <= tol):
+                self._prop.get_steady_state()   # leave the turboprops in their run phase
+                self.last_steady_states += 1
+                return np.array([alpha, throttle, pitch])
+            offset = thrust - float(np.interp(throttle, THROTTLE_GRID, self.thrust_grid))
+        return None
+
+    # -- the nominal, once -------------------------------------------------------------------
+    def prepare(self, jsbsim_trim) -> None:
+        """Nominal trim by JSBSim (`jsbsim_trim()` trims with all properties as loaded), then
+        the thrust table and B at the nominal, then the nominal refined by this trim."""
+        result = jsbsim_trim()
+        alpha, pitch = math.radians(result.alpha_deg), self._pitch.get_double_value()
+        throttle = float(np.mean(result.throttle))
+        self.thrust_grid = np.array([self._steady(alpha, pitch, float(x))[1] for x in THROTTLE_GRID])
+        if not np.all(np.diff(self.thrust_grid) > 0):
+            raise RuntimeError(f"steady-state thrust is not increasing with the throttle: {self.thrust_grid}")
+        # B from two steady states around the nominal throttle at the nominal α and pitch trim.
+        h = 0.02 if throttle < 0.98 else -0.02
+        base_r, base_t = self._steady(alpha, pitch, throttle)
+        r2, t2 = self._steady(alpha, pitch, throttle + h)
+        self.B = (r2 - base_r) / (t2 - base_t)
+        # How the steady thrust at a fixed throttle moves with alpha (the advance ratio).
+        self.nominal_alpha = alpha
+        self.dthrust_dalpha = (self._steady(alpha + 0.01, pitch, throttle)[1] - base_t) / 0.01
+        refined = self.solve(np.array([alpha, throttle, pitch]))
+        if refined is None:
+            raise RuntimeError("the Newton trim does not converge at the nominal")
+        self.nominal = refined
