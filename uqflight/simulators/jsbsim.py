@@ -246,12 +246,12 @@ class JSBSimFlight:
         return self._jsbsim_trim(settings)
 
     def _level_trim(self):
-        """The Newton trim, its nominal computed on first use (right after the load: deterministic)."""
+        """The Newton trim, with the nominal it starts every sample from (see LevelTrim.prepare)."""
         level = getattr(self, "_level", None)
         if level is None:
             from .trim import LevelTrim
             level = LevelTrim(self)
-            level.prepare(lambda: self._jsbsim_trim({}))
+            level.prepare()
             self._level = level
         return level
 

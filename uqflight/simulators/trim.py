@@ -35,8 +35,11 @@ falls back to JSBSim's trim (`fallbacks` counts them).
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 
 import numpy as np
+
+from .jsbsim import aircraft_hash
 
 RESIDUALS = ("accelerations/udot-ft_sec2", "accelerations/wdot-ft_sec2", "accelerations/qdot-rad_sec2")
 LATERAL = ("accelerations/vdot-ft_sec2", "accelerations/pdot-rad_sec2", "accelerations/rdot-rad_sec2")
@@ -52,6 +55,9 @@ MAX_OUTER = 6
 FD_STEP = (1e-6, 1e-6)     # α [rad], pitch trim [-]: forward differences of a smooth model
 THROTTLE_GRID = np.linspace(0.0, 1.0, 41)
 ALPHA_LIMITS = (math.radians(-10.0), math.radians(20.0))
+
+# Nominals computed in this process: (aircraft hash, altitude, airspeed, rate) -> values.
+_NOMINALS: dict[tuple, tuple] = {}
 
 
 class LevelTrim:
@@ -166,8 +172,31 @@ class LevelTrim:
             offset = thrust - float(np.interp(throttle, THROTTLE_GRID, self.thrust_grid))
         return None
 
-    # -- the nominal, once -------------------------------------------------------------------
-    def prepare(self, jsbsim_trim) -> None:
+    # -- the nominal, once per process ------------------------------------------------------
+    def prepare(self) -> None:
+        """The nominal (α, throttle, pitch trim), thrust table, B and dT/dα for this flight
+        condition, from this process's cache or computed on a freshly loaded, throw-away copy of
+        the aircraft and cached.
+
+        A worker restarts its simulator at every chunk: the cache keeps the nominal's cost
+        (~50 ms) to once per process. The throw-away copy keeps this instance exactly as loaded,
+        so a chunk's results do not depend on whether its process computed the nominal first
+        (bit for bit: an instance that ran other trims differs in the last bits).
+        """
+        setup = self.flight.setup
+        key = (aircraft_hash(setup), str(setup.aircraft_file), setup.altitude_ft, setup.airspeed_ktas,
+               setup.rate_hz)
+        cached = _NOMINALS.get(key)
+        if cached is None:
+            scratch = type(self.flight)(replace(setup, trim="jsbsim"))
+            helper = LevelTrim(scratch)
+            helper.compute(lambda: scratch.trim({}))
+            _NOMINALS[key] = cached = (helper.nominal, helper.thrust_grid, helper.B,
+                                       helper.nominal_alpha, helper.dthrust_dalpha)
+        self.nominal, self.thrust_grid, self.B, self.nominal_alpha, self.dthrust_dalpha = (
+            cached[0].copy(), cached[1].copy(), cached[2].copy(), cached[3], cached[4])
+
+    def compute(self, jsbsim_trim) -> None:
         """Nominal trim by JSBSim (`jsbsim_trim()` trims with all properties as loaded), then
         the thrust table and B at the nominal, then the nominal refined by this trim."""
         result = jsbsim_trim()
