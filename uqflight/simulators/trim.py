@@ -50,14 +50,15 @@ JSBSIM_TOLERANCE = np.array([1e-3, 1e-3, 1e-4])
 # 1/100 of JSBSim's tolerance is reachable and 100 times tighter than JSBSim's trim.
 FRACTION = 1e-2
 INNER_FRACTION = 1e-3      # the frozen-propeller model is solved tighter than the outer loop
-MAX_INNER = 8
+MAX_INNER = 30           # chord iterations cost one dt = 0 run (~15 µs) each
 MAX_OUTER = 6
-FD_STEP = (1e-6, 1e-6)     # α [rad], pitch trim [-]: forward differences of a smooth model
+FD_STEP = (1e-4, 1e-4)     # α [rad], pitch trim [-]: forward differences (see _inner)
 THROTTLE_GRID = np.linspace(0.0, 1.0, 41)
 ALPHA_LIMITS = (math.radians(-10.0), math.radians(20.0))
 
 # Nominals computed in this process: (aircraft hash, altitude, airspeed, rate) -> values.
-_NOMINALS: dict[tuple, tuple] = {}
+_NOMINALS: dict[tuple, dict] = {}
+NOMINAL_FIELDS = ("nominal", "thrust_grid", "B", "jacobian", "nominal_alpha", "dthrust_dalpha")
 
 
 class LevelTrim:
@@ -76,6 +77,7 @@ class LevelTrim:
         self.nominal: np.ndarray | None = None     # (α [rad], throttle, pitch trim)
         self.thrust_grid: np.ndarray | None = None  # steady-state total thrust at THROTTLE_GRID
         self.B: np.ndarray | None = None            # d(u̇, ẇ, q̇)/dT [per lbf]
+        self.jacobian: np.ndarray | None = None     # the inner model's, at the nominal
         self.nominal_alpha = 0.0                    # alpha [rad] of the thrust table
         self.dthrust_dalpha = 0.0                   # its steady thrust's slope in alpha [lbf/rad]
         self.fallbacks = 0
@@ -110,45 +112,64 @@ class LevelTrim:
         return r + self.B * (thrust - frozen)
 
     # -- the solve ---------------------------------------------------------------------------
+    def _jacobian(self, y: np.ndarray) -> np.ndarray:
+        """d(model residual)/d(α, pitch trim, T): finite differences for α and the pitch trim
+        (each point evaluated twice, see `_inner`), B for the thrust."""
+        jac = np.empty((3, 3))
+        self._model(*y)
+        base = self._model(*y)
+        for j, h in enumerate(FD_STEP):
+            z = y.copy()
+            z[j] += h
+            self._model(*z)
+            jac[:, j] = (self._model(*z) - base) / h
+        jac[:, 2] = self.B
+        return jac
+
     def _inner(self, y: np.ndarray) -> np.ndarray | None:
-        """Newton on y = (α, pitch trim, T) with the propellers frozen."""
+        """Newton on y = (α, pitch trim, T) with the propellers frozen.
+
+        Chord iterations with the nominal Jacobian (one dt = 0 run each), refreshed by finite
+        differences when the residual stops halving. JSBSim's alpha-dot comes from the
+        accelerations of the previous run, so a run's residual depends (weakly, ~1e-4 of the
+        previous one's) on the run before it: the differences use steps of 1e-4 and evaluate
+        every point twice, and the chord iterations converge through it as the residual does.
+        """
         tol = JSBSIM_TOLERANCE * INNER_FRACTION
+        jac = self.jacobian
+        last = math.inf
         for _ in range(MAX_INNER):
             r = self._model(*y)
             if not np.all(np.isfinite(r)):
                 return None
-            if np.all(np.abs(r) <= tol):
+            size = float(np.max(np.abs(r) / tol))
+            if size <= 1.0:
                 return y
-            jac = np.empty((3, 3))
-            for j, h in enumerate(FD_STEP):
-                z = y.copy()
-                z[j] += h
-                jac[:, j] = (self._model(*z) - r) / h
-            jac[:, 2] = self.B
+            if size > 0.5 * last:
+                jac = self._jacobian(y)
+            last = size
             try:
                 y = y - np.linalg.solve(jac, r)
             except np.linalg.LinAlgError:
                 return None
             if not (ALPHA_LIMITS[0] < y[0] < ALPHA_LIMITS[1]) or abs(y[1]) > 2.0:
                 return None
-        return y if np.all(np.abs(self._model(*y)) <= tol) else None
+        return None
 
     def solve(self, start: np.ndarray) -> np.ndarray | None:
         """(α, throttle, pitch trim) trimmed from `start`; None if not converged.
 
-        The first Newton step uses the propellers as the reset and `set-running` left them
-        (any frozen state will do: the model adds B (T − T_frozen)). The aircraft is left in
-        the trimmed state, evaluated at dt = 0, and the engines run once more to their steady
-        state, as after JSBSim's trim.
+        The first Newton step uses the propellers as the reset left them (stopped: any frozen
+        state will do, the model adds B (T − T_frozen)). It lands within a few hundredths of
+        JSBSim's tolerance, not closer: JSBSim's alpha-dot (in CL and Cm) comes from the
+        accelerations of the previous dt = 0 run, which the frozen thrust biases. The second
+        step starts from propellers at their steady state near the trim and converges. The
+        aircraft is left in the trimmed state, evaluated at dt = 0, and the engines run once
+        more to their steady state, as after JSBSim's trim: three steady states in all.
         """
         self.last_steady_states = 0
         alpha, throttle, pitch = (float(v) for v in start)
-        # Propellers at the steady state of the start: the frozen state the Newton model starts
-        # from. Its thrust is close to the trimmed one, which matters beyond the B (T − T_frozen)
-        # term: JSBSim's alpha-dot (in CL, Cm) is computed from the accelerations of the
-        # previous dt = 0 run, so a frozen thrust far from the trimmed one biases alpha and the
-        # pitch trim of the first Newton step.
-        r, wanted = self._steady(alpha, pitch, throttle)
+        wanted = float(np.interp(throttle, THROTTLE_GRID, self.thrust_grid))
         tol = JSBSIM_TOLERANCE * FRACTION
         offset = None                 # steady thrust minus the nominal table's, at this sample's state
         for _ in range(MAX_OUTER):
@@ -191,10 +212,9 @@ class LevelTrim:
             scratch = type(self.flight)(replace(setup, trim="jsbsim"))
             helper = LevelTrim(scratch)
             helper.compute(lambda: scratch.trim({}))
-            _NOMINALS[key] = cached = (helper.nominal, helper.thrust_grid, helper.B,
-                                       helper.nominal_alpha, helper.dthrust_dalpha)
-        self.nominal, self.thrust_grid, self.B, self.nominal_alpha, self.dthrust_dalpha = (
-            cached[0].copy(), cached[1].copy(), cached[2].copy(), cached[3], cached[4])
+            _NOMINALS[key] = cached = {name: getattr(helper, name) for name in NOMINAL_FIELDS}
+        for name, value in cached.items():
+            setattr(self, name, value.copy() if isinstance(value, np.ndarray) else value)
 
     def compute(self, jsbsim_trim) -> None:
         """Nominal trim by JSBSim (`jsbsim_trim()` trims with all properties as loaded), then
@@ -213,6 +233,8 @@ class LevelTrim:
         # How the steady thrust at a fixed throttle moves with alpha (the advance ratio).
         self.nominal_alpha = alpha
         self.dthrust_dalpha = (self._steady(alpha + 0.01, pitch, throttle)[1] - base_t) / 0.01
+        self._steady(alpha, pitch, throttle)
+        self.jacobian = self._jacobian(np.array([alpha, pitch, base_t]))
         refined = self.solve(np.array([alpha, throttle, pitch]))
         if refined is None:
             raise RuntimeError("the Newton trim does not converge at the nominal")
