@@ -237,8 +237,8 @@ class JSBSimFlight:
         `setup.trim` chooses the trim: "newton" (uqflight.simulators.trim, falling back to
         JSBSim's when it does not converge) or "jsbsim" (`simulation/do_simple_trim`).
         """
-        if self.setup.trim == "newton":
-            level = self._level_trim()
+        level = self._level_trim() if self.setup.trim == "newton" else None
+        if level is not None:
             self._reset(settings, settle_engines=False)
             if level.solve(level.nominal) is not None:
                 return self._checked_trim()
@@ -246,14 +246,17 @@ class JSBSimFlight:
         return self._jsbsim_trim(settings)
 
     def _level_trim(self):
-        """The Newton trim, with the nominal it starts every sample from (see LevelTrim.prepare)."""
-        level = getattr(self, "_level", None)
-        if level is None:
+        """The Newton trim, with the nominal it starts every sample from (see LevelTrim.prepare);
+        None when the nominal itself cannot be trimmed (then JSBSim's trim does every sample)."""
+        if not hasattr(self, "_level"):
             from .trim import LevelTrim
             level = LevelTrim(self)
-            level.prepare()
+            try:
+                level.prepare()
+            except (FlightError, RuntimeError):
+                level = None
             self._level = level
-        return level
+        return self._level
 
     def _jsbsim_trim(self, settings: dict[str, float]) -> TrimResult:
         fdm = self.fdm
