@@ -58,8 +58,10 @@ def engine_kinds(fdm) -> list[tuple[str, str, str]]:
     return _KIND_CACHE[key]
 
 
-def prepare_engines(fdm) -> None:
-    """Engines ready for the trim, after the reset and the sample's settings (see the module doc)."""
+def prepare_engines(fdm, settle: bool = True) -> None:
+    """Engines ready for the trim, after the reset and the sample's settings (see the module doc).
+    `settle`: `propulsion/set-running` = -1, which also brings them to their steady state; otherwise
+    each engine is only set running (the Newton trim runs its own steady states)."""
     kinds = engine_kinds(fdm)
     fdm["propulsion/fuel_freeze"] = 1
     for i, (_, kind, thruster) in enumerate(kinds):
@@ -69,4 +71,8 @@ def prepare_engines(fdm) -> None:
             fdm[f"fcs/mixture-cmd-norm[{i}]"] = 1.0
     if any(kind == "piston" for _, kind, _ in kinds):
         fdm["propulsion/magneto_cmd"] = 3
-    fdm["propulsion/set-running"] = -1
+    if settle:
+        fdm["propulsion/set-running"] = -1
+    else:
+        for i in range(len(kinds)):
+            fdm[f"propulsion/engine[{i}]/set-running"] = 1

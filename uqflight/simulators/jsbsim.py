@@ -104,8 +104,13 @@ class FlightSetup:
     rate_hz: float = 120.0
     output_rate_hz: float = 20.0
     outputs: tuple[str, ...] = DEFAULT_OUTPUTS
+    trim: str = "newton"
+
+    TRIMS = ("newton", "jsbsim")
 
     def __post_init__(self):
+        if self.trim not in self.TRIMS:
+            raise ValueError(f"trim: expected one of {', '.join(self.TRIMS)}, got {self.trim!r}")
         ratio = self.rate_hz / self.output_rate_hz
         if self.output_rate_hz <= 0 or abs(ratio - round(ratio)) > 1e-9 or round(ratio) < 1:
             raise ValueError(
@@ -217,7 +222,46 @@ class JSBSimFlight:
         return self.run_trimmed(trim)
 
     def trim(self, settings: dict[str, float]) -> TrimResult:
-        """Reset, apply `settings`, trim in unaccelerated level flight and settle the engines."""
+        """Reset, apply `settings`, trim in unaccelerated level flight and settle the engines.
+
+        `setup.trim` chooses the trim: "newton" (uqflight.simulators.trim, falling back to
+        JSBSim's when it does not converge) or "jsbsim" (`simulation/do_simple_trim`).
+        """
+        level = self._level_trim() if self.setup.trim == "newton" else None
+        if level is not None:
+            self._reset(settings, settle_engines=False)
+            if level.solve(level.nominal) is not None:
+                return self._checked_trim()
+            level.fallbacks += 1
+        return self._jsbsim_trim(settings)
+
+    def _level_trim(self):
+        """The Newton trim, with the nominal it starts every sample from (see LevelTrim.prepare);
+        None when the nominal itself cannot be trimmed (then JSBSim's trim does every sample)."""
+        if not hasattr(self, "_level"):
+            from .trim import LevelTrim
+            level = LevelTrim(self)
+            try:
+                level.prepare()
+            except (FlightError, RuntimeError):
+                level = None
+            self._level = level
+        return self._level
+
+    def _jsbsim_trim(self, settings: dict[str, float]) -> TrimResult:
+        fdm = self.fdm
+        self._reset(settings)
+        try:
+            fdm["simulation/do_simple_trim"] = 1
+        except jsbsim.TrimFailureError as exc:
+            raise TrimError(self._trim_failure(exc)) from exc
+        fdm.get_propulsion().get_steady_state()
+        return self._checked_trim()
+
+    def _reset(self, settings: dict[str, float], settle_engines: bool = True) -> None:
+        """Controls as loaded, the flight condition's ICs, reset, `settings`, engines running
+        (and at their steady state at full throttle, unless `settle_engines` is false: the
+        Newton trim runs its own steady states)."""
         fdm, s = self.fdm, self.setup
         for name, value in self._load_values.items():
             self.node(name).set_double_value(value)
@@ -225,7 +269,8 @@ class JSBSimFlight:
             self.node(name).set_double_value(value)
         fdm["ic/h-sl-ft"] = s.altitude_ft
         fdm["ic/vt-kts"] = s.airspeed_ktas
-        for ic in ("ic/gamma-deg", "ic/beta-deg", "ic/phi-deg", "ic/psi-true-deg"):
+        # ic/alpha-deg first: the Newton trim leaves its alpha there, the reset must not see it.
+        for ic in ("ic/alpha-deg", "ic/gamma-deg", "ic/beta-deg", "ic/phi-deg", "ic/psi-true-deg"):
             fdm[ic] = 0.0
         # Initial conditions are read by the reset; every other property must be set after
         # it, because the reset restores the values declared in the aircraft's XML.
@@ -233,13 +278,7 @@ class JSBSimFlight:
         self._apply(initial)
         fdm.reset_to_initial_conditions(0)
         self._apply({k: v for k, v in settings.items() if k not in initial})
-        prepare_engines(fdm)  # per engine kind: fuel frozen, running, mixture, propeller (engines.py)
-        try:
-            fdm["simulation/do_simple_trim"] = 1
-        except jsbsim.TrimFailureError as exc:
-            raise TrimError(self._trim_failure(exc)) from exc
-        fdm.get_propulsion().get_steady_state()
-        return self._checked_trim()
+        prepare_engines(fdm, settle=settle_engines)  # per engine kind (engines.py)
 
     def _trim_failure(self, exc) -> str:
         """Why the trim failed: the axis furthest outside its tolerance, and the state and
@@ -362,4 +401,5 @@ def flight_setup_from(config: dict, root: Path | None = None, base: Path | None 
         rate_hz=float(config.get("rate_hz", 120.0)),
         output_rate_hz=float(config.get("output_rate_hz", 20.0)),
         outputs=tuple(config.get("outputs", DEFAULT_OUTPUTS)),
+        trim=config.get("trim", "newton"),
     )
