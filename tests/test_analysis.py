@@ -1,6 +1,7 @@
 """uqflight.analysis against closed forms: moments, bands, KDE, KL divergence, Eq. 49, Sobol' indices."""
 import numpy as np
 import pytest
+from conftest import ishigami, ishigami_indices
 from scipy.stats import gaussian_kde
 
 from uqflight.analysis import (
@@ -19,21 +20,6 @@ from uqflight.methods import fit
 from uqflight.parameters.germs import draw_germs
 
 Z_995 = 2.5758293035489
-
-
-def ishigami(xi, a=7.0, b=0.1):
-    """Ishigami function of x = πξ, ξ ~ U(−1, 1)³."""
-    x = np.pi * xi
-    return np.sin(x[:, 0]) + a * np.sin(x[:, 1]) ** 2 + b * x[:, 2] ** 4 * np.sin(x[:, 0])
-
-
-def ishigami_indices(a=7.0, b=0.1):
-    """Closed-form first and total Sobol' indices of the Ishigami function."""
-    v1 = 0.5 * (1 + b * np.pi**4 / 5) ** 2
-    v2 = a**2 / 8
-    v13 = b**2 * np.pi**8 * (1 / 18 - 1 / 50)
-    variance = v1 + v2 + v13
-    return np.array([v1, v2, 0.0]) / variance, np.array([v1 + v13, v2, v13]) / variance
 
 
 def saltelli_design(germs, n, seed):

@@ -1,17 +1,14 @@
 """Campaign validation: every bad file gets one clear message (file, field, what was expected),
 `uqflight plan` and `uqflight run` exit with code 2 and no traceback, and nothing is written."""
-import subprocess
-import sys
 from pathlib import Path
 
 import pytest
 
+from conftest import ROOT, cli
 from uqflight.campaign import CampaignError, load_campaign, parse_campaign
 from uqflight.simulators.jsbsim_probe import jsbsim_probe
 
-ROOT = Path(__file__).resolve().parents[1]
 DATA = Path(__file__).parent / "data" / "campaigns"
-UQFLIGHT = str(Path(sys.executable).with_name("uqflight"))
 
 # file -> (field the message names, "" for the file as a whole; words that say what was expected)
 BAD = {
@@ -91,7 +88,7 @@ def test_a_bad_file_gets_one_message_naming_file_field_and_expectation(name):
 
 
 def uqflight(*args, cwd):
-    return subprocess.run([UQFLIGHT, *map(str, args)], cwd=cwd, capture_output=True, text=True, timeout=120)
+    return cli(*args, cwd=cwd)
 
 
 @pytest.mark.parametrize("name", CLI_BAD)

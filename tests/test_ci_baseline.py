@@ -5,15 +5,12 @@ If a deliberate change moves the statistics, regenerate the baseline and commit 
     uqflight report results/ci-small.h5 --out /tmp/ci --write-baseline tests/baselines/ci-small.json
 """
 import subprocess
-import sys
-from pathlib import Path
 
+from conftest import ROOT, UQFLIGHT
 from uqflight.campaign import load_campaign
 from uqflight.simulators.jsbsim_probe import jsbsim_probe
 from uqflight.execution import run_campaign
 
-ROOT = Path(__file__).resolve().parents[1]
-UQFLIGHT = str(Path(sys.executable).with_name("uqflight"))
 
 
 def test_small_campaign_matches_the_committed_baseline(tmp_path):

@@ -3,7 +3,6 @@
 give bit-identical results to the local pool, and refuse other aircraft files."""
 import json
 import os
-import shutil
 import subprocess
 import sys
 import time

@@ -2,19 +2,18 @@
 import os
 import signal
 import subprocess
-import sys
 from pathlib import Path
 
 import h5py
 import numpy as np
 import pytest
+from conftest import UQFLIGHT, read_results
 
 from uqflight.campaign import parse_campaign
 from uqflight.simulators.jsbsim_probe import jsbsim_probe
 from uqflight.execution import run_campaign
 from uqflight.store import ResultStore, Status
 
-UQFLIGHT = str(Path(sys.executable).with_name("uqflight"))
 DATA = Path(__file__).parent / "data"
 
 JSBSIM_CAMPAIGN = """
@@ -37,16 +36,8 @@ def jsbsim_campaign(samples=12, duration=5):
     return parse_campaign(JSBSIM_CAMPAIGN.format(samples=samples, duration=duration), "small.yaml", jsbsim_probe)
 
 
-def read_all(path):
-    """Every dataset of a results file (design, status, raw outputs or tSVD factors)."""
-    data = {}
-    with h5py.File(path, "r") as f:
-        f.visititems(lambda name, obj: data.update({name: obj[()]}) if isinstance(obj, h5py.Dataset) else None)
-    return data
-
-
 def assert_same_results(a, b):
-    ra, rb = read_all(a), read_all(b)
+    ra, rb = read_results(a), read_results(b)
     assert ra.keys() == rb.keys()
     for key in ra:
         np.testing.assert_array_equal(ra[key], rb[key], err_msg=key)
@@ -76,14 +67,14 @@ def test_stored_runs_match_a_fresh_flight(tmp_path):
 
 
 def test_failed_runs_are_recorded_and_the_campaign_goes_on(tmp_path):
-    text = f"""
+    text = """
 name: flaky
 seed: 3
-simulator: {{kind: python, function: "flaky_model.py:flaky"}}
+simulator: {kind: python, function: "flaky_model.py:flaky"}
 parameters:
-  x: {{distribution: uniform, lower: -2, upper: 2}}
-design: {{kind: monte_carlo, samples: 200}}
-execution: {{workers: 2, chunk: 8}}
+  x: {distribution: uniform, lower: -2, upper: 2}
+design: {kind: monte_carlo, samples: 200}
+execution: {workers: 2, chunk: 8}
 """
     campaign = parse_campaign(text, str(DATA / "flaky.yaml"))
     summary = run_campaign(campaign, out=tmp_path / "f.h5")

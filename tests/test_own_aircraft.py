@@ -1,7 +1,6 @@
 """Any aircraft: locating, hashing, patching functions (exactly), campaign keys, stock aircraft."""
 import hashlib
 import shutil
-from pathlib import Path
 
 import jsbsim
 import numpy as np
@@ -9,7 +8,7 @@ import pytest
 
 from uqflight.campaign import CampaignError, load_campaign
 from uqflight.simulators.aircraft import AircraftFiles, AircraftNotFound, locate
-from uqflight.simulators.jsbsim import REPO_ROOT, Excitation, JSBSimFlight, flight_setup_from, quiet_jsbsim
+from uqflight.simulators.jsbsim import REPO_ROOT, JSBSimFlight, flight_setup_from, quiet_jsbsim
 from uqflight.simulators.jsbsim_probe import jsbsim_probe
 from uqflight.simulators.patch import PreparedAircraft
 

@@ -2,14 +2,13 @@
 folder and its temp-dir-then-move, repeatable --method, `design --csv`, `surrogate export`."""
 import csv
 import json
-import subprocess
-import sys
 from pathlib import Path
 
 import numpy as np
 import pytest
 
 import uqflight
+from conftest import cli
 from uqflight.campaign import parse_campaign
 from uqflight.execution import run_campaign
 from uqflight.methods.basis import orthonormal_basis
@@ -17,7 +16,6 @@ from uqflight.report import write_report
 from uqflight.statistics import analyse
 from uqflight.surrogate import fit_surrogate, load
 
-UQFLIGHT = str(Path(sys.executable).with_name("uqflight"))
 
 DECAY = """
 name: decay-people
@@ -31,9 +29,6 @@ method: {kind: pseudo_galerkin, order: 2}
 analysis: {band_samples: 500, bootstrap: 0}
 """
 
-
-def cli(*args) -> subprocess.CompletedProcess:
-    return subprocess.run([UQFLIGHT, *map(str, args)], capture_output=True, text=True, timeout=300)
 
 
 @pytest.fixture(scope="module")

@@ -3,20 +3,19 @@ import csv
 import json
 import re
 import subprocess
-import sys
 from pathlib import Path
 
 import h5py
 import numpy as np
 import pytest
 
+from conftest import UQFLIGHT, cli, read_summary
 from uqflight.campaign import parse_campaign
 from uqflight.simulators.jsbsim_probe import jsbsim_probe
 from uqflight.execution import run_campaign
 from uqflight.report import write_report
 from uqflight.statistics import analyse
 
-UQFLIGHT = str(Path(sys.executable).with_name("uqflight"))
 
 DECAY = """
 name: decay-{name}
@@ -81,9 +80,6 @@ def files(tmp_path_factory) -> dict[str, Path]:
     }
 
 
-def cli(*args) -> subprocess.CompletedProcess:
-    return subprocess.run([UQFLIGHT, *map(str, args)], capture_output=True, text=True, timeout=120)
-
 
 def read_csv(path: Path) -> list[dict]:
     with open(path, newline="") as fh:
@@ -95,7 +91,7 @@ def test_report_of_several_files_against_a_reference(files, tmp_path):
     result = cli("report", files["pg"], files["int"], "--reference", files["mc"], "--out", out, "--times", "1,2.5,end")
     assert result.returncode == 0, result.stderr
 
-    summary = json.loads((out / "summary.json").read_text())
+    summary = read_summary(out / "summary.json")
     entry = summary["outputs"]["x"]
     n = len(entry["time"])
     assert n == 51 and entry["time"][-1] == 5.0
@@ -153,7 +149,7 @@ def test_report_of_a_jsbsim_campaign_and_its_check(tmp_path):
     baseline = tmp_path / "baseline.json"
     result = cli("report", results, "--out", tmp_path / "report", "--write-baseline", baseline)
     assert result.returncode == 0, result.stderr
-    summary = json.loads((tmp_path / "report" / "summary.json").read_text())
+    summary = read_summary(tmp_path / "report" / "summary.json")
     assert list(summary["outputs"]) == ["alpha_deg", "h_ft"] and len(summary["outputs"]["h_ft"]["time"]) == 51
     with h5py.File(results, "r") as f:
         assert json.loads(baseline.read_text())["campaign_hash"] == f.attrs["campaign_hash"]
@@ -269,7 +265,7 @@ def test_method_override_reports_another_method_on_the_same_runs(files, tmp_path
     result = subprocess.run([UQFLIGHT, "report", str(files["pg"]), "--method", "least_squares", "--order", "3",
                              "--out", str(tmp_path / "ls")], capture_output=True, text=True)
     assert result.returncode == 0, result.stderr
-    summary = json.loads((tmp_path / "ls" / "summary.json").read_text())
+    summary = read_summary(tmp_path / "ls" / "summary.json")
     assert summary["method"]["kind"] == "least_squares" and summary["method"]["order"] == 3
     exact = analyse(files["pg"], method={"kind": "least_squares", "order": 3}).outputs["x"].mean
     np.testing.assert_allclose(summary["outputs"]["x"]["mean"], exact, rtol=1e-12)

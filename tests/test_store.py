@@ -13,6 +13,7 @@ import time
 import h5py
 import numpy as np
 import pytest
+from conftest import read_results
 
 import uqflight.store.compressed
 import uqflight.store.results
@@ -61,17 +62,9 @@ def in_design_order(batch):
     return np.array_split(np.arange(N), N // batch)
 
 
-def file_contents(path):
-    """Every dataset of a results file, by path."""
-    found = {}
-    with h5py.File(path, "r") as f:
-        f.visititems(lambda key, item: found.update({key: item[()]}) if isinstance(item, h5py.Dataset) else None)
-    return found
-
-
 def assert_same_results(a, b):
     """Same datasets; identical samples and raw outputs; tSVD factors equal to 1e-12."""
-    ca, cb = file_contents(a), file_contents(b)
+    ca, cb = read_results(a), read_results(b)
     assert ca.keys() == cb.keys()
     for key in ca:
         if key.startswith("tsvd/") and ca[key].dtype.kind == "f":
@@ -93,7 +86,7 @@ def test_create_writes_the_fixed_layout_and_reopens(tmp_path):
     path = tmp_path / "r.h5"
     args = create_args()
     ResultStore.create(path, campaign_text=CAMPAIGN, **args).close()
-    datasets = set(file_contents(path))
+    datasets = set(read_results(path))
     with h5py.File(path, "r") as f:
         assert {"samples/xi", "samples/kappa", "samples/weight", "samples/status", "samples/reason", "time",
                 "outputs/alpha_deg", "outputs/h_ft"} <= datasets
@@ -161,7 +154,7 @@ def test_tsvd_factors_do_not_depend_on_the_arrival_order(tmp_path, reference):
         assert_same_results(path, reference)
     status, _, outputs = expected_runs(np.arange(N))
     ok = status == Status.OK
-    contents = file_contents(reference)
+    contents = read_results(reference)
     np.testing.assert_array_equal(contents["tsvd/h_ft/columns"], np.flatnonzero(ok))
     assert contents["tsvd/h_ft/buffer"].shape == (0, T)
     compressed = tmp_path / "compressed.h5"

@@ -14,7 +14,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .statistics import BadInput, Statistics, json_ready, read_statistics
+from .statistics import BadInput, Statistics, json_ready
 
 BASELINE_KIND = "uqflight-baseline"
 BASELINE_VERSION = 1

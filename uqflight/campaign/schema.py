@@ -15,7 +15,7 @@ from ..methods import METHOD_KINDS, method_entry
 from ..methods.exactness import exact_total_degree, max_projection_order
 from ..methods.validity import method_problem
 from ..parameters import DISTRIBUTIONS, Parameter, make_parameter
-from ..simulators.jsbsim import NAMED_OUTPUTS, Excitation
+from ..simulators.jsbsim import Excitation
 from ..simulators.python import PluginError, load_function
 
 SIMULATOR_KINDS = ("jsbsim", "python")

@@ -84,9 +84,9 @@ def make_parameter(
 ) -> Parameter:
     """A Parameter from its interval: ±interval_pct percent of |nominal| (the paper's Table 1),
     or the absolute bounds lower and upper. Exactly one of the two forms."""
-    for field, value in (("name", name), ("property", property)):
+    for key, value in (("name", name), ("property", property)):
         if not isinstance(value, str) or not value:
-            raise ValueError(f"parameter {name!r}: {field} must be a non-empty string, got {value!r}")
+            raise ValueError(f"parameter {name!r}: {key} must be a non-empty string, got {value!r}")
     nominal = _as_float(name, "nominal", nominal)
     given_bounds = [bound for bound in (lower, upper) if bound is not None]
     if (interval_pct is None) == (not given_bounds):

@@ -21,9 +21,11 @@ from pathlib import Path
 
 from ..check import write_baseline
 from .files import _write_text, write_csv, write_statistics_tables, write_summaries
-from .loading import Entry, load_entries, method_label, parse_methods  # noqa: F401
+from .loading import Entry, load_entries, parse_methods
 from .render import render_html, render_markdown
 from .sections import Table, build_sections, files_section
+
+__all__ = ["default_out_dir", "parse_methods", "write_report"]
 
 DEFAULT_TIMES = (10.0, 25.0, float("inf"))  # the tables' times: 10 s, 25 s and the final time
 

@@ -2,7 +2,6 @@
 from __future__ import annotations
 
 import difflib
-from pathlib import Path
 
 import jsbsim
 
@@ -15,7 +14,7 @@ class AircraftProperties:
     `ic/vc-kts` the matching calibrated airspeed). Validation reads nominal values here."""
 
     def __init__(self, simulator: dict):
-        from .aircraft import AircraftFiles, aero_functions
+        from .aircraft import aero_functions
 
         setup = flight_setup_from({**simulator, "outputs": []})  # raises AircraftNotFound (a FileNotFoundError)
         self.aircraft = setup.aircraft

@@ -1,0 +1,67 @@
+"""What the tests share: paths, the command line, file readers and the closed-form models they check
+the numbers against. Test modules import these names (`from conftest import ...`)."""
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import h5py
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[1]
+DATA = Path(__file__).parent / "data"
+CAMPAIGNS = DATA / "campaigns"
+UQFLIGHT = str(Path(sys.executable).with_name("uqflight"))
+
+
+def cli(*args, cwd=None, timeout: float = 300) -> subprocess.CompletedProcess:
+    """`uqflight ARGS...` in a fresh process, its output captured."""
+    return subprocess.run([UQFLIGHT, *map(str, args)], cwd=cwd, capture_output=True, text=True, timeout=timeout)
+
+
+def read_results(path) -> dict[str, np.ndarray]:
+    """Every dataset of a results file (design, status, raw outputs or tSVD factors), by path."""
+    found = {}
+    with h5py.File(path, "r") as f:
+        f.visititems(lambda key, item: found.update({key: item[()]}) if isinstance(item, h5py.Dataset) else None)
+    return found
+
+
+def _refuse_constant(name: str):
+    raise ValueError(f"{name} is not JSON: summary.json must be strict")
+
+
+def read_summary(path) -> dict:
+    """A summary.json (or any JSON the tool writes), read as a strict parser would: NaN, Infinity and
+    -Infinity are errors."""
+    return json.loads(Path(path).read_text(encoding="utf-8"), parse_constant=_refuse_constant)
+
+
+def ishigami(xi, a=7.0, b=0.1):
+    """Ishigami function of x = πξ, ξ ~ U(−1, 1)³."""
+    x = np.pi * np.asarray(xi, dtype=float)
+    return np.sin(x[:, 0]) + a * np.sin(x[:, 1]) ** 2 + b * x[:, 2] ** 4 * np.sin(x[:, 0])
+
+
+def ishigami_indices(a=7.0, b=0.1) -> tuple[np.ndarray, np.ndarray]:
+    """Closed-form first and total Sobol' indices of the Ishigami function."""
+    v1 = 0.5 * (1 + b * np.pi**4 / 5) ** 2
+    v2 = a**2 / 8
+    v13 = b**2 * np.pi**8 * (1 / 18 - 1 / 50)
+    variance = v1 + v2 + v13
+    return np.array([v1, v2, 0.0]) / variance, np.array([v1 + v13, v2, v13]) / variance
+
+
+def run_python_campaign(folder: Path, text: str, name: str = "c"):
+    """Write the campaign text to FOLDER/NAME.yaml, run it with one worker into FOLDER/NAME.h5, and
+    return the results path (python simulators only: quick)."""
+    from uqflight.campaign import load_campaign
+    from uqflight.execution import run_campaign
+
+    source = Path(folder) / f"{name}.yaml"
+    source.write_text(text, encoding="utf-8")
+    out = Path(folder) / f"{name}.h5"
+    run_campaign(load_campaign(source), out=out, workers=1)
+    return out
