@@ -30,16 +30,17 @@ class DesignKind:
 
     build: Callable
     sampled: bool
+    example: dict  # a small `design:` mapping of this kind (help text and tests)
 
 
 REGISTRY: dict[str, DesignKind] = {
-    "monte_carlo": DesignKind(monte_carlo_design, sampled=True),
-    "sobol": DesignKind(sobol_design, sampled=True),
-    "halton": DesignKind(halton_design, sampled=True),
-    "latin_hypercube": DesignKind(latin_hypercube_design, sampled=True),
-    "sparse_grid": DesignKind(sparse_grid_design, sampled=False),
-    "tensor_grid": DesignKind(tensor_grid_design, sampled=False),
-    "pick_freeze": DesignKind(pick_freeze_design, sampled=True),
+    "monte_carlo": DesignKind(monte_carlo_design, True, {"kind": "monte_carlo", "samples": 64}),
+    "sobol": DesignKind(sobol_design, True, {"kind": "sobol", "samples": 64}),
+    "halton": DesignKind(halton_design, True, {"kind": "halton", "samples": 64}),
+    "latin_hypercube": DesignKind(latin_hypercube_design, True, {"kind": "latin_hypercube", "samples": 64}),
+    "sparse_grid": DesignKind(sparse_grid_design, False, {"kind": "sparse_grid", "level": 2}),
+    "tensor_grid": DesignKind(tensor_grid_design, False, {"kind": "tensor_grid", "points": 4}),
+    "pick_freeze": DesignKind(pick_freeze_design, True, {"kind": "pick_freeze", "samples": 16}),
 }
 DESIGN_KINDS = tuple(REGISTRY)
 SAMPLED_DESIGNS = tuple(kind for kind, entry in REGISTRY.items() if entry.sampled)

@@ -1,0 +1,97 @@
+"""Every registered germ, distribution, rule, design and method, picked up from its registry and checked
+against closed forms: a new entry is tested without a new test."""
+import math
+
+import numpy as np
+import pytest
+
+from uqflight.designs import REGISTRY as DESIGNS
+from uqflight.designs import build_design
+from uqflight.designs.rules import RULE_TABLE, nodes_weights
+from uqflight.methods import METHODS, fit
+from uqflight.methods.basis import orthonormal_basis, orthonormal_polynomials, total_degree_indices
+from uqflight.parameters import DISTRIBUTIONS, GERMS, make_parameter
+
+GERM_NAMES = list(GERMS)
+
+
+@pytest.mark.parametrize("germ", GERM_NAMES)
+def test_a_germs_polynomials_are_orthonormal_under_its_default_rule(germ):
+    # a 12-point Gauss rule is exact to degree 23 ≥ 2·8: the Gram matrix of p_0..p_8 is the identity
+    nodes, weights = nodes_weights(GERMS[germ].default_rule, 12)
+    values = orthonormal_polynomials(germ, nodes, 8)
+    np.testing.assert_allclose(values.T @ (weights[:, None] * values), np.eye(9), atol=1e-11)
+    assert RULE_TABLE[GERMS[germ].default_rule].germ == RULE_TABLE[GERMS[germ].nested_rule].germ == germ
+
+
+@pytest.mark.parametrize("germ", GERM_NAMES)
+def test_a_germs_quantile_maps_uniforms_to_its_law(germ):
+    u = (np.arange(20000) + 0.5) / 20000
+    xi = GERMS[germ].quantile(u)
+    nodes, weights = nodes_weights(GERMS[germ].default_rule, 10)
+    for power in (1, 2, 4):  # midpoint rule in u against the Gauss rule; the normal's tails beyond the
+        # outermost midpoints (|ξ| > 4.4) hold 4e-4 of E[ξ⁴]'s 3, hence 5e-3
+        assert np.mean(xi**power) == pytest.approx(weights @ nodes**power, abs=5e-3)
+
+
+@pytest.mark.parametrize("name", list(DISTRIBUTIONS))
+def test_a_distributions_maps_invert_and_its_moments_match_quadrature(name):
+    parameter = make_parameter("p", "p", name, 2.0, interval_pct=30.0)
+    nodes, weights = nodes_weights(GERMS[parameter.germ].default_rule, 60)
+    kappa = parameter.to_physical(nodes)
+    inner = np.abs(nodes) <= 6  # beyond, a truncated law's κ sits on its bound to double precision
+    np.testing.assert_allclose(parameter.to_standard(kappa[inner]), nodes[inner], atol=1e-9)
+    assert np.all(np.diff(kappa[inner]) > 0)  # κ grows with ξ
+    mean = weights @ kappa  # a 60-point rule: the moments of these smooth maps to ~1e-10
+    assert mean == pytest.approx(parameter.mean, rel=1e-9)
+    assert math.sqrt(weights @ (kappa - mean) ** 2) == pytest.approx(parameter.std, rel=1e-7)
+
+
+@pytest.mark.parametrize("name", list(RULE_TABLE))
+def test_a_rule_sums_to_one_and_is_exact_to_its_degree_and_not_beyond(name):
+    rule = RULE_TABLE[name]
+    for size in (rule.sizes or (1, 3, 5, 9))[:4]:
+        nodes, weights = rule.nodes_weights(size)
+        degree = rule.degree(size)
+        assert weights.sum() == pytest.approx(1.0, abs=1e-12)
+        values = orthonormal_polynomials(rule.germ, nodes, degree + 2)
+        errors = np.abs(weights @ values - np.eye(degree + 3)[0])
+        assert errors[: degree + 1].max() < 1e-8, (size, degree)
+        assert errors[degree + 1:].max() > 1e-6, (size, degree)  # degree + 1 is odd: degree + 2 must miss
+
+
+@pytest.mark.parametrize("kind", list(DESIGNS))
+def test_a_design_has_weights_summing_to_one_and_is_random_only_if_sampled(kind):
+    germs = ["normal", "uniform"]
+    one, other = (build_design(DESIGNS[kind].example, germs, seed) for seed in (1, 2))
+    assert one.xi.shape == (len(one.weights), 2) and one.weights.sum() == pytest.approx(1.0)
+    assert np.all(np.abs(one.xi[:, 1]) <= 1.0)  # the uniform germ's support
+    assert (not np.array_equal(one.xi, other.xi)) == DESIGNS[kind].sampled
+
+
+def _polynomial_case():
+    """A 5 × 5 Gauss tensor grid (exact to degree 9) and a random order-2 PCE sampled on it."""
+    germs = ["normal", "uniform"]
+    design = build_design({"kind": "tensor_grid", "points": 5}, germs, 0)
+    indices = total_degree_indices(2, 2)
+    coefficients = np.random.default_rng(3).normal(size=(len(indices), 3))
+    return germs, design, coefficients, orthonormal_basis(germs, indices, design.xi) @ coefficients
+
+
+@pytest.mark.parametrize("kind", [k for k, m in METHODS.items() if not m.sampled_only])
+def test_every_grid_method_recovers_a_polynomial_in_its_basis(kind):
+    germs, design, coefficients, Y = _polynomial_case()
+    result = fit(kind, design.xi, design.weights, Y, germs, order=2)
+    np.testing.assert_allclose(result.mean, coefficients[0], atol=1e-12)
+    np.testing.assert_allclose(result.variance, (coefficients[1:] ** 2).sum(axis=0), rtol=1e-11)
+    np.testing.assert_allclose(result.pce.coefficients, coefficients, atol=1e-11)
+
+
+@pytest.mark.parametrize("kind", [k for k, m in METHODS.items() if m.sampled_only])
+def test_every_sampling_method_gives_the_sample_moments(kind):
+    germs = ["normal"]
+    design = build_design({"kind": "monte_carlo", "samples": 500}, germs, 4)
+    Y = np.exp(design.xi)
+    result = fit(kind, design.xi, design.weights, Y, germs)
+    np.testing.assert_allclose(result.mean, Y.mean(axis=0), rtol=1e-14)
+    np.testing.assert_allclose(result.variance, Y.var(axis=0, ddof=1), rtol=1e-12)
