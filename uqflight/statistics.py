@@ -88,6 +88,7 @@ class OutputStatistics:
     coefficient_decay: dict[int, np.ndarray] | None = None  # degree -> RSS of its PCE coefficients (T,)
     final_samples: np.ndarray | None = None  # runs or surrogate draws at the final time, for the KLD
     fourth_central: np.ndarray | None = None  # of the runs, for a sampled reference's noise floor
+    replicate_moments: tuple[np.ndarray, np.ndarray] | None = None  # (R, T) means and variances of RQMC replicates
     errors: dict = field(default_factory=dict)
 
     @property
@@ -113,6 +114,7 @@ class Statistics:
     notes: list[str] = field(default_factory=list)
     reference: str | None = None
     from_runs: bool = False  # statistics of the runs themselves (a sampled design), not of a PCE
+    replicates: int = 1  # independent randomised-QMC replicates of the design
 
 
 def campaign_facts(store: ResultStore) -> tuple[dict, list[str], dict]:
@@ -173,8 +175,12 @@ def analyse(path, reference: str | None = None, options: Options | None = None, 
             raise BadInput(f"{path}: method {method['kind']} order {method['order']}: {problem}")
         _note_runs(store, stats, sampled, allow_aliasing)
         stats.from_runs = method_entry(method["kind"]).runs_on_sampled and sampled
+        replicates = int(json.loads(store.attrs.get("design_info", "{}")).get("replicates", 1))
+        stats.replicates = replicates if stats.from_runs and ok.all() else 1
         for name in store.output_names:
-            stats.outputs[name] = _output_statistics(store, name, method, germs, design_kind, ok, options)
+            out = stats.outputs[name] = _output_statistics(store, name, method, germs, design_kind, ok, options)
+            if stats.replicates > 1:
+                out.replicate_moments = _replicate_moments(store, name, stats.replicates)
     if reference:
         add_reference_errors(stats, analyse(reference, options=Options(
             band_samples=options.band_samples, bootstrap=0, seed=options.seed, quantiles=options.quantiles)))
@@ -295,6 +301,14 @@ def _output_statistics(store: ResultStore, name: str, method: dict, germs: list[
     return stats
 
 
+def _replicate_moments(store: ResultStore, name: str, replicates: int) -> tuple[np.ndarray, np.ndarray]:
+    """Sample mean and variance of each randomised-QMC replicate (consecutive equal blocks of runs): (R, T) each."""
+    basis, scale = output_basis(store, name, np.ones(store.status.size, dtype=bool))
+    blocks = [weighted_moments(rows, None, scale, unbiased=True)
+              for rows in np.split(basis, replicates)]
+    return np.array([m for m, _ in blocks]), np.array([v for _, v in blocks])
+
+
 def _tsvd_resolution(store: ResultStore, scale: np.ndarray | None, n: int) -> float:
     """The std a tSVD truncation can hide: tol·σ₁/√n per run, σ₁ the norm of scale = diag(s) Uᵀ's first
     row (0 for raw storage)."""
@@ -380,6 +394,15 @@ def add_reference_errors(stats: Statistics, reference: Statistics) -> None:
 
 def _reference_floor(reference: Statistics, ref: OutputStatistics, out: OutputStatistics) -> dict:
     """The errors a reference's own noise alone would show, and which floor that is."""
+    if ref.replicate_moments is not None:
+        means, variances = ref.replicate_moments
+        r = len(means)
+        se_mean, se_variance = means.std(axis=0, ddof=1) / np.sqrt(r), variances.std(axis=0, ddof=1) / np.sqrt(r)
+        peak_mean, peak_variance = np.max(np.abs(ref.mean)) or 1.0, np.max(np.abs(ref.variance)) or 1.0
+        note = (f"reference: randomised QMC, {r} replicates of {reference.completed // r} scrambled Sobol' points; "
+                "floor = the standard errors of its mean and variance from the spread of the replicates")
+        return {"eps_m_floor": se_mean / peak_mean, "eps_v_floor": se_variance / peak_variance,
+                "kld_floor": float(kld_floor(ref.final_samples, n_method=len(out.final_samples))), "floor_note": note}
     if reference.from_runs and ref.fourth_central is not None:
         floors = floors_from_moments(ref.mean, ref.variance, ref.fourth_central, reference.completed)
         qmc = reference.design_kind != "monte_carlo"

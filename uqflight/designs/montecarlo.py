@@ -36,12 +36,23 @@ def monte_carlo_design(spec: dict, germs: list[str], seed: int):
 
 
 def sobol_design(spec: dict, germs: list[str], seed: int):
-    """`sobol` {samples, scramble (default true)}: Sobol' points, Owen-scrambled with the seed."""
-    check_keys(spec, "sobol", ("samples", "scramble"))
+    """`sobol` {samples, scramble (default true), replicates (default 1)}: Sobol' points, Owen-scrambled
+    with the seed. With R replicates (randomised QMC), R independent scrambles of `samples` points each
+    (seeds spawned from the campaign's), stacked replicate after replicate: R × samples runs whose
+    replicate-to-replicate spread gives the standard error of every statistic."""
+    check_keys(spec, "sobol", ("samples", "scramble", "replicates"))
     n = integer(spec, "samples", "sobol", minimum=1)
     scramble = optional_boolean(spec, "scramble", default=True)
-    xi = germ_quantiles(sobol_points(n, len(germs), scramble, seed), germs)
-    return xi, equal_weights(n), {"samples": n, "scramble": scramble, "seed": seed}
+    replicates = integer(spec, "replicates", "sobol", minimum=1) if "replicates" in spec else 1
+    if replicates == 1:
+        xi = germ_quantiles(sobol_points(n, len(germs), scramble, seed), germs)
+        return xi, equal_weights(n), {"samples": n, "scramble": scramble, "seed": seed}
+    if not scramble:
+        raise ValueError("design.replicates: replicates need scramble: true (unscrambled copies are identical)")
+    children = np.random.SeedSequence(seed).spawn(replicates)
+    u = np.vstack([sobol_points(n, len(germs), True, np.random.default_rng(child)) for child in children])
+    return (germ_quantiles(u, germs), equal_weights(n * replicates),
+            {"samples": n, "replicates": replicates, "scramble": True, "seed": seed})
 
 
 def halton_design(spec: dict, germs: list[str], seed: int):
