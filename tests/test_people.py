@@ -161,4 +161,4 @@ def test_surrogate_export_round_trip(results, tmp_path):
     near = surrogate.evaluate([[1.0, 1.5]])["x"][0]
     assert near.shape == time.shape
     mc = cli("surrogate", "export", results, "--out", tmp_path / "mc.json", "--method", "monte_carlo")
-    assert mc.returncode == 2 and "builds no PCE" in mc.stderr and not (tmp_path / "mc.json").exists()
+    assert mc.returncode == 2 and "needs a sampled design" in mc.stderr and not (tmp_path / "mc.json").exists()

@@ -90,6 +90,7 @@ class OutputStatistics:
     fourth_central: np.ndarray | None = None  # of the runs, for a sampled reference's noise floor
     replicate_moments: tuple[np.ndarray, np.ndarray] | None = None  # (R, T) means and variances of RQMC replicates
     errors: dict = field(default_factory=dict)
+    pce: PCE | None = None  # the expansion behind the statistics (None: statistics of the runs themselves)
 
     @property
     def std(self) -> np.ndarray:
@@ -285,6 +286,7 @@ def _output_statistics(store: ResultStore, name: str, method: dict, germs: list[
         return np.where(resolved, indices, np.nan)
 
     if pce is not None:
+        stats.pce = pce
         stats.sobol_first = dict(zip(names, masked(pce.sobol_first())))
         stats.sobol_total = dict(zip(names, masked(pce.sobol_total())))
         stats.coefficient_decay = _coefficient_decay(pce)

@@ -78,47 +78,33 @@ class Surrogate:
         return {name: (c[~constant] ** 2).sum(axis=0) for name, c in self.coefficients.items()}
 
 
-def fit_surrogate(path, method: dict | None = None) -> Surrogate:
-    """The PCE of every output of the results file `path`, fitted as `uqflight.statistics.analyse`
-    fits it (with `method` overriding the campaign's). SurrogateError when the method builds none."""
-    from .designs import is_sampled
-    from .methods import PCE, method_entry
-    from .statistics import campaign_facts, output_basis
-    from .store import ResultStore, Status
+def fit_surrogate(path, method: dict | None = None, partial: bool = False,
+                  allow_aliasing: bool = False) -> Surrogate:
+    """The PCE of every output of the results file `path`, exactly as `uqflight.statistics.analyse`
+    fits it (with `method` overriding the campaign's), after the same checks: pending or failed runs,
+    a projection the grid cannot integrate and a rank-deficient fit are refused (statistics.BadInput).
+    SurrogateError when the method builds no PCE."""
+    from .statistics import analyse
+    from .store import ResultStore
 
+    stats = analyse(path, method=method, partial=partial, allow_aliasing=allow_aliasing)
+    pces = {name: out.pce for name, out in stats.outputs.items()}
+    if any(pce is None for pce in pces.values()):
+        raise SurrogateError(f"{path}: method {stats.method['kind']} on a {stats.design_kind} design builds no PCE; "
+                             "give a PCE method, e.g. --method least_squares:2")
     with ResultStore.open(path) as store:
-        stored_method, germs, _ = campaign_facts(store)
-        method = {**stored_method, **(method or {})}
-        entry = method_entry(method["kind"])
-        design_kind = store.attrs.get("design_kind", "")
-        if entry.pce is None or entry.moments == "sample" or (entry.runs_on_sampled and is_sampled(design_kind)):
-            raise SurrogateError(f"{path}: method {method['kind']} on a {design_kind} design builds no PCE; "
-                                 "give a PCE method, e.g. --method least_squares:2")
-        ok = store.status == Status.OK
-        if not ok.any():
-            raise SurrogateError(f"{path}: no successful runs")
-        xi, weights = store.xi[ok], store.weights[ok]
-        coefficients, indices = {}, None
-        for name in store.output_names:
-            basis, scale = output_basis(store, name, ok)
-            x0 = None
-            if method.get("split") and entry.split:  # as statistics: x = x0 + S with each run's x(0)
-                basis = basis if scale is None else basis @ scale
-                scale, x0 = None, basis[:, :1]
-            fitted = entry.pce(xi, weights, basis, germs, method["order"], x0)
-            pce = PCE(fitted.germs, fitted.indices, fitted.coefficients if scale is None
-                      else fitted.coefficients @ scale)
-            coefficients[name] = np.asarray(pce.coefficients, dtype=float)
-            indices = np.asarray(pce.indices, dtype=int)
-        return Surrogate(_parameters(store), list(germs), indices, np.asarray(store.time, dtype=float),
-                         coefficients, dict(store.units), method, str(store.attrs.get("campaign_name", "")))
+        parameters, units, time = _parameters(store), dict(store.units), np.asarray(store.time, dtype=float)
+    first = next(iter(pces.values()))
+    return Surrogate(parameters, list(first.germs), np.asarray(first.indices, dtype=int), time,
+                     {name: np.asarray(pce.coefficients, dtype=float) for name, pce in pces.items()}, units,
+                     stats.method, stats.campaign_name)
 
 
 def _parameters(store) -> list[dict]:
     """The parameters' laws from the stored campaign text (κ ↔ ξ), via the campaign parser."""
-    from .report.loading import campaign_parameters
+    from .campaign import stored_parameters
 
-    found = campaign_parameters(store.campaign_text)
+    found = stored_parameters(store.campaign_text)
     names = store.parameter_names
     if found is None or [p["name"] for p in found] != names:
         raise SurrogateError("cannot read the parameters' distributions from the campaign text in the results file")

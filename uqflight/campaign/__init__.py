@@ -105,3 +105,17 @@ def parse_campaign(text: str, source: str = "<campaign>", probe: PropertyProbe |
     return campaign
 
 
+def stored_parameters(campaign_text: str) -> list[dict] | None:
+    """The parameters of a campaign text stored in a results file, as dicts (name, property, distribution,
+    lower, upper, nominal), read through the campaign parser (nominal values from the aircraft when the
+    campaign leaves them to it); None when the text cannot be parsed."""
+    from ..simulators.jsbsim_probe import jsbsim_probe
+
+    for probe in (None, jsbsim_probe):
+        try:
+            campaign = parse_campaign(campaign_text, "<results file>", probe)
+        except Exception:  # noqa: BLE001 - e.g. an aircraft not on this machine: try the next way, else None
+            continue
+        return [{"name": p.name, "property": p.property, "distribution": p.distribution, "lower": p.lower,
+                 "upper": p.upper, "nominal": p.nominal} for p in campaign.parameters]
+    return None

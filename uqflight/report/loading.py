@@ -63,24 +63,6 @@ def input_distributions(campaign_text: str) -> str:
     return ", ".join(dict.fromkeys(str(spec.get("distribution", "?")) for spec in parameters.values()))
 
 
-def campaign_parameters(campaign_text: str) -> list[dict] | None:
-    """The campaign's parameters as dicts (name, property, distribution, lower, upper, nominal), read
-    through the campaign parser (nominal values from the aircraft when the campaign leaves them to
-    it); None when the text cannot be parsed."""
-    from ..campaign import parse_campaign
-
-    for probe in (None, "jsbsim"):
-        try:
-            if probe == "jsbsim":
-                from ..simulators.jsbsim_probe import jsbsim_probe as probe
-            campaign = parse_campaign(campaign_text, "<results file>", probe)
-        except Exception:  # noqa: BLE001 - a report describes what it can; the table says "not readable"
-            continue
-        return [{"name": p.name, "property": p.property, "distribution": p.distribution, "lower": p.lower,
-                 "upper": p.upper, "nominal": p.nominal} for p in campaign.parameters]
-    return None
-
-
 def campaign_settings(campaign_text: str) -> dict:
     """The campaign's mapping as written (YAML), {} when unreadable."""
     try:

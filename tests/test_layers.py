@@ -1,0 +1,73 @@
+"""The import graph runs one way, down the data flow: no module imports a layer above its own (lazy
+imports inside functions included), and a worker imports only what flying needs."""
+import ast
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+PACKAGE = Path(__file__).resolve().parents[1] / "uqflight"
+
+# Lowest first; a module may import its own layer and those below. Longest prefix wins.
+LAYERS = [
+    ("uqflight.paper", "uqflight.tsvd", "uqflight.simulators.base", "uqflight.parameters.germs"),
+    ("uqflight.parameters", "uqflight.analysis", "uqflight.simulators"),
+    ("uqflight.designs",),
+    ("uqflight.methods",),
+    ("uqflight.store", "uqflight.worker"),
+    ("uqflight.campaign", "uqflight.statistics"),
+    ("uqflight.execution", "uqflight.check", "uqflight.surrogate", "uqflight.calibration"),
+    ("uqflight.report",),
+    ("uqflight.cli",),
+]
+
+
+def layer(module: str) -> int:
+    if module == "uqflight":  # the package's own __init__: its version only
+        return 0
+    matches = [(len(prefix), i) for i, prefixes in enumerate(LAYERS) for prefix in prefixes
+               if module == prefix or module.startswith(prefix + ".")]
+    assert matches, f"{module} has no layer: add it to LAYERS"
+    return max(matches)[1]
+
+
+def module_name(path: Path) -> str:
+    parts = path.relative_to(PACKAGE.parent).with_suffix("").parts
+    return ".".join(parts[:-1] if parts[-1] == "__init__" else parts)
+
+
+def imports(path: Path) -> set[str]:
+    """The uqflight modules a file imports, anywhere in it (relative imports resolved)."""
+    name = module_name(path)
+    package = name if path.name == "__init__.py" else name.rpartition(".")[0]
+    found = set()
+    for node in ast.walk(ast.parse(path.read_text())):
+        if isinstance(node, ast.Import):
+            found |= {alias.name for alias in node.names if alias.name.startswith("uqflight")}
+        elif isinstance(node, ast.ImportFrom):
+            if node.level:
+                base = package.split(".")[: len(package.split(".")) - node.level + 1]
+                target = ".".join(base + ([node.module] if node.module else []))
+            else:
+                target = node.module or ""
+            if target.startswith("uqflight"):
+                found.add(target)
+    return found
+
+
+MODULES = sorted(PACKAGE.rglob("*.py"))
+
+
+@pytest.mark.parametrize("path", MODULES, ids=lambda p: module_name(p))
+def test_no_module_imports_a_layer_above_its_own(path):
+    own = layer(module_name(path))
+    upward = sorted(target for target in imports(path) if layer(target) > own)
+    assert not upward, f"{module_name(path)} (layer {own}) imports {upward}"
+
+
+def test_a_worker_imports_only_what_flying_needs():
+    code = ("import sys, uqflight.worker; print(' '.join(sorted(m for m in sys.modules "
+            "if m.startswith(('uqflight', 'scipy', 'h5py', 'yaml', 'matplotlib', 'dask')))))")
+    loaded = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout.split()
+    assert all(m.startswith(("uqflight.simulators", "uqflight.worker")) or m == "uqflight" for m in loaded), loaded
