@@ -24,7 +24,7 @@ JSBSIM_KEYS = ("kind", "aircraft", "flight", "excitation", "duration_s", "output
 PYTHON_KEYS = ("kind", "function", "outputs")
 PARAMETER_KEYS = ("property", "distribution", "nominal", "interval_pct", "lower", "upper")
 METHOD_KEYS = ("kind", "order", "split")
-EXECUTION_KEYS = ("workers", "executor", "scheduler", "chunk")
+EXECUTION_KEYS = ("workers", "executor", "scheduler", "chunk", "timeout_s")
 STORAGE_KEYS = ("path", "raw", "tsvd")
 TSVD_KEYS = ("tol", "batch")
 ANALYSIS_KEYS = ("band_samples", "bootstrap")
@@ -277,6 +277,8 @@ def execution(check: Checker, value) -> dict:
     execution["chunk"] = check.integer(execution.get("chunk", 16), "execution.chunk", 1)
     if execution.get("scheduler") is not None:
         check.string(execution["scheduler"], "execution.scheduler")
+    if execution.get("timeout_s") is not None:  # default: derived from a measured nominal flight
+        execution["timeout_s"] = check.number(execution["timeout_s"], "execution.timeout_s", 0.0, strict=True)
     return execution
 
 
