@@ -52,7 +52,7 @@ from .worker import WorkerSpec
 DEFAULT_TIMEOUT_FLOOR_S = 60.0   # default timeout: max(this, TIMEOUT_FLIGHTS x one nominal flight)
 TIMEOUT_FLIGHTS = 50
 PROBE_TIMEOUT_S = 600.0          # the nominal flight that measures the cost (no limit known yet)
-SPACE_MARGIN_BYTES = 4 << 20     # free space kept beyond a batch's estimate (HDF5 metadata, journal)
+SPACE_MARGIN_BYTES = 1 << 20     # free space kept beyond a batch's estimate (HDF5 metadata)
 
 
 class DiskFull(OSError):
