@@ -364,3 +364,45 @@ def test_refusals_through_the_cli_exit_2(tmp_path):
     for command in ("plan", "run"):
         done = subprocess.run([UQFLIGHT, command, str(path)], capture_output=True, text=True, timeout=60)
         assert done.returncode == 2 and "limits.max_runs" in done.stderr, done.stderr
+
+
+# -- check: baselines and tolerances ------------------------------------------------------------------
+def baseline_text(mean):
+    return ('{"kind": "uqflight-baseline", "version": 1, "outputs": {"y": {"time": [0, 1], "mean": %s, '
+            '"variance": [1, 1], "band99": {"lower": [0, 0], "upper": [1, 1]}, "sobol_first": {}, '
+            '"sobol_total": {}}}}' % mean)
+
+
+@pytest.mark.parametrize("mean", ["[Infinity, 1]", "[-Infinity, 1]", "[1e999, 1]"])
+def test_check_refuses_infinite_baseline_values(tmp_path, mean):
+    from uqflight.check import BadInput, load_baseline
+
+    path = tmp_path / "b.json"
+    path.write_text(baseline_text(mean))
+    with pytest.raises(BadInput, match="infinite|Infinity"):
+        load_baseline(path)
+
+
+def test_check_accepts_nan_and_null_baseline_values(tmp_path):
+    from uqflight.check import load_baseline
+
+    path = tmp_path / "b.json"
+    path.write_text(baseline_text("[NaN, null]"))
+    assert load_baseline(path)["outputs"]["y"]["mean"][1] is None
+
+
+def test_check_refuses_deeply_nested_json(tmp_path):
+    from uqflight.check import BadInput, load_baseline
+
+    path = tmp_path / "b.json"
+    path.write_text("[" * 100000 + "]" * 100000)
+    with pytest.raises(BadInput, match="nested too deeply"):
+        load_baseline(path)
+
+
+@pytest.mark.parametrize("rtol, atol", [(1e-6, float("inf")), (float("nan"), 1e-9), (float("inf"), 0.0)])
+def test_check_refuses_non_finite_tolerances(rtol, atol):
+    from uqflight.check import BadInput, compare
+
+    with pytest.raises(BadInput, match="expected a finite number >= 0"):
+        compare(None, {"outputs": {}}, rtol, atol)
