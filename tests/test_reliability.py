@@ -406,3 +406,20 @@ def test_check_refuses_non_finite_tolerances(rtol, atol):
 
     with pytest.raises(BadInput, match="expected a finite number >= 0"):
         compare(None, {"outputs": {}}, rtol, atol)
+
+
+def test_a_write_that_hits_the_full_disk_is_rerun_on_resume(tmp_path, small_disk, monkeypatch):
+    """As if another process filled the disk after the free-space check: HDF5 loses chunks at
+    flush; the run must not pass for complete, and the resume reruns what was lost."""
+    import uqflight.execution as execution
+
+    out = small_disk / "r.h5"
+    with monkeypatch.context() as patch:
+        patch.setattr(execution, "ensure_space", lambda *args, **kwargs: None)
+        with pytest.raises((execution.DiskFull, execution.IncompleteFile, OSError, RuntimeError)):
+            run_campaign(campaign("long_histories", samples=300, chunk=10, workers=2), out=out)
+    subprocess.run(["mount", "-o", "remount,size=64m", str(small_disk)], check=True)
+    resumed = run_campaign(campaign("long_histories", samples=300, chunk=10, workers=2), out=out)
+    assert resumed.ran > 0
+    run_campaign(campaign("long_histories", samples=300, chunk=10, workers=2), out=tmp_path / "whole.h5")
+    assert_same_results(out, tmp_path / "whole.h5")

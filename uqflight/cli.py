@@ -144,7 +144,7 @@ def run(
     Exit 0: done; 1: a run-time failure; 2: refused (bad campaign, a file another run holds, a file
     that is not this campaign's, a full disk: the message says what to do); 130 (SIGINT) or 143
     (SIGTERM): stopped cleanly, the finished runs are kept, rerun to resume."""
-    from .execution import DiskFull, WorkerError, run_campaign
+    from .execution import DiskFull, IncompleteFile, WorkerError, run_campaign
     from .store import CorruptFile
 
     spec = _load(campaign)
@@ -165,6 +165,9 @@ def run(
     except CorruptFile as exc:
         typer.echo(f"error: {exc}", err=True)
         raise typer.Exit(2)
+    except IncompleteFile as exc:
+        typer.echo(f"error: {exc}", err=True)
+        raise typer.Exit(1)
     except (FileExistsError, ValueError, WorkerError) as exc:
         typer.echo(f"error: {campaign}: {exc}", err=True)
         raise typer.Exit(2)

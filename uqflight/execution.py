@@ -59,6 +59,10 @@ class DiskFull(OSError):
     """The results file's filesystem has no room for the next batch; the file is closed intact."""
 
 
+class IncompleteFile(OSError):
+    """Runs counted as done did not reach the file (a write failed late); a resume reruns them."""
+
+
 class WorkerError(RuntimeError):
     """A worker could not build the simulator (not a sample's failure: the campaign cannot run)."""
 
@@ -262,7 +266,11 @@ def verify_written(path: Path, summary: RunSummary) -> None:
     if done < summary.ran + summary.skipped:
         problems.append(f"{summary.ran + summary.skipped} runs were counted as done but {done} are stored")
     if problems:
-        raise OSError(f"{path}: the file does not hold what was written: " + "; ".join(problems[:5]))
+        message = (f"{path}: the file does not hold what was written: " + "; ".join(problems[:5])
+                   + "; rerun to resume: the missing runs are run again")
+        if free_bytes(path) < 2 * SPACE_MARGIN_BYTES:
+            raise DiskFull(errno.ENOSPC, disk_full_message(path, done - summary.ran) + f" ({message})")
+        raise IncompleteFile(message)
 
 
 # -- supervised worker processes ------------------------------------------------------------------

@@ -79,6 +79,7 @@ class ResultStore:
 
     def __init__(self, file: h5py.File):
         self._file = file
+        self.repaired = 0  # ok runs found without their data on opening to resume, made pending again
 
     @classmethod
     def create(cls, path, *, campaign_text: str, xi, kappa, weights, parameter_names, outputs, time,
@@ -158,6 +159,8 @@ class ResultStore:
             raise CorruptFile(f"{path}: /samples/status holds unknown status codes {unknown.tolist()} "
                               f"(known: {', '.join(f'{s.value} {s.name.lower()}' for s in Status)}); "
                               "the file is damaged or was written by a newer uqflight")
+        store.repaired = store._repair_lost_runs() if mode == "a" else 0
+        status = store.status
         if mode == "a" and "tsvd" in f:
             for name in f["tsvd"]:
                 apply_staged(f["tsvd"][_key(name)])
@@ -277,6 +280,27 @@ class ResultStore:
             finally:
                 os.close(fd)
 
+    def _repair_lost_runs(self, block: int = 1000) -> int:
+        """Mark pending again the ok runs whose raw histories did not reach the disk (a write that
+        failed late, e.g. a full disk hit by HDF5's cache at flush), so that a resume reruns them;
+        returns how many."""
+        if not self._raw:
+            return 0
+        status = self.status
+        lost = np.zeros(status.size, dtype=bool)
+        for key in self._file["outputs"]:
+            data = self._file["outputs"][key]
+            for start in range(0, status.size, block):
+                ok = status[start:start + block] == Status.OK
+                if ok.any():
+                    lost[start:start + block] |= ok & ~np.isfinite(data[start:start + block]).all(axis=1)
+        if lost.any():
+            index = np.flatnonzero(lost)
+            self._file["samples/status"][index] = Status.PENDING
+            self._file["samples/reason"][index] = [""] * index.size
+            self._flush(sync=True)
+        return int(lost.sum())
+
     def batch_bytes(self, n: int) -> int:
         """An upper estimate of the bytes the next batch of `n` runs may add to the file: its rows
         (a new chunk per output at worst), and for tSVD a staged copy of the factors and buffer."""
@@ -311,6 +335,8 @@ class ResultStore:
             for name in self.output_names:
                 group = self._file["tsvd"][_key(name)]
                 _, index, _ = buffer_rows(group, status)
+                for key in ("U", "s", "V", "buffer"):  # read once: their checksums are verified
+                    group[key][()]
                 held = np.union1d(group["columns"][()], index)
                 missing = np.setdiff1d(ok, held)
                 if missing.size:
