@@ -317,7 +317,7 @@ def test_a_huge_level_is_refused_up_front():
 
 def test_a_raised_limit_lets_a_large_design_through():
     text = limited(design="{kind: monte_carlo, samples: 2000000}") + "limits: {max_runs: 3000000}\n"
-    from uqflight.campaign.schema import CampaignLoader, Checker, check_size, limits
+    from uqflight.campaign.schema import CampaignLoader, Checker, limits
     import yaml
     data = yaml.load(text, Loader=CampaignLoader)
     found = limits(Checker("x"), data["limits"])

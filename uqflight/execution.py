@@ -52,6 +52,7 @@ from .worker import WorkerSpec
 DEFAULT_TIMEOUT_FLOOR_S = 60.0   # default timeout: max(this, TIMEOUT_FLIGHTS x one nominal flight)
 TIMEOUT_FLIGHTS = 50
 PROBE_TIMEOUT_S = 600.0          # the nominal flight that measures the cost (no limit known yet)
+STARTUP_GRACE_S = 60.0           # a chunk's limit before its first sample (worker start, simulator build)
 SPACE_MARGIN_BYTES = 1 << 20     # free space kept beyond a batch's estimate (HDF5 metadata)
 
 
@@ -199,7 +200,12 @@ def run_campaign(campaign: Campaign, out: Path | None = None, workers: int | Non
         # multi-threaded BLAS competing with them is 10-100x slower, and the tSVD factors must not
         # depend on where a resume starts (the same limit for every fold makes them bit-identical).
         with threadpool_limits(limits=1):
-            store = prepare_store(campaign, design, out, force, probed=(time_grid, outputs, units))
+            try:
+                store = prepare_store(campaign, design, out, force, probed=(time_grid, outputs, units))
+            except (OSError, RuntimeError) as exc:
+                if is_disk_full(exc) and not isinstance(exc, FileExistsError):
+                    raise DiskFull(errno.ENOSPC, disk_full_message(out, 0)) from exc
+                raise
             try:
                 summary = _run_pending(store, campaign, pool, spec, chunk, workers, executor, scheduler,
                                        timeout, out, progress)
@@ -376,7 +382,7 @@ class WorkerPool:
         if not slot.send(("probe", self.spec, kappa)):
             raise WorkerError(death_reason(self._drop(slot)))
         if not wait_connections([slot.conn], timeout=self.timeout):
-            self._drop(slot)
+            self._drop(slot, dead=False)
             raise WorkerError(f"the nominal flight did not finish within {self.timeout:g} s")
         try:
             kind, payload = slot.conn.recv()
@@ -406,7 +412,7 @@ class WorkerPool:
                 busy.append(slot)
             if not busy:
                 continue
-            deadline = min(slot.since for slot in busy) + self.timeout
+            deadline = min(slot.since + self._limit(slot) for slot in busy)
             ready = wait_connections([slot.conn for slot in busy], timeout=max(0.0, deadline - time.monotonic()))
             for conn in ready:
                 slot = next(s for s in busy if s.conn is conn)
@@ -432,10 +438,16 @@ class WorkerPool:
                     except (EOFError, OSError):
                         continue  # closed: the next recv reports the death
             now = time.monotonic()
-            for slot in [s for s in busy if now - s.since > self.timeout]:
-                self._drop(slot)
+            for slot in [s for s in busy if now - s.since > self._limit(s)]:
+                self._drop(slot, dead=False)
                 self._lost(slot, busy, queue, f"timed out: still running after {self.timeout:g} s "
                            "(execution.timeout_s); its worker was replaced", Status.TIMEOUT)
+
+    def _limit(self, slot: WorkerProcess) -> float:
+        """The time `slot` may take from `since`: the per-run limit once a sample has started; before
+        the chunk's first sample (a fresh worker starting, the simulator being built) at least
+        STARTUP_GRACE_S, so that a loaded machine does not turn a slow start into timeouts."""
+        return self.timeout if slot.row is not None else max(self.timeout, STARTUP_GRACE_S)
 
     def _lost(self, slot, busy, queue, reason: str, status: Status) -> None:
         """The slot's worker is gone: blame the sample it was flying, fly its chunk again."""
@@ -464,8 +476,9 @@ class WorkerPool:
         self.slots.append(slot)
         return slot
 
-    def _drop(self, slot: WorkerProcess) -> int | None:
-        code = slot.died() if slot.proc.poll() is not None else slot.kill()
+    def _drop(self, slot: WorkerProcess, dead: bool = True) -> int | None:
+        """Forget a worker: `dead` (its socket closed) waits for its own exit status, else kill it."""
+        code = slot.died() if dead else slot.kill()
         if slot in self.slots:
             self.slots.remove(slot)
         return code
