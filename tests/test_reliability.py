@@ -423,3 +423,42 @@ def test_a_write_that_hits_the_full_disk_is_rerun_on_resume(tmp_path, small_disk
     assert resumed.ran > 0
     run_campaign(campaign("long_histories", samples=300, chunk=10, workers=2), out=tmp_path / "whole.h5")
     assert_same_results(out, tmp_path / "whole.h5")
+
+
+def test_sigint_to_the_runner_alone_stops_it_cleanly(tmp_path):
+    yaml = write_campaign(tmp_path, "hanging", samples=200, chunk=4, workers=2, extra=", timeout_s: 300")
+    out = tmp_path / "r.h5"
+    runner = subprocess.Popen([UQFLIGHT, "run", str(yaml)] + ["--out", str(out)], stdout=subprocess.PIPE,
+                              stderr=subprocess.PIPE, text=True)
+    try:
+        assert wait_for(lambda: len(children(runner.pid)) >= 2 and out.exists())
+        time.sleep(1.0)  # a worker is now stuck in a hung sample
+        workers = children(runner.pid)
+        runner.send_signal(signal.SIGINT)
+        _, stderr = runner.communicate(timeout=30)
+    finally:
+        if runner.poll() is None:
+            runner.kill()
+    assert runner.returncode == 130, stderr
+    assert f"interrupted: the finished runs are stored; rerun `uqflight run {yaml} --out {out}`" in stderr
+    assert wait_for(lambda: not any(alive(pid) for pid in workers), 10)
+
+
+def test_the_cli_exits_2_when_the_disk_fills_past_the_check(tmp_path, small_disk):
+    """The free-space check bypassed (another process fills the disk): exit 2, never 0 or 139."""
+    out = small_disk / "r.h5"
+    yaml = write_campaign(tmp_path, "long_histories", samples=300, chunk=10, workers=2)
+    script = ("import sys; import uqflight.execution as e; e.ensure_space = lambda *a, **k: None; "
+              "from uqflight.cli import app; sys.argv = ['uqflight', 'run', sys.argv[1], '--out', sys.argv[2]]; app()")
+    done = subprocess.run([sys.executable, "-c", script, str(yaml), str(out)], capture_output=True, text=True,
+                          timeout=300)
+    assert done.returncode in (1, 2), done.stderr[-2000:]
+    assert "rerun to resume" in done.stderr
+    subprocess.run(["mount", "-o", "remount,size=64m", str(small_disk)], check=True)
+    resumed = subprocess.run([UQFLIGHT, "run", str(yaml), "--out", str(out)], capture_output=True, text=True,
+                             timeout=300)
+    assert resumed.returncode == 0, resumed.stderr[-2000:]
+    whole = subprocess.run([UQFLIGHT, "run", str(yaml), "--out", str(tmp_path / "whole.h5")],
+                           capture_output=True, text=True, timeout=300)
+    assert whole.returncode == 0, whole.stderr
+    assert_same_results(out, tmp_path / "whole.h5")

@@ -161,13 +161,13 @@ def run(
                                force=force, progress=True)
     except DiskFull as exc:
         typer.echo(f"\nerror: {exc.strerror}", err=True)
-        raise typer.Exit(2)
+        _exit_now(2)
     except CorruptFile as exc:
         typer.echo(f"error: {exc}", err=True)
         raise typer.Exit(2)
     except IncompleteFile as exc:
         typer.echo(f"error: {exc}", err=True)
-        raise typer.Exit(1)
+        _exit_now(1)
     except (FileExistsError, ValueError, WorkerError) as exc:
         typer.echo(f"error: {campaign}: {exc}", err=True)
         raise typer.Exit(2)
@@ -179,6 +179,17 @@ def run(
     finally:
         signal.signal(signal.SIGTERM, previous)
     typer.echo(summary.describe())
+
+
+def _exit_now(code: int):
+    """Exit without the interpreter's teardown: after HDF5 met a full disk, its library may crash
+    (exit 139) while freeing the failed file's objects at exit. The file is closed and the lock
+    released by then; only the exit code and the message matter."""
+    import sys
+
+    sys.stdout.flush()
+    sys.stderr.flush()
+    os._exit(code)
 
 
 class Terminated(KeyboardInterrupt):

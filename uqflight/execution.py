@@ -213,9 +213,9 @@ def run_campaign(campaign: Campaign, out: Path | None = None, workers: int | Non
             finally:
                 try:
                     store.close()
-                except (OSError, RuntimeError) as exc:
-                    if is_disk_full(exc):
-                        raise DiskFull(errno.ENOSPC, disk_full_message(out, -1)) from exc
+                except (OSError, RuntimeError) as exc:  # HDF5 reports a late write failure oddly
+                    if is_disk_full(exc) or free_bytes(out) < 2 * SPACE_MARGIN_BYTES:
+                        raise DiskFull(errno.ENOSPC, disk_full_message(out, _stored_runs(out))) from exc
                     raise
         pool.close()
         verify_written(out, summary)
@@ -261,6 +261,15 @@ def _run_pending(store, campaign, pool, spec, chunk, workers, executor, schedule
         bar.advance(int(keep.sum()))
     bar.close()
     return summary
+
+
+def _stored_runs(path: Path) -> str:
+    """How many runs a file holds, for a message (as many as a resume will find)."""
+    try:
+        with ResultStore.open(path) as store:
+            return str(int(np.count_nonzero(store.status != Status.PENDING)))
+    except Exception:
+        return "the stored"
 
 
 def verify_written(path: Path, summary: RunSummary) -> None:

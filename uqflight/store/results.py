@@ -159,8 +159,13 @@ class ResultStore:
             raise CorruptFile(f"{path}: /samples/status holds unknown status codes {unknown.tolist()} "
                               f"(known: {', '.join(f'{s.value} {s.name.lower()}' for s in Status)}); "
                               "the file is damaged or was written by a newer uqflight")
-        store.repaired = store._repair_lost_runs() if mode == "a" else 0
-        status = store.status
+        if mode == "a":
+            try:
+                store.repaired = store._repair_lost_runs()
+            except OSError as exc:
+                f.close()
+                raise CorruptFile(f"{path}: {read_error(exc)}") from exc
+            status = store.status
         if mode == "a" and "tsvd" in f:
             for name in f["tsvd"]:
                 apply_staged(f["tsvd"][_key(name)])
@@ -284,16 +289,23 @@ class ResultStore:
         """Mark pending again the ok runs whose raw histories did not reach the disk (a write that
         failed late, e.g. a full disk hit by HDF5's cache at flush), so that a resume reruns them;
         returns how many."""
-        if not self._raw:
-            return 0
         status = self.status
         lost = np.zeros(status.size, dtype=bool)
-        for key in self._file["outputs"]:
-            data = self._file["outputs"][key]
-            for start in range(0, status.size, block):
-                ok = status[start:start + block] == Status.OK
-                if ok.any():
-                    lost[start:start + block] |= ok & ~np.isfinite(data[start:start + block]).all(axis=1)
+        if self._raw:
+            for key in self._file["outputs"]:
+                data = self._file["outputs"][key]
+                for start in range(0, status.size, block):
+                    ok = status[start:start + block] == Status.OK
+                    if ok.any():
+                        lost[start:start + block] |= ok & ~np.isfinite(data[start:start + block]).all(axis=1)
+        elif "tsvd" in self._file:  # ok runs neither in the factors nor in the buffer (their order in the
+            for key in self._file["tsvd"]:  # factors then follows the rerun: equal data, other rounding)
+                group = self._file["tsvd"][key]
+                apply_staged(group)
+                _, index, _ = buffer_rows(group, status)
+                held = np.zeros(status.size, dtype=bool)
+                held[np.union1d(group["columns"][()], index).astype(np.int64)] = True
+                lost |= (status == Status.OK) & ~held
         if lost.any():
             index = np.flatnonzero(lost)
             self._file["samples/status"][index] = Status.PENDING

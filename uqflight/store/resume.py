@@ -56,7 +56,12 @@ def open_for_campaign(path, *, campaign_text: str, force: bool = False, **create
             raise FileExistsError(f"{path} holds the results of another campaign (campaign_hash {stored}); "
                                   "choose another results file, or force to overwrite it")
         path.unlink()
-    return ResultStore.create(path, campaign_text=campaign_text, **create_args)
+    try:
+        return ResultStore.create(path, campaign_text=campaign_text, **create_args)
+    except BaseException:  # e.g. a full disk: a half-made file would later look damaged; nothing is lost
+        if path.exists():
+            path.unlink()
+        raise
 
 
 def compact(path) -> None:
