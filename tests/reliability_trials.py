@@ -134,4 +134,7 @@ if __name__ == "__main__":
                   "crash": crash_trials(root, int(os.environ.get("CRASHES", "5"))),
                   "enospc": enospc_trials(root, int(os.environ.get("ENOSPC", "4")))}
     for kind, (n, same_count) in totals.items():
-        print(f"{kind}: {same_count}/{n} identical")
+        print(f"{kind}: {same_count}/{n} identical", flush=True)
+    # HDF5 may crash freeing the objects of a file that met a full disk (the bypassed trials, in this
+    # process): the results are printed, skip the interpreter's teardown.
+    os._exit(0)
