@@ -188,7 +188,12 @@ def run_campaign(campaign: Campaign, out: Path | None = None, workers: int | Non
     spec = worker_spec(campaign)
     out.parent.mkdir(parents=True, exist_ok=True)
     lock = ResultsLock(out)
-    lock.acquire()
+    try:
+        lock.acquire()
+    except OSError as exc:
+        if is_disk_full(exc) and not isinstance(exc, FileExistsError):
+            raise DiskFull(errno.ENOSPC, disk_full_message(out, _stored_runs(out) if out.is_file() else 0)) from exc
+        raise
     pool = None
     try:
         pool = WorkerPool(spec, workers if executor == "local" else 1,

@@ -83,10 +83,14 @@ class ResultsLock:
                     continue
                 raise LockHeld(f"{self.path} is being written by another run ({describe_holder(holder)}); "
                                f"wait for it or stop it. If no such run exists, remove {self.file}") from None
-            with os.fdopen(fd, "w") as fh:
-                json.dump(me, fh)
-                fh.flush()
-                os.fsync(fh.fileno())
+            try:
+                with os.fdopen(fd, "w") as fh:
+                    json.dump(me, fh)
+                    fh.flush()
+                    os.fsync(fh.fileno())
+            except OSError:  # e.g. a full disk: leave no empty lock behind
+                self.file.unlink(missing_ok=True)
+                raise
             self.held = True
             return
         raise LockHeld(f"{self.path}: cannot take the lock {self.file} (other runs keep taking it)")
