@@ -139,11 +139,26 @@ def test_tsvd_storage_and_property_outputs(tmp_path):
 
 
 def test_an_unreadable_results_file_is_refused_unless_forced(tmp_path):
-    broken = tmp_path / "r.h5"
-    broken.write_bytes(b"not an HDF5 file")
-    with pytest.raises(FileExistsError, match="not a readable results file"):
+    run_campaign(jsbsim_campaign(samples=2), out=tmp_path / "whole.h5")
+    broken = tmp_path / "r.h5"  # as if killed while the file was being created: HDF5, unreadable
+    broken.write_bytes((tmp_path / "whole.h5").read_bytes()[:2048])
+    with pytest.raises(FileExistsError, match="damaged HDF5 file"):
         run_campaign(jsbsim_campaign(samples=2), out=broken)
     assert run_campaign(jsbsim_campaign(samples=2), out=broken, force=True).ran == 2
+
+
+def test_force_never_replaces_what_is_not_a_results_file(tmp_path):
+    text = tmp_path / "notes.h5"
+    text.write_text("my notes")
+    with pytest.raises(FileExistsError, match="not a uqflight results file.*rm "):
+        run_campaign(jsbsim_campaign(samples=2), out=text, force=True)
+    assert text.read_text() == "my notes"
+    with pytest.raises(FileExistsError, match="is a directory"):
+        run_campaign(jsbsim_campaign(samples=2), out=tmp_path, force=True)
+    with h5py.File(tmp_path / "other.h5", "w") as f:
+        f["x"] = [1, 2, 3]
+    with pytest.raises(FileExistsError, match="HDF5 file but not a uqflight results file"):
+        run_campaign(jsbsim_campaign(samples=2), out=tmp_path / "other.h5", force=True)
 
 
 def test_resuming_with_changed_aircraft_files_is_refused_unless_forced(tmp_path):

@@ -79,12 +79,20 @@ def write_baseline(stats: Statistics, campaign_hash: str, path: Path) -> Path:
 def load_baseline(path: Path) -> dict:
     """A baseline file, checked for shape: BadInput naming the file and the first bad field."""
     path = Path(path)
+
+    def refuse_constant(name):  # Infinity would match anything (|x - inf| <= rtol * inf); NaN matches only NaN
+        if name == "NaN":
+            return math.nan
+        raise BadInput(f"{path}: {name} is not a value a baseline may hold (expected finite numbers, null or NaN)")
+
     try:
-        data = json.loads(path.read_text(encoding="utf-8"))
+        data = json.loads(path.read_text(encoding="utf-8"), parse_constant=refuse_constant)
     except OSError as exc:
         raise BadInput(f"{path}: cannot read the baseline ({exc.strerror or exc})") from exc
     except (UnicodeDecodeError, json.JSONDecodeError) as exc:
-        raise BadInput(f"{path}: not a JSON baseline ({exc})") from exc
+        raise BadInput(f"{path}: not a JSON baseline ({' '.join(str(exc).split())[:200]})") from exc
+    except RecursionError as exc:
+        raise BadInput(f"{path}: not a baseline (JSON nested too deeply)") from exc
     if not isinstance(data, dict) or data.get("kind") != BASELINE_KIND:
         raise BadInput(f"{path}: not a uqflight baseline (expected a JSON object with \"kind\": \"{BASELINE_KIND}\"; "
                        "write one with `uqflight report RESULTS.h5 --out DIR --write-baseline FILE`)")
@@ -119,6 +127,8 @@ def _numbers(where: str, values, length: int | None) -> int:
     if not isinstance(values, list) or not all(v is None or (isinstance(v, (int, float)) and not isinstance(v, bool))
                                                for v in values):
         raise BadInput(f"{where}: expected a list of numbers")
+    if any(v is not None and math.isinf(v) for v in values):  # e.g. 1e999 parses as inf: it would match anything
+        raise BadInput(f"{where}: expected finite numbers (null for undefined), got an infinite value")
     if not values or (length is not None and len(values) != length):
         raise BadInput(f"{where}: expected {length or 'at least one'} values (one per time), got {len(values)}")
     return len(values)
@@ -126,7 +136,11 @@ def _numbers(where: str, values, length: int | None) -> int:
 
 def compare(stats: Statistics, baseline: dict, rtol: float, atol: float) -> Comparison:
     """Every value of `stats` against the baseline; BadInput when outputs, time grids or the Sobol'
-    parameters differ (then the two describe different things and nothing is compared)."""
+    parameters differ (then the two describe different things and nothing is compared), or when a
+    tolerance is negative or not finite (an infinite tolerance would let anything match)."""
+    for label, tol in (("rtol", rtol), ("atol", atol)):
+        if not isinstance(tol, (int, float)) or not math.isfinite(tol) or tol < 0:
+            raise BadInput(f"{label}: expected a finite number >= 0, got {tol!r}")
     fresh = baseline_json(stats, "")["outputs"]
     expected = baseline["outputs"]
     if set(fresh) != set(expected):

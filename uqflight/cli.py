@@ -3,6 +3,7 @@ from __future__ import annotations
 
 import csv
 import os
+import signal
 from collections import Counter
 from pathlib import Path
 from typing import List, Optional
@@ -176,10 +177,16 @@ def run(
     executor: Optional[str] = typer.Option(None, help="local or dask (default: execution.executor)."),
     scheduler: Optional[str] = typer.Option(None, help="Dask scheduler address, e.g. tcp://host:8786; "
                                                        "without it, a LocalCluster."),
-    force: bool = typer.Option(False, help="Overwrite a results file made from another campaign."),
+    force: bool = typer.Option(False, help="Overwrite a results file made from another campaign (never a file "
+                                           "another run holds, nor one that is not a uqflight results file)."),
 ):
-    """Run a campaign into its HDF5 results file; rerunning resumes where it stopped."""
-    from .execution import run_campaign
+    """Run a campaign into its HDF5 results file; rerunning resumes where it stopped.
+
+    Exit 0: done; 1: a run-time failure; 2: refused (bad campaign, a file another run holds, a file
+    that is not this campaign's, a full disk: the message says what to do); 130 (SIGINT) or 143
+    (SIGTERM): stopped cleanly, the finished runs are kept, rerun to resume."""
+    from .execution import DiskFull, IncompleteFile, WorkerError, run_campaign
+    from .store import CorruptFile
 
     spec = _load(campaign)
     if executor not in (None, "local", "dask"):
@@ -188,46 +195,99 @@ def run(
     if workers is not None and workers < 1:
         typer.echo(f"error: --workers: expected an integer >= 1, got {workers}", err=True)
         raise typer.Exit(2)
+    resume = f"uqflight run {campaign}" + (f" --out {out}" if out else "")
+    previous = _stop_on_sigterm()
     try:
         summary = run_campaign(spec, out=out, workers=workers, executor=executor, scheduler=scheduler,
                                force=force, progress=True)
-    except (FileExistsError, ValueError) as exc:
+    except DiskFull as exc:
+        typer.echo(f"\nerror: {exc.strerror}", err=True)
+        _exit_now(2)
+    except CorruptFile as exc:
+        typer.echo(f"error: {exc}", err=True)
+        raise typer.Exit(2)
+    except IncompleteFile as exc:
+        typer.echo(f"error: {exc}", err=True)
+        _exit_now(1)
+    except (FileExistsError, ValueError, WorkerError) as exc:
         typer.echo(f"error: {campaign}: {exc}", err=True)
         raise typer.Exit(2)
-    except KeyboardInterrupt:
-        typer.echo(f"\ninterrupted: the finished runs are stored; rerun `uqflight run {campaign}` to resume", err=True)
-        raise typer.Exit(130)
+    except KeyboardInterrupt as exc:
+        code = 143 if isinstance(exc, Terminated) else 130
+        typer.echo(f"\n{'terminated' if code == 143 else 'interrupted'}: the finished runs are stored; "
+                   f"rerun `{resume}` to resume", err=True)
+        raise typer.Exit(code)
+    finally:
+        signal.signal(signal.SIGTERM, previous)
     typer.echo(summary.describe())
+
+
+def _exit_now(code: int):
+    """Exit without the interpreter's teardown: after HDF5 met a full disk, its library may crash
+    (exit 139) while freeing the failed file's objects at exit. The file is closed and the lock
+    released by then; only the exit code and the message matter."""
+    import sys
+
+    sys.stdout.flush()
+    sys.stderr.flush()
+    os._exit(code)
+
+
+class Terminated(KeyboardInterrupt):
+    """SIGTERM, handled like SIGINT: a clean stop."""
+
+
+def _stop_on_sigterm():
+    def stop(signum, frame):
+        raise Terminated()
+
+    return signal.signal(signal.SIGTERM, stop)
 
 
 @app.command()
 def info(results: Path = typer.Argument(..., help="Results file (.h5).")):
     """Show a results file's campaign, design, done and failed runs, storage and versions."""
-    from .store import ResultStore, Status
+    from .store import CorruptFile, ResultStore, Status, read_error
 
     try:
         store = ResultStore.open(results)
+    except CorruptFile as exc:
+        typer.echo(f"error: {exc}", err=True)
+        raise typer.Exit(2)
     except (OSError, ValueError) as exc:
-        typer.echo(f"error: {results}: {exc}", err=True)
+        typer.echo(f"error: {results}: {read_error(exc)}", err=True)
         raise typer.Exit(2)
     with store:
-        status = store.status
-        attrs = store.attrs
-        typer.echo(f"file: {results}")
-        typer.echo(f"campaign: {attrs.get('campaign_name', '?')} (sha256 {store.campaign_hash[:12]})")
-        typer.echo(f"design: {attrs.get('design_kind', '?')} {attrs.get('design_info', '')}")
-        typer.echo(f"parameters: {', '.join(store.parameter_names)}")
-        typer.echo(f"outputs: {', '.join(store.output_names)} ({store.time.size} times, "
-                   f"{store.time[0]:g} to {store.time[-1]:g} s)")
-        counts = {s.name.lower(): int(np.sum(status == s)) for s in Status}
-        typer.echo("runs: " + ", ".join(f"{v} {k}" for k, v in counts.items()) + f" (of {status.size})")
-        reasons = Counter(r for r, s in zip(store.reasons, status) if s > 0)
-        for reason, n in reasons.most_common(5):
-            typer.echo(f"  failed ({n}): {reason}")
-        typer.echo(f"storage: {store.storage_description}")
-        typer.echo(f"versions: {attrs.get('versions', '?')}")
-        if "aircraft_hash" in attrs:
-            typer.echo(f"aircraft sha256: {attrs['aircraft_hash']}")
+        try:
+            _describe_results(results, store, Status)
+        except OSError as exc:
+            typer.echo(f"error: {results}: {read_error(exc)}", err=True)
+            raise typer.Exit(2)
+
+
+def _describe_results(results, store, Status) -> None:
+    status = store.status
+    attrs = store.attrs
+    typer.echo(f"file: {results}")
+    typer.echo(f"campaign: {attrs.get('campaign_name', '?')} (sha256 {store.campaign_hash[:12]})")
+    typer.echo(f"design: {attrs.get('design_kind', '?')} {attrs.get('design_info', '')}")
+    typer.echo(f"parameters: {', '.join(store.parameter_names)}")
+    typer.echo(f"outputs: {', '.join(store.output_names)} ({store.time.size} times, "
+               f"{store.time[0]:g} to {store.time[-1]:g} s)")
+    counts = {s.name.lower(): int(np.sum(status == s)) for s in Status}
+    typer.echo("runs: " + ", ".join(f"{v} {k}" for k, v in counts.items()) + f" (of {status.size})")
+    reasons = Counter(r for r, s in zip(store.reasons, status) if s > 0)
+    for reason, n in reasons.most_common(5):
+        typer.echo(f"  failed ({n}): {reason}")
+    problems = store.verify()  # reads every checksummed chunk: a flipped byte is reported
+    for problem in problems:
+        typer.echo(f"  problem: {problem}")
+    typer.echo(f"storage: {store.storage_description}")
+    typer.echo(f"versions: {attrs.get('versions', '?')}")
+    if "aircraft_hash" in attrs:
+        typer.echo(f"aircraft sha256: {attrs['aircraft_hash']}")
+    if problems:
+        raise typer.Exit(2)
 
 
 @app.command()

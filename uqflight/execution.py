@@ -1,21 +1,42 @@
-"""Run a campaign's samples in worker processes (local pool or Dask) and stream them to HDF5.
+"""Run a campaign's samples in worker processes (local or Dask) and stream them to HDF5.
 
 The design is cut into fixed chunks of consecutive samples (`execution.chunk`). A worker keeps
 its simulator between chunks and restarts it at the start of each chunk, so every sample's
 result depends only on its chunk: results are identical whatever the number of workers, the
-executor, or an interruption. Chunks are written to the store as they finish (data, then
-status, then a flush), so a killed run loses only the chunks in flight and resumes from there.
+executor, or an interruption. Chunks are written to the store as they finish, so a killed run
+loses only the chunks in flight and resumes from there.
+
+Nothing lost, nothing hung:
+- Simulators never run in the runner's process (not even with one worker): each worker is a
+  `python -m uqflight.worker` child (see `WorkerProcess`) that announces every sample before
+  flying it. A worker that dies (exit, signal, out of memory) or runs one sample past the time
+  limit is killed and replaced; the sample it was flying is recorded with Status.WORKER_DIED or
+  Status.TIMEOUT and its reason, and its chunk is flown again from the start without that sample
+  (the simulator restarts at the chunk start, so the other samples get the results they would
+  have had). The campaign goes on. Dask tasks run their chunk the same way, in a supervised child
+  of the Dask worker.
+- The per-run limit is `execution.timeout_s`; by default max(60 s, 50 x the cost of one flight at
+  the nominal point, measured in a worker before the campaign starts).
+- One writer per file (`store.lock`); a free-space check before every batch stops the run cleanly
+  (`DiskFull`) before HDF5 could hit a full disk half-way through a write.
+- Workers die with their runner (PR_SET_PDEATHSIG and a parent watchdog).
 """
 from __future__ import annotations
 
+import errno
 import json
+import os
+import shutil
+import signal
+import socket
+import subprocess
 import sys
 import time
-from collections import Counter
-from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
+from collections import Counter, deque
 from dataclasses import dataclass, field
 from importlib import metadata
-from multiprocessing import get_context
+from multiprocessing.connection import Connection
+from multiprocessing.connection import wait as wait_connections
 from pathlib import Path
 
 import numpy as np
@@ -25,7 +46,26 @@ from .campaign import Campaign
 from .designs import Design
 from .parameters import to_physical
 from .store import ResultStore, Status, compact, open_for_campaign
-from .worker import WorkerSpec, run_chunk
+from .store.lock import ResultsLock
+from .worker import WorkerSpec
+
+DEFAULT_TIMEOUT_FLOOR_S = 60.0   # default timeout: max(this, TIMEOUT_FLIGHTS x one nominal flight)
+TIMEOUT_FLIGHTS = 50
+PROBE_TIMEOUT_S = 600.0          # the nominal flight that measures the cost (no limit known yet)
+STARTUP_GRACE_S = 60.0           # a chunk's limit before its first sample (worker start, simulator build)
+SPACE_MARGIN_BYTES = 1 << 20     # free space kept beyond a batch's estimate (HDF5 metadata)
+
+
+class DiskFull(OSError):
+    """The results file's filesystem has no room for the next batch; the file is closed intact."""
+
+
+class IncompleteFile(OSError):
+    """Runs counted as done did not reach the file (a write failed late); a resume reruns them."""
+
+
+class WorkerError(RuntimeError):
+    """A worker could not build the simulator (not a sample's failure: the campaign cannot run)."""
 
 
 @dataclass
@@ -36,6 +76,7 @@ class RunSummary:
     skipped: int
     seconds: float
     failures: Counter = field(default_factory=Counter)
+    timeout_s: float = float("nan")
 
     def describe(self) -> str:
         rate = self.ran / self.seconds if self.seconds > 0 else float("nan")
@@ -57,26 +98,36 @@ def versions() -> dict[str, str]:
     return found
 
 
-def prepare_store(campaign: Campaign, design: Design, out: Path, force: bool) -> ResultStore:
-    """Open the campaign's results file to resume it, or create it with the design and provenance."""
+def prepare_store(campaign: Campaign, design: Design, out: Path, force: bool, probed=None) -> ResultStore:
+    """Open the campaign's results file to resume it, or create it with the design and provenance.
+    `probed` = (time, outputs, units) from a worker (`WorkerPool.probe`); measured here in a worker
+    process when not given."""
     spec = worker_spec(campaign)
     kappa = to_physical(campaign.parameters, design.xi)
-    simulator = spec.build()
-    time_grid, outputs = simulator.probe(to_physical(campaign.parameters, np.zeros((1, len(campaign.parameters))))[0])
+    if probed is None:
+        pool = WorkerPool(spec, 1, PROBE_TIMEOUT_S)
+        try:
+            probed = pool.probe(nominal_kappa(campaign))[:3]
+        finally:
+            pool.close()
+    time_grid, outputs, units = probed[:3]
     attrs = {"versions": json.dumps(versions()), "campaign_name": campaign.name,
              "campaign_path": str(Path(campaign.source).resolve()),
              "method": json.dumps(campaign.method), "germs": json.dumps(campaign.germs),
              "analysis": json.dumps(campaign.analysis),
              "design_kind": design.kind, "design_info": json.dumps(design.info, default=str)}
     if campaign.simulator["kind"] == "jsbsim":
-        from .simulators.jsbsim import aircraft_hash
-        attrs["aircraft_hash"] = aircraft_hash(simulator.setup)
+        from .simulators.jsbsim import aircraft_hash, flight_setup_from
+        attrs["aircraft_hash"] = aircraft_hash(flight_setup_from(campaign.simulator))
     out.parent.mkdir(parents=True, exist_ok=True)
     return open_for_campaign(
         out, campaign_text=campaign.text, force=force, xi=design.xi, kappa=kappa, weights=design.weights,
         parameter_names=[p.name for p in campaign.parameters], outputs=outputs, time=time_grid,
-        raw=campaign.storage["raw"], tsvd=campaign.storage.get("tsvd"), attrs=attrs,
-        units=getattr(simulator, "units", {}))
+        raw=campaign.storage["raw"], tsvd=campaign.storage.get("tsvd"), attrs=attrs, units=units)
+
+
+def nominal_kappa(campaign: Campaign) -> np.ndarray:
+    return to_physical(campaign.parameters, np.zeros((1, len(campaign.parameters))))[0]
 
 
 def worker_spec(campaign: Campaign) -> WorkerSpec:
@@ -95,11 +146,42 @@ def pending_chunks(pending: np.ndarray, chunk: int, total: int) -> list[np.ndarr
     return [np.arange(c * chunk, min((c + 1) * chunk, total)) for c in np.unique(pending // chunk)]
 
 
+def default_timeout(flight_seconds: float) -> float:
+    """The per-run limit when the campaign sets none: max(60 s, 50 nominal flights)."""
+    return max(DEFAULT_TIMEOUT_FLOOR_S, TIMEOUT_FLIGHTS * flight_seconds)
+
+
+def free_bytes(path: Path) -> int:
+    return shutil.disk_usage(path.parent if not path.is_dir() else path).free
+
+
+def ensure_space(path: Path, needed: int, kept: int) -> None:
+    """DiskFull unless the filesystem of `path` has `needed` bytes and the margin free."""
+    free = free_bytes(path)
+    if free < needed + SPACE_MARGIN_BYTES:
+        raise DiskFull(errno.ENOSPC, disk_full_message(path, kept, free, needed + SPACE_MARGIN_BYTES))
+
+
+def disk_full_message(path: Path, kept: int, free: int | None = None, needed: int | None = None) -> str:
+    detail = f" ({free / 2**20:.1f} MiB free, {needed / 2**20:.1f} MiB needed for the next batch)" \
+        if free is not None else ""
+    return (f"no space left on {path}'s filesystem{detail}; {kept} runs kept; "
+            "free space and rerun to resume")
+
+
+def is_disk_full(exc: BaseException) -> bool:
+    text = str(exc)
+    return getattr(exc, "errno", None) == errno.ENOSPC or "No space left" in text or "errno = 28" in text
+
+
 def run_campaign(campaign: Campaign, out: Path | None = None, workers: int | None = None,
                  executor: str | None = None, scheduler: str | None = None, force: bool = False,
                  progress: bool = False) -> RunSummary:
     """Run every pending sample of the campaign into its results file; returns a summary.
-    `progress` shows a progress bar (a terminal) or log lines (otherwise) on stderr."""
+    `progress` shows a progress bar (a terminal) or log lines (otherwise) on stderr.
+
+    Raises LockHeld (another run writes the file), FileExistsError (a file that is not this
+    campaign's), DiskFull (stopped cleanly, resumable), WorkerError (no simulator could be built)."""
     execution = campaign.execution
     workers = workers or execution["workers"]
     executor = executor or execution["executor"]
@@ -108,62 +190,341 @@ def run_campaign(campaign: Campaign, out: Path | None = None, workers: int | Non
     out = Path(out or campaign.storage["path"])
     design = campaign.design()
     started = time.perf_counter()
-    store = prepare_store(campaign, design, out, force)
+    spec = worker_spec(campaign)
+    out.parent.mkdir(parents=True, exist_ok=True)
+    lock = ResultsLock(out)
     try:
-        total = len(design.xi)
-        pending = store.pending()
-        chunks = pending_chunks(pending, chunk, total)
-        kappa = store.kappa
-        spec = worker_spec(campaign)
-        n_times, outputs = store.time.size, store.output_names
-        summary = RunSummary(out, total, 0, total - pending.size, 0.0)
-        bar = Progress(pending.size, quiet=not progress)
-        # A chunk with some samples already stored (impossible with this writer, but a file
-        # written elsewhere may have one) is rerun whole; only its pending rows are written.
-        tasks = [(spec, c, kappa[c], n_times, outputs) for c in chunks]
-        # One BLAS thread here: the workers keep every core busy, and a multi-threaded BLAS
-        # competing with them makes the tSVD updates of this process 10-100x slower.
+        lock.acquire()
+    except OSError as exc:
+        if is_disk_full(exc) and not isinstance(exc, FileExistsError):
+            raise DiskFull(errno.ENOSPC, disk_full_message(out, _stored_runs(out) if out.is_file() else 0)) from exc
+        raise
+    pool = None
+    try:
+        pool = WorkerPool(spec, workers if executor == "local" else 1,
+                          execution.get("timeout_s") or PROBE_TIMEOUT_S)
+        time_grid, outputs, units, seconds = pool.probe(nominal_kappa(campaign))
+        timeout = execution.get("timeout_s") or default_timeout(seconds)
+        pool.timeout = timeout
+        # One BLAS thread here, for the folds on opening too: the workers keep every core busy, a
+        # multi-threaded BLAS competing with them is 10-100x slower, and the tSVD factors must not
+        # depend on where a resume starts (the same limit for every fold makes them bit-identical).
         with threadpool_limits(limits=1):
-            for indices, status, reasons, values in _execute(tasks, workers, executor, scheduler):
-                keep = store.status[indices] == Status.PENDING
-                store.write_batch(indices[keep], status[keep], np.asarray(reasons, dtype=object)[keep],
-                                  {k: v[keep] for k, v in values.items()})
-                summary.ran += int(keep.sum())
-                summary.failures.update(r for r, s in zip(np.asarray(reasons)[keep], status[keep]) if s != 0)
-                bar.advance(int(keep.sum()))
-        bar.close()
-        complete = store.pending().size == 0
+            try:
+                store = prepare_store(campaign, design, out, force, probed=(time_grid, outputs, units))
+            except (OSError, RuntimeError) as exc:
+                if is_disk_full(exc) and not isinstance(exc, FileExistsError):
+                    raise DiskFull(errno.ENOSPC, disk_full_message(out, 0)) from exc
+                raise
+            try:
+                summary = _run_pending(store, campaign, pool, spec, chunk, workers, executor, scheduler,
+                                       timeout, out, progress)
+                complete = store.pending().size == 0
+            finally:
+                try:
+                    store.close()
+                except (OSError, RuntimeError) as exc:  # HDF5 reports a late write failure oddly
+                    if is_disk_full(exc) or free_bytes(out) < 2 * SPACE_MARGIN_BYTES:
+                        raise DiskFull(errno.ENOSPC, disk_full_message(out, _stored_runs(out))) from exc
+                    raise
+        pool.close()
+        verify_written(out, summary)
+        if complete and campaign.storage.get("tsvd"):
+            if free_bytes(out) > 2 * out.stat().st_size + SPACE_MARGIN_BYTES:
+                compact(out)
     finally:
-        store.close()
-    if complete and campaign.storage.get("tsvd"):
-        compact(out)
+        if pool is not None:
+            pool.close()
+        lock.release()
     summary.seconds = time.perf_counter() - started
+    summary.timeout_s = timeout
     return summary
 
 
-def _execute(tasks, workers: int, executor: str, scheduler: str | None):
-    """Yield chunk results as they finish, keeping about two chunks per worker in flight."""
+def _run_pending(store, campaign, pool, spec, chunk, workers, executor, scheduler, timeout, out, progress):
+    total = store.status.size
+    pending = store.pending()
+    chunks = pending_chunks(pending, chunk, total)
+    kappa = store.kappa
+    n_times, outputs = store.time.size, store.output_names
+    summary = RunSummary(out, total, 0, total - pending.size, 0.0)
+    bar = Progress(pending.size, quiet=not progress)
+    # A chunk with some samples already stored (impossible with this writer, but a file
+    # written elsewhere may have one) is rerun whole; only its pending rows are written.
+    tasks = [Task(c, kappa[c]) for c in chunks]
+    if executor == "dask":
+        results = _execute_dask(tasks, spec, n_times, outputs, workers, scheduler, timeout)
+    else:
+        results = pool.run(tasks, n_times, outputs)
+    for indices, status, reasons, values in results:
+        keep = store.status[indices] == Status.PENDING
+        ensure_space(out, store.batch_bytes(int(keep.sum())), total - store.pending().size)
+        try:
+            store.write_batch(indices[keep], status[keep], np.asarray(reasons, dtype=object)[keep],
+                              {k: v[keep] for k, v in values.items()})
+        except (OSError, RuntimeError) as exc:
+            if is_disk_full(exc):
+                raise DiskFull(errno.ENOSPC, disk_full_message(out, total - store.pending().size)) from exc
+            raise
+        summary.ran += int(keep.sum())
+        summary.failures.update(r for r, s in zip(np.asarray(reasons)[keep], status[keep]) if s != 0)
+        bar.advance(int(keep.sum()))
+    bar.close()
+    return summary
+
+
+def _stored_runs(path: Path) -> str:
+    """How many runs a file holds, for a message (as many as a resume will find)."""
+    try:
+        with ResultStore.open(path) as store:
+            return str(int(np.count_nonzero(store.status != Status.PENDING)))
+    except Exception:
+        return "the stored"
+
+
+def verify_written(path: Path, summary: RunSummary) -> None:
+    """Reread the file: every run counted as done must be stored (its status written, ok rows
+    finite). A file that disagrees is an error, never a silent success."""
+    with ResultStore.open(path) as store:
+        problems = store.verify()
+        done = int(np.count_nonzero(store.status != Status.PENDING))
+    if done < summary.ran + summary.skipped:
+        problems.append(f"{summary.ran + summary.skipped} runs were counted as done but {done} are stored")
+    if problems:
+        message = (f"{path}: the file does not hold what was written: " + "; ".join(problems[:5])
+                   + "; rerun to resume: the missing runs are run again")
+        if free_bytes(path) < 2 * SPACE_MARGIN_BYTES:
+            raise DiskFull(errno.ENOSPC, disk_full_message(path, done - summary.ran) + f" ({message})")
+        raise IncompleteFile(message)
+
+
+# -- supervised worker processes ------------------------------------------------------------------
+@dataclass
+class Task:
+    """One chunk, and the rows that killed or hung a worker (row -> (status, reason))."""
+
+    indices: np.ndarray
+    kappa: np.ndarray
+    failed: dict = field(default_factory=dict)
+    attempts: int = 0  # deaths before the first sample (building the simulator)
+
+    @property
+    def settled(self) -> bool:
+        return len(self.failed) == len(self.indices)
+
+    def result(self, flown, n_times: int, outputs: list[str]):
+        """(indices, status, reasons, values) with the failed rows put in."""
+        n = len(self.indices)
+        if flown is None:
+            status, reasons = np.zeros(n, np.int8), [""] * n
+            values = {name: np.full((n, n_times), np.nan) for name in outputs}
+        else:
+            _, status, reasons, values = flown
+            status, reasons = np.array(status, np.int8), list(reasons)
+        for row, (code, reason) in self.failed.items():
+            status[row], reasons[row] = code, reason
+            for name in values:
+                values[name][row] = np.nan
+        return self.indices, status, reasons, values
+
+
+def death_reason(returncode: int | None) -> str:
+    if returncode is None:
+        return "worker process died: no exit status"
+    if returncode < 0:
+        try:
+            name = signal.Signals(-returncode).name
+        except ValueError:
+            name = "unknown"
+        hint = " (out of memory, or killed)" if -returncode == signal.SIGKILL else ""
+        return f"worker process died: signal {-returncode} ({name}){hint}"
+    return f"worker process died: exit code {returncode}"
+
+
+class WorkerProcess:
+    """One `python -m uqflight.worker` child and its socket."""
+
+    def __init__(self):
+        parent, child = socket.socketpair()
+        try:
+            self.proc = subprocess.Popen(
+                [sys.executable, "-m", "uqflight.worker", str(child.fileno()), str(os.getpid())],
+                pass_fds=[child.fileno()], stdin=subprocess.DEVNULL)
+        finally:
+            child.close()
+        self.conn = Connection(parent.detach())
+        self.task: Task | None = None
+        self.row: int | None = None
+        self.since = time.monotonic()
+
+    def send(self, message) -> bool:
+        try:
+            self.conn.send(message)
+            return True
+        except OSError:
+            return False
+
+    def kill(self) -> int | None:
+        """Kill the child (if alive) and return its exit status."""
+        if self.proc.poll() is None:
+            try:
+                self.proc.kill()
+            except ProcessLookupError:
+                pass
+        try:
+            code = self.proc.wait(timeout=10)
+        except subprocess.TimeoutExpired:
+            code = None
+        self.conn.close()
+        return code
+
+    def died(self) -> int | None:
+        """The exit status of a child whose socket closed."""
+        try:
+            code = self.proc.wait(timeout=5)
+        except subprocess.TimeoutExpired:
+            code = None
+        self.kill()
+        return code
+
+
+class WorkerPool:
+    """`workers` supervised worker processes flying chunks; see the module docstring."""
+
+    def __init__(self, spec: WorkerSpec, workers: int, timeout: float):
+        self.spec, self.workers, self.timeout = spec, max(1, int(workers)), float(timeout)
+        self.slots: list[WorkerProcess] = []
+
+    def probe(self, kappa: np.ndarray):
+        """(time, outputs, units, seconds of a nominal flight), from a worker."""
+        slot = self._slot()
+        if not slot.send(("probe", self.spec, kappa)):
+            raise WorkerError(death_reason(self._drop(slot)))
+        if not wait_connections([slot.conn], timeout=self.timeout):
+            self._drop(slot, dead=False)
+            raise WorkerError(f"the nominal flight did not finish within {self.timeout:g} s")
+        try:
+            kind, payload = slot.conn.recv()
+        except (EOFError, OSError):
+            raise WorkerError(death_reason(self._drop(slot)) + " during the nominal flight") from None
+        if kind != "probe":
+            raise WorkerError(str(payload))
+        return payload
+
+    def run(self, tasks, n_times: int, outputs: list[str]):
+        """Yield (indices, status, reasons, values) per chunk as they finish; every chunk is
+        yielded once, whatever its samples do to the workers."""
+        queue = deque(tasks)
+        busy: list[WorkerProcess] = []
+        while queue or busy:
+            while queue and len(busy) < self.workers:
+                task = queue.popleft()
+                if task.settled:
+                    yield task.result(None, n_times, outputs)
+                    continue
+                slot = self._idle_slot(busy)
+                slot.task, slot.row, slot.since = task, None, time.monotonic()
+                skip = tuple(task.failed)
+                if not slot.send(("chunk", self.spec, task.indices, task.kappa, n_times, outputs, skip)):
+                    self._lost(slot, busy, queue, death_reason(self._drop(slot)), Status.WORKER_DIED)
+                    continue
+                busy.append(slot)
+            if not busy:
+                continue
+            deadline = min(slot.since + self._limit(slot) for slot in busy)
+            ready = wait_connections([slot.conn for slot in busy], timeout=max(0.0, deadline - time.monotonic()))
+            for conn in ready:
+                slot = next(s for s in busy if s.conn is conn)
+                while True:  # every message already there, so that a backlog never looks like a hang
+                    try:
+                        kind, payload = conn.recv()
+                    except (EOFError, OSError):
+                        self._lost(slot, busy, queue, death_reason(self._drop(slot)), Status.WORKER_DIED)
+                        break
+                    if kind == "start":
+                        slot.row, slot.since = payload, time.monotonic()
+                    elif kind == "done":
+                        task = slot.task
+                        slot.task = None
+                        busy.remove(slot)
+                        yield task.result(payload, n_times, outputs)
+                        break
+                    else:
+                        raise WorkerError(str(payload))
+                    try:
+                        if not conn.poll():
+                            break
+                    except (EOFError, OSError):
+                        continue  # closed: the next recv reports the death
+            now = time.monotonic()
+            for slot in [s for s in busy if now - s.since > self._limit(s)]:
+                self._drop(slot, dead=False)
+                self._lost(slot, busy, queue, f"timed out: still running after {self.timeout:g} s "
+                           "(execution.timeout_s); its worker was replaced", Status.TIMEOUT)
+
+    def _limit(self, slot: WorkerProcess) -> float:
+        """The time `slot` may take from `since`: the per-run limit once a sample has started; before
+        the chunk's first sample (a fresh worker starting, the simulator being built) at least
+        STARTUP_GRACE_S, so that a loaded machine does not turn a slow start into timeouts."""
+        return self.timeout if slot.row is not None else max(self.timeout, STARTUP_GRACE_S)
+
+    def _lost(self, slot, busy, queue, reason: str, status: Status) -> None:
+        """The slot's worker is gone: blame the sample it was flying, fly its chunk again."""
+        task, row = slot.task, slot.row
+        if slot in busy:
+            busy.remove(slot)
+        if row is not None:
+            task.failed[row] = (int(status), reason)
+        else:
+            task.attempts += 1
+            if task.attempts >= 2:  # twice before its first sample: no sample of it can be flown
+                for r in range(len(task.indices)):
+                    task.failed.setdefault(r, (int(status), reason + " (before the chunk's first sample)"))
+        queue.appendleft(task)
+
+    def _slot(self) -> WorkerProcess:
+        if not self.slots:
+            self.slots.append(WorkerProcess())
+        return self.slots[0]
+
+    def _idle_slot(self, busy) -> WorkerProcess:
+        for slot in self.slots:
+            if slot not in busy:
+                return slot
+        slot = WorkerProcess()
+        self.slots.append(slot)
+        return slot
+
+    def _drop(self, slot: WorkerProcess, dead: bool = True) -> int | None:
+        """Forget a worker: `dead` (its socket closed) waits for its own exit status, else kill it."""
+        code = slot.died() if dead else slot.kill()
+        if slot in self.slots:
+            self.slots.remove(slot)
+        return code
+
+    def close(self) -> None:
+        for slot in self.slots:
+            slot.kill()
+        self.slots = []
+
+
+_DASK_POOLS: dict[str, WorkerPool] = {}
+
+
+def supervised_chunk(spec: WorkerSpec, indices, kappa, n_times: int, outputs: list[str], timeout: float):
+    """A Dask task: fly one chunk in a supervised child of this Dask worker (kept between tasks),
+    so that a sample that kills or hangs the child is recorded like on the local executor."""
+    pool = _DASK_POOLS.get(spec.key)
+    if pool is None:
+        pool = _DASK_POOLS[spec.key] = WorkerPool(spec, 1, timeout)
+    pool.timeout = timeout
+    return next(iter(pool.run([Task(np.asarray(indices), np.asarray(kappa))], n_times, outputs)))
+
+
+def _execute_dask(tasks, spec, n_times, outputs, workers: int, scheduler: str | None, timeout: float):
+    """Yield chunk results as they finish, keeping about four chunks per worker in flight."""
     if not tasks:
         return
-    if executor == "dask":
-        yield from _execute_dask(tasks, workers, scheduler)
-        return
-    if workers == 1:
-        for task in tasks:
-            yield run_chunk(*task)
-        return
-    with ProcessPoolExecutor(max_workers=workers, mp_context=get_context("spawn")) as pool:
-        queue = list(reversed(tasks))
-        running = set()
-        while queue or running:
-            while queue and len(running) < 2 * workers:
-                running.add(pool.submit(run_chunk, *queue.pop()))
-            done, running = wait(running, return_when=FIRST_COMPLETED)
-            for future in done:
-                yield future.result()
-
-
-def _execute_dask(tasks, workers: int, scheduler: str | None):
     from dask.distributed import Client, LocalCluster, as_completed
 
     cluster = None
@@ -175,14 +536,18 @@ def _execute_dask(tasks, workers: int, scheduler: str | None):
         client = Client(cluster)
     try:
         queue = list(reversed(tasks))
+
+        def submit(task):
+            return client.submit(supervised_chunk, spec, task.indices, task.kappa, n_times, outputs, timeout,
+                                 pure=False)
+
         # a deeper queue than the local pool's: it hides the scheduler round trip of a remote cluster
         in_flight = 4 * max(workers, len(client.scheduler_info().get("workers", {})) or 1)
-        futures = as_completed([client.submit(run_chunk, *queue.pop(), pure=False)
-                                for _ in range(min(in_flight, len(queue)))])
+        futures = as_completed([submit(queue.pop()) for _ in range(min(in_flight, len(queue)))])
         for future in futures:
             yield future.result()
             if queue:
-                futures.add(client.submit(run_chunk, *queue.pop(), pure=False))
+                futures.add(submit(queue.pop()))
     finally:
         client.close()
         if cluster is not None:

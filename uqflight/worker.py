@@ -2,10 +2,22 @@
 
 Kept apart from the runner so that a worker imports only NumPy and the simulator (the
 campaign, designs and HDF5 modules stay in the runner process): workers start faster.
+
+A worker is a separate Python process (`python -m uqflight.worker FD PPID`) that talks to its
+runner over a socket (pickled messages, `multiprocessing.connection.Connection`): it receives
+chunks, announces each sample before flying it ("start", row) so that the runner knows which
+sample a dead or hung worker was flying, and returns the chunk's results. It never outlives its
+runner: the kernel kills it when the runner dies (PR_SET_PDEATHSIG), and a watchdog thread exits
+when its parent process changes or the socket closes. It ignores SIGINT: the runner decides.
 """
 from __future__ import annotations
 
 import json
+import os
+import signal
+import sys
+import threading
+import time
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -45,15 +57,25 @@ def worker_simulator(spec: WorkerSpec):
     return simulator
 
 
-def run_chunk(spec: WorkerSpec, indices: np.ndarray, kappa: np.ndarray, n_times: int, outputs: list[str]):
-    """Fly the samples of one chunk; failures are recorded, never raised."""
+def run_chunk(spec: WorkerSpec, indices: np.ndarray, kappa: np.ndarray, n_times: int, outputs: list[str],
+              skip=(), on_start=None):
+    """Fly the samples of one chunk; failures are recorded, never raised.
+
+    `skip`: rows (positions in the chunk) not to fly (they killed or hung a worker before; the
+    runner records them); they are left NaN with status ok, for the runner to overwrite.
+    `on_start(row)` is called before each sample is flown."""
     simulator = worker_simulator(spec)
     simulator.restart()
     n = len(indices)
     status = np.zeros(n, dtype=np.int8)
     reasons = [""] * n
     values = {name: np.full((n, n_times), np.nan) for name in outputs}
+    skip = set(skip)
     for row, k in enumerate(kappa):
+        if row in skip:
+            continue
+        if on_start is not None:
+            on_start(row)
         try:
             result = simulator.evaluate(k)
             for name in outputs:
@@ -67,3 +89,73 @@ def run_chunk(spec: WorkerSpec, indices: np.ndarray, kappa: np.ndarray, n_times:
         except Exception as exc:  # a simulator bug must not stop the campaign: record it
             status[row], reasons[row] = FlightError.status, f"{type(exc).__name__}: {exc}"
     return indices, status, reasons, values
+
+
+def probe(spec: WorkerSpec, kappa: np.ndarray):
+    """(time, output names, units, seconds of one flight at `kappa`): what the runner needs to create
+    the results file and derive the default per-run time limit, measured here, not in the runner."""
+    simulator = spec.build()
+    time_grid, outputs = simulator.probe(kappa)
+    started = time.perf_counter()
+    try:
+        simulator.evaluate(kappa)
+    except Exception:  # a failed nominal flight still measures the cost of a flight
+        pass
+    seconds = time.perf_counter() - started
+    return np.asarray(time_grid, dtype=float), list(outputs), dict(getattr(simulator, "units", {}) or {}), seconds
+
+
+def _die_with_parent(parent: int) -> None:
+    """Ask the kernel to SIGKILL this process when its parent dies, and watch for it anyway."""
+    if sys.platform.startswith("linux"):
+        try:
+            import ctypes
+
+            libc = ctypes.CDLL(None, use_errno=True)
+            libc.prctl(1, signal.SIGKILL, 0, 0, 0)  # PR_SET_PDEATHSIG
+        except (OSError, AttributeError):
+            pass
+
+    def watch():
+        while True:
+            if os.getppid() != parent:
+                os._exit(70)
+            time.sleep(0.5)
+
+    if os.getppid() != parent:  # the parent died before the prctl
+        os._exit(70)
+    threading.Thread(target=watch, daemon=True, name="uqflight-parent-watchdog").start()
+
+
+def main(argv=None) -> None:
+    """Serve the runner on the socket `fd` until it closes."""
+    from multiprocessing.connection import Connection
+
+    argv = sys.argv[1:] if argv is None else argv
+    fd, parent = int(argv[0]), int(argv[1])
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    signal.signal(signal.SIGTERM, signal.SIG_DFL)
+    _die_with_parent(parent)
+    conn = Connection(fd)
+    while True:
+        try:
+            message = conn.recv()
+        except (EOFError, OSError):
+            os._exit(0)
+        kind, args = message[0], message[1:]
+        try:
+            if kind == "chunk":
+                result = run_chunk(*args, on_start=lambda row: conn.send(("start", row)))
+                conn.send(("done", result))
+            elif kind == "probe":
+                conn.send(("probe", probe(*args)))
+            else:
+                conn.send(("error", f"unknown request {kind!r}"))
+        except (BrokenPipeError, ConnectionResetError):
+            os._exit(0)
+        except Exception as exc:  # building the simulator failed: the runner reports it
+            conn.send(("error", f"{type(exc).__name__}: {exc}"))
+
+
+if __name__ == "__main__":
+    main()

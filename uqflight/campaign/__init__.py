@@ -54,7 +54,12 @@ def load_campaign(path: str | Path, probe: PropertyProbe | None = None) -> Campa
     """
     source = str(path)
     try:
-        text = Path(path).read_text(encoding="utf-8")
+        with open(path, "rb") as fh:
+            raw = fh.read(schema.MAX_FILE_BYTES + 1)
+        if len(raw) > schema.MAX_FILE_BYTES:
+            raise CampaignError(source, "", f"the file is larger than {schema.MAX_FILE_BYTES // 1024} KiB; "
+                                            "a campaign file is a few lines of YAML")
+        text = raw.decode("utf-8")
     except OSError as exc:
         raise CampaignError(source, "", f"cannot read the file ({exc.strerror})") from exc
     except UnicodeDecodeError as exc:
@@ -66,12 +71,15 @@ def load_campaign(path: str | Path, probe: PropertyProbe | None = None) -> Campa
 def parse_campaign(text: str, source: str = "<campaign>", probe: PropertyProbe | None = None) -> Campaign:
     """Validate campaign text; see `load_campaign`."""
     check = Checker(source)
+    if len(text) > schema.MAX_FILE_BYTES:
+        check.fail("", f"the text is longer than {schema.MAX_FILE_BYTES // 1024} KiB; a campaign is a few "
+                       "lines of YAML")
     try:
         data = yaml.load(text, Loader=CampaignLoader)
     except yaml.YAMLError as exc:
         raise CampaignError(source, "", yaml_error(exc)) from exc
     data = check.mapping(data, "", TOP_KEYS, required=("name", "simulator", "parameters", "design"))
-    name = check.string(data["name"], "name")
+    name = schema.campaign_name(check, data["name"])
     seed = check.integer(data.get("seed", 0), "seed", 0)
     simulator = schema.simulator(check, data["simulator"], source)
     aircraft = None
@@ -91,6 +99,9 @@ def parse_campaign(text: str, source: str = "<campaign>", probe: PropertyProbe |
     execution = schema.execution(check, data.get("execution", {}))
     storage = schema.storage(check, data.get("storage", {}), name)
     analysis = schema.analysis(check, data.get("analysis", {}))
+    limits = schema.limits(check, data.get("limits", {}))
+    if isinstance(data["design"], dict):  # sizes from the campaign alone, before building anything
+        schema.check_size(check, data, simulator, parameters, method, execution, storage, limits)
     campaign = Campaign(source, text, name, seed, simulator, parameters, data["design"], method,
                         execution, storage, analysis)
     try:

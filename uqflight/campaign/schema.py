@@ -8,12 +8,13 @@ import re
 from collections.abc import Hashable
 from pathlib import Path
 
+import numpy as np
 import yaml
 
 from ..designs import Design, is_sampled
 from ..methods import METHOD_KINDS, method_entry
 from ..methods.exactness import exact_total_degree, max_projection_order
-from ..methods.validity import method_problem
+from ..methods.validity import MAX_TERMS, method_problem
 from ..parameters import DISTRIBUTIONS, Parameter, make_parameter
 from ..simulators.jsbsim import Excitation
 from ..simulators.python import PluginError, load_function
@@ -21,17 +22,23 @@ from ..simulators.python import PluginError, load_function
 SIMULATOR_KINDS = ("jsbsim", "python")
 EXECUTORS = ("local", "dask")
 TOP_KEYS = ("name", "description", "seed", "simulator", "parameters", "design", "method",
-            "execution", "storage", "analysis")
+            "execution", "storage", "analysis", "limits")
 JSBSIM_KEYS = ("kind", "aircraft", "flight", "excitation", "duration_s", "output_rate_hz", "outputs")
 PYTHON_KEYS = ("kind", "function", "outputs")
 PARAMETER_KEYS = ("property", "function", "perturbation", "distribution", "nominal", "interval_pct", "lower", "upper")
 PERTURBATIONS = ("scale", "offset")
 METHOD_KEYS = ("kind", "order", "split", "allow_aliasing")
-EXECUTION_KEYS = ("workers", "executor", "scheduler", "chunk")
+EXECUTION_KEYS = ("workers", "executor", "scheduler", "chunk", "timeout_s")
 STORAGE_KEYS = ("path", "raw", "tsvd")
 TSVD_KEYS = ("tol", "batch")
 DEFAULT_ORDER = 2
 ANALYSIS_KEYS = ("band_samples", "bootstrap")
+# Refused before anything is built (see `check_size`); a campaign raises them under `limits:`.
+DEFAULT_LIMITS = {"max_runs": 1_000_000, "max_memory_gb": 8.0, "max_disk_gb": 100.0, "max_pce_terms": MAX_TERMS}
+LIMIT_KEYS = tuple(DEFAULT_LIMITS)
+MAX_FILE_BYTES = 1 << 20  # a campaign file is at most 1 MiB
+MAX_LEVEL = 1000          # sparse grid levels beyond this are refused before any estimate
+NAME_PATTERN = re.compile(r"[A-Za-z0-9_][A-Za-z0-9_.-]{0,99}")
 
 
 class CampaignError(ValueError):
@@ -39,6 +46,10 @@ class CampaignError(ValueError):
 
     def __init__(self, source: str, field_path: str, message: str):
         self.source, self.field = source, field_path
+        if len(field_path) > 200:
+            field_path = field_path[:197] + "..."
+        if len(message) > 2000:  # never quote a huge value back
+            message = message[:1997] + "..."
         where = f"{source}: {field_path}: " if field_path else f"{source}: "
         super().__init__(where + message)
 
@@ -71,7 +82,8 @@ class Checker:
             if key not in allowed:
                 close = difflib.get_close_matches(str(key), allowed, n=1)
                 hint = f"did you mean {close[0]}? " if close else ""
-                self.fail(f"{path}.{key}" if path else str(key),
+                key = str(key) if len(str(key)) <= 60 else str(key)[:57] + "..."
+                self.fail(f"{path}.{key}" if path else key,
                           f"unknown key; {hint}expected one of {', '.join(allowed)}")
         for key in required:
             if key not in value:
@@ -104,7 +116,16 @@ class Checker:
 
 class CampaignLoader(yaml.SafeLoader):
     """YAML's safe loader, except that a key given twice in one mapping is an error (plain YAML
-    keeps the last one silently, so a parameter pasted twice would vanish)."""
+    keeps the last one silently, so a parameter pasted twice would vanish), and that aliases
+    (`*name`) are refused: nested aliases expand exponentially (a "billion laughs" bomb)."""
+
+    def compose_node(self, parent, index):
+        if self.check_event(yaml.events.AliasEvent):
+            event = self.peek_event()
+            raise yaml.composer.ComposerError(
+                None, None, "YAML aliases (*name) are not accepted in campaign files; write the value out",
+                event.start_mark)
+        return super().compose_node(parent, index)
 
     def construct_mapping(self, node, deep=False):
         seen = set()
@@ -326,6 +347,8 @@ def execution(check: Checker, value) -> dict:
     execution["chunk"] = check.integer(execution.get("chunk", 16), "execution.chunk", 1)
     if execution.get("scheduler") is not None:
         check.string(execution["scheduler"], "execution.scheduler")
+    if execution.get("timeout_s") is not None:  # default: derived from a measured nominal flight
+        execution["timeout_s"] = check.number(execution["timeout_s"], "execution.timeout_s", 0.0, strict=True)
     return execution
 
 
@@ -351,3 +374,115 @@ def analysis(check: Checker, value) -> dict:
     analysis["band_samples"] = check.integer(analysis.get("band_samples", 20000), "analysis.band_samples", 100)
     analysis["bootstrap"] = check.integer(analysis.get("bootstrap", 200), "analysis.bootstrap", 0)
     return analysis
+
+
+def campaign_name(check: Checker, value) -> str:
+    """A name that is safe in a path (the default results file is results/NAME.h5)."""
+    name = check.string(value, "name")
+    if not NAME_PATTERN.fullmatch(name):
+        check.fail("name", f"expected 1-100 characters among A-Z a-z 0-9 _ . - (not starting with . or -), "
+                           f"got {shown(name)}")
+    return name
+
+
+def limits(check: Checker, value) -> dict:
+    """The campaign's size limits (`limits:`), defaults in DEFAULT_LIMITS."""
+    given = dict(check.mapping(value, "limits", LIMIT_KEYS))
+    found = dict(DEFAULT_LIMITS)
+    for key, default in DEFAULT_LIMITS.items():
+        if key in given:
+            if isinstance(default, int):
+                found[key] = check.integer(given[key], f"limits.{key}", 1)
+            else:
+                found[key] = check.number(given[key], f"limits.{key}", 0.0, strict=True)
+    return found
+
+
+def _points_bound(check: Checker, design: dict, germs: list[str]) -> float | None:
+    """The number of points the design builds (for a sparse grid: before merging the tensor rules'
+    shared points, an upper bound on the runs and the size of the arrays built), computed without
+    building anything; None when the design's own checks should speak first."""
+    from ..designs import rules as rule_catalog
+
+    kind, d = design.get("kind"), len(germs)
+
+    def count(key):
+        value = design.get(key)
+        return value if isinstance(value, int) and not isinstance(value, bool) and value >= 1 else None
+
+    if kind in ("monte_carlo", "sobol", "halton", "latin_hypercube"):
+        return count("samples")
+    if kind == "pick_freeze":
+        n = count("samples")
+        return None if n is None else float(n) * (d + 2)
+    if kind == "tensor_grid":
+        n = count("points")
+        return None if n is None else float(n) ** d
+    if kind == "sparse_grid":
+        level = design.get("level")
+        if not isinstance(level, int) or isinstance(level, bool) or level < 0:
+            return None
+        if level > MAX_LEVEL:
+            check.fail("design.level", f"expected at most {MAX_LEVEL}, got {level}")
+        try:
+            rules = rule_catalog.rules_by_dimension(design.get("rule"), germs, design.get("nested"))
+            growth = design.get("growth") or "linear"
+            sizes = {}
+            for rule in dict.fromkeys(rules):
+                top = rule_catalog.max_level(rule, growth)
+                if top is not None and level + 1 > top:
+                    return None
+                sizes[rule] = np.array(rule_catalog.level_sizes(rule, growth, level + 1), dtype=float)
+        except (ValueError, KeyError, TypeError):
+            return None
+        # polynomial product over dimensions: coefficient s = sum over |j| = s of prod sizes[j_k]
+        total = np.array([1.0])
+        for rule in rules:
+            total = np.convolve(total, sizes[rule])[: level + 1]
+        return float(total[max(0, level - d + 1): level + 1].sum())
+    return None
+
+
+def check_size(check: Checker, data: dict, simulator: dict, parameters: list, method: dict, execution: dict,
+               storage: dict, limits: dict) -> dict:
+    """The design's size, its memory and disk estimate and the PCE size, from the campaign alone
+    (nothing built): refused beyond `limits` (CampaignError naming the figure and the limit).
+    Returns the figures {"runs", "memory_gb", "disk_gb", "pce_terms"}."""
+    d = len(parameters)
+    points = _points_bound(check, data["design"], [p.germ for p in parameters])
+    figures = {"runs": points}
+    if points is not None and points > limits["max_runs"]:
+        check.fail("design", f"{points:.4g} runs (points built), more than limits.max_runs = {limits['max_runs']}; "
+                             "choose a smaller design or raise limits.max_runs")
+    order = method.get("order", DEFAULT_ORDER)  # without it, at most DEFAULT_ORDER (check_method_fits_design)
+    terms = math.comb(d + order, order) if order <= 10**6 else math.inf
+    figures["pce_terms"] = terms
+    if terms > limits["max_pce_terms"]:
+        check.fail("method.order", f"a PCE of order {order} in {d} dimensions has {float(terms):.4g} "
+                                   f"terms, more than limits.max_pce_terms = {limits['max_pce_terms']}")
+    if simulator["kind"] == "jsbsim":
+        times = math.floor(float(simulator.get("duration_s", 50.0)) * float(simulator.get("output_rate_hz", 20.0))) + 1
+        n_outputs = len(simulator.get("outputs", ())) or 5
+    else:
+        times, n_outputs = 1, len(simulator.get("outputs", ())) or 1  # known only once a sample has run
+    n = points or 0
+    rank = min(times, n, 1000)
+    memory = 8.0 * (n * (3 * d + 6)                                    # the design, status, merging
+                    + execution["workers"] * execution["chunk"] * times * n_outputs * 3  # chunks in flight
+                    + n_outputs * times * execution["chunk"] * 4)      # results being written
+    tsvd = storage.get("tsvd")
+    if tsvd:
+        memory += 8.0 * 4 * times * (tsvd["batch"] + rank) + 8.0 * n * rank
+    disk = 8.0 * n * times * n_outputs if storage["raw"] else 0.0
+    if tsvd:
+        disk += 8.0 * n_outputs * (times + n) * rank * 2
+    figures["memory_gb"], figures["disk_gb"] = memory / 1e9, disk / 1e9
+    if memory / 1e9 > limits["max_memory_gb"]:
+        check.fail("design", f"the campaign needs about {memory / 1e9:.3g} GB of memory ({n:.4g} runs of "
+                             f"{times:.4g} times x {n_outputs} outputs), more than limits.max_memory_gb = "
+                             f"{limits['max_memory_gb']:g}")
+    if disk / 1e9 > limits["max_disk_gb"]:
+        check.fail("storage", f"the results file would take about {disk / 1e9:.3g} GB ({n:.4g} runs of "
+                              f"{times:.4g} times x {n_outputs} outputs), more than limits.max_disk_gb = "
+                              f"{limits['max_disk_gb']:g}")
+    return figures

@@ -19,7 +19,7 @@ import math
 from . import method_entry
 from .exactness import design_matrix_rank, exact_total_degree, max_projection_order
 
-MAX_TERMS = 200_000  # PCE terms beyond which a fit is refused before any basis is built
+MAX_TERMS = 100_000  # PCE terms beyond which a fit is refused before any basis is built (campaign: limits.max_pce_terms)
 
 
 def method_problem(kind: str, order: int, xi, weights, germs: list[str], sampled: bool,

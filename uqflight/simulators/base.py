@@ -19,6 +19,8 @@ class Status(enum.IntEnum):
     TRIM_FAILURE = 1
     DIVERGED = 2
     SIMULATOR_ERROR = 3
+    WORKER_DIED = 4  # the sample killed its worker process (exit, signal, out of memory)
+    TIMEOUT = 5  # the sample ran past execution.timeout_s; its worker was replaced
 
 
 class FlightError(RuntimeError):

@@ -2,6 +2,8 @@
 policy (`resume`)."""
 from ..simulators.base import Status
 from .resume import compact, open_for_campaign
-from .results import ResultStore, text_hash
+from .lock import LockHeld, ResultsLock
+from .results import CorruptFile, ResultStore, read_error, text_hash
 
-__all__ = ["ResultStore", "Status", "compact", "open_for_campaign", "text_hash"]
+__all__ = ["CorruptFile", "LockHeld", "ResultStore", "ResultsLock", "Status", "compact", "open_for_campaign",
+           "read_error", "text_hash"]

@@ -52,11 +52,12 @@ def buffer_rows(group: h5py.Group, status: np.ndarray) -> tuple[np.ndarray, np.n
 def write_state(group: h5py.Group, svd: IncrementalSVD, columns, rows, index) -> None:
     """Create the factor and buffer datasets of one output in `group`."""
     for key, data in (("U", svd.U), ("s", svd.s), ("V", svd.V), ("columns", columns)):
-        group.create_dataset(key, data=data)
+        group.create_dataset(key, data=data, chunks=True, fletcher32=True)
     n_times = rows.shape[1]
     chunk = chunk_rows(n_times, group.file["tsvd"].attrs["batch"])
-    group.create_dataset("buffer", data=rows, maxshape=(None, n_times), chunks=(chunk, n_times))
-    group.create_dataset("buffer_index", data=index.astype(np.int64), maxshape=(None,), chunks=(chunk,),
+    group.create_dataset("buffer", data=rows, maxshape=(None, n_times), chunks=(chunk, n_times),
+                         fletcher32=True)
+    group.create_dataset("buffer_index", data=index.astype(np.int64), maxshape=(None,), chunks=(chunk,), fletcher32=True,
                          fillvalue=-1)
 
 

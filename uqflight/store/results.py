@@ -11,24 +11,34 @@ Layout (fixed by DESIGN.md; N runs, d parameters, T recorded times):
     root attributes: campaign (YAML text), campaign_hash (its sha256), created, and the caller's
     (versions, aircraft_hash, ...)
 
-Crash safety: every batch writes its data first and the status last, then flushes, so a killed
-process loses at most the batch in flight and `pending()` tells exactly what to rerun. The factors
+Crash safety: every batch writes its data first, flushes and fsyncs, then writes the status,
+flushes and fsyncs again (one flush would let HDF5 write its cached chunks in its own order, and a
+kill or full disk could then leave a status without its data), so a killed process loses at most
+the batch in flight and `pending()` tells exactly what to rerun. The factors
 and the buffer of an output are replaced together: written into `/tsvd/<name>/next`, marked complete,
 flushed, then moved in place; reopening with mode "a" finishes or discards such a half-done step.
 
 Determinism: runs complete in any order, but the tSVD ingests the ok runs in design order, `batch`
 columns at a time, folding only the contiguous completed prefix (and the last partial batch once no
-run is pending), so the factors do not depend on the number of workers or on interruptions.
+run is pending), so the factors do not depend on the number of workers or on interruptions. Every
+fold runs with one BLAS thread (threadpoolctl), whoever calls it, so a resume gives the same bits.
+
+Integrity: every dataset is chunked with HDF5's fletcher32 checksum, so a flipped byte is reported
+on reading (`CorruptFile`) instead of read back as a valid value; status codes outside `Status`
+are refused on opening.
 """
 from __future__ import annotations
 
 import hashlib
 import json
+import os
 from collections.abc import Iterator
 from datetime import datetime, timezone
 
 import h5py
 import numpy as np
+
+from threadpoolctl import threadpool_limits
 
 from ..simulators.base import Status
 from ..tsvd import IncrementalSVD, iter_column_blocks
@@ -49,11 +59,27 @@ def text_hash(text: str) -> str:
     return hashlib.sha256(text.encode("utf-8")).hexdigest()
 
 
+CHECKED = {"chunks": True, "fletcher32": True}  # every fixed-size dataset: chunked and checksummed
+
+
+class CorruptFile(ValueError):
+    """A results file whose contents fail their checks (checksum, unknown status codes)."""
+
+
+def read_error(exc: BaseException) -> str:
+    """One line on an HDF5 read error; a failed checksum is called what it is."""
+    text = " ".join(str(exc).split())
+    if "filter" in text.lower() or "checksum" in text.lower():
+        return f"data corrupted: a checksum (fletcher32) does not match ({text})"
+    return text
+
+
 class ResultStore:
     """One campaign's results file. Build it with `create`, `open` or `open_for_campaign`."""
 
     def __init__(self, file: h5py.File):
         self._file = file
+        self.repaired = 0  # ok runs found without their data on opening to resume, made pending again
 
     @classmethod
     def create(cls, path, *, campaign_text: str, xi, kappa, weights, parameter_names, outputs, time,
@@ -85,19 +111,20 @@ class ResultStore:
                         "created": datetime.now(timezone.utc).isoformat(timespec="seconds")})
         f.attrs.update({k: json.dumps(v) if isinstance(v, dict) else v for k, v in (attrs or {}).items()})
         samples = f.create_group("samples")
-        samples.create_dataset("xi", data=xi).attrs["dimensions"] = ["sample", "parameter"]
-        samples.create_dataset("kappa", data=kappa).attrs.update(
+        samples.create_dataset("xi", data=xi, **CHECKED).attrs["dimensions"] = ["sample", "parameter"]
+        samples.create_dataset("kappa", data=kappa, **CHECKED).attrs.update(
             {"names": parameter_names, "dimensions": ["sample", "parameter"]})
-        samples.create_dataset("weight", data=weights)
-        samples.create_dataset("status", shape=(n,), dtype="i1", fillvalue=Status.PENDING).attrs["codes"] = \
-            json.dumps({s.name.lower(): s.value for s in Status})
+        samples.create_dataset("weight", data=weights, **CHECKED)
+        samples.create_dataset("status", shape=(n,), dtype="i1", fillvalue=Status.PENDING,
+                               **CHECKED).attrs["codes"] = json.dumps({s.name.lower(): s.value for s in Status})
+        # variable-length strings take no HDF5 filter: the reasons are the one unchecked dataset
         samples.create_dataset("reason", shape=(n,), dtype=h5py.string_dtype())
-        f.create_dataset("time", data=time).attrs["units"] = "s"
+        f.create_dataset("time", data=time, **CHECKED).attrs["units"] = "s"
         if raw:
             group = f.create_group("outputs", track_order=True)
             for name in outputs:
                 ds = group.create_dataset(_key(name), shape=(n, time.size), dtype="f8", fillvalue=np.nan,
-                                          chunks=(chunk_rows(time.size, n), time.size))
+                                          chunks=(chunk_rows(time.size, n), time.size), fletcher32=True)
                 ds.attrs.update({"units": units.get(name, ""), "dimensions": ["sample", "time"]})
         if tsvd is not None:
             group = f.create_group("tsvd", track_order=True)
@@ -121,8 +148,25 @@ class ResultStore:
             f.close()
             raise ValueError(f"{path} is not a uqflight results file (no /samples/status)")
         store = cls(f)
-        if mode == "a" and "tsvd" in f:
+        try:
             status = store.status
+        except OSError as exc:
+            f.close()
+            raise CorruptFile(f"{path}: {read_error(exc)}") from exc
+        unknown = np.setdiff1d(np.unique(status), [s.value for s in Status])
+        if unknown.size:
+            f.close()
+            raise CorruptFile(f"{path}: /samples/status holds unknown status codes {unknown.tolist()} "
+                              f"(known: {', '.join(f'{s.value} {s.name.lower()}' for s in Status)}); "
+                              "the file is damaged or was written by a newer uqflight")
+        if mode == "a":
+            try:
+                store.repaired = store._repair_lost_runs()
+            except OSError as exc:
+                f.close()
+                raise CorruptFile(f"{path}: {read_error(exc)}") from exc
+            status = store.status
+        if mode == "a" and "tsvd" in f:
             for name in f["tsvd"]:
                 apply_staged(f["tsvd"][_key(name)])
                 store._fold_ready(name, status)
@@ -227,13 +271,94 @@ class ResultStore:
                 self._file["outputs"][_key(name)][idx] = np.where(ok[:, None], rows, np.nan)
             if "tsvd" in self._file:
                 append_rows(self._file["tsvd"][_key(name)], rows[ok], idx[ok])
+        self._flush(sync=True)
         self._file["samples/reason"][idx] = reasons
         self._file["samples/status"][idx] = status
-        self._file.flush()
+        self._flush(sync=True)
         if "tsvd" in self._file:
             all_status = self.status
             for name in values:
                 self._fold_ready(name, all_status)
+
+    def _flush(self, sync: bool) -> None:
+        """HDF5's caches to the OS, then (sync) the OS's to the disk."""
+        self._file.flush()
+        if sync and self._file.filename:
+            fd = os.open(self._file.filename, os.O_RDONLY)
+            try:
+                os.fsync(fd)
+            finally:
+                os.close(fd)
+
+    def _repair_lost_runs(self, block: int = 1000) -> int:
+        """Mark pending again the ok runs whose raw histories did not reach the disk (a write that
+        failed late, e.g. a full disk hit by HDF5's cache at flush), so that a resume reruns them;
+        returns how many."""
+        status = self.status
+        lost = np.zeros(status.size, dtype=bool)
+        if self._raw:
+            for key in self._file["outputs"]:
+                data = self._file["outputs"][key]
+                for start in range(0, status.size, block):
+                    ok = status[start:start + block] == Status.OK
+                    if ok.any():
+                        lost[start:start + block] |= ok & ~np.isfinite(data[start:start + block]).all(axis=1)
+        elif "tsvd" in self._file:  # ok runs neither in the factors nor in the buffer (their order in the
+            for key in self._file["tsvd"]:  # factors then follows the rerun: equal data, other rounding)
+                group = self._file["tsvd"][key]
+                apply_staged(group)
+                _, index, _ = buffer_rows(group, status)
+                held = np.zeros(status.size, dtype=bool)
+                held[np.union1d(group["columns"][()], index).astype(np.int64)] = True
+                lost |= (status == Status.OK) & ~held
+        if lost.any():
+            index = np.flatnonzero(lost)
+            self._file["samples/status"][index] = Status.PENDING
+            self._file["samples/reason"][index] = [""] * index.size
+            self._flush(sync=True)
+        return int(lost.sum())
+
+    def batch_bytes(self, n: int) -> int:
+        """An upper estimate of the bytes the next batch of `n` runs may add to the file: its rows
+        (a new chunk per output at worst), and for tSVD a staged copy of the factors and buffer."""
+        n_times, total = self.time.size, self._file["samples/status"].shape[0]
+        estimate = 64 * 1024 + n * 1024
+        if self._raw:
+            for ds in self._file["outputs"].values():
+                rows = ds.chunks[0] if ds.chunks else n
+                estimate += 8 * n_times * (n + 2 * rows)
+        if "tsvd" in self._file:
+            for group in self._file["tsvd"].values():
+                size = sum(group[key].size * group[key].dtype.itemsize for key in ("U", "s", "V", "buffer"))
+                estimate += 2 * (size + 8 * n_times * (n + self._batch)) + 8 * total
+        return int(estimate)
+
+    def verify(self, block: int = 1000) -> list[str]:
+        """Problems of the stored runs (empty when sound): ok runs whose raw histories are not
+        finite, buffered tSVD runs missing. Reads every checksummed chunk once."""
+        problems, status = [], self.status
+        if self._raw:
+            for name in self.output_names:
+                data = self._file["outputs"][_key(name)]
+                for start in range(0, status.size, block):
+                    ok = status[start:start + block] == Status.OK
+                    rows = data[start:start + block]
+                    bad = start + np.flatnonzero(ok & ~np.isfinite(rows).all(axis=1))
+                    if bad.size:
+                        problems.append(f"output {name}: {bad.size} ok runs without data (e.g. run {bad[0]})")
+                        break
+        elif "tsvd" in self._file:
+            ok = np.flatnonzero(status == Status.OK)
+            for name in self.output_names:
+                group = self._file["tsvd"][_key(name)]
+                _, index, _ = buffer_rows(group, status)
+                for key in ("U", "s", "V", "buffer"):  # read once: their checksums are verified
+                    group[key][()]
+                held = np.union1d(group["columns"][()], index)
+                missing = np.setdiff1d(ok, held)
+                if missing.size:
+                    problems.append(f"output {name}: {missing.size} ok runs missing (e.g. run {missing[0]})")
+        return problems
 
     def _checked_batch(self, indices, status, reasons, outputs):
         """The batch sorted by index, after checking it against the file."""
@@ -279,7 +404,8 @@ class ResultStore:
             return
         rows = group["buffer"][()][positions]
         svd, columns = self._stored_factors(group)
-        ingest(svd, rows[:ready], self._batch)
+        with threadpool_limits(limits=1):
+            ingest(svd, rows[:ready], self._batch)
         commit(group, svd, np.concatenate([columns, index[:ready]]), rows[ready:], index[ready:])
 
     # -- reading ----------------------------------------------------------------------------
@@ -320,7 +446,8 @@ class ResultStore:
         group = self._file["tsvd"][_key(name)]
         positions, index, _ = buffer_rows(group, self.status)
         svd, columns = self._stored_factors(group)
-        ingest(svd, group["buffer"][()][positions], self._batch)
+        with threadpool_limits(limits=1):
+            ingest(svd, group["buffer"][()][positions], self._batch)
         return svd.U, svd.s, svd.V, np.concatenate([columns, index])
 
     def _stored_factors(self, group: h5py.Group) -> tuple[IncrementalSVD, np.ndarray]:

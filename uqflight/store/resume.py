@@ -13,19 +13,39 @@ def open_for_campaign(path, *, campaign_text: str, force: bool = False, **create
     """Resume `path` when it holds this campaign, else create it (see ResultStore.create).
 
     A file holding another campaign (a different campaign_hash), or made with other aircraft files
-    (attrs["aircraft_hash"]), is refused unless `force`, which deletes and recreates it.
+    (attrs["aircraft_hash"]), is refused unless `force`, which deletes and recreates it. `force`
+    never deletes what is not a uqflight results file (a directory, a text file, another HDF5 file):
+    those are refused, with how to remove them. (The caller holds the file's lock: `force` never
+    touches a file another run writes.)
     """
     path = Path(path)
     aircraft = (create_args.get("attrs") or {}).get("aircraft_hash")
-    if path.exists():
+    if path.is_dir():
+        raise FileExistsError(f"{path} is a directory, not a results file; choose a file path such as "
+                              f"{path / 'results.h5'}")
+    if path.exists() or path.is_symlink():
+        if not path.is_file():
+            raise FileExistsError(f"{path} is not a regular file; uqflight does not replace it: choose "
+                                  "another results file")
+        if not h5py.is_hdf5(path):
+            raise FileExistsError(f"{path} is not a uqflight results file (not HDF5); uqflight never "
+                                  f"overwrites it, even with --force: remove it yourself (rm {path}) or "
+                                  "choose another results file")
         try:
             with h5py.File(path, "r") as f:
                 stored, stored_aircraft = f.attrs.get("campaign_hash"), f.attrs.get("aircraft_hash")
+                ours = stored is not None and "samples/status" in f
         except OSError as exc:  # e.g. killed while the file was being created: nothing to resume
             if not force:
-                raise FileExistsError(f"{path} is not a readable results file ({exc}); choose another "
-                                      "results file, or force to overwrite it") from exc
+                reason = " ".join(str(exc).split())[:200]
+                raise FileExistsError(f"{path} is a damaged HDF5 file ({reason}); choose another results "
+                                      "file, or force to overwrite it") from exc
             stored = stored_aircraft = None
+            ours = True
+        if not ours:
+            raise FileExistsError(f"{path} is an HDF5 file but not a uqflight results file (no campaign_hash "
+                                  "or /samples/status); uqflight never overwrites it, even with --force: "
+                                  f"remove it yourself (rm {path}) or choose another results file")
         if stored == text_hash(campaign_text) and stored_aircraft == aircraft:
             return ResultStore.open(path, "a")
         if not force:
@@ -36,7 +56,12 @@ def open_for_campaign(path, *, campaign_text: str, force: bool = False, **create
             raise FileExistsError(f"{path} holds the results of another campaign (campaign_hash {stored}); "
                                   "choose another results file, or force to overwrite it")
         path.unlink()
-    return ResultStore.create(path, campaign_text=campaign_text, **create_args)
+    try:
+        return ResultStore.create(path, campaign_text=campaign_text, **create_args)
+    except BaseException:  # e.g. a full disk: a half-made file would later look damaged; nothing is lost
+        if path.exists():
+            path.unlink()
+        raise
 
 
 def compact(path) -> None:

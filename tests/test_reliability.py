@@ -1,0 +1,456 @@
+"""Nothing lost, nothing hung: worker deaths and hangs are failed runs, a full disk stops cleanly and
+resumes, one writer per file, no orphans, corruption reported (issue 17). Real processes, real HDF5."""
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import h5py
+import numpy as np
+import pytest
+
+from uqflight.campaign import parse_campaign
+from uqflight.execution import run_campaign
+from uqflight.store import CorruptFile, ResultStore, Status
+
+UQFLIGHT = str(Path(sys.executable).with_name("uqflight"))
+DATA = Path(__file__).parent / "data"
+
+
+def campaign_text(function, samples=40, chunk=8, workers=1, extra="", name="hostile"):
+    return f"""
+name: {name}
+seed: 5
+simulator: {{kind: python, function: "{DATA / 'hostile_model.py'}:{function}"}}
+parameters:
+  x: {{distribution: uniform, lower: -2, upper: 2}}
+design: {{kind: monte_carlo, samples: {samples}}}
+execution: {{workers: {workers}, chunk: {chunk}{extra}}}
+"""
+
+
+def campaign(function, **kwargs):
+    return parse_campaign(campaign_text(function, **kwargs), str(DATA / "hostile.yaml"))
+
+
+def read_all(path):
+    data = {}
+    with h5py.File(path, "r") as f:
+        f.visititems(lambda name, obj: data.update({name: obj[()]}) if isinstance(obj, h5py.Dataset) else None)
+    return data
+
+
+def assert_same_results(a, b):
+    ra, rb = read_all(a), read_all(b)
+    assert ra.keys() == rb.keys()
+    for key in ra:
+        np.testing.assert_array_equal(ra[key], rb[key], err_msg=key)
+
+
+def children(pid):
+    """Pids whose parent is `pid` (a /proc scan)."""
+    found = []
+    for entry in Path("/proc").iterdir():
+        if entry.name.isdigit():
+            try:
+                stat = (entry / "stat").read_text()
+            except OSError:
+                continue
+            if int(stat.rsplit(")", 1)[1].split()[1]) == pid:
+                found.append(int(entry.name))
+    return found
+
+
+def alive(pid):
+    try:
+        stat = Path(f"/proc/{pid}/stat").read_text()
+    except OSError:
+        return False
+    return stat.rsplit(")", 1)[1].split()[0] != "Z"
+
+
+def test_samples_that_kill_their_worker_are_failed_runs_with_any_number_of_workers(tmp_path):
+    results = {}
+    for workers in (1, 2):
+        out = tmp_path / f"w{workers}.h5"
+        summary = run_campaign(campaign("crashing"), out=out, workers=workers)
+        results[workers] = summary
+        with ResultStore.open(out) as store:
+            x, status, reasons, y = store.kappa[:, 0], store.status, np.array(store.reasons), store.output_matrix("y")
+        exited, segfaulted = x > 1.6, x < -1.6
+        assert exited.any() and segfaulted.any()
+        assert np.all(status[exited | segfaulted] == Status.WORKER_DIED)
+        assert all(r == "worker process died: exit code 3" for r in reasons[exited])
+        assert all(r == "worker process died: signal 11 (SIGSEGV)" for r in reasons[segfaulted])
+        ok = ~(exited | segfaulted)
+        assert np.all(status[ok] == Status.OK)
+        np.testing.assert_array_equal(y[ok], np.column_stack([x[ok], x[ok] ** 2]))
+        assert np.isnan(y[~ok]).all()
+        assert summary.ran == 40 and sum(summary.failures.values()) == int((~ok).sum())
+    assert_same_results(tmp_path / "w1.h5", tmp_path / "w2.h5")
+
+
+def test_a_worker_death_on_dask_is_a_failed_run(tmp_path):
+    pytest.importorskip("dask.distributed")
+    summary = run_campaign(campaign("crashing", samples=16), out=tmp_path / "d.h5", workers=2, executor="dask")
+    run_campaign(campaign("crashing", samples=16), out=tmp_path / "l.h5", workers=1)
+    assert summary.ran == 16
+    assert_same_results(tmp_path / "d.h5", tmp_path / "l.h5")
+
+
+def test_a_hung_sample_is_stopped_by_its_timeout(tmp_path):
+    started = time.monotonic()
+    summary = run_campaign(campaign("hanging", extra=", timeout_s: 1"), out=tmp_path / "h.h5", workers=2)
+    assert time.monotonic() - started < 30
+    with ResultStore.open(tmp_path / "h.h5") as store:
+        x, status, reasons = store.kappa[:, 0], store.status, np.array(store.reasons)
+    hung = x > 1.7
+    assert hung.any()
+    assert np.all(status[hung] == Status.TIMEOUT) and np.all(status[~hung] == Status.OK)
+    assert all("timed out: still running after 1 s (execution.timeout_s)" in r for r in reasons[hung])
+    assert summary.timeout_s == 1
+
+
+def test_the_default_timeout_comes_from_a_measured_flight(tmp_path):
+    summary = run_campaign(campaign("slow", samples=2), out=tmp_path / "s.h5")
+    assert summary.timeout_s == 60.0  # max(60 s, 50 x 0.1 s)
+
+
+def test_status_codes_are_listed_in_the_file(tmp_path):
+    run_campaign(campaign("slow", samples=1), out=tmp_path / "s.h5")
+    with h5py.File(tmp_path / "s.h5", "r") as f:
+        codes = f["samples/status"].attrs["codes"]
+    assert '"worker_died": 4' in codes and '"timeout": 5' in codes
+
+
+def write_campaign(tmp_path, function, **kwargs):
+    path = tmp_path / "c.yaml"
+    path.write_text(campaign_text(function, **kwargs))
+    return path
+
+
+def wait_for(predicate, seconds=60.0):
+    deadline = time.monotonic() + seconds
+    while time.monotonic() < deadline:
+        if predicate():
+            return True
+        time.sleep(0.05)
+    return False
+
+
+def test_one_writer_per_file_and_sigterm_stops_cleanly(tmp_path):
+    yaml = write_campaign(tmp_path, "slow", samples=400, chunk=4, workers=2)
+    out = tmp_path / "r.h5"
+    first = subprocess.Popen([UQFLIGHT, "run", str(yaml), "--out", str(out)], stdout=subprocess.PIPE,
+                             stderr=subprocess.PIPE, text=True)
+    try:
+        assert wait_for(lambda: out.exists() and Path(str(out) + ".lock").exists())
+        second = subprocess.run([UQFLIGHT, "run", str(yaml), "--out", str(out)], capture_output=True, text=True)
+        assert second.returncode == 2
+        assert f"being written by another run (pid {first.pid} on" in second.stderr
+        forced = subprocess.run([UQFLIGHT, "run", str(yaml), "--out", str(out), "--force"],
+                                capture_output=True, text=True)
+        assert forced.returncode == 2 and f"pid {first.pid}" in forced.stderr
+        workers = children(first.pid)
+        assert workers
+        first.send_signal(signal.SIGTERM)
+        _, stderr = first.communicate(timeout=30)
+    finally:
+        if first.poll() is None:
+            first.kill()
+    assert first.returncode == 143, stderr
+    assert f"rerun `uqflight run {yaml} --out {out}` to resume" in stderr
+    assert wait_for(lambda: not any(alive(pid) for pid in workers), 10)
+    assert not Path(str(out) + ".lock").exists()
+    with ResultStore.open(out) as store:
+        assert 0 < store.pending().size < 400
+
+
+def test_a_stale_lock_is_taken_over(tmp_path):
+    dead = subprocess.Popen([sys.executable, "-c", "pass"])
+    dead.wait()
+    lock = tmp_path / "s.h5.lock"
+    lock.write_text(f'{{"pid": {dead.pid}, "host": "{os.uname().nodename}", "started": null}}')
+    assert run_campaign(campaign("slow", samples=2), out=tmp_path / "s.h5").ran == 2
+    assert not lock.exists()
+
+
+def test_no_orphan_workers_after_the_runner_is_killed(tmp_path):
+    yaml = write_campaign(tmp_path, "slow", samples=400, chunk=4, workers=2)
+    out = tmp_path / "r.h5"
+    runner = subprocess.Popen([UQFLIGHT, "run", str(yaml), "--out", str(out)], stdout=subprocess.DEVNULL,
+                              stderr=subprocess.DEVNULL)
+    try:
+        assert wait_for(lambda: len(children(runner.pid)) >= 2 and out.exists())
+        time.sleep(1.0)
+        workers = children(runner.pid)
+        os.kill(runner.pid, signal.SIGKILL)
+        runner.wait()
+        assert wait_for(lambda: not any(alive(pid) for pid in workers), 10), \
+            [p for p in workers if alive(p)]
+    finally:
+        if runner.poll() is None:
+            runner.kill()
+    # the killed run left its lock behind: the next run takes it over (then is stopped)
+    lock = Path(str(out) + ".lock")
+    assert f'"pid": {runner.pid},' in lock.read_text()
+    resumed = subprocess.Popen([UQFLIGHT, "run", str(yaml), "--out", str(out)], stdout=subprocess.PIPE,
+                               stderr=subprocess.PIPE, text=True)
+    try:
+        assert wait_for(lambda: lock.exists() and f'"pid": {resumed.pid},' in lock.read_text())
+        resumed.send_signal(signal.SIGTERM)
+        _, stderr = resumed.communicate(timeout=30)
+    finally:
+        if resumed.poll() is None:
+            resumed.kill()
+    assert resumed.returncode == 143, stderr
+
+
+@pytest.fixture
+def small_disk(tmp_path):
+    mount = tmp_path / "disk"
+    mount.mkdir()
+    done = subprocess.run(["mount", "-t", "tmpfs", "-o", "size=8m", "tmpfs", str(mount)],
+                          capture_output=True, text=True)
+    if done.returncode != 0:
+        pytest.skip(f"cannot mount a small tmpfs here ({done.stderr.strip()}); needs root")
+    yield mount
+    subprocess.run(["umount", "-l", str(mount)], check=False)
+
+
+def test_a_full_disk_stops_cleanly_and_the_resume_equals_an_uninterrupted_run(tmp_path, small_disk):
+    yaml = write_campaign(tmp_path, "long_histories", samples=300, chunk=10, workers=2)
+    out = small_disk / "r.h5"
+    full = subprocess.run([UQFLIGHT, "run", str(yaml), "--out", str(out)], capture_output=True, text=True,
+                          timeout=300)
+    assert full.returncode == 2, full.stderr
+    assert f"no space left on {out}'s filesystem" in full.stderr
+    kept = int(full.stderr.split("MiB needed for the next batch); ")[1].split(" runs kept")[0])
+    assert "free space and rerun to resume" in full.stderr
+    with ResultStore.open(out) as store:
+        assert store.pending().size == 300 - kept and 0 < kept < 300
+        assert store.verify() == []
+    subprocess.run(["mount", "-o", "remount,size=64m", str(small_disk)], check=True)
+    resumed = subprocess.run([UQFLIGHT, "run", str(yaml), "--out", str(out)], capture_output=True, text=True,
+                             timeout=300)
+    assert resumed.returncode == 0, resumed.stderr
+    assert f"{kept} already done" in resumed.stdout
+    whole = subprocess.run([UQFLIGHT, "run", str(yaml), "--out", str(tmp_path / "whole.h5")],
+                           capture_output=True, text=True, timeout=300)
+    assert whole.returncode == 0, whole.stderr
+    assert_same_results(out, tmp_path / "whole.h5")
+
+
+def test_a_flipped_byte_is_reported(tmp_path):
+    out = tmp_path / "r.h5"
+    run_campaign(campaign("slow", samples=4), out=out)
+    with h5py.File(out, "r") as f:
+        offset = f["outputs/y"].id.get_chunk_info(0).byte_offset
+    with open(out, "r+b") as fh:
+        fh.seek(offset + 3)
+        byte = fh.read(1)
+        fh.seek(offset + 3)
+        fh.write(bytes([byte[0] ^ 0x10]))
+    info = subprocess.run([UQFLIGHT, "info", str(out)], capture_output=True, text=True)
+    assert info.returncode == 2
+    assert "data corrupted: a checksum (fletcher32) does not match" in info.stderr
+
+
+def test_an_unknown_status_code_is_an_error(tmp_path):
+    out = tmp_path / "r.h5"
+    run_campaign(campaign("slow", samples=2), out=out)
+    with h5py.File(out, "a") as f:
+        f["samples/status"][1] = 9
+    with pytest.raises(CorruptFile, match=r"unknown status codes \[9\]"):
+        ResultStore.open(out)
+    info = subprocess.run([UQFLIGHT, "info", str(out)], capture_output=True, text=True)
+    assert info.returncode == 2 and "unknown status codes [9]" in info.stderr
+
+
+# -- limits before work ------------------------------------------------------------------------------
+BASE = """
+name: {name}
+simulator: {{kind: jsbsim, duration_s: {duration}}}
+parameters:
+  CL0: {{property: aero/uq/CL0, distribution: normal, lower: 0.2, upper: 0.3}}
+  k2:  {{property: aero/uq/k2, distribution: normal, lower: 0.01, upper: 0.05}}
+  V:   {{property: ic/vt-kts, distribution: normal, lower: 195, upper: 205}}
+design: {design}
+method: {method}
+"""
+
+
+def refused(text, match, source="limits.yaml"):
+    import tracemalloc
+
+    from uqflight.campaign import CampaignError
+
+    tracemalloc.start()
+    started = time.perf_counter()
+    try:
+        with pytest.raises(CampaignError, match=match) as info:
+            parse_campaign(text, source)
+        _, peak = tracemalloc.get_traced_memory()
+    finally:
+        tracemalloc.stop()
+    assert time.perf_counter() - started < 3.0
+    assert peak < 50e6, f"{peak / 1e6:.0f} MB allocated before refusing"
+    assert len(str(info.value)) < 2500
+    return str(info.value)
+
+
+def limited(name="lim", duration=5, design="{kind: monte_carlo, samples: 10}",
+            method="{kind: monte_carlo, order: 2}"):
+    return BASE.format(name=name, duration=duration, design=design, method=method)
+
+
+@pytest.mark.parametrize("design", ["{kind: monte_carlo, samples: 1000000000000}",
+                                    "{kind: sobol, samples: 1000000000}",
+                                    "{kind: pick_freeze, samples: 400000000}"])
+def test_too_many_samples_are_refused_up_front(design):
+    refused(limited(design=design), r"design: .* runs \(points built\), more than limits.max_runs = 1000000")
+
+
+@pytest.mark.parametrize("design", ["{kind: sparse_grid, rule: gauss_hermite, level: 50}",
+                                    "{kind: tensor_grid, rule: gauss_hermite, points: 1000}"])
+def test_too_large_grids_are_refused_up_front(design):
+    refused(limited(design=design, method="{kind: integration, order: 2}"), r"limits.max_runs")
+
+
+def test_a_huge_level_is_refused_up_front():
+    refused(limited(design="{kind: sparse_grid, rule: gauss_hermite, level: 1000000000}",
+                    method="{kind: integration, order: 2}"), r"design.level: expected at most 1000")
+
+
+def test_a_raised_limit_lets_a_large_design_through():
+    text = limited(design="{kind: monte_carlo, samples: 2000000}") + "limits: {max_runs: 3000000}\n"
+    from uqflight.campaign.schema import CampaignLoader, Checker, limits
+    import yaml
+    data = yaml.load(text, Loader=CampaignLoader)
+    found = limits(Checker("x"), data["limits"])
+    assert found["max_runs"] == 3000000
+
+
+def test_a_long_flight_is_refused_by_its_memory_or_disk():
+    refused(limited(duration="1e9"), r"more than limits.max_(memory|disk)_gb")
+
+
+def test_a_huge_pce_order_is_refused():
+    refused(limited(design="{kind: sparse_grid, rule: gauss_hermite, level: 2}",
+                    method="{kind: integration, order: 1000}"), r"method.order: .* more than limits.max_pce_terms")
+
+
+def test_yaml_aliases_are_refused():
+    bomb = "a: &a [x, x, x, x, x, x, x, x, x]\n" + "".join(
+        f"{chr(98 + i)}: &{chr(98 + i)} [*{chr(97 + i)}, *{chr(97 + i)}, *{chr(97 + i)}, *{chr(97 + i)}, "
+        f"*{chr(97 + i)}, *{chr(97 + i)}, *{chr(97 + i)}, *{chr(97 + i)}, *{chr(97 + i)}]\n" for i in range(8))
+    text = limited().replace("design: {kind: monte_carlo, samples: 10}",
+                             "design: {kind: monte_carlo, samples: 10, extra: *i}") + bomb
+    refused(text, "YAML aliases")
+
+
+def test_a_huge_campaign_file_is_refused(tmp_path):
+    from uqflight.campaign import CampaignError, load_campaign
+
+    path = tmp_path / "big.yaml"
+    path.write_text(limited() + "description: " + "x" * (2 << 20) + "\n")
+    started = time.perf_counter()
+    with pytest.raises(CampaignError, match="larger than 1024 KiB"):
+        load_campaign(path)
+    assert time.perf_counter() - started < 3.0
+
+
+@pytest.mark.parametrize("name", ["../../x", "a/b", ".hidden", "x" * 101, "spaces here"])
+def test_unsafe_names_are_refused(name):
+    refused(limited(name=f'"{name}"'), r"name: expected 1-100 characters")
+
+
+def test_refusals_through_the_cli_exit_2(tmp_path):
+    path = tmp_path / "c.yaml"
+    path.write_text(limited(design="{kind: monte_carlo, samples: 1000000000000}"))
+    for command in ("plan", "run"):
+        done = subprocess.run([UQFLIGHT, command, str(path)], capture_output=True, text=True, timeout=60)
+        assert done.returncode == 2 and "limits.max_runs" in done.stderr, done.stderr
+
+
+# -- check: baselines and tolerances ------------------------------------------------------------------
+def baseline_text(mean):
+    return ('{"kind": "uqflight-baseline", "version": 1, "outputs": {"y": {"time": [0, 1], "mean": %s, '
+            '"variance": [1, 1], "band99": {"lower": [0, 0], "upper": [1, 1]}, "sobol_first": {}, '
+            '"sobol_total": {}}}}' % mean)
+
+
+@pytest.mark.parametrize("mean", ["[Infinity, 1]", "[-Infinity, 1]", "[1e999, 1]"])
+def test_check_refuses_infinite_baseline_values(tmp_path, mean):
+    from uqflight.check import BadInput, load_baseline
+
+    path = tmp_path / "b.json"
+    path.write_text(baseline_text(mean))
+    with pytest.raises(BadInput, match="infinite|Infinity"):
+        load_baseline(path)
+
+
+def test_check_accepts_nan_and_null_baseline_values(tmp_path):
+    from uqflight.check import load_baseline
+
+    path = tmp_path / "b.json"
+    path.write_text(baseline_text("[NaN, null]"))
+    assert load_baseline(path)["outputs"]["y"]["mean"][1] is None
+
+
+def test_check_refuses_deeply_nested_json(tmp_path):
+    from uqflight.check import BadInput, load_baseline
+
+    path = tmp_path / "b.json"
+    path.write_text("[" * 100000 + "]" * 100000)
+    with pytest.raises(BadInput, match="nested too deeply"):
+        load_baseline(path)
+
+
+@pytest.mark.parametrize("rtol, atol", [(1e-6, float("inf")), (float("nan"), 1e-9), (float("inf"), 0.0)])
+def test_check_refuses_non_finite_tolerances(rtol, atol):
+    from uqflight.check import BadInput, compare
+
+    with pytest.raises(BadInput, match="expected a finite number >= 0"):
+        compare(None, {"outputs": {}}, rtol, atol)
+
+
+def test_sigint_to_the_runner_alone_stops_it_cleanly(tmp_path):
+    yaml = write_campaign(tmp_path, "hanging", samples=200, chunk=4, workers=2, extra=", timeout_s: 300")
+    out = tmp_path / "r.h5"
+    runner = subprocess.Popen([UQFLIGHT, "run", str(yaml)] + ["--out", str(out)], stdout=subprocess.PIPE,
+                              stderr=subprocess.PIPE, text=True)
+    try:
+        assert wait_for(lambda: len(children(runner.pid)) >= 2 and out.exists())
+        time.sleep(1.0)  # a worker is now stuck in a hung sample
+        workers = children(runner.pid)
+        runner.send_signal(signal.SIGINT)
+        _, stderr = runner.communicate(timeout=30)
+    finally:
+        if runner.poll() is None:
+            runner.kill()
+    assert runner.returncode == 130, stderr
+    assert f"interrupted: the finished runs are stored; rerun `uqflight run {yaml} --out {out}`" in stderr
+    assert wait_for(lambda: not any(alive(pid) for pid in workers), 10)
+
+
+def test_the_cli_exits_2_when_the_disk_fills_past_the_check(tmp_path, small_disk):
+    """The free-space check bypassed (another process fills the disk): exit 2, never 0 or 139."""
+    out = small_disk / "r.h5"
+    yaml = write_campaign(tmp_path, "long_histories", samples=300, chunk=10, workers=2)
+    script = ("import sys; import uqflight.execution as e; e.ensure_space = lambda *a, **k: None; "
+              "from uqflight.cli import app; sys.argv = ['uqflight', 'run', sys.argv[1], '--out', sys.argv[2]]; app()")
+    done = subprocess.run([sys.executable, "-c", script, str(yaml), str(out)], capture_output=True, text=True,
+                          timeout=300)
+    assert done.returncode in (1, 2), done.stderr[-2000:]
+    assert "rerun to resume" in done.stderr
+    subprocess.run(["mount", "-o", "remount,size=64m", str(small_disk)], check=True)
+    resumed = subprocess.run([UQFLIGHT, "run", str(yaml), "--out", str(out)], capture_output=True, text=True,
+                             timeout=300)
+    assert resumed.returncode == 0, resumed.stderr[-2000:]
+    whole = subprocess.run([UQFLIGHT, "run", str(yaml), "--out", str(tmp_path / "whole.h5")],
+                           capture_output=True, text=True, timeout=300)
+    assert whole.returncode == 0, whole.stderr
+    assert_same_results(out, tmp_path / "whole.h5")
