@@ -248,14 +248,27 @@ def _stop_on_sigterm():
 def info(results: Path = typer.Argument(..., help="Results file (.h5).")):
     """Show a results file's campaign, design, done and failed runs, storage and versions."""
     from .store import CorruptFile, ResultStore, Status, read_error
+    from .store.lock import describe_holder, live_holder
 
+    if not results.is_file():
+        typer.echo(f"error: {results}: no such results file", err=True)
+        raise typer.Exit(2)
+    writer = live_holder(results)
+    if writer:
+        typer.echo(f"being written by {describe_holder(writer)}")
     try:
-        store = ResultStore.open(results)
+        try:
+            store = ResultStore.open(results, while_written=writer is not None)
+        except BlockingIOError:  # HDF5's lock held by a writer without a lock file of ours
+            typer.echo("locked by another process (a run writing it?): read as it is now")
+            writer = {"locked": True}
+            store = ResultStore.open(results, while_written=True)
     except CorruptFile as exc:
         typer.echo(f"error: {exc}", err=True)
         raise typer.Exit(2)
     except (OSError, ValueError) as exc:
-        typer.echo(f"error: {results}: {read_error(exc)}", err=True)
+        retry = "; it is being written: try again in a moment" if writer else ""
+        typer.echo(f"error: {results}: {read_error(exc)}{retry}", err=True)
         raise typer.Exit(2)
     with store:
         try:
@@ -276,6 +289,8 @@ def _describe_results(results, store, Status) -> None:
                f"{store.time[0]:g} to {store.time[-1]:g} s)")
     counts = {s.name.lower(): int(np.sum(status == s)) for s in Status}
     typer.echo("runs: " + ", ".join(f"{v} {k}" for k, v in counts.items()) + f" (of {status.size})")
+    done = status.size - counts["pending"]
+    typer.echo(f"progress: {done} of {status.size} runs done ({100 * done / max(status.size, 1):.1f} %)")
     reasons = Counter(r for r, s in zip(store.reasons, status) if s > 0)
     for reason, n in reasons.most_common(5):
         typer.echo(f"  failed ({n}): {reason}")

@@ -32,7 +32,7 @@ from .analysis.errors import error_summary, relative_errors
 from .analysis.failures import failure_probability
 from .analysis.floors import central_moments, floors_from_moments, kld_floor
 from .analysis.moments import modified_cov, standardised_moments, weighted_moments, weighted_quantiles
-from .analysis.resolution import resolved_variance
+from .analysis.resolution import RESOLUTION_RTOL, resolved_variance
 from .analysis.sobol import pick_freeze_indices
 from .designs import REGISTRY as DESIGNS
 from .designs import is_sampled
@@ -47,6 +47,10 @@ PDF_POINTS = 120
 TIME_BLOCK = 100  # recorded times whose runs or surrogate draws are rebuilt at once
 BAND_LEVEL = 0.99
 DEFAULT_QUANTILES = (0.005, 0.995)
+# The relative spread a JSBSim output can resolve: the same sample flown on a reused model and on a
+# freshly loaded one differs by up to 3.7e-9 of the output (JSBSim's trim; 1e-12 with the Newton
+# trim), so a spread below 1e-9 of the output's own size is the simulator's noise, not the inputs'.
+JSBSIM_RESOLUTION = 1e-9
 
 
 class BadInput(ValueError):
@@ -273,8 +277,10 @@ def _output_statistics(store: ResultStore, name: str, method: dict, germs: list[
     pick_freeze = pce is None and design_kind == "pick_freeze" and ok.all()
     blocks = _over_time_blocks(rows, row_scale, store.time.size, band_weights,
                                len(store.parameter_names) if pick_freeze else 0, options, from_runs)
-    resolved = resolved_variance(variance, mean, n=int(ok.sum()), weights=None if from_runs else weights,
-                                 atol=truncation)
+    magnitude = np.max(np.sqrt(mean**2 + np.maximum(variance, 0.0)))  # the output's own size over its history
+    rtol = JSBSIM_RESOLUTION if "aircraft_hash" in store.attrs else RESOLUTION_RTOL
+    resolved = resolved_variance(variance, mean, scale=magnitude, rtol=rtol, n=int(ok.sum()),
+                                 weights=None if from_runs else weights, atol=truncation)
     stats = OutputStatistics(name, store.units.get(name, ""), store.time, mean, variance, blocks["band"],
                              blocks["support"], blocks["density"], modified_cov(mean, np.sqrt(np.maximum(variance, 0))),
                              resolved, quantiles=dict(zip(options.quantiles, blocks["quantiles"])),

@@ -52,6 +52,14 @@ def read_holder(path) -> dict | None:
         return None
 
 
+def live_holder(path) -> dict | None:
+    """The holder of FILE's lock when it is a live run on this host (a run writing the file now), else None."""
+    holder = read_holder(path)
+    if holder and holder.get("host") == socket.gethostname() and _alive(int(holder.get("pid", 0)), holder.get("started")):
+        return holder
+    return None
+
+
 def describe_holder(holder: dict | None) -> str:
     if not holder:
         return "a run whose lock file is unreadable"

@@ -139,11 +139,14 @@ class ResultStore:
         return cls(f)
 
     @classmethod
-    def open(cls, path, mode: str = "r") -> ResultStore:
-        """An existing file, read-only ("r") or to resume ("a": half-done steps of a killed writer are mended)."""
+    def open(cls, path, mode: str = "r", while_written: bool = False) -> ResultStore:
+        """An existing file, read-only ("r") or to resume ("a": half-done steps of a killed writer are mended).
+        `while_written`: read a file that a live run is writing (HDF5's file lock off; the writer flushes
+        whole batches, so what is read is a consistent earlier state, or an OSError to retry)."""
         if mode not in ("r", "a"):
             raise ValueError(f"mode must be 'r' or 'a', got {mode!r}")
-        f = h5py.File(path, "r" if mode == "r" else "r+")
+        f = h5py.File(path, "r", locking=False) if while_written and mode == "r" else \
+            h5py.File(path, "r" if mode == "r" else "r+")
         if "samples/status" not in f:
             f.close()
             raise ValueError(f"{path} is not a uqflight results file (no /samples/status)")
