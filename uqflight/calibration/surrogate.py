@@ -184,3 +184,41 @@ def simulate(campaign: Campaign, kappa: np.ndarray, outputs: list[str]):
         for name in outputs:
             values[name][row] = result[name]
     return np.asarray(time, dtype=float), values, failures
+
+
+GERM_CI95 = {"normal": 1.959963984540054, "uniform": 0.95}  # 97.5 % quantile of N(0, 1) and of U(-1, 1)
+
+
+def prior_summaries(parameters) -> dict[str, dict]:
+    """Prior mean, std and central 95 % interval of every parameter, in physical units."""
+    out = {}
+    for p in parameters:
+        q = GERM_CI95[p.germ]
+        lower, upper = (float(v) for v in p.to_physical(np.array([-q, q])))
+        out[p.name] = {"mean": float(p.mean), "std": float(p.std), "ci95": [lower, upper]}
+    return out
+
+
+def parameter_specs(campaign: Campaign) -> dict[str, dict]:
+    """Each parameter as plain data: property, distribution, germ, nominal, lower, upper."""
+    return {p.name: {"property": p.property, "distribution": p.distribution, "germ": p.germ,
+                     "nominal": float(p.nominal), "lower": float(p.lower), "upper": float(p.upper)}
+            for p in campaign.parameters}
+
+
+def campaign_mapping(campaign: Campaign) -> dict:
+    """The campaign file as a YAML mapping (read as `uqflight` reads it), and the folder it is in."""
+    import yaml
+
+    from ..campaign import _CampaignLoader
+
+    return yaml.load(campaign.text, Loader=_CampaignLoader)
+
+
+def campaign_folder(campaign: Campaign) -> Path:
+    return Path(campaign.source).resolve().parent
+
+
+def check_campaign_text(text: str, source: str) -> None:
+    """Validate campaign text as `uqflight plan` does (CampaignError when it would be refused)."""
+    parse_campaign(text, source, probe=jsbsim_probe)

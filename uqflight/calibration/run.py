@@ -1,0 +1,184 @@
+"""`calibrate` from end to end: surrogate → likelihood → sampler → (if converged) outputs."""
+from __future__ import annotations
+
+import json
+import shutil
+import tempfile
+import time as clock
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from .likelihood import DataError, LogPosterior, interpolate_in_time, parse_noise, read_flight_csv
+from .outputs import (OUTPUT_FILES, calibrated_campaign, corner_plot, marginal, marginals_plot, predictive_plot,
+                      write_json, write_posterior)
+from .sampler import sample
+from .surrogate import (SurrogateError, campaign_folder, campaign_mapping, check_campaign_text, fit_surrogate,
+                        parameter_specs, prior_summaries, simulate, to_physical)
+
+TIME_HANDLING = ("PCE coefficients (and the surrogate's error variance) interpolated linearly in time "
+                 "onto the data times; data times outside the results file's time range are refused")
+NOISE_PRIOR = ("inferred noise: half-Cauchy(0, S) prior on sigma, sampled as log sigma; S = RMS over the "
+               "data of (data - prior-mean prediction)^2 + prior variance + surrogate error variance")
+PREDICTIVE_NOISE_DRAWS = 40  # noise draws per simulator run for the 95 % predictive band
+
+
+class NotConverged(RuntimeError):
+    """The chain failed the convergence rule; nothing was written (stale outputs were removed)."""
+
+    def __init__(self, diagnostics: dict, removed: list[str]):
+        self.diagnostics, self.removed = diagnostics, removed
+        super().__init__("; ".join(diagnostics["problems"]))
+
+
+@dataclass
+class Calibration:
+    out: Path
+    summary: dict
+    written: list[str] = field(default_factory=list)
+
+
+def calibrate(results, data, out, outputs: list[str] | None = None, noise: list[str] = (), seed: int = 0,
+              walkers: int | None = None, steps: int = 6000, method: str | None = None, order: int | None = None,
+              campaign: str | None = None, predictive_draws: int = 50, truth: dict | None = None,
+              progress: bool = False) -> Calibration:
+    """Calibrate the campaign of `results` on flight `data`; see docs/calibration.md.
+
+    Raises DataError / SurrogateError (bad input), ValueError (bad settings), NotConverged."""
+    started = clock.perf_counter()
+    out = Path(out)
+    surrogate = fit_surrogate(results, method=method, order=order, campaign_path=campaign)
+    flight = read_flight_csv(data, outputs, surrogate.outputs)
+    given = parse_noise(list(noise), list(flight.values))
+    names, germs = surrogate.names, surrogate.germs
+    posterior = LogPosterior.build(surrogate.time, surrogate.coefficients, surrogate.error_variance, germs,
+                                   names, surrogate.basis, flight, given)
+    walkers = walkers or max(32, 2 * posterior.ndim + 2)
+    if steps < 100:
+        raise ValueError(f"--steps: expected at least 100, got {steps}")
+    fitted = clock.perf_counter()
+
+    def prior_draw(rng, n):
+        xi = np.column_stack([rng.standard_normal(n) if g == "normal" else rng.uniform(-1, 1, n) for g in germs])
+        rest = np.tile(posterior.start()[len(germs):], (n, 1))
+        return np.hstack([xi, rest])
+
+    chain = sample(posterior, posterior.ndim, posterior.labels, posterior.start(), prior_draw, walkers, steps,
+                   seed, progress=progress)
+    sampled = clock.perf_counter()
+    diagnostics = chain.diagnostics
+    if not diagnostics["converged"]:
+        removed = []
+        for name in OUTPUT_FILES:  # outputs of an earlier run in DIR would look like this run's
+            if (out / name).is_file():
+                (out / name).unlink()
+                removed.append(name)
+        raise NotConverged(diagnostics, removed)
+
+    d = len(names)
+    draws = chain.kept.transpose(1, 0, 2).reshape(-1, posterior.ndim)  # walker by walker
+    log_prob = chain.log_prob[chain.burn:].T.reshape(-1)
+    xi = draws[:, :d]
+    kappa = to_physical(surrogate.parameters, xi)
+    sigmas = posterior.sigmas(draws)
+    sigma_matrix = np.column_stack([sigmas[o] for o in flight.values])
+
+    specs = parameter_specs(surrogate.campaign)
+    prior = prior_summaries(surrogate.parameters)
+    post = {name: marginal(kappa[:, k]) for k, name in enumerate(names)}
+    with np.errstate(invalid="ignore", divide="ignore"):
+        correlation = np.corrcoef(kappa, rowvar=False) if d > 1 else np.ones((1, 1))
+    parameters = {}
+    for k, name in enumerate(names):
+        ratio = post[name]["std"] / prior[name]["std"] if prior[name]["std"] > 0 else float("nan")
+        parameters[name] = {
+            "property": specs[name]["property"], "distribution": specs[name]["distribution"],
+            "prior": prior[name], "posterior": post[name],
+            "posterior_standard": marginal(xi[:, k]),
+            "std_ratio": ratio, "narrowing": 1.0 / ratio if ratio > 0 else None,
+        }
+        if truth and name in truth:
+            t = float(truth[name])
+            parameters[name]["truth"] = t
+            parameters[name]["truth_in_ci95"] = bool(post[name]["ci95"][0] <= t <= post[name]["ci95"][1])
+
+    # posterior predictive: the real simulator at draws of the posterior
+    rng = np.random.default_rng(seed + 1)
+    pick = rng.choice(len(kappa), size=min(predictive_draws, len(kappa)), replace=False)
+    sim_time, runs, failures = simulate(surrogate.campaign, kappa[pick], list(flight.values))
+    ok = np.all([np.all(np.isfinite(runs[o]), axis=1) for o in runs], axis=0)
+    at_data, band, coverage = {}, {}, {}
+    for o in flight.values:
+        at_data[o] = interpolate_in_time(runs[o][ok], sim_time, flight.time)
+        noisy = at_data[o][:, None, :] + sigmas[o][pick][ok][:, None, None] * rng.standard_normal(
+            (int(ok.sum()), PREDICTIVE_NOISE_DRAWS, flight.time.size))
+        lower, upper = np.quantile(noisy.reshape(-1, flight.time.size), [0.025, 0.975], axis=0)
+        band[o] = (lower, upper)
+        y = flight.values[o]
+        present = np.isfinite(y)
+        coverage[o] = float(np.mean((y[present] >= lower[present]) & (y[present] <= upper[present]))) if ok.any() \
+            else None
+    predicted = clock.perf_counter()
+
+    noise_summary = {}
+    for j, o in enumerate(flight.values):
+        term = posterior.terms[j]
+        noise_summary[o] = {"given": given.get(o), "inferred": None if o in given else marginal(sigmas[o]),
+                            "prior": None if o in given else {"kind": "half_cauchy", "scale": term.scale},
+                            "surrogate_error_rms": float(np.sqrt(np.mean(term.error_variance))),
+                            "data_points": int(term.y.size)}
+    summary = {
+        "results": str(results), "data": str(data), "campaign": surrogate.campaign.name,
+        "seed": seed,
+        "surrogate": {**surrogate.method, "runs": surrogate.runs, "time_handling": TIME_HANDLING,
+                      "error": "mean square leave-one-out residual of the weighted least-squares fit of the same "
+                               "basis (or the surrogate's own misfit at the runs, if larger), per output and time, "
+                               "added to the noise variance"},
+        "noise_model": NOISE_PRIOR,
+        "noise": noise_summary,
+        "parameters": parameters,
+        "correlation": {"names": names, "matrix": correlation},
+        "diagnostics": diagnostics,
+        "predictive": {"draws": int(len(pick)), "failed": int((~ok).sum()), "failures": failures,
+                       "coverage95": coverage,
+                       "band": "2.5 % and 97.5 % quantiles of simulator runs + noise draws at the data times"},
+        "seconds": {"surrogate": fitted - started, "sampling": sampled - fitted, "predictive": predicted - sampled},
+    }
+
+    # write into a scratch folder first, then move: an interrupted run leaves no half set of outputs
+    out.mkdir(parents=True, exist_ok=True)
+    scratch = Path(tempfile.mkdtemp(prefix=".calibrate-", dir=out))
+    try:
+        (scratch / "plots").mkdir()
+        attrs = {"results": str(results), "data": str(data), "campaign": surrogate.campaign.text,
+                 "seed": seed, "labels": json.dumps(posterior.labels)}
+        write_posterior(scratch / "posterior.h5", names, [specs[n]["property"] for n in names], xi, kappa,
+                        list(flight.values), sigma_matrix, log_prob, chain.samples, posterior.labels, chain.burn, attrs)
+        function_path = None
+        sim = surrogate.campaign.simulator
+        if sim["kind"] == "python" and ".py:" in sim["function"]:
+            file, _, attr = sim["function"].rpartition(":")
+            function_path = f"{(campaign_folder(surrogate.campaign) / file).resolve()}:{attr}"
+        text = calibrated_campaign(campaign_mapping(surrogate.campaign), specs, post, prior, correlation, names,
+                                   function_path, f"{results}, {data}")
+        check_campaign_text(text, str(out / "calibrated.yaml"))  # loadable by `uqflight plan`, or a bug here
+        (scratch / "calibrated.yaml").write_text(text, encoding="utf-8")
+        truth_row = np.array([truth.get(n, np.nan) for n in names]) if truth else None
+        corner_plot(scratch / "plots/corner.png", kappa, names, truth_row)
+        prior_xi = prior_draw(np.random.default_rng(seed + 2), 20000)[:, :d]
+        marginals_plot(scratch / "plots/marginals.png", to_physical(surrogate.parameters, prior_xi), kappa, names,
+                       truth_row)
+        predictive_plot(scratch / "plots/predictive.png", flight.time, flight.values, at_data, band,
+                        surrogate.units, int((~ok).sum()))
+        summary["seconds"]["total"] = clock.perf_counter() - started
+        write_json(scratch / "summary.json", summary)
+        (out / "plots").mkdir(exist_ok=True)
+        for name in OUTPUT_FILES:
+            (scratch / name).replace(out / name)
+    finally:
+        shutil.rmtree(scratch, ignore_errors=True)
+    return Calibration(out, summary, list(OUTPUT_FILES))
+
+
+__all__ = ["Calibration", "DataError", "NotConverged", "SurrogateError", "calibrate"]
