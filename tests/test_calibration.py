@@ -111,7 +111,7 @@ def test_posterior_matches_the_closed_form(results):
                                    {"y": SIGMA, "z": SIGMA})
     chain = sample(posterior, posterior.ndim, posterior.labels, posterior.start(),
                    lambda rng, n: np.column_stack([rng.standard_normal((n, 2)), rng.uniform(-1, 1, n)]),
-                   walkers=32, steps=3000, seed=1)
+                   walkers=32, steps=2000, seed=1)
     assert chain.diagnostics["converged"], chain.diagnostics["problems"]
     flat = chain.flat
     kappa = np.column_stack([1.0 + 0.1 * flat[:, 0], -0.5 + 0.05 * flat[:, 1]])
@@ -130,7 +130,7 @@ def test_calibrate_end_to_end(results, tmp_path):
     write_csv(data, TIME, synthetic(1))
     out = tmp_path / "out"
     run = CliRunner().invoke(app(), ["calibrate", str(results), "--data", str(data), "--out", str(out),
-                                     "--noise", f"y={SIGMA}", "--steps", "3000", "--predictive-draws", "20"])
+                                     "--noise", f"y={SIGMA}", "--steps", "2000", "--predictive-draws", "20"])
     assert run.exit_code == 0, run.output
     for name in ("posterior.h5", "summary.json", "calibrated.yaml", "plots/corner.png", "plots/marginals.png",
                  "plots/predictive.png"):
