@@ -194,20 +194,27 @@ def marginals_plot(path: Path, prior: np.ndarray, posterior: np.ndarray, names: 
 
 
 def predictive_plot(path: Path, time, data: dict, runs: dict, band: dict, units: dict, failed: int) -> None:
-    """Per output: the data, the simulator runs of the posterior draws and the 95 % predictive band."""
+    """Per output: the data, the simulator runs of the posterior draws and the 95 % predictive band
+    (left), and the same about the runs' median (right), where the noise can be seen."""
     plt = _pyplot()
     outputs = list(data)
-    fig, axes = plt.subplots(len(outputs), 1, figsize=(9, 2.4 * len(outputs)), squeeze=False, sharex=True)
-    for ax, name in zip(axes[:, 0], outputs):
+    fig, axes = plt.subplots(len(outputs), 2, figsize=(13, 2.4 * len(outputs)), squeeze=False, sharex=True)
+    for row, name in enumerate(outputs):
+        median = np.median(runs[name], axis=0) if len(runs[name]) else np.zeros_like(time)
         lower, upper = band[name]
-        ax.fill_between(time, lower, upper, color="C0", alpha=0.3, lw=0, label="95 % predictive (runs + noise)")
-        ax.plot(time, runs[name].T, color="C0", lw=0.4, alpha=0.5)
-        ax.plot(time, data[name], ".", color="k", ms=1.5, label="data")
         unit = units.get(name, "")
-        ax.set_ylabel(f"{name}" + (f" [{unit}]" if unit else ""), fontsize=8)
-        ax.tick_params(labelsize=7)
+        for col, offset in enumerate((0.0, median)):
+            ax = axes[row, col]
+            ax.fill_between(time, lower - offset, upper - offset, color="C0", alpha=0.3, lw=0,
+                            label="95 % predictive (runs + noise)")
+            ax.plot(time, (runs[name] - offset).T, color="C0", lw=0.4, alpha=0.5)
+            ax.plot(time, data[name] - offset, ".", color="k", ms=1.5, label="data")
+            label = name if col == 0 else f"{name} - median run"
+            ax.set_ylabel(label + (f" [{unit}]" if unit else ""), fontsize=8)
+            ax.tick_params(labelsize=7)
     axes[0, 0].legend(fontsize=7, loc="best")
-    axes[-1, 0].set_xlabel("time [s]")
+    for ax in axes[-1]:
+        ax.set_xlabel("time [s]")
     title = f"posterior predictive: {len(next(iter(runs.values())))} simulator runs of posterior draws"
     fig.suptitle(title + (f" ({failed} failed)" if failed else ""))
     fig.tight_layout()
