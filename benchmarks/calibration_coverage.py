@@ -87,6 +87,8 @@ def main() -> None:
         lower, upper = np.quantile(kappa, [0.025, 0.975], axis=0)
         inside[seed] = (lower <= kappa_true) & (kappa_true <= upper)
         stds[seed] = kappa.std(axis=0)
+        print(f"seed {seed}: {seconds[-1]:.1f} s, outside the 95 % interval: "
+              f"{', '.join(n for n, i in zip(names, inside[seed]) if not i) or 'none'}", flush=True)
     used = stds[:, 0] > 0
     n = int(used.sum())
     print(f"\n{n} seeds converged ({unconverged} not), {args.walkers} walkers x {args.steps} steps, "

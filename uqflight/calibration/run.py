@@ -124,9 +124,14 @@ def calibrate(results, data, out, outputs: list[str] | None = None, noise: list[
     noise_summary = {}
     for j, o in enumerate(flight.values):
         term = posterior.terms[j]
+        relative = surrogate.relative_error[o]
+        resolved = relative[np.isfinite(relative)]
         noise_summary[o] = {"given": given.get(o), "inferred": None if o in given else marginal(sigmas[o]),
                             "prior": None if o in given else {"kind": "half_cauchy", "scale": term.scale},
                             "surrogate_error_rms": float(np.sqrt(np.mean(term.error_variance))),
+                            "surrogate_relative_loo_error": {
+                                "median": float(np.median(resolved)) if resolved.size else None,
+                                "max": float(np.max(resolved)) if resolved.size else None},
                             "data_points": int(term.y.size)}
     summary = {
         "results": str(results), "data": str(data), "campaign": surrogate.campaign.name,

@@ -16,7 +16,7 @@ import numpy as np
 from ..campaign import Campaign, CampaignError, jsbsim_probe, load_campaign, parse_campaign
 from ..methods import METHOD_KINDS, fit
 from ..methods.basis import orthonormal_basis, total_degree_indices
-from ..methods.loo import loo_residuals
+from ..methods.loo import loo_residuals, relative_loo_error
 from ..parameters import Parameter
 from ..parameters import to_physical as _to_physical
 from ..parameters import to_standard as _to_standard
@@ -51,6 +51,7 @@ class Surrogate:
     error_variance: dict[str, np.ndarray]
     units: dict[str, str]
     runs: int
+    relative_error: dict[str, np.ndarray]  # relative LOO error per time (NaN where the output does not vary)
 
     @property
     def parameters(self) -> list[Parameter]:
@@ -147,20 +148,21 @@ def fit_surrogate(results, method: str | None = None, order: int | None = None,
         design = orthonormal_basis(germs, indices, xi)
         error_weights = np.full(len(xi), 1.0) if design_kind in SAMPLED_KINDS else np.abs(weights)
         error_weights = error_weights / error_weights.sum()
-        coefficients, error_variance = {}, {}
+        coefficients, error_variance, relative = {}, {}, {}
         for name in names:
             rows, scale = output_basis(store, name, ok)
             Y = rows if scale is None else rows @ scale
             try:
                 pce = fit(kind, xi, weights, Y, germs, order).pce
                 loo = loo_residuals(design, Y, error_weights)
+                relative[name] = relative_loo_error(design, Y, error_weights)
             except ValueError as exc:
                 raise SurrogateError(f"{results}: output {name!r}: {exc}") from exc
             misfit = Y - design @ pce.coefficients
             coefficients[name] = pce.coefficients
             error_variance[name] = np.maximum(error_weights @ loo**2, error_weights @ misfit**2)
         return Surrogate(campaign, str(results), {"kind": kind, "order": order}, list(germs), indices,
-                         store.time, coefficients, error_variance, store.units, int(ok.sum()))
+                         store.time, coefficients, error_variance, store.units, int(ok.sum()), relative)
 
 
 def simulate(campaign: Campaign, kappa: np.ndarray, outputs: list[str]):
