@@ -192,6 +192,15 @@ def test_bad_input_exits_2(results, tmp_path):
         run = runner.invoke(app(), ["calibrate", str(results), "--data", str(good), "--out", str(tmp_path / "o"),
                                     *extra])
         assert run.exit_code == 2 and message in run.output, (extra, run.output)
+    other = tmp_path / "other.yaml"
+    other.write_text(CAMPAIGN.replace("seed: 3", "seed: 4"))
+    (tmp_path / "model.py").write_text(MODEL)
+    for bad, message in ((["--campaign", str(other)], "is not the campaign"), (["--order", "9"], "coefficients")):
+        run = runner.invoke(app(), ["calibrate", str(results), "--data", str(good), "--out", str(tmp_path / "o"),
+                                    *bad])
+        assert run.exit_code == 2 and message in run.output, (bad, run.output)
+    run = runner.invoke(app(), ["calibrate", str(good), "--data", str(good), "--out", str(tmp_path / "o")])
+    assert run.exit_code == 2, run.output
     assert not (tmp_path / "o" / "summary.json").exists()
 
 
