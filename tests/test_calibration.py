@@ -272,3 +272,12 @@ def test_aircraft_calibration_recovers_cl0_and_k2(tmp_path):
     assert summary["parameters"]["Cmq"]["narrowing"] < 1.5  # ±0.53 %: the flight hardly sees it
     assert summary["predictive"]["failed"] == 0
     assert min(summary["predictive"]["coverage95"].values()) > 0.85
+
+
+def test_the_sampler_is_reproducible_from_its_seed():
+    log_prob = lambda theta: -0.5 * (np.atleast_2d(theta) ** 2).sum(axis=1)  # noqa: E731
+    draw = lambda rng, n: rng.standard_normal((n, 2))  # noqa: E731
+    runs = [sample(log_prob, 2, ["x", "y"], np.zeros(2), draw, walkers=8, steps=200, seed=seed).samples
+            for seed in (5, 5, 6)]
+    np.testing.assert_array_equal(runs[0], runs[1])
+    assert not np.array_equal(runs[0], runs[2])

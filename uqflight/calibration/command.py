@@ -34,12 +34,10 @@ def calibrate_command(
 ):
     """Bayesian calibration of the campaign's parameters on flight data (PCE surrogate + emcee).
 
-    Writes OUT/posterior.h5 (draws in standard and physical variables), OUT/summary.json (prior and
-    posterior mean, std, 95 % interval per parameter, correlations, diagnostics; strict JSON),
-    OUT/calibrated.yaml (the campaign with the posterior marginals), OUT/plots/{corner,marginals,
-    predictive}.png. Exit 0: done; 2: bad input (data, options, results file, data times outside the
-    surrogate's); 3: the chain did not converge (nothing written; the message says what to change).
-    """
+    Writes OUT/posterior.h5 (draws in standard and physical variables), OUT/summary.json (prior and posterior mean, std, 95 % interval per parameter, correlations, diagnostics; strict JSON), OUT/calibrated.yaml (the campaign with the posterior marginals) and OUT/plots/ (corner, marginals, posterior predictive from real simulator runs).
+
+    Exit 0: done; 2: bad input (data, options, results file, data times outside the surrogate's); 3: the chain did not converge (nothing written; the message says what to change).
+    """  # noqa: E501
     from .run import DataError, NotConverged, SurrogateError, calibrate
 
     if order is not None and order < 0:
