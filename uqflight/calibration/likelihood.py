@@ -123,6 +123,7 @@ def interpolate_in_time(values: np.ndarray, source: np.ndarray, target: np.ndarr
     return values[..., left] * (1.0 - fraction) + values[..., right] * fraction
 
 
+LOG_SIGMA_RANGE = (-30.0, 10.0)  # log(σ / S) of an inferred noise: the support of its (cut) prior
 GERM_LOG_DENSITY = {"normal": -0.5 * math.log(2 * math.pi), "uniform": math.log(0.5)}
 
 
@@ -176,9 +177,12 @@ class LogPosterior:
         outside = (np.abs(xi[:, self._uniform]) > 1.0).any(axis=1)
         for j, term in enumerate(self.inferred):
             log_sigma = theta[:, len(self.germs) + j]
-            # half-Cauchy(scale) on σ, with the Jacobian dσ/dlogσ = σ
-            lp = lp + math.log(2.0 / (math.pi * term.scale)) - np.log1p(np.exp(2 * log_sigma) / term.scale**2) \
-                + log_sigma
+            # half-Cauchy(scale) on σ, with the Jacobian dσ/dlogσ = σ; log(1 + (σ/S)²) without overflow
+            relative = log_sigma - math.log(term.scale)
+            lp = lp + math.log(2.0 / math.pi) + relative - np.logaddexp(0.0, 2 * relative)
+            # cut at S·e^-30 and S·e^10 (σ from 1e-13 to 2e4 times the data's scale): keeps the variance
+            # positive in floating point; the prior mass cut off is below 1e-4
+            outside |= (relative < LOG_SIGMA_RANGE[0]) | (relative > LOG_SIGMA_RANGE[1])
         return np.where(outside, -np.inf, lp)
 
     def sigmas(self, theta: np.ndarray) -> dict[str, np.ndarray]:
@@ -214,7 +218,8 @@ class LogPosterior:
         finite = np.isfinite(lp)
         out = np.full(len(theta), -np.inf)
         if finite.any():
-            out[finite] = lp[finite] + self.log_likelihood(theta[finite])
+            with np.errstate(over="ignore", divide="ignore", invalid="ignore"):  # far tails: -inf below
+                out[finite] = lp[finite] + self.log_likelihood(theta[finite])
         out[~np.isfinite(out)] = -np.inf
         return out
 

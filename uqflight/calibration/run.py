@@ -20,7 +20,8 @@ from .surrogate import (SurrogateError, campaign_folder, campaign_mapping, check
 TIME_HANDLING = ("PCE coefficients (and the surrogate's error variance) interpolated linearly in time "
                  "onto the data times; data times outside the results file's time range are refused")
 NOISE_PRIOR = ("inferred noise: half-Cauchy(0, S) prior on sigma, sampled as log sigma; S = RMS over the "
-               "data of (data - prior-mean prediction)^2 + prior variance + surrogate error variance")
+               "data of (data - prior-mean prediction)^2 + prior variance + surrogate error variance; cut to "
+               "S e^-30 < sigma < S e^10")
 PREDICTIVE_NOISE_DRAWS = 40  # noise draws per simulator run for the 95 % predictive band
 
 
