@@ -66,7 +66,7 @@ def study(label, args, surrogate, draw_xi, time_grid, clean, given, prior) -> li
             grid, flown = time_grid, clean
         values = {o: flown[o][0] + NOISE[o] * rng.standard_normal(grid.size) for o in surrogate.outputs}
         data = FlightData(f"seed {seed}", grid, values)
-        posterior = LogPosterior.build(surrogate.time, surrogate.coefficients, surrogate.error_variance,
+        posterior = LogPosterior.build(surrogate.time, surrogate.coefficients, surrogate.error_factors,
                                        surrogate.germs, names, surrogate.basis, data, given)
         start = time.perf_counter()
         chain = sample(posterior, posterior.ndim, posterior.labels, posterior.start(),

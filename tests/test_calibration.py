@@ -106,7 +106,7 @@ def test_surrogate_of_a_polynomial_model_is_exact(results):
 def test_posterior_matches_the_closed_form(results):
     surrogate = fit_surrogate(results)
     data = synthetic(0)
-    posterior = LogPosterior.build(surrogate.time, surrogate.coefficients, surrogate.error_variance, surrogate.germs,
+    posterior = LogPosterior.build(surrogate.time, surrogate.coefficients, surrogate.error_factors, surrogate.germs,
                                    surrogate.names, surrogate.basis, FlightData("test", TIME, data),
                                    {"y": SIGMA, "z": SIGMA})
     chain = sample(posterior, posterior.ndim, posterior.labels, posterior.start(),
@@ -214,20 +214,25 @@ def test_time_interpolation_is_linear_and_refuses_extrapolation():
 
 
 def test_surrogate_error_widens_the_posterior():
-    # one parameter, prior N(0, 1), y = ξ at 10 times with noise 0.1: posterior std 0.1/sqrt(10) ≈ 0.032;
-    # a surrogate error variance of 0.3² per time makes it sqrt(0.1² + 0.3²)/sqrt(10) ≈ 0.1
-    coefficients = {"y": np.array([[0.0] * 10, [1.0] * 10])}
+    # one parameter, prior N(0, 1), y = ξ at n = 10 times, noise 0.1. Without surrogate error the
+    # posterior variance is 1 / (1 + n / 0.1²). A surrogate error curve that is a constant offset of std
+    # 0.3 (covariance 0.09 11ᵀ) cannot be averaged away over times: the information 1ᵀΣ⁻¹1 becomes
+    # n / (0.1² + n 0.09), and the same error as independent per time gives n / (0.1² + 0.09).
+    n = 10
+    coefficients = {"y": np.array([[0.0] * n, [1.0] * n])}
     basis = lambda xi: np.column_stack([np.ones(len(xi)), xi[:, 0]])  # noqa: E731
-    data = FlightData("x", np.arange(10.0), {"y": np.full(10, 0.5)})
-    for error, expected in ((0.0, 0.1 / math.sqrt(10)), (0.3, math.sqrt(0.1**2 + 0.3**2) / math.sqrt(10))):
-        posterior = LogPosterior.build(np.arange(10.0), coefficients, {"y": np.full(10, error**2)}, ["normal"], ["x"],
-                                       basis, data, {"y": 0.1})
-        theta = np.linspace(-1, 2, 3001)[:, None]
+    data = FlightData("x", np.arange(float(n)), {"y": np.full(n, 0.5)})
+    cases = ((np.zeros((n, 0)), n / 0.01), (np.full((n, 1), 0.3), n / (0.01 + n * 0.09)),
+             (0.3 * np.eye(n), n / (0.01 + 0.09)))
+    for factors, information in cases:
+        posterior = LogPosterior.build(np.arange(float(n)), coefficients, {"y": factors}, ["normal"], ["x"], basis,
+                                       data, {"y": 0.1})
+        theta = np.linspace(-1, 2, 6001)[:, None]
         p = np.exp(posterior(theta) - posterior(theta).max())
         mean = (theta[:, 0] * p).sum() / p.sum()
         std = math.sqrt(((theta[:, 0] - mean) ** 2 * p).sum() / p.sum())
-        prior_factor = 1 / math.sqrt(1 + expected**2)  # the N(0, 1) prior narrows it slightly
-        assert std == pytest.approx(expected * prior_factor, rel=1e-3)
+        assert std == pytest.approx(1 / math.sqrt(1 + information), rel=1e-3)
+        assert mean == pytest.approx(0.5 * information / (1 + information), rel=1e-3)
 
 
 def test_split_rhat_detects_disagreeing_chains():

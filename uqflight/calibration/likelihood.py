@@ -123,20 +123,54 @@ def interpolate_in_time(values: np.ndarray, source: np.ndarray, target: np.ndarr
     return values[..., left] * (1.0 - fraction) + values[..., right] * fraction
 
 
+def error_factors_of(curves: np.ndarray, rtol: float = 1e-10) -> np.ndarray:
+    """F (T, r) with F Fᵀ = curvesᵀ curves for error curves (K, T), the directions below rtol of the
+    largest singular value dropped."""
+    curves = np.asarray(curves, dtype=float)
+    if not curves.size or not np.any(curves):
+        return np.zeros((curves.shape[1] if curves.ndim == 2 else 0, 0))
+    _, s, Vt = np.linalg.svd(curves, full_matrices=False)
+    keep = s > rtol * s[0]
+    return (Vt[keep].T * s[keep])
+
+
 LOG_SIGMA_RANGE = (-30.0, 10.0)  # log(σ / S) of an inferred noise: the support of its (cut) prior
 GERM_LOG_DENSITY = {"normal": -0.5 * math.log(2 * math.pi), "uniform": math.log(0.5)}
 
 
 @dataclass
 class OutputTerm:
-    """One output's data, surrogate coefficients and error variance at the data times."""
+    """One output's data, surrogate coefficients and error model at the data times.
+
+    Error covariance: σ² I + U diag(λ) Uᵀ (U orthonormal (n, r)): the noise plus the surrogate's
+    error, a random function of time whose covariance comes from error curves (see error_factors_of).
+    """
 
     name: str
     y: np.ndarray            # (n,) observed values (missing ones dropped)
     coefficients: np.ndarray  # (Z, n) PCE coefficients at the data times
-    error_variance: np.ndarray  # (n,) surrogate error variance at the data times
+    error_basis: np.ndarray   # U (n, r)
+    error_eigen: np.ndarray   # λ (r,)
     sigma: float | None      # given noise std; None: inferred
     scale: float             # half-Cauchy scale of an inferred σ
+
+    def __post_init__(self):
+        self.projected_y = self.error_basis.T @ self.y              # Uᵀy (r,)
+        self.projected_c = self.coefficients @ self.error_basis     # C U (Z, r)
+
+    @property
+    def error_variance(self) -> np.ndarray:
+        """The surrogate error variance at each data time, (n,)."""
+        return (self.error_basis**2) @ self.error_eigen
+
+
+def error_model(factors: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(U, λ) with U diag(λ) Uᵀ = F Fᵀ, U orthonormal, for factors F (n, k)."""
+    if factors.shape[1] == 0 or not np.any(factors):
+        return np.zeros((factors.shape[0], 0)), np.zeros(0)
+    U, s, _ = np.linalg.svd(factors, full_matrices=False)
+    keep = s > 1e-10 * s[0]
+    return U[:, keep], s[keep] ** 2
 
 
 class LogPosterior:
@@ -155,19 +189,25 @@ class LogPosterior:
         self._constant = sum(GERM_LOG_DENSITY[g] for g in germs)
 
     @classmethod
-    def build(cls, surrogate_time, coefficients: dict, error_variance: dict, germs, names, basis,
-              data: FlightData, noise: dict[str, float]) -> LogPosterior:
+    def build(cls, surrogate_time, coefficients: dict, error_factors: dict, germs, names, basis,
+              data: FlightData, noise: dict[str, float], extra_error: dict | None = None) -> LogPosterior:
+        """`error_factors[o]` (T, r) on the surrogate's times; `extra_error[o]` (n, k): more error
+        factors at the data times (e.g. measured at posterior draws), added to the covariance."""
         terms = []
         for name, y in data.values.items():
             keep = np.isfinite(y)
             times = data.time[keep]
             c = interpolate_in_time(coefficients[name], surrogate_time, times)
-            s2 = interpolate_in_time(error_variance[name], surrogate_time, times)
+            factors = interpolate_in_time(error_factors[name].T, surrogate_time, times).T
+            if extra_error and name in extra_error:
+                factors = np.hstack([factors, extra_error[name][keep]])
+            U, eigen = error_model(factors)
             # half-Cauchy scale: the RMS of the data about the prior-mean prediction, prior spread included
-            constant = c[0]
+            # (the constant term is first in the graded basis)
             prior_var = (c[1:] ** 2).sum(axis=0)
-            scale = math.sqrt(float(np.mean((y[keep] - constant) ** 2 + prior_var + s2)))
-            terms.append(OutputTerm(name, y[keep], c, s2, noise.get(name), max(scale, 1e-300)))
+            s2 = (factors**2).sum(axis=1)
+            scale = math.sqrt(float(np.mean((y[keep] - c[0]) ** 2 + prior_var + s2)))
+            terms.append(OutputTerm(name, y[keep], c, U, eigen, noise.get(name), max(scale, 1e-300)))
         return cls(germs, names, basis, terms)
 
     def log_prior(self, theta: np.ndarray) -> np.ndarray:
@@ -198,6 +238,8 @@ class LogPosterior:
         return out
 
     def log_likelihood(self, theta: np.ndarray) -> np.ndarray:
+        """Σ_o log N(y_o; f_o(ξ), σ_o² I + U_o diag(λ_o) U_oᵀ), with the closed-form inverse and
+        determinant of that covariance (its eigenvalues are σ² + λ_k along U and σ² elsewhere)."""
         theta = np.atleast_2d(theta)
         xi = theta[:, :len(self.germs)]
         if self._uniform.any():  # the basis of a uniform germ is only defined on [-1, 1]
@@ -207,9 +249,17 @@ class LogPosterior:
         sigmas = self.sigmas(theta)
         ll = np.zeros(len(theta))
         for term in self.terms:
-            variance = sigmas[term.name][:, None] ** 2 + term.error_variance[None, :]
-            residual = term.y[None, :] - B @ term.coefficients
-            ll -= 0.5 * (residual**2 / variance + np.log(2 * np.pi * variance)).sum(axis=1)
+            n, r = term.y.size, term.error_eigen.size
+            s2 = sigmas[term.name][:, None] ** 2                     # (M, 1)
+            residual = term.y[None, :] - B @ term.coefficients       # (M, n)
+            projected = term.projected_y[None, :] - B @ term.projected_c  # Uᵀ residual (M, r)
+            total = (residual**2).sum(axis=1)
+            along = (projected**2).sum(axis=1)
+            across = np.maximum(total - along, 0.0)                  # the part outside the error directions
+            eigen = s2 + term.error_eigen[None, :]                   # (M, r)
+            quadratic = across / s2[:, 0] + (projected**2 / eigen).sum(axis=1)
+            log_det = (n - r) * np.log(s2[:, 0]) + np.log(eigen).sum(axis=1)
+            ll -= 0.5 * (quadratic + log_det + n * math.log(2 * math.pi))
         return ll
 
     def __call__(self, theta: np.ndarray) -> np.ndarray:

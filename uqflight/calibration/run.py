@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import json
+import math
 import shutil
 import tempfile
 import time as clock
@@ -53,7 +54,7 @@ def calibrate(results, data, out, outputs: list[str] | None = None, noise: list[
     flight = read_flight_csv(data, outputs, surrogate.outputs)
     given = parse_noise(list(noise), list(flight.values))
     names, germs = surrogate.names, surrogate.germs
-    posterior = LogPosterior.build(surrogate.time, surrogate.coefficients, surrogate.error_variance, germs,
+    posterior = LogPosterior.build(surrogate.time, surrogate.coefficients, surrogate.error_factors, germs,
                                    names, surrogate.basis, flight, given)
     walkers = walkers or max(32, 2 * posterior.ndim + 2)
     if steps < 100:
@@ -65,20 +66,41 @@ def calibrate(results, data, out, outputs: list[str] | None = None, noise: list[
         rest = np.tile(posterior.start()[len(germs):], (n, 1))
         return np.hstack([xi, rest])
 
-    chain = sample(posterior, posterior.ndim, posterior.labels, posterior.start(), prior_draw, walkers, steps,
-                   seed, progress=progress)
-    sampled = clock.perf_counter()
-    diagnostics = chain.diagnostics
-    if not diagnostics["converged"]:
-        removed = []
-        for name in OUTPUT_FILES:  # outputs of an earlier run in DIR would look like this run's
-            if (out / name).is_file():
-                (out / name).unlink()
-                removed.append(name)
-        raise NotConverged(diagnostics, removed)
+    def converged(chain):
+        if not chain.diagnostics["converged"]:
+            removed = []
+            for name in OUTPUT_FILES:  # outputs of an earlier run in DIR would look like this run's
+                if (out / name).is_file():
+                    (out / name).unlink()
+                    removed.append(name)
+            raise NotConverged(chain.diagnostics, removed)
+        return chain
 
+    chain = converged(sample(posterior, posterior.ndim, posterior.labels, posterior.start(), prior_draw, walkers,
+                             steps, seed, progress=progress))
+    sampled = clock.perf_counter()
     d = len(names)
-    draws = chain.kept.transpose(1, 0, 2).reshape(-1, posterior.ndim)  # walker by walker
+    rng = np.random.default_rng(seed + 1)
+    draws, pick, sim_time, runs, failures, ok, errors = _predictive(chain, posterior, surrogate, flight, rng,
+                                                                    predictive_draws)
+    # The surrogate's error measured where the posterior is (the real simulator at its draws): when it
+    # is larger than the error model assumed and not negligible against the noise, it joins the error
+    # model (as curves over time) and the posterior is sampled again.
+    check = _surrogate_check(posterior, errors, draws[pick][ok])
+    if check["refine"]:
+        extra = {o: _full_rows(flight.values[o], errors[o].T / math.sqrt(errors[o].shape[0])) for o in errors}
+        posterior = LogPosterior.build(surrogate.time, surrogate.coefficients, surrogate.error_factors, germs,
+                                       names, surrogate.basis, flight, given, extra_error=extra)
+        chain = converged(sample(posterior, posterior.ndim, posterior.labels, posterior.start(), prior_draw,
+                                 walkers, steps, seed + 1, progress=progress))
+        draws, pick, sim_time, runs, failures, ok, errors = _predictive(chain, posterior, surrogate, flight, rng,
+                                                                        predictive_draws)
+        check = {**_surrogate_check(posterior, errors, draws[pick][ok]), "refined": True,
+                 "first_pass": {k: v for k, v in check.items() if k != "refine"}}
+    else:
+        check["refined"] = False
+    check.pop("refine")
+    diagnostics = chain.diagnostics
     log_prob = chain.log_prob[chain.burn:].T.reshape(-1)
     xi = draws[:, :d]
     kappa = to_physical(surrogate.parameters, xi)
@@ -104,11 +126,6 @@ def calibrate(results, data, out, outputs: list[str] | None = None, noise: list[
             parameters[name]["truth"] = t
             parameters[name]["truth_in_ci95"] = bool(post[name]["ci95"][0] <= t <= post[name]["ci95"][1])
 
-    # posterior predictive: the real simulator at draws of the posterior
-    rng = np.random.default_rng(seed + 1)
-    pick = rng.choice(len(kappa), size=min(predictive_draws, len(kappa)), replace=False)
-    sim_time, runs, failures = simulate(surrogate.campaign, kappa[pick], list(flight.values))
-    ok = np.all([np.all(np.isfinite(runs[o]), axis=1) for o in runs], axis=0)
     at_data, band, coverage = {}, {}, {}
     for o in flight.values:
         at_data[o] = interpolate_in_time(runs[o][ok], sim_time, flight.time)
@@ -146,10 +163,12 @@ def calibrate(results, data, out, outputs: list[str] | None = None, noise: list[
         "parameters": parameters,
         "correlation": {"names": names, "matrix": correlation},
         "diagnostics": diagnostics,
+        "surrogate_check": check,
         "predictive": {"draws": int(len(pick)), "failed": int((~ok).sum()), "failures": failures,
                        "coverage95": coverage,
                        "band": "2.5 % and 97.5 % quantiles of simulator runs + noise draws at the data times"},
-        "seconds": {"surrogate": fitted - started, "sampling": sampled - fitted, "predictive": predicted - sampled},
+        "seconds": {"surrogate": fitted - started, "first_sampling": sampled - fitted,
+                    "predictive_and_refinement": predicted - sampled},
     }
 
     # write into a scratch folder first, then move: an interrupted run leaves no half set of outputs
@@ -185,6 +204,52 @@ def calibrate(results, data, out, outputs: list[str] | None = None, noise: list[
     finally:
         shutil.rmtree(scratch, ignore_errors=True)
     return Calibration(out, summary, list(OUTPUT_FILES))
+
+
+def _predictive(chain, posterior, surrogate, flight, rng, count):
+    """Posterior draws (walker by walker), `count` of them flown with the real simulator, and the
+    surrogate's error at those draws and the data times: {output: (K, n)} (data minus nothing: the
+    simulator run minus the surrogate)."""
+    draws = chain.kept.transpose(1, 0, 2).reshape(-1, posterior.ndim)
+    pick = rng.choice(len(draws), size=min(count, len(draws)), replace=False)
+    xi = draws[pick, :len(surrogate.names)]
+    sim_time, runs, failures = simulate(surrogate.campaign, to_physical(surrogate.parameters, xi), list(flight.values))
+    ok = np.all([np.all(np.isfinite(runs[o]), axis=1) for o in runs], axis=0)
+    errors = {}
+    basis = surrogate.basis(xi[ok])
+    for term in posterior.terms:
+        keep = np.isfinite(flight.values[term.name])
+        at_data = interpolate_in_time(runs[term.name][ok], sim_time, flight.time[keep])
+        errors[term.name] = at_data - basis @ term.coefficients
+    return draws, pick, sim_time, runs, failures, ok, errors
+
+
+REFINE_NOISE_SHARE = 0.01  # measured surrogate error variance above this share of the noise variance ...
+REFINE_MODEL_FACTOR = 2.0  # ... and this many times what the error model assumed: refine
+
+
+def _surrogate_check(posterior, errors: dict, draws: np.ndarray) -> dict:
+    """Measured (at posterior draws) against assumed surrogate error, per output."""
+    sigmas = posterior.sigmas(draws) if len(draws) else {}
+    out, refine = {}, False
+    for term in posterior.terms:
+        e = errors[term.name]
+        measured = float(np.mean(e**2)) if e.size else float("nan")
+        assumed = float(np.mean(term.error_variance))
+        noise = float(np.mean(sigmas[term.name] ** 2)) if len(draws) else float("nan")
+        flag = bool(measured > REFINE_NOISE_SHARE * noise and measured > REFINE_MODEL_FACTOR * assumed)
+        refine |= flag
+        out[term.name] = {"measured_error_rms": math.sqrt(measured) if measured == measured else None,
+                          "assumed_error_rms": math.sqrt(assumed), "noise_rms": math.sqrt(noise)
+                          if noise == noise else None, "exceeds": flag}
+    return {"outputs": out, "refine": refine}
+
+
+def _full_rows(values: np.ndarray, kept_rows: np.ndarray) -> np.ndarray:
+    """Rows at the data times with values (kept_rows), zero rows where the data are missing."""
+    full = np.zeros((values.size, kept_rows.shape[1]))
+    full[np.isfinite(values)] = kept_rows
+    return full
 
 
 __all__ = ["Calibration", "DataError", "NotConverged", "SurrogateError", "calibrate"]

@@ -13,6 +13,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .likelihood import error_factors_of
 from ..campaign import Campaign, CampaignError, jsbsim_probe, load_campaign, parse_campaign
 from ..methods import METHOD_KINDS, fit
 from ..methods.basis import orthonormal_basis, total_degree_indices
@@ -36,9 +37,11 @@ class SurrogateError(ValueError):
 class Surrogate:
     """x_o(t, ξ) ≈ Σ_α c_α,o(t) Ψ_α(ξ) per output o, with its error variance per time.
 
-    `coefficients[o]` is (Z, T) on the results file's `time`; `error_variance[o]` (T,) is the mean
-    square leave-one-out residual (absolute units²) of the weighted least-squares fit of the same
-    basis on the same runs, or the mean square misfit of the surrogate itself at the runs when larger.
+    `coefficients[o]` is (Z, T) on the results file's `time`. The surrogate error is a random
+    function of time with covariance F Fᵀ, `error_factors[o]` = F (T, r): the weighted leave-one-out
+    residual curves √w_i (y_i − ŷ_(−i)) of the least-squares fit of the same basis on the same runs
+    (or the surrogate's own misfit curves at the runs, when larger), compressed by an SVD.
+    `error_variance[o]` (T,) is its diagonal: the mean square error per time (absolute units²).
     """
 
     campaign: Campaign
@@ -49,6 +52,7 @@ class Surrogate:
     time: np.ndarray
     coefficients: dict[str, np.ndarray]
     error_variance: dict[str, np.ndarray]
+    error_factors: dict[str, np.ndarray]
     units: dict[str, str]
     runs: int
     relative_error: dict[str, np.ndarray]  # relative LOO error per time (NaN where the output does not vary)
@@ -148,7 +152,7 @@ def fit_surrogate(results, method: str | None = None, order: int | None = None,
         design = orthonormal_basis(germs, indices, xi)
         error_weights = np.full(len(xi), 1.0) if design_kind in SAMPLED_KINDS else np.abs(weights)
         error_weights = error_weights / error_weights.sum()
-        coefficients, error_variance, relative = {}, {}, {}
+        coefficients, error_variance, error_factors, relative = {}, {}, {}, {}
         for name in names:
             rows, scale = output_basis(store, name, ok)
             Y = rows if scale is None else rows @ scale
@@ -160,9 +164,12 @@ def fit_surrogate(results, method: str | None = None, order: int | None = None,
                 raise SurrogateError(f"{results}: output {name!r}: {exc}") from exc
             misfit = Y - design @ pce.coefficients
             coefficients[name] = pce.coefficients
-            error_variance[name] = np.maximum(error_weights @ loo**2, error_weights @ misfit**2)
+            curves = loo if error_weights @ (loo**2).sum(axis=1) >= error_weights @ (misfit**2).sum(axis=1) else misfit
+            error_factors[name] = error_factors_of(np.sqrt(error_weights)[:, None] * curves)
+            error_variance[name] = (error_factors[name] ** 2).sum(axis=1)
         return Surrogate(campaign, str(results), {"kind": kind, "order": order}, list(germs), indices,
-                         store.time, coefficients, error_variance, store.units, int(ok.sum()), relative)
+                         store.time, coefficients, error_variance, error_factors, store.units, int(ok.sum()),
+                         relative)
 
 
 def simulate(campaign: Campaign, kappa: np.ndarray, outputs: list[str]):
