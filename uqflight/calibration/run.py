@@ -23,6 +23,7 @@ TIME_HANDLING = ("PCE coefficients (and the surrogate's error variance) interpol
 NOISE_PRIOR = ("inferred noise: half-Cauchy(0, S) prior on sigma, sampled as log sigma; S = RMS over the "
                "data of (data - prior-mean prediction)^2 + prior variance + surrogate error variance; cut to "
                "S e^-30 < sigma < S e^10")
+NOISE_FREE = 1e-6  # an inferred noise below this share of the data's scale: hint that the data look noise-free
 PREDICTIVE_NOISE_DRAWS = 40  # noise draws per simulator run for the 95 % predictive band
 
 
@@ -68,6 +69,14 @@ def calibrate(results, data, out, outputs: list[str] | None = None, noise: list[
 
     def converged(chain):
         if not chain.diagnostics["converged"]:
+            kept = chain.kept.reshape(-1, chain.kept.shape[2])
+            for j, term in enumerate(posterior.inferred):
+                sigma = float(np.exp(np.median(kept[:, len(germs) + j])))
+                if sigma < NOISE_FREE * term.scale:
+                    chain.diagnostics["problems"].append(
+                        f"the inferred noise of {term.name} is {sigma:.2g}, {sigma / term.scale:.1g} of the data's "
+                        f"scale: are the data noise-free (simulated)? Then the posterior is limited only by the "
+                        f"surrogate's error and hard to sample: give the measurement noise, --noise {term.name}=SIGMA")
             removed = []
             for name in OUTPUT_FILES:  # outputs of an earlier run in DIR would look like this run's
                 if (out / name).is_file():
