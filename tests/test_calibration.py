@@ -286,3 +286,36 @@ def test_the_sampler_is_reproducible_from_its_seed():
             for seed in (5, 5, 6)]
     np.testing.assert_array_equal(runs[0], runs[1])
     assert not np.array_equal(runs[0], runs[2])
+
+
+def test_surrogate_error_measured_at_the_posterior_is_added_when_larger(tmp_path):
+    # x(t) = exp(-a t), a ~ N(1, 0.2²), order-2 PCE from 30 points: fine near the prior, 6x worse than
+    # its LOO estimate at a = 1.75 (3.75σ), where the data are. The check at the posterior draws sees
+    # it, adds the measured error curves to the error model and samples again: the truth is covered.
+    from uqflight.simulators.models import DECAY_TIME
+
+    text = """
+name: decay
+seed: 1
+simulator: {kind: python, function: "uqflight.simulators.models:exp_decay"}
+parameters:
+  a: {distribution: normal, nominal: 1.0, interval_pct: 60}
+design: {kind: latin_hypercube, samples: 30}
+method: {kind: regression, order: 2}
+execution: {workers: 1}
+"""
+    results = tmp_path / "decay.h5"
+    run_campaign(parse_campaign(text, str(tmp_path / "decay.yaml")), out=results)
+    rng = np.random.default_rng(0)
+    data = tmp_path / "decay.csv"
+    write_csv(data, DECAY_TIME, {"x": np.exp(-1.75 * DECAY_TIME) + 0.002 * rng.standard_normal(DECAY_TIME.size)})
+    out = tmp_path / "out"
+    run = CliRunner().invoke(app(), ["calibrate", str(results), "--data", str(data), "--out", str(out),
+                                     "--noise", "x=0.002", "--steps", "1000", "--predictive-draws", "30"])
+    assert run.exit_code == 0, run.output
+    summary = json.loads((out / "summary.json").read_text())
+    check = summary["surrogate_check"]
+    assert check["refined"] and check["first_pass"]["outputs"]["x"]["exceeds"]
+    assert not check["outputs"]["x"]["exceeds"]
+    lower, upper = summary["parameters"]["a"]["posterior"]["ci95"]
+    assert lower <= 1.75 <= upper
