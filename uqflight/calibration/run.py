@@ -10,6 +10,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
+from threadpoolctl import threadpool_limits
 
 from .likelihood import DataError, LogPosterior, interpolate_in_time, parse_noise, read_flight_csv
 from .outputs import (OUTPUT_FILES, calibrated_campaign, corner_plot, marginal, marginals_plot, predictive_plot,
@@ -48,7 +49,16 @@ def calibrate(results, data, out, outputs: list[str] | None = None, noise: list[
               progress: bool = False) -> Calibration:
     """Calibrate the campaign of `results` on flight `data`; see docs/calibration.md.
 
-    Raises DataError / SurrogateError (bad input), ValueError (bad settings), NotConverged."""
+    Raises DataError / SurrogateError (bad input), ValueError (bad settings), NotConverged.
+    One BLAS thread: the matrices are small (a few hundred rows), where several threads on a shared
+    machine make the SVDs 10-100x slower."""
+    with threadpool_limits(limits=1):
+        return _calibrate(results, data, out, outputs, noise, seed, walkers, steps, method, order, campaign,
+                          predictive_draws, truth, progress)
+
+
+def _calibrate(results, data, out, outputs, noise, seed, walkers, steps, method, order, campaign,
+               predictive_draws, truth, progress) -> Calibration:
     started = clock.perf_counter()
     out = Path(out)
     surrogate = fit_surrogate(results, method=method, order=order, campaign_path=campaign)
