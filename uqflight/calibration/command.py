@@ -1,0 +1,88 @@
+"""The `uqflight calibrate` command; `register(app)` adds it to a typer app (the lead wires it into cli.py)."""
+from __future__ import annotations
+
+from pathlib import Path
+from typing import List, Optional
+
+import typer
+
+EXIT_BAD_INPUT = 2
+EXIT_NOT_CONVERGED = 3
+
+
+def calibrate_command(
+    results: Path = typer.Argument(..., help="Results file (.h5) of the campaign to calibrate: its runs give the "
+                                             "surrogate, its campaign the prior and the simulator."),
+    data: Path = typer.Option(..., help="Flight data CSV as `uqflight simulate --out` writes it: time_s and "
+                                        "output columns (an empty cell is a missing value)."),
+    out: Path = typer.Option(..., help="Output directory (created if missing)."),
+    output: List[str] = typer.Option([], "--output", help="Output to calibrate on (repeatable; default: every "
+                                                          "data column that is an output of the campaign)."),
+    noise: List[str] = typer.Option([], "--noise", help="OUTPUT=SIGMA: known noise std in the output's unit "
+                                                        "(repeatable); other outputs' noise is inferred."),
+    seed: int = typer.Option(0, help="Seeds the optimiser starts, the walkers and the predictive draws."),
+    walkers: Optional[int] = typer.Option(None, help="Ensemble walkers (even, >= 2 x dimensions; default "
+                                                     "max(32, 2 x dimensions + 2))."),
+    steps: int = typer.Option(6000, help="Steps per walker; the first half is burn-in."),
+    method: Optional[str] = typer.Option(None, help="Surrogate method (default: the results file's): "
+                                                    "pseudo_galerkin, least_squares, regression, ..."),
+    order: Optional[int] = typer.Option(None, help="Total degree of the surrogate PCE (default: the file's)."),
+    campaign: Optional[Path] = typer.Option(None, help="The campaign file, when the one stored in the results "
+                                                       "file cannot be rebuilt (a python model file elsewhere)."),
+    predictive_draws: int = typer.Option(50, help="Posterior draws flown with the real simulator for the "
+                                                  "posterior predictive band."),
+):
+    """Bayesian calibration of the campaign's parameters on flight data (PCE surrogate + emcee).
+
+    Writes OUT/posterior.h5 (draws in standard and physical variables), OUT/summary.json (prior and posterior mean, std, 95 % interval per parameter, correlations, diagnostics; strict JSON), OUT/calibrated.yaml (the campaign with the posterior marginals) and OUT/plots/ (corner, marginals, posterior predictive from real simulator runs).
+
+    Exit 0: done; 2: bad input (data, options, results file, data times outside the surrogate's); 3: the chain did not converge (nothing written; the message says what to change).
+    """  # noqa: E501
+    from .run import DataError, NotConverged, SurrogateError, calibrate
+
+    if order is not None and order < 0:
+        typer.echo(f"error: --order: expected an integer >= 0, got {order}", err=True)
+        raise typer.Exit(EXIT_BAD_INPUT)
+    if predictive_draws < 1:
+        typer.echo(f"error: --predictive-draws: expected an integer >= 1, got {predictive_draws}", err=True)
+        raise typer.Exit(EXIT_BAD_INPUT)
+    try:
+        result = calibrate(results, data, out, outputs=list(output) or None, noise=list(noise), seed=seed,
+                           walkers=walkers, steps=steps, method=method, order=order, campaign=campaign,
+                           predictive_draws=predictive_draws, progress=False)
+    except (DataError, SurrogateError, ValueError) as exc:
+        typer.echo(f"error: {exc}", err=True)
+        raise typer.Exit(EXIT_BAD_INPUT)
+    except NotConverged as exc:
+        typer.echo("not converged: no posterior is reported.", err=True)
+        for problem in exc.diagnostics["problems"]:
+            typer.echo(f"  - {problem}", err=True)
+        if exc.removed:
+            typer.echo(f"  (removed the outputs of an earlier run from {out}: {', '.join(exc.removed)})", err=True)
+        raise typer.Exit(EXIT_NOT_CONVERGED)
+    summary = result.summary
+    diag = summary["diagnostics"]
+    typer.echo(f"surrogate: {summary['surrogate']['kind']} order {summary['surrogate']['order']} from "
+               f"{summary['surrogate']['runs']} runs; {diag['walkers']} walkers x {diag['steps']} steps, "
+               f"acceptance {diag['acceptance_fraction']['mean']:.2f}, {diag['steps_per_tau']:.0f} tau kept, "
+               f"max split-R-hat {max(diag['split_rhat'].values()):.3f}")
+    typer.echo(f"{'parameter':<10} {'prior mean':>12} {'prior std':>11} {'post mean':>12} {'post std':>11} "
+               f"{'narrowing':>9}  95 % interval")
+    for name, p in summary["parameters"].items():
+        narrowing = p["narrowing"]
+        typer.echo(f"{name:<10} {p['prior']['mean']:12.6g} {p['prior']['std']:11.4g} {p['posterior']['mean']:12.6g} "
+                   f"{p['posterior']['std']:11.4g} {narrowing if narrowing is not None else float('nan'):9.2f}  "
+                   f"[{p['posterior']['ci95'][0]:.6g}, {p['posterior']['ci95'][1]:.6g}]")
+    for name, n in summary["noise"].items():
+        if n["inferred"]:
+            typer.echo(f"noise {name}: sigma {n['inferred']['mean']:.4g} (inferred)")
+    pred = summary["predictive"]
+    cover = ", ".join(f"{k} {v:.0%}" if v is not None else f"{k} -" for k, v in pred["coverage95"].items())
+    typer.echo(f"posterior predictive ({pred['draws']} simulator runs, {pred['failed']} failed): data inside the "
+               f"95 % band: {cover}")
+    typer.echo(f"wrote {', '.join(result.written)} to {out} ({summary['seconds']['total']:.1f} s)")
+
+
+def register(app: typer.Typer) -> None:
+    """Add the `calibrate` command to `app`."""
+    app.command("calibrate")(calibrate_command)

@@ -1,0 +1,281 @@
+"""Flight data, the noise model and the log posterior of the standard variables ξ (and log σ).
+
+Model, per output o and data time t_k:
+
+    y_o(t_k) = f_o(t_k, ξ) + ε,   ε ~ N(0, σ_o² + s_o²(t_k))   independent over o and k,
+
+f_o the PCE surrogate with its coefficients interpolated linearly in time onto the data times,
+σ_o the measurement noise (given, or inferred with a half-Cauchy prior of scale S_o on σ_o,
+sampled as log σ_o), s_o²(t) the surrogate's own error variance (mean square leave-one-out
+residual over the runs, interpolated the same way). Prior of ξ: the campaign's germs, N(0, 1) or
+U(−1, 1) per parameter. Plain arrays here: the surrogate reaches this module as its coefficients
+and a basis function.
+"""
+from __future__ import annotations
+
+import csv
+import math
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Callable
+
+import numpy as np
+
+
+class DataError(ValueError):
+    """Flight data or a noise setting that cannot be used; the message names the file or option."""
+
+
+@dataclass
+class FlightData:
+    """Measured outputs at `time` (n,); NaN marks a missing value."""
+
+    source: str
+    time: np.ndarray
+    values: dict[str, np.ndarray]
+
+
+def read_flight_csv(path, outputs: list[str] | None, available: list[str]) -> FlightData:
+    """A CSV as `uqflight simulate --out` writes it: `time_s` and one column per output.
+
+    `outputs` (None: every column that is one of `available`) selects the columns; an empty cell
+    or NaN is a missing value. Refused: no time_s, non-numeric cells, times not increasing, a
+    requested output missing from the file or from the campaign.
+    """
+    path = Path(path)
+    try:
+        with open(path, newline="", encoding="utf-8") as fh:
+            rows = list(csv.reader(fh))
+    except (OSError, UnicodeDecodeError) as exc:
+        raise DataError(f"{path}: cannot read the file ({exc})") from exc
+    rows = [row for row in rows if any(cell.strip() for cell in row)]
+    if len(rows) < 2:
+        raise DataError(f"{path}: expected a header (time_s, outputs...) and at least one row of data")
+    header = [cell.strip() for cell in rows[0]]
+    if "time_s" not in header:
+        raise DataError(f"{path}: no time_s column (header: {', '.join(header)})")
+    if outputs is None:
+        outputs = [name for name in header if name in available]
+        if not outputs:
+            raise DataError(f"{path}: none of the columns {', '.join(h for h in header if h != 'time_s')} is an "
+                            f"output of the campaign ({', '.join(available)})")
+    for name in outputs:
+        if name not in available:
+            raise DataError(f"--output {name}: not an output of the campaign ({', '.join(available)})")
+        if name not in header:
+            raise DataError(f"{path}: no column {name!r} (header: {', '.join(header)})")
+    table = np.full((len(rows) - 1, len(header)), np.nan)
+    for i, row in enumerate(rows[1:], start=2):
+        if len(row) != len(header):
+            raise DataError(f"{path}: line {i} has {len(row)} cells, the header {len(header)}")
+        for j, cell in enumerate(row):
+            cell = cell.strip()
+            if cell:
+                try:
+                    table[i - 2, j] = float(cell)
+                except ValueError:
+                    raise DataError(f"{path}: line {i}, column {header[j]}: expected a number, got {cell!r}") from None
+    time = table[:, header.index("time_s")]
+    if not np.all(np.isfinite(time)) or np.any(np.diff(time) <= 0):
+        raise DataError(f"{path}: time_s must be finite and strictly increasing")
+    values = {name: table[:, header.index(name)] for name in outputs}
+    for name, column in values.items():
+        if np.any(np.isinf(column)):
+            raise DataError(f"{path}: column {name!r} holds an infinite value")
+        if not np.isfinite(column).any():
+            raise DataError(f"{path}: column {name!r} holds no value")
+    return FlightData(str(path), time, values)
+
+
+def parse_noise(pairs: list[str], outputs: list[str]) -> dict[str, float]:
+    """`NAME=SIGMA` pairs (SIGMA > 0, in the output's unit) for outputs among `outputs`."""
+    noise = {}
+    for pair in pairs:
+        name, sep, value = pair.partition("=")
+        name = name.strip()
+        try:
+            sigma = float(value)
+        except ValueError:
+            sigma = float("nan")
+        if not sep or not name or not (math.isfinite(sigma) and sigma > 0):
+            raise DataError(f"--noise: expected OUTPUT=SIGMA with SIGMA > 0, got {pair!r}")
+        if name not in outputs:
+            raise DataError(f"--noise {name}: not one of the calibrated outputs ({', '.join(outputs)})")
+        noise[name] = sigma
+    return noise
+
+
+def interpolate_in_time(values: np.ndarray, source: np.ndarray, target: np.ndarray) -> np.ndarray:
+    """values (..., T) given at `source` times, linearly interpolated to `target` times (..., n).
+
+    Refuses target times outside [source[0], source[-1]] (beyond a rounding tolerance)."""
+    span = source[-1] - source[0]
+    slack = 1e-9 * max(span, 1.0)
+    if target.min() < source[0] - slack or target.max() > source[-1] + slack:
+        raise DataError(f"data times {target.min():g} to {target.max():g} s reach outside the surrogate's "
+                        f"{source[0]:g} to {source[-1]:g} s: crop the data or run a longer campaign")
+    t = np.clip(target, source[0], source[-1])
+    if source.size == 1:
+        return np.repeat(values[..., :1], t.size, axis=-1)
+    right = np.clip(np.searchsorted(source, t, side="right"), 1, source.size - 1)
+    left = right - 1
+    fraction = (t - source[left]) / (source[right] - source[left])
+    return values[..., left] * (1.0 - fraction) + values[..., right] * fraction
+
+
+def error_factors_of(curves: np.ndarray, rtol: float = 1e-10) -> np.ndarray:
+    """F (T, r) with F Fᵀ = curvesᵀ curves for error curves (K, T), the directions below rtol of the
+    largest singular value dropped."""
+    curves = np.asarray(curves, dtype=float)
+    if not curves.size or not np.any(curves):
+        return np.zeros((curves.shape[1] if curves.ndim == 2 else 0, 0))
+    _, s, Vt = np.linalg.svd(curves, full_matrices=False)
+    keep = s > rtol * s[0]
+    return (Vt[keep].T * s[keep])
+
+
+LOG_SIGMA_RANGE = (-30.0, 10.0)  # log(σ / S) of an inferred noise: the support of its (cut) prior
+GERM_LOG_DENSITY = {"normal": -0.5 * math.log(2 * math.pi), "uniform": math.log(0.5)}
+
+
+@dataclass
+class OutputTerm:
+    """One output's data, surrogate coefficients and error model at the data times.
+
+    Error covariance: σ² I + U diag(λ) Uᵀ (U orthonormal (n, r)): the noise plus the surrogate's
+    error, a random function of time whose covariance comes from error curves (see error_factors_of).
+    """
+
+    name: str
+    y: np.ndarray            # (n,) observed values (missing ones dropped)
+    coefficients: np.ndarray  # (Z, n) PCE coefficients at the data times
+    error_basis: np.ndarray   # U (n, r)
+    error_eigen: np.ndarray   # λ (r,)
+    sigma: float | None      # given noise std; None: inferred
+    scale: float             # half-Cauchy scale of an inferred σ
+
+    def __post_init__(self):
+        self.projected_y = self.error_basis.T @ self.y              # Uᵀy (r,)
+        self.projected_c = self.coefficients @ self.error_basis     # C U (Z, r)
+
+    @property
+    def error_variance(self) -> np.ndarray:
+        """The surrogate error variance at each data time, (n,)."""
+        return (self.error_basis**2) @ self.error_eigen
+
+
+def error_model(factors: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(U, λ) with U diag(λ) Uᵀ = F Fᵀ, U orthonormal, for factors F (n, k)."""
+    if factors.shape[1] == 0 or not np.any(factors):
+        return np.zeros((factors.shape[0], 0)), np.zeros(0)
+    U, s, _ = np.linalg.svd(factors, full_matrices=False)
+    keep = s > 1e-10 * s[0]
+    return U[:, keep], s[keep] ** 2
+
+
+class LogPosterior:
+    """log p(θ | data) up to a constant, vectorised: θ (M, D) → (M,).
+
+    θ = (ξ_1 … ξ_d, log σ_o for each output whose noise is inferred)."""
+
+    def __init__(self, germs: list[str], names: list[str], basis: Callable[[np.ndarray], np.ndarray],
+                 terms: list[OutputTerm]):
+        self.germs, self.names, self.basis, self.terms = list(germs), list(names), basis, terms
+        self.inferred = [term for term in terms if term.sigma is None]
+        self.labels = self.names + [f"sigma_{term.name}" for term in self.inferred]
+        self.ndim = len(self.labels)
+        self._uniform = np.array([g == "uniform" for g in germs])
+        self._normal = ~self._uniform
+        self._constant = sum(GERM_LOG_DENSITY[g] for g in germs)
+
+    @classmethod
+    def build(cls, surrogate_time, coefficients: dict, error_factors: dict, germs, names, basis,
+              data: FlightData, noise: dict[str, float], extra_error: dict | None = None) -> LogPosterior:
+        """`error_factors[o]` (T, r) on the surrogate's times; `extra_error[o]` (n, k): more error
+        factors at the data times (e.g. measured at posterior draws), added to the covariance."""
+        terms = []
+        for name, y in data.values.items():
+            keep = np.isfinite(y)
+            times = data.time[keep]
+            c = interpolate_in_time(coefficients[name], surrogate_time, times)
+            factors = interpolate_in_time(error_factors[name].T, surrogate_time, times).T
+            if extra_error and name in extra_error:
+                factors = np.hstack([factors, extra_error[name][keep]])
+            U, eigen = error_model(factors)
+            # half-Cauchy scale: the RMS of the data about the prior-mean prediction, prior spread included
+            # (the constant term is first in the graded basis)
+            prior_var = (c[1:] ** 2).sum(axis=0)
+            s2 = (factors**2).sum(axis=1)
+            scale = math.sqrt(float(np.mean((y[keep] - c[0]) ** 2 + prior_var + s2)))
+            terms.append(OutputTerm(name, y[keep], c, U, eigen, noise.get(name), max(scale, 1e-300)))
+        return cls(germs, names, basis, terms)
+
+    def log_prior(self, theta: np.ndarray) -> np.ndarray:
+        theta = np.atleast_2d(theta)
+        xi = theta[:, :len(self.germs)]
+        lp = self._constant - 0.5 * (xi[:, self._normal] ** 2).sum(axis=1)
+        outside = (np.abs(xi[:, self._uniform]) > 1.0).any(axis=1)
+        for j, term in enumerate(self.inferred):
+            log_sigma = theta[:, len(self.germs) + j]
+            # half-Cauchy(scale) on σ, with the Jacobian dσ/dlogσ = σ; log(1 + (σ/S)²) without overflow
+            relative = log_sigma - math.log(term.scale)
+            lp = lp + math.log(2.0 / math.pi) + relative - np.logaddexp(0.0, 2 * relative)
+            # cut at S·e^-30 and S·e^10 (σ from 1e-13 to 2e4 times the data's scale): keeps the variance
+            # positive in floating point; the prior mass cut off is below 1e-4
+            outside |= (relative < LOG_SIGMA_RANGE[0]) | (relative > LOG_SIGMA_RANGE[1])
+        return np.where(outside, -np.inf, lp)
+
+    def sigmas(self, theta: np.ndarray) -> dict[str, np.ndarray]:
+        """σ_o per row of θ (M,) for every output (given ones repeated)."""
+        theta = np.atleast_2d(theta)
+        out, j = {}, len(self.germs)
+        for term in self.terms:
+            if term.sigma is None:
+                out[term.name] = np.exp(theta[:, j])
+                j += 1
+            else:
+                out[term.name] = np.full(len(theta), term.sigma)
+        return out
+
+    def log_likelihood(self, theta: np.ndarray) -> np.ndarray:
+        """Σ_o log N(y_o; f_o(ξ), σ_o² I + U_o diag(λ_o) U_oᵀ), with the closed-form inverse and
+        determinant of that covariance (its eigenvalues are σ² + λ_k along U and σ² elsewhere)."""
+        theta = np.atleast_2d(theta)
+        xi = theta[:, :len(self.germs)]
+        if self._uniform.any():  # the basis of a uniform germ is only defined on [-1, 1]
+            xi = xi.copy()
+            xi[:, self._uniform] = np.clip(xi[:, self._uniform], -1.0, 1.0)
+        B = self.basis(xi)
+        sigmas = self.sigmas(theta)
+        ll = np.zeros(len(theta))
+        for term in self.terms:
+            n, r = term.y.size, term.error_eigen.size
+            s2 = sigmas[term.name][:, None] ** 2                     # (M, 1)
+            residual = term.y[None, :] - B @ term.coefficients       # (M, n)
+            projected = term.projected_y[None, :] - B @ term.projected_c  # Uᵀ residual (M, r)
+            total = (residual**2).sum(axis=1)
+            along = (projected**2).sum(axis=1)
+            across = np.maximum(total - along, 0.0)                  # the part outside the error directions
+            eigen = s2 + term.error_eigen[None, :]                   # (M, r)
+            quadratic = across / s2[:, 0] + (projected**2 / eigen).sum(axis=1)
+            log_det = (n - r) * np.log(s2[:, 0]) + np.log(eigen).sum(axis=1)
+            ll -= 0.5 * (quadratic + log_det + n * math.log(2 * math.pi))
+        return ll
+
+    def __call__(self, theta: np.ndarray) -> np.ndarray:
+        theta = np.atleast_2d(theta)
+        lp = self.log_prior(theta)
+        finite = np.isfinite(lp)
+        out = np.full(len(theta), -np.inf)
+        if finite.any():
+            with np.errstate(over="ignore", divide="ignore", invalid="ignore"):  # far tails: -inf below
+                out[finite] = lp[finite] + self.log_likelihood(theta[finite])
+        out[~np.isfinite(out)] = -np.inf
+        return out
+
+    def start(self) -> np.ndarray:
+        """A starting θ: the prior mean ξ = 0 and each inferred σ at its half-Cauchy scale / 10."""
+        theta = np.zeros(self.ndim)
+        for j, term in enumerate(self.inferred):
+            theta[len(self.germs) + j] = math.log(term.scale / 10.0)
+        return theta

@@ -1,0 +1,274 @@
+"""`calibrate` from end to end: surrogate → likelihood → sampler → (if converged) outputs."""
+from __future__ import annotations
+
+import json
+import math
+import shutil
+import tempfile
+import time as clock
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+from threadpoolctl import threadpool_limits
+
+from .likelihood import DataError, LogPosterior, interpolate_in_time, parse_noise, read_flight_csv
+from .outputs import (OUTPUT_FILES, calibrated_campaign, corner_plot, marginal, marginals_plot, predictive_plot,
+                      write_json, write_posterior)
+from .sampler import sample
+from .surrogate import (SurrogateError, campaign_folder, campaign_mapping, check_campaign_text, fit_surrogate,
+                        parameter_specs, prior_summaries, simulate, to_physical)
+
+TIME_HANDLING = ("PCE coefficients (and the surrogate's error variance) interpolated linearly in time "
+                 "onto the data times; data times outside the results file's time range are refused")
+NOISE_PRIOR = ("inferred noise: half-Cauchy(0, S) prior on sigma, sampled as log sigma; S = RMS over the "
+               "data of (data - prior-mean prediction)^2 + prior variance + surrogate error variance; cut to "
+               "S e^-30 < sigma < S e^10")
+NOISE_FREE = 1e-6  # an inferred noise below this share of the data's scale: hint that the data look noise-free
+PREDICTIVE_NOISE_DRAWS = 40  # noise draws per simulator run for the 95 % predictive band
+
+
+class NotConverged(RuntimeError):
+    """The chain failed the convergence rule; nothing was written (stale outputs were removed)."""
+
+    def __init__(self, diagnostics: dict, removed: list[str]):
+        self.diagnostics, self.removed = diagnostics, removed
+        super().__init__("; ".join(diagnostics["problems"]))
+
+
+@dataclass
+class Calibration:
+    out: Path
+    summary: dict
+    written: list[str] = field(default_factory=list)
+
+
+def calibrate(results, data, out, outputs: list[str] | None = None, noise: list[str] = (), seed: int = 0,
+              walkers: int | None = None, steps: int = 6000, method: str | None = None, order: int | None = None,
+              campaign: str | None = None, predictive_draws: int = 50, truth: dict | None = None,
+              progress: bool = False) -> Calibration:
+    """Calibrate the campaign of `results` on flight `data`; see docs/calibration.md.
+
+    Raises DataError / SurrogateError (bad input), ValueError (bad settings), NotConverged.
+    One BLAS thread: the matrices are small (a few hundred rows), where several threads on a shared
+    machine make the SVDs 10-100x slower."""
+    with threadpool_limits(limits=1):
+        return _calibrate(results, data, out, outputs, noise, seed, walkers, steps, method, order, campaign,
+                          predictive_draws, truth, progress)
+
+
+def _calibrate(results, data, out, outputs, noise, seed, walkers, steps, method, order, campaign,
+               predictive_draws, truth, progress) -> Calibration:
+    started = clock.perf_counter()
+    out = Path(out)
+    surrogate = fit_surrogate(results, method=method, order=order, campaign_path=campaign)
+    flight = read_flight_csv(data, outputs, surrogate.outputs)
+    given = parse_noise(list(noise), list(flight.values))
+    names, germs = surrogate.names, surrogate.germs
+    posterior = LogPosterior.build(surrogate.time, surrogate.coefficients, surrogate.error_factors, germs,
+                                   names, surrogate.basis, flight, given)
+    walkers = walkers or max(32, 2 * posterior.ndim + 2)
+    if steps < 100:
+        raise ValueError(f"--steps: expected at least 100, got {steps}")
+    fitted = clock.perf_counter()
+
+    def prior_draw(rng, n):
+        xi = np.column_stack([rng.standard_normal(n) if g == "normal" else rng.uniform(-1, 1, n) for g in germs])
+        rest = np.tile(posterior.start()[len(germs):], (n, 1))
+        return np.hstack([xi, rest])
+
+    def converged(chain):
+        if not chain.diagnostics["converged"]:
+            kept = chain.kept.reshape(-1, chain.kept.shape[2])
+            for j, term in enumerate(posterior.inferred):
+                sigma = float(np.exp(np.median(kept[:, len(germs) + j])))
+                if sigma < NOISE_FREE * term.scale:
+                    chain.diagnostics["problems"].append(
+                        f"the inferred noise of {term.name} is {sigma:.2g}, {sigma / term.scale:.1g} of the data's "
+                        f"scale: are the data noise-free (simulated)? Then the posterior is limited only by the "
+                        f"surrogate's error and hard to sample: give the measurement noise, --noise {term.name}=SIGMA")
+            removed = []
+            for name in OUTPUT_FILES:  # outputs of an earlier run in DIR would look like this run's
+                if (out / name).is_file():
+                    (out / name).unlink()
+                    removed.append(name)
+            raise NotConverged(chain.diagnostics, removed)
+        return chain
+
+    chain = converged(sample(posterior, posterior.ndim, posterior.labels, posterior.start(), prior_draw, walkers,
+                             steps, seed, progress=progress))
+    sampled = clock.perf_counter()
+    d = len(names)
+    rng = np.random.default_rng(seed + 1)
+    draws, pick, sim_time, runs, failures, ok, errors = _predictive(chain, posterior, surrogate, flight, rng,
+                                                                    predictive_draws)
+    # The surrogate's error measured where the posterior is (the real simulator at its draws): when it
+    # is larger than the error model assumed and not negligible against the noise, it joins the error
+    # model (as curves over time) and the posterior is sampled again.
+    check = _surrogate_check(posterior, errors, draws[pick][ok])
+    if check["refine"]:
+        extra = {o: _full_rows(flight.values[o], errors[o].T / math.sqrt(errors[o].shape[0])) for o in errors}
+        posterior = LogPosterior.build(surrogate.time, surrogate.coefficients, surrogate.error_factors, germs,
+                                       names, surrogate.basis, flight, given, extra_error=extra)
+        chain = converged(sample(posterior, posterior.ndim, posterior.labels, posterior.start(), prior_draw,
+                                 walkers, steps, seed + 1, progress=progress))
+        draws, pick, sim_time, runs, failures, ok, errors = _predictive(chain, posterior, surrogate, flight, rng,
+                                                                        predictive_draws)
+        check = {**_surrogate_check(posterior, errors, draws[pick][ok]), "refined": True,
+                 "first_pass": {k: v for k, v in check.items() if k != "refine"}}
+    else:
+        check["refined"] = False
+    check.pop("refine")
+    diagnostics = chain.diagnostics
+    log_prob = chain.log_prob[chain.burn:].T.reshape(-1)
+    xi = draws[:, :d]
+    kappa = to_physical(surrogate.parameters, xi)
+    sigmas = posterior.sigmas(draws)
+    sigma_matrix = np.column_stack([sigmas[o] for o in flight.values])
+
+    specs = parameter_specs(surrogate.campaign)
+    prior = prior_summaries(surrogate.parameters)
+    post = {name: marginal(kappa[:, k]) for k, name in enumerate(names)}
+    with np.errstate(invalid="ignore", divide="ignore"):
+        correlation = np.corrcoef(kappa, rowvar=False) if d > 1 else np.ones((1, 1))
+    parameters = {}
+    for k, name in enumerate(names):
+        ratio = post[name]["std"] / prior[name]["std"] if prior[name]["std"] > 0 else float("nan")
+        parameters[name] = {
+            "property": specs[name]["property"], "distribution": specs[name]["distribution"],
+            "prior": prior[name], "posterior": post[name],
+            "posterior_standard": marginal(xi[:, k]),
+            "std_ratio": ratio, "narrowing": 1.0 / ratio if ratio > 0 else None,
+        }
+        if truth and name in truth:
+            t = float(truth[name])
+            parameters[name]["truth"] = t
+            parameters[name]["truth_in_ci95"] = bool(post[name]["ci95"][0] <= t <= post[name]["ci95"][1])
+
+    at_data, band, coverage = {}, {}, {}
+    for o in flight.values:
+        at_data[o] = interpolate_in_time(runs[o][ok], sim_time, flight.time)
+        noisy = at_data[o][:, None, :] + sigmas[o][pick][ok][:, None, None] * rng.standard_normal(
+            (int(ok.sum()), PREDICTIVE_NOISE_DRAWS, flight.time.size))
+        lower, upper = np.quantile(noisy.reshape(-1, flight.time.size), [0.025, 0.975], axis=0)
+        band[o] = (lower, upper)
+        y = flight.values[o]
+        present = np.isfinite(y)
+        coverage[o] = float(np.mean((y[present] >= lower[present]) & (y[present] <= upper[present]))) if ok.any() \
+            else None
+    predicted = clock.perf_counter()
+
+    noise_summary = {}
+    for j, o in enumerate(flight.values):
+        term = posterior.terms[j]
+        relative = surrogate.relative_error[o]
+        resolved = relative[np.isfinite(relative)]
+        noise_summary[o] = {"given": given.get(o), "inferred": None if o in given else marginal(sigmas[o]),
+                            "prior": None if o in given else {"kind": "half_cauchy", "scale": term.scale},
+                            "surrogate_error_rms": float(np.sqrt(np.mean(term.error_variance))),
+                            "surrogate_relative_loo_error": {
+                                "median": float(np.median(resolved)) if resolved.size else None,
+                                "max": float(np.max(resolved)) if resolved.size else None},
+                            "data_points": int(term.y.size)}
+    summary = {
+        "results": str(results), "data": str(data), "campaign": surrogate.campaign.name,
+        "seed": seed,
+        "surrogate": {**surrogate.method, "runs": surrogate.runs, "time_handling": TIME_HANDLING,
+                      "error": "mean square leave-one-out residual of the weighted least-squares fit of the same "
+                               "basis (or the surrogate's own misfit at the runs, if larger), per output and time, "
+                               "added to the noise variance"},
+        "noise_model": NOISE_PRIOR,
+        "noise": noise_summary,
+        "parameters": parameters,
+        "correlation": {"names": names, "matrix": correlation},
+        "diagnostics": diagnostics,
+        "surrogate_check": check,
+        "predictive": {"draws": int(len(pick)), "failed": int((~ok).sum()), "failures": failures,
+                       "coverage95": coverage,
+                       "band": "2.5 % and 97.5 % quantiles of simulator runs + noise draws at the data times"},
+        "seconds": {"surrogate": fitted - started, "first_sampling": sampled - fitted,
+                    "predictive_and_refinement": predicted - sampled},
+    }
+
+    # write into a scratch folder first, then move: an interrupted run leaves no half set of outputs
+    out.mkdir(parents=True, exist_ok=True)
+    scratch = Path(tempfile.mkdtemp(prefix=".calibrate-", dir=out))
+    try:
+        (scratch / "plots").mkdir()
+        attrs = {"results": str(results), "data": str(data), "campaign": surrogate.campaign.text,
+                 "seed": seed, "labels": json.dumps(posterior.labels)}
+        write_posterior(scratch / "posterior.h5", names, [specs[n]["property"] for n in names], xi, kappa,
+                        list(flight.values), sigma_matrix, log_prob, chain.samples, posterior.labels, chain.burn, attrs)
+        function_path = None
+        sim = surrogate.campaign.simulator
+        if sim["kind"] == "python" and ".py:" in sim["function"]:
+            file, _, attr = sim["function"].rpartition(":")
+            function_path = f"{(campaign_folder(surrogate.campaign) / file).resolve()}:{attr}"
+        text = calibrated_campaign(campaign_mapping(surrogate.campaign), specs, post, prior, correlation, names,
+                                   function_path, f"{results}, {data}")
+        check_campaign_text(text, str(out / "calibrated.yaml"))  # loadable by `uqflight plan`, or a bug here
+        (scratch / "calibrated.yaml").write_text(text, encoding="utf-8")
+        truth_row = np.array([truth.get(n, np.nan) for n in names]) if truth else None
+        corner_plot(scratch / "plots/corner.png", kappa, names, truth_row)
+        prior_xi = prior_draw(np.random.default_rng(seed + 2), 20000)[:, :d]
+        marginals_plot(scratch / "plots/marginals.png", to_physical(surrogate.parameters, prior_xi), kappa, names,
+                       truth_row)
+        predictive_plot(scratch / "plots/predictive.png", flight.time, flight.values, at_data, band,
+                        surrogate.units, int((~ok).sum()))
+        summary["seconds"]["total"] = clock.perf_counter() - started
+        write_json(scratch / "summary.json", summary)
+        (out / "plots").mkdir(exist_ok=True)
+        for name in OUTPUT_FILES:
+            (scratch / name).replace(out / name)
+    finally:
+        shutil.rmtree(scratch, ignore_errors=True)
+    return Calibration(out, summary, list(OUTPUT_FILES))
+
+
+def _predictive(chain, posterior, surrogate, flight, rng, count):
+    """Posterior draws (walker by walker), `count` of them flown with the real simulator, and the
+    surrogate's error at those draws and the data times: {output: (K, n)} (data minus nothing: the
+    simulator run minus the surrogate)."""
+    draws = chain.kept.transpose(1, 0, 2).reshape(-1, posterior.ndim)
+    pick = rng.choice(len(draws), size=min(count, len(draws)), replace=False)
+    xi = draws[pick, :len(surrogate.names)]
+    sim_time, runs, failures = simulate(surrogate.campaign, to_physical(surrogate.parameters, xi), list(flight.values))
+    ok = np.all([np.all(np.isfinite(runs[o]), axis=1) for o in runs], axis=0)
+    errors = {}
+    basis = surrogate.basis(xi[ok])
+    for term in posterior.terms:
+        keep = np.isfinite(flight.values[term.name])
+        at_data = interpolate_in_time(runs[term.name][ok], sim_time, flight.time[keep])
+        errors[term.name] = at_data - basis @ term.coefficients
+    return draws, pick, sim_time, runs, failures, ok, errors
+
+
+REFINE_NOISE_SHARE = 0.01  # measured surrogate error variance above this share of the noise variance ...
+REFINE_MODEL_FACTOR = 2.0  # ... and this many times what the error model assumed: refine
+
+
+def _surrogate_check(posterior, errors: dict, draws: np.ndarray) -> dict:
+    """Measured (at posterior draws) against assumed surrogate error, per output."""
+    sigmas = posterior.sigmas(draws) if len(draws) else {}
+    out, refine = {}, False
+    for term in posterior.terms:
+        e = errors[term.name]
+        measured = float(np.mean(e**2)) if e.size else float("nan")
+        assumed = float(np.mean(term.error_variance))
+        noise = float(np.mean(sigmas[term.name] ** 2)) if len(draws) else float("nan")
+        flag = bool(measured > REFINE_NOISE_SHARE * noise and measured > REFINE_MODEL_FACTOR * assumed)
+        refine |= flag
+        out[term.name] = {"measured_error_rms": math.sqrt(measured) if measured == measured else None,
+                          "assumed_error_rms": math.sqrt(assumed), "noise_rms": math.sqrt(noise)
+                          if noise == noise else None, "exceeds": flag}
+    return {"outputs": out, "refine": refine}
+
+
+def _full_rows(values: np.ndarray, kept_rows: np.ndarray) -> np.ndarray:
+    """Rows at the data times with values (kept_rows), zero rows where the data are missing."""
+    full = np.zeros((values.size, kept_rows.shape[1]))
+    full[np.isfinite(values)] = kept_rows
+    return full
+
+
+__all__ = ["Calibration", "DataError", "NotConverged", "SurrogateError", "calibrate"]

@@ -1,0 +1,233 @@
+"""The calibration's view of a results file: the campaign, a PCE surrogate per output and time,
+its leave-one-out error, and the simulator for posterior-predictive runs.
+
+This is the ONLY module of uqflight.calibration that imports other uqflight modules (results
+store, campaign loading, parameters, methods, statistics, simulators): after a restructure of
+the package, retarget the imports here.
+"""
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from .likelihood import error_factors_of
+from ..campaign import Campaign, CampaignError, jsbsim_probe, load_campaign, parse_campaign
+from ..methods import METHOD_KINDS, fit
+from ..methods.basis import orthonormal_basis, total_degree_indices
+from ..methods.loo import loo_residuals, relative_loo_error
+from ..parameters import Parameter
+from ..parameters import to_physical as _to_physical
+from ..parameters import to_standard as _to_standard
+from ..simulators import FlightError, make_simulator
+from ..statistics import SAMPLED_KINDS, output_basis
+from ..store import ResultStore, Status
+
+__all__ = ["CampaignError", "Surrogate", "SurrogateError", "fit_surrogate", "load_campaign_file",
+           "simulate", "to_physical", "to_standard"]
+
+
+class SurrogateError(ValueError):
+    """A results file or method that gives no usable surrogate; the message says what to do."""
+
+
+@dataclass
+class Surrogate:
+    """x_o(t, ξ) ≈ Σ_α c_α,o(t) Ψ_α(ξ) per output o, with its error variance per time.
+
+    `coefficients[o]` is (Z, T) on the results file's `time`. The surrogate error is a random
+    function of time with covariance F Fᵀ, `error_factors[o]` = F (T, r): the weighted leave-one-out
+    residual curves √w_i (y_i − ŷ_(−i)) of the least-squares fit of the same basis on the same runs
+    (or the surrogate's own misfit curves at the runs, when larger), compressed by an SVD.
+    `error_variance[o]` (T,) is its diagonal: the mean square error per time (absolute units²).
+    """
+
+    campaign: Campaign
+    results: str
+    method: dict
+    germs: list[str]
+    indices: np.ndarray
+    time: np.ndarray
+    coefficients: dict[str, np.ndarray]
+    error_variance: dict[str, np.ndarray]
+    error_factors: dict[str, np.ndarray]
+    units: dict[str, str]
+    runs: int
+    relative_error: dict[str, np.ndarray]  # relative LOO error per time (NaN where the output does not vary)
+
+    @property
+    def parameters(self) -> list[Parameter]:
+        return self.campaign.parameters
+
+    @property
+    def names(self) -> list[str]:
+        return [p.name for p in self.campaign.parameters]
+
+    @property
+    def outputs(self) -> list[str]:
+        return list(self.coefficients)
+
+    def basis(self, xi: np.ndarray) -> np.ndarray:
+        """Ψ_α(ξ) at the rows of xi (M, d): (M, Z)."""
+        return orthonormal_basis(self.germs, self.indices, xi)
+
+    def prior_mean_variance(self, output: str) -> tuple[np.ndarray, np.ndarray]:
+        """Mean and variance over time of the surrogate under the prior (orthonormal basis)."""
+        c = self.coefficients[output]
+        constant = ~self.indices.any(axis=1)
+        return c[constant].sum(axis=0), (c[~constant] ** 2).sum(axis=0)
+
+
+def to_physical(parameters, xi) -> np.ndarray:
+    """κ (M, d) from ξ (M, d)."""
+    return _to_physical(parameters, np.atleast_2d(xi))
+
+
+def to_standard(parameters, kappa) -> np.ndarray:
+    """ξ (M, d) from κ (M, d)."""
+    return _to_standard(parameters, np.atleast_2d(kappa))
+
+
+def load_campaign_file(path) -> Campaign:
+    """A campaign file (for --campaign), validated against its aircraft."""
+    return load_campaign(path, probe=jsbsim_probe)
+
+
+def _campaign_of(store: ResultStore, results: Path, campaign_path: Path | None) -> Campaign:
+    """The campaign stored in the results file (a python model file is looked up beside the results
+    file), or the campaign file given, which must be the same text."""
+    text = store.campaign_text
+    if campaign_path is not None:
+        campaign = load_campaign_file(campaign_path)
+        if campaign.text != text:
+            raise SurrogateError(f"{campaign_path} is not the campaign {results} was run from (the texts differ)")
+        return campaign
+    try:
+        return parse_campaign(text, str(results), probe=jsbsim_probe)
+    except CampaignError as exc:
+        raise SurrogateError(f"cannot rebuild the campaign stored in {results}: {exc}; pass the campaign file "
+                             "with --campaign (a python model file is looked up beside it)") from exc
+
+
+def fit_surrogate(results, method: str | None = None, order: int | None = None,
+                  campaign_path=None, outputs: list[str] | None = None) -> Surrogate:
+    """Fit the PCE surrogate of every output (or of `outputs`) of a results file.
+
+    Default: the file's method and order. Monte Carlo kinds (monte_carlo, integration) build no
+    PCE of their own: sampled designs then use least squares, grids pseudo-Galerkin projection.
+    """
+    results = Path(results)
+    try:
+        store = ResultStore.open(results)
+    except (OSError, ValueError) as exc:
+        raise SurrogateError(f"{results}: {exc}") from exc
+    with store:
+        campaign = _campaign_of(store, results, Path(campaign_path) if campaign_path else None)
+        stored = json.loads(store.attrs["method"])
+        germs = json.loads(store.attrs["germs"])
+        design_kind = store.attrs.get("design_kind", "")
+        kind = method or stored["kind"]
+        order = stored.get("order", 2) if order is None else order
+        if kind not in METHOD_KINDS:
+            raise SurrogateError(f"--method: expected one of {', '.join(METHOD_KINDS)}, got {kind!r}")
+        if kind in ("monte_carlo", "integration"):
+            kind = "least_squares" if design_kind in SAMPLED_KINDS else "pseudo_galerkin"
+        if kind == "interpolation":  # its PCE is the projection
+            kind = "pseudo_galerkin"
+        ok = store.status == Status.OK
+        if ok.sum() == 0:
+            raise SurrogateError(f"{results}: no successful runs")
+        if not ok.all() and kind == "pseudo_galerkin":
+            raise SurrogateError(f"{results}: {int((~ok).sum())} runs failed or are missing, so the grid's "
+                                 "projection is incomplete: use --method least_squares")
+        names = store.output_names if outputs is None else outputs
+        missing = [name for name in names if name not in store.output_names]
+        if missing:
+            raise SurrogateError(f"{results} has no output {', '.join(map(repr, missing))} "
+                                 f"(it has {', '.join(store.output_names)})")
+        xi, weights = store.xi[ok], store.weights[ok]
+        indices = total_degree_indices(len(germs), order)
+        design = orthonormal_basis(germs, indices, xi)
+        error_weights = np.full(len(xi), 1.0) if design_kind in SAMPLED_KINDS else np.abs(weights)
+        error_weights = error_weights / error_weights.sum()
+        coefficients, error_variance, error_factors, relative = {}, {}, {}, {}
+        for name in names:
+            rows, scale = output_basis(store, name, ok)
+            Y = rows if scale is None else rows @ scale
+            try:
+                pce = fit(kind, xi, weights, Y, germs, order).pce
+                loo = loo_residuals(design, Y, error_weights)
+                relative[name] = relative_loo_error(design, Y, error_weights)
+            except ValueError as exc:
+                raise SurrogateError(f"{results}: output {name!r}: {exc}") from exc
+            misfit = Y - design @ pce.coefficients
+            coefficients[name] = pce.coefficients
+            curves = loo if error_weights @ (loo**2).sum(axis=1) >= error_weights @ (misfit**2).sum(axis=1) else misfit
+            error_factors[name] = error_factors_of(np.sqrt(error_weights)[:, None] * curves)
+            error_variance[name] = (error_factors[name] ** 2).sum(axis=1)
+        return Surrogate(campaign, str(results), {"kind": kind, "order": order}, list(germs), indices,
+                         store.time, coefficients, error_variance, error_factors, store.units, int(ok.sum()),
+                         relative)
+
+
+def simulate(campaign: Campaign, kappa: np.ndarray, outputs: list[str]):
+    """Fly (or call) the campaign's simulator at every row of kappa (M, d), as `uqflight run` does.
+
+    Returns (time (T,), {output: (M, T)} with NaN rows for failed runs, [failure reasons]).
+    """
+    names = [p.name for p in campaign.parameters]
+    properties = [p.property for p in campaign.parameters]
+    simulator = make_simulator(campaign.simulator, names, properties, Path(campaign.source).resolve().parent)
+    time, _ = simulator.probe(np.asarray(kappa)[0])
+    values = {name: np.full((len(kappa), len(time)), np.nan) for name in outputs}
+    failures = []
+    for row, k in enumerate(np.asarray(kappa, dtype=float)):
+        simulator.restart()  # each run as from a fresh worker: independent of the order of the draws
+        try:
+            result = simulator.evaluate(k)
+        except FlightError as exc:
+            failures.append(str(exc))
+            continue
+        for name in outputs:
+            values[name][row] = result[name]
+    return np.asarray(time, dtype=float), values, failures
+
+
+GERM_CI95 = {"normal": 1.959963984540054, "uniform": 0.95}  # 97.5 % quantile of N(0, 1) and of U(-1, 1)
+
+
+def prior_summaries(parameters) -> dict[str, dict]:
+    """Prior mean, std and central 95 % interval of every parameter, in physical units."""
+    out = {}
+    for p in parameters:
+        q = GERM_CI95[p.germ]
+        lower, upper = (float(v) for v in p.to_physical(np.array([-q, q])))
+        out[p.name] = {"mean": float(p.mean), "std": float(p.std), "ci95": [lower, upper]}
+    return out
+
+
+def parameter_specs(campaign: Campaign) -> dict[str, dict]:
+    """Each parameter as plain data: property, distribution, germ, nominal, lower, upper."""
+    return {p.name: {"property": p.property, "distribution": p.distribution, "germ": p.germ,
+                     "nominal": float(p.nominal), "lower": float(p.lower), "upper": float(p.upper)}
+            for p in campaign.parameters}
+
+
+def campaign_mapping(campaign: Campaign) -> dict:
+    """The campaign file as a YAML mapping (read as `uqflight` reads it), and the folder it is in."""
+    import yaml
+
+    from ..campaign import _CampaignLoader
+
+    return yaml.load(campaign.text, Loader=_CampaignLoader)
+
+
+def campaign_folder(campaign: Campaign) -> Path:
+    return Path(campaign.source).resolve().parent
+
+
+def check_campaign_text(text: str, source: str) -> None:
+    """Validate campaign text as `uqflight plan` does (CampaignError when it would be refused)."""
+    parse_campaign(text, source, probe=jsbsim_probe)
