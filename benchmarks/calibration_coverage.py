@@ -37,7 +37,8 @@ NOISE = {"alpha_deg": 0.05, "theta_deg": 0.05, "h_ft": 1.0, "q_degps": 0.05, "vt
 def ensure_results(path: Path) -> Path:
     if path.is_file():
         return path
-    from uqflight.campaign import jsbsim_probe, load_campaign
+    from uqflight.campaign import load_campaign
+    from uqflight.simulators.jsbsim_probe import jsbsim_probe
     from uqflight.execution import run_campaign
 
     print(f"running campaigns/grid-gh-l2.yaml into {path} (113 flights)")

@@ -11,6 +11,8 @@ from typing import List, Optional
 import numpy as np
 import typer
 
+from .calibration.command import register as register_calibrate
+
 from .methods import METHOD_KINDS
 from .simulators.base import FlightError
 from .simulators.aircraft import default_condition
@@ -24,6 +26,7 @@ app = typer.Typer(help="Uncertainty quantification campaigns on a JSBSim flight-
 surrogate_app = typer.Typer(help="The PCE surrogate of a results file: export it as JSON.", no_args_is_help=True,
                             context_settings=CONTEXT, rich_markup_mode=None)
 app.add_typer(surrogate_app, name="surrogate")
+register_calibrate(app)
 
 
 def _version(value: bool):
@@ -143,7 +146,7 @@ def _load(path: Path):
 
 
 @app.command()
-def plan(campaign: Path = typer.Argument(..., help="Campaign YAML file.")):
+def plan(campaign: Path = typer.Argument(..., metavar="CAMPAIGN", help="Campaign YAML file.")):
     """Validate a campaign and print its design, the number of runs and an estimated time."""
     from .designs import describe
 
@@ -171,7 +174,7 @@ CORES = os.cpu_count() or 1
 
 @app.command()
 def run(
-    campaign: Path = typer.Argument(..., help="Campaign YAML file."),
+    campaign: Path = typer.Argument(..., metavar="CAMPAIGN", help="Campaign YAML file."),
     workers: Optional[int] = typer.Option(None, help="Worker processes (default: execution.workers)."),
     out: Optional[Path] = typer.Option(None, help="Results file (default: storage.path)."),
     executor: Optional[str] = typer.Option(None, help="local or dask (default: execution.executor)."),
@@ -245,7 +248,7 @@ def _stop_on_sigterm():
 
 
 @app.command()
-def info(results: Path = typer.Argument(..., help="Results file (.h5).")):
+def info(results: Path = typer.Argument(..., metavar="RESULTS", help="Results file (.h5).")):
     """Show a results file's campaign, design, done and failed runs, storage and versions."""
     from .store import CorruptFile, ResultStore, Status, read_error
     from .store.lock import describe_holder, live_holder
@@ -307,7 +310,7 @@ def _describe_results(results, store, Status) -> None:
 
 @app.command()
 def report(
-    results: List[Path] = typer.Argument(..., help="Results files (.h5). The first is the one summary.json, "
+    results: List[Path] = typer.Argument(..., metavar="RESULTS", help="Results files (.h5). The first is the one summary.json, "
                                                    "the baseline and the default folder describe."),
     out: Optional[Path] = typer.Option(None, help="Report directory (default: RESULTS-report/ next to the first "
                                                   "results file). Replaced only when the new report is complete."),
@@ -402,7 +405,7 @@ class _status:
 
 @app.command()
 def design(
-    campaign: Path = typer.Argument(..., help="Campaign YAML file."),
+    campaign: Path = typer.Argument(..., metavar="CAMPAIGN", help="Campaign YAML file."),
     csv_path: Path = typer.Option(..., "--csv", help="Write the design to this CSV file: one row per run, columns "
                                                      "xi_<name> (standard variables), <name> (physical values "
                                                      "kappa) and weight."),
@@ -429,7 +432,7 @@ def design(
 
 @surrogate_app.command("export")
 def surrogate_export(
-    results: Path = typer.Argument(..., help="Results file (.h5)."),
+    results: Path = typer.Argument(..., metavar="RESULTS", help="Results file (.h5)."),
     out: Path = typer.Option(..., help="JSON file to write (strict JSON)."),
     method: Optional[str] = typer.Option(None, help="KIND[:ORDER] instead of the campaign's method, "
                                                     "e.g. least_squares:3 (a PCE method)."),
@@ -465,7 +468,7 @@ def parse_method_option(method: str | None) -> dict | None:
 
 @app.command()
 def check(
-    results: Path = typer.Argument(..., help="Results file (.h5) to recompute the statistics of."),
+    results: Path = typer.Argument(..., metavar="RESULTS", help="Results file (.h5) to recompute the statistics of."),
     baseline: Path = typer.Option(..., help="Baseline JSON from `uqflight report ... --write-baseline`."),
     rtol: float = typer.Option(1e-6, help="Relative tolerance."),
     atol: float = typer.Option(1e-9, help="Absolute tolerance, in each statistic's own unit."),
@@ -505,7 +508,7 @@ def check(
 
 @app.command("aircraft")
 def aircraft_command(
-    aircraft: Optional[str] = typer.Argument(None, help="Aircraft: a name in the project's aircraft/ or JSBSim's, "
+    aircraft: Optional[str] = typer.Argument(None, metavar="AIRCRAFT", help="Aircraft: a name in the project's aircraft/ or JSBSim's, "
                                                         "or a path to an aircraft folder."),
     altitude_ft: Optional[float] = typer.Option(None, help="Trim altitude [ft] (default: the aircraft's)."),
     airspeed_ktas: Optional[float] = typer.Option(None, help="Trim true airspeed [kt] (default: the aircraft's)."),

@@ -11,7 +11,7 @@ EXIT_NOT_CONVERGED = 3
 
 
 def calibrate_command(
-    results: Path = typer.Argument(..., help="Results file (.h5) of the campaign to calibrate: its runs give the "
+    results: Path = typer.Argument(..., metavar="RESULTS", help="Results file (.h5) of the campaign to calibrate: its runs give the "
                                              "surrogate, its campaign the prior and the simulator."),
     data: Path = typer.Option(..., help="Flight data CSV as `uqflight simulate --out` writes it: time_s and "
                                         "output columns (an empty cell is a missing value)."),

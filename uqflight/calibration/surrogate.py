@@ -13,17 +13,20 @@ from pathlib import Path
 
 import numpy as np
 
-from .likelihood import error_factors_of
-from ..campaign import Campaign, CampaignError, jsbsim_probe, load_campaign, parse_campaign
-from ..methods import METHOD_KINDS, fit
-from ..methods.basis import orthonormal_basis, total_degree_indices
+from ..campaign import Campaign, CampaignError, load_campaign, parse_campaign
+from ..designs import is_sampled
+from ..methods import METHOD_KINDS
+from ..methods.basis import orthonormal_basis
 from ..methods.loo import loo_residuals, relative_loo_error
 from ..parameters import Parameter
 from ..parameters import to_physical as _to_physical
 from ..parameters import to_standard as _to_standard
-from ..simulators import FlightError, make_simulator
-from ..statistics import SAMPLED_KINDS, output_basis
+from ..simulators import make_simulator
+from ..simulators.base import FlightError
+from ..simulators.jsbsim_probe import jsbsim_probe
+from ..statistics import BadInput, Options, analyse, output_basis
 from ..store import ResultStore, Status
+from .likelihood import error_factors_of
 
 __all__ = ["CampaignError", "Surrogate", "SurrogateError", "fit_surrogate", "load_campaign_file",
            "simulate", "to_physical", "to_standard"]
@@ -132,32 +135,33 @@ def fit_surrogate(results, method: str | None = None, order: int | None = None,
         order = stored.get("order", 2) if order is None else order
         if kind not in METHOD_KINDS:
             raise SurrogateError(f"--method: expected one of {', '.join(METHOD_KINDS)}, got {kind!r}")
+        sampled = is_sampled(design_kind)
         if kind in ("monte_carlo", "integration"):
-            kind = "least_squares" if design_kind in SAMPLED_KINDS else "pseudo_galerkin"
+            kind = "least_squares" if sampled else "pseudo_galerkin"
         if kind == "interpolation":  # its PCE is the projection
             kind = "pseudo_galerkin"
         ok = store.status == Status.OK
-        if ok.sum() == 0:
-            raise SurrogateError(f"{results}: no successful runs")
-        if not ok.all() and kind == "pseudo_galerkin":
-            raise SurrogateError(f"{results}: {int((~ok).sum())} runs failed or are missing, so the grid's "
-                                 "projection is incomplete: use --method least_squares")
         names = store.output_names if outputs is None else outputs
         missing = [name for name in names if name not in store.output_names]
         if missing:
             raise SurrogateError(f"{results} has no output {', '.join(map(repr, missing))} "
                                  f"(it has {', '.join(store.output_names)})")
+        try:  # the statistics' own PCE, after their checks (pending or failed runs, aliasing, rank)
+            stats = analyse(results, method={"kind": kind, "order": order},
+                            options=Options(band_samples=200, bootstrap=0))
+        except BadInput as exc:
+            raise SurrogateError(str(exc)) from exc
         xi, weights = store.xi[ok], store.weights[ok]
-        indices = total_degree_indices(len(germs), order)
+        indices = stats.outputs[names[0]].pce.indices
         design = orthonormal_basis(germs, indices, xi)
-        error_weights = np.full(len(xi), 1.0) if design_kind in SAMPLED_KINDS else np.abs(weights)
+        error_weights = np.full(len(xi), 1.0) if sampled else np.abs(weights)
         error_weights = error_weights / error_weights.sum()
         coefficients, error_variance, error_factors, relative = {}, {}, {}, {}
         for name in names:
             rows, scale = output_basis(store, name, ok)
             Y = rows if scale is None else rows @ scale
+            pce = stats.outputs[name].pce
             try:
-                pce = fit(kind, xi, weights, Y, germs, order).pce
                 loo = loo_residuals(design, Y, error_weights)
                 relative[name] = relative_loo_error(design, Y, error_weights)
             except ValueError as exc:
@@ -219,9 +223,9 @@ def campaign_mapping(campaign: Campaign) -> dict:
     """The campaign file as a YAML mapping (read as `uqflight` reads it), and the folder it is in."""
     import yaml
 
-    from ..campaign import _CampaignLoader
+    from ..campaign.schema import CampaignLoader
 
-    return yaml.load(campaign.text, Loader=_CampaignLoader)
+    return yaml.load(campaign.text, Loader=CampaignLoader)
 
 
 def campaign_folder(campaign: Campaign) -> Path:
