@@ -161,15 +161,33 @@ def plan(campaign: Path = typer.Argument(..., metavar="CAMPAIGN", help="Campaign
     typer.echo(f"method: {spec.method['kind']} (order {spec.method['order']})")
     runs = len(design.xi)
     typer.echo(f"runs: {runs}")
-    if spec.simulator["kind"] == "jsbsim":
-        workers = spec.execution["workers"]
-        seconds = runs * SECONDS_PER_FLIGHT * spec.simulator.get("duration_s", 50.0) / 50.0 / min(workers, CORES)
-        typer.echo(f"estimated time: {seconds:.0f} s with {workers} worker(s) "
-                   f"(~{SECONDS_PER_FLIGHT * 1e3:.0f} ms per 50-s flight on this machine)")
+    typer.echo(f"results: {Path(spec.storage['path']).resolve()} (storage.path, from the working directory; "
+               "--out to choose)")
+    seconds = _seconds_per_run(spec)
+    workers = min(spec.execution["workers"], CORES)
+    typer.echo(f"estimated time: {runs * seconds / workers:.0f} s with {workers} worker(s) "
+               f"({seconds * 1e3:.0f} ms per run, one nominal run timed now on this machine)")
 
 
-SECONDS_PER_FLIGHT = 0.05  # measured by benchmarks/flight_cost.py (trim + 50 s at 120 Hz)
 CORES = os.cpu_count() or 1
+
+
+def _seconds_per_run(spec) -> float:
+    """One nominal run of the campaign's simulator, timed here (after a first, warming run)."""
+    import time
+
+    from .execution import worker_spec
+
+    simulator = worker_spec(spec).build()
+    nominal = np.array([p.nominal for p in spec.parameters])
+    for _ in range(2):  # the first run loads what every later one reuses (the Newton trim's nominal)
+        simulator.restart()
+        started = time.perf_counter()
+        try:
+            simulator.evaluate(nominal)
+        except FlightError:
+            pass
+    return time.perf_counter() - started
 
 
 @app.command()
