@@ -16,14 +16,14 @@ from ..methods import METHOD_KINDS, method_entry
 from ..methods.exactness import exact_total_degree, max_projection_order
 from ..methods.validity import MAX_TERMS, method_problem
 from ..parameters import DISTRIBUTIONS, Parameter, make_parameter
-from ..simulators.jsbsim import Excitation
+from ..simulators.jsbsim import Excitation, FlightSetup
 from ..simulators.python import PluginError, load_function
 
 SIMULATOR_KINDS = ("jsbsim", "python")
 EXECUTORS = ("local", "dask")
 TOP_KEYS = ("name", "description", "seed", "simulator", "parameters", "design", "method",
             "execution", "storage", "analysis", "limits")
-JSBSIM_KEYS = ("kind", "aircraft", "flight", "excitation", "duration_s", "output_rate_hz", "outputs")
+JSBSIM_KEYS = ("kind", "aircraft", "flight", "excitation", "duration_s", "output_rate_hz", "outputs", "trim")
 PYTHON_KEYS = ("kind", "function", "outputs")
 PARAMETER_KEYS = ("property", "function", "perturbation", "distribution", "nominal", "interval_pct", "lower", "upper")
 PERTURBATIONS = ("scale", "offset")
@@ -32,7 +32,7 @@ EXECUTION_KEYS = ("workers", "executor", "scheduler", "chunk", "timeout_s")
 STORAGE_KEYS = ("path", "raw", "tsvd")
 TSVD_KEYS = ("tol", "batch")
 DEFAULT_ORDER = 2
-ANALYSIS_KEYS = ("band_samples", "bootstrap")
+ANALYSIS_KEYS = ("band_samples", "bootstrap", "quantiles")
 # Refused before anything is built (see `check_size`); a campaign raises them under `limits:`.
 DEFAULT_LIMITS = {"max_runs": 1_000_000, "max_memory_gb": 8.0, "max_disk_gb": 100.0, "max_pce_terms": MAX_TERMS}
 LIMIT_KEYS = tuple(DEFAULT_LIMITS)
@@ -208,6 +208,8 @@ def simulator(check: Checker, value, source: str) -> dict:
         sim["aircraft_path"] = str(locate(sim["aircraft"], Path(source).resolve().parent).folder)
     except AircraftNotFound as exc:
         check.fail("simulator.aircraft", str(exc))
+    if "trim" in sim:
+        check.string(sim["trim"], "simulator.trim", FlightSetup.TRIMS)
     flight = check.mapping(sim.get("flight", {}), "simulator.flight", ("altitude_ft", "airspeed_ktas"))
     if "altitude_ft" in flight:
         check.number(flight["altitude_ft"], "simulator.flight.altitude_ft", 0.0)
@@ -373,6 +375,14 @@ def analysis(check: Checker, value) -> dict:
     analysis = dict(check.mapping(value, "analysis", ANALYSIS_KEYS))
     analysis["band_samples"] = check.integer(analysis.get("band_samples", 20000), "analysis.band_samples", 100)
     analysis["bootstrap"] = check.integer(analysis.get("bootstrap", 200), "analysis.bootstrap", 0)
+    if "quantiles" in analysis:  # kept only when given (default: statistics.DEFAULT_QUANTILES)
+        value = analysis["quantiles"]
+        if not isinstance(value, list) or not value or len(value) > 20:
+            check.fail("analysis.quantiles", f"expected a list of 1 to 20 probabilities, got {shown(value)}")
+        for i, probability in enumerate(value):
+            check.number(probability, f"analysis.quantiles[{i}]")
+            if not 0.0 < probability < 1.0:
+                check.fail(f"analysis.quantiles[{i}]", f"expected a probability in (0, 1), got {probability!r}")
     return analysis
 
 
