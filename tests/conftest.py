@@ -29,6 +29,14 @@ def read_results(path) -> dict[str, np.ndarray]:
     return found
 
 
+def assert_same_results(a, b) -> None:
+    """Two results files hold the same datasets, bit for bit."""
+    ra, rb = read_results(a), read_results(b)
+    assert ra.keys() == rb.keys()
+    for key in ra:
+        np.testing.assert_array_equal(ra[key], rb[key], err_msg=key)
+
+
 def _refuse_constant(name: str):
     raise ValueError(f"{name} is not JSON: summary.json must be strict")
 

@@ -2,19 +2,17 @@
 import os
 import signal
 import subprocess
-from pathlib import Path
 
 import h5py
 import numpy as np
 import pytest
-from conftest import UQFLIGHT, read_results
+from conftest import DATA, UQFLIGHT, assert_same_results
 
 from uqflight.campaign import parse_campaign
 from uqflight.simulators.jsbsim_probe import jsbsim_probe
 from uqflight.execution import run_campaign
 from uqflight.store import ResultStore, Status
 
-DATA = Path(__file__).parent / "data"
 
 JSBSIM_CAMPAIGN = """
 name: small-jsbsim
@@ -35,12 +33,6 @@ execution: {{workers: 1, chunk: 4}}
 def jsbsim_campaign(samples=12, duration=5):
     return parse_campaign(JSBSIM_CAMPAIGN.format(samples=samples, duration=duration), "small.yaml", jsbsim_probe)
 
-
-def assert_same_results(a, b):
-    ra, rb = read_results(a), read_results(b)
-    assert ra.keys() == rb.keys()
-    for key in ra:
-        np.testing.assert_array_equal(ra[key], rb[key], err_msg=key)
 
 
 def test_results_do_not_depend_on_workers_or_executor(tmp_path):

@@ -10,13 +10,12 @@ from pathlib import Path
 import h5py
 import numpy as np
 import pytest
+from conftest import DATA, UQFLIGHT, assert_same_results
 
 from uqflight.campaign import parse_campaign
 from uqflight.execution import run_campaign
 from uqflight.store import CorruptFile, ResultStore, Status
 
-UQFLIGHT = str(Path(sys.executable).with_name("uqflight"))
-DATA = Path(__file__).parent / "data"
 
 
 def campaign_text(function, samples=40, chunk=8, workers=1, extra="", name="hostile"):
@@ -33,20 +32,6 @@ execution: {{workers: {workers}, chunk: {chunk}{extra}}}
 
 def campaign(function, **kwargs):
     return parse_campaign(campaign_text(function, **kwargs), str(DATA / "hostile.yaml"))
-
-
-def read_all(path):
-    data = {}
-    with h5py.File(path, "r") as f:
-        f.visititems(lambda name, obj: data.update({name: obj[()]}) if isinstance(obj, h5py.Dataset) else None)
-    return data
-
-
-def assert_same_results(a, b):
-    ra, rb = read_all(a), read_all(b)
-    assert ra.keys() == rb.keys()
-    for key in ra:
-        np.testing.assert_array_equal(ra[key], rb[key], err_msg=key)
 
 
 def children(pid):

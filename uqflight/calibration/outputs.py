@@ -9,26 +9,11 @@ import h5py
 import numpy as np
 import yaml
 
+from ..statistics import json_ready as strict
+
 OUTPUT_FILES = ("posterior.h5", "summary.json", "calibrated.yaml", "plots/corner.png", "plots/marginals.png",
                 "plots/predictive.png")
 INFORMED = 0.9  # posterior std below this fraction of the prior's: the parameter gets the posterior marginal
-
-
-def strict(value):
-    """value with every non-finite float (NaN, ±inf) replaced by None, numpy scalars as Python numbers."""
-    if isinstance(value, dict):
-        return {str(k): strict(v) for k, v in value.items()}
-    if isinstance(value, (list, tuple)):
-        return [strict(v) for v in value]
-    if isinstance(value, np.ndarray):
-        return strict(value.tolist())
-    if isinstance(value, (np.floating, float)):
-        return float(value) if math.isfinite(value) else None
-    if isinstance(value, np.integer):
-        return int(value)
-    if isinstance(value, np.bool_):
-        return bool(value)
-    return value
 
 
 def marginal(values: np.ndarray) -> dict:
