@@ -1,16 +1,22 @@
-"""Accuracy of the non-intrusive methods on the bacm against Monte Carlo, and runs per accuracy.
+"""Accuracy of the non-intrusive methods on the bacm against a sharp reference, with its own floor.
 
-Uses the results of the shipped campaigns mc-normal, grid-gh-l1..l4 and grid-gk-l1..l4 in
---results, and runs those that are missing first (about 10 minutes on 2 cores for all of them).
+The reference is the randomised-QMC campaign rqmc-normal (16 independent scrambles of 1024 Sobol'
+points, 16,384 runs): the spread of its replicates gives the standard error of its mean and
+variance at every time, the floor below which it cannot tell a method from the truth. Beside it,
+the floor a Monte Carlo reference of N runs would have, σ/√N for the mean and the distribution-free
+standard error of the variance, computed from the same runs' moments (no need to fly 10^5 runs to
+know how well they would resolve).
 
 Tables:
-1. max over time of eps_m and eps_v (paper Eq. 49) for every output, method and grid, against
-   the Monte Carlo reference (results/mc-normal.h5, 10^4 runs).
-2. Runs per accuracy: the reference above resolves eps_v only down to its own sampling error
-   (~sqrt(2/N) = 1.4 % at N = 10^4). The highest grid (2437 points, pseudo-Galerkin of order 4)
-   serves as a sharper reference instead, once checked against the Monte Carlo one. For theta,
-   alpha and V_TAS: max eps_v of PG-2 on the 113-point grid against it, and the number of Monte
-   Carlo runs whose max eps_v (median over disjoint subsets of mc-normal) first falls below it.
+1. max over time of eps_m and eps_v (paper Eq. 49) for every output, method and grid (grid-gh-l1..l4)
+   against the reference, with the reference's floor; "~" marks an error below 2 floors (within the
+   reference's noise).
+2. The floors: RQMC 16 × 1024 against Monte Carlo with 10^4 and 10^5 runs.
+3. Runs per accuracy: the fewest grid runs whose max eps_v lies below the error Monte Carlo makes
+   with 10^4 and with 10^5 runs (its floor at that N), per method.
+
+Uses results/rqmc-normal.h5 and results/grid-gh-l*.h5 in --results, running the missing campaigns
+first (about 12 minutes on 2 quiet cores).
 
 Run: .venv/bin/python benchmarks/accuracy.py [--results results]
 """
@@ -22,94 +28,48 @@ from pathlib import Path
 import numpy as np
 
 from uqflight.analysis.errors import relative_errors
+from uqflight.analysis.floors import floors_from_moments
 from uqflight.campaign import load_campaign
-from uqflight.simulators.jsbsim_probe import jsbsim_probe
 from uqflight.execution import run_campaign
-from uqflight.statistics import Options, analyse
-from uqflight.store import ResultStore, Status
+from uqflight.simulators.jsbsim_probe import jsbsim_probe
+from uqflight.statistics import BadInput, Options, analyse
+from uqflight.store import ResultStore
 
 OUTPUTS = ("theta_deg", "alpha_deg", "q_degps", "h_ft", "vtas_kt")
-METHODS = [("integration", 2), ("pseudo_galerkin", 2), ("interpolation", 2), ("regression", 2),
-           ("least_squares", 2)]
+METHODS = [("pseudo_galerkin", None), ("interpolation", None), ("least_squares", None), ("regression", None)]
+LEVELS = (1, 2, 3, 4)
 CAMPAIGNS = Path(__file__).resolve().parents[1] / "campaigns"
 FAST = Options(band_samples=2000, bootstrap=0)
 
 
-def max_errors(stats, reference):
-    row = {}
-    for name in OUTPUTS:
-        eps_m, eps_v = relative_errors(stats.outputs[name].mean, stats.outputs[name].variance,
-                                       reference.outputs[name].mean, reference.outputs[name].variance)
-        row[name] = (eps_m.max(), eps_v.max())
-    return row
-
-
-def method_table(results: Path, reference) -> None:
-    print("## max over time of eps_m / eps_v against Monte Carlo (10^4 runs)\n")
-    print("| grid | runs | method | " + " | ".join(OUTPUTS) + " |")
-    print("|---|---|---|" + "---|" * len(OUTPUTS))
-    for grid in ("gh", "gk"):
-        for level in (1, 2, 3, 4):
-            path = results / f"grid-{grid}-l{level}.h5"
-            if not path.exists():
-                continue
-            with ResultStore.open(path) as store:
-                runs = store.status.size
-            for kind, order in METHODS:
-                try:
-                    stats = analyse(path, options=FAST, method={"kind": kind, "order": order})
-                except ValueError as exc:  # e.g. too few points for the regression's terms
-                    print(f"| {grid}-l{level} | {runs} | {kind} {order} | {exc} |")
-                    continue
-                cells = [f"{m:.1e} / {v:.1e}" for m, v in max_errors(stats, reference).values()]
-                print(f"| {grid}-l{level} | {runs} | {kind} {order} | " + " | ".join(cells) + " |")
-
-
-def runs_per_accuracy(results: Path, reference) -> None:
-    grid_ref = analyse(results / "grid-gh-l4.h5", options=FAST, method={"kind": "pseudo_galerkin", "order": 4})
-    pg2 = analyse(results / "grid-gh-l2.h5", options=FAST, method={"kind": "pseudo_galerkin", "order": 2})
-    with ResultStore.open(results / "mc-normal.h5") as store:
-        ok = np.flatnonzero(store.status == Status.OK)
-        runs = {name: store.output_matrix(name, ok) for name in ("theta_deg", "alpha_deg", "vtas_kt")}
-    print("\n## Runs per accuracy (reference: PG-4 on the 2437-point grid)\n")
-    print("| output | PG-4/2437 vs MC 10^4: max eps_v | PG-2/113: max eps_v | MC runs for the same | ratio |")
-    print("|---|---|---|---|---|")
-    for name, Y in runs.items():
-        ref_mean, ref_var = grid_ref.outputs[name].mean, grid_ref.outputs[name].variance
-        check = relative_errors(ref_mean, ref_var, reference.outputs[name].mean, reference.outputs[name].variance)[1]
-        target = relative_errors(pg2.outputs[name].mean, pg2.outputs[name].variance, ref_mean, ref_var)[1].max()
-        needed, error = None, np.inf
-        for n in (50, 100, 200, 400, 800, 1600, 3200, 5000, 10000):
-            if n > len(Y):
-                break
-            subsets = [Y[i:i + n] for i in range(0, len(Y) - n + 1, n)]
-            errors = [relative_errors(s.mean(0), s.var(0, ddof=1), ref_mean, ref_var)[1].max() for s in subsets]
-            error, largest = np.median(errors), n
-            if error <= target:
-                needed = n
-                break
-        if needed:
-            shown, ratio = f"{needed}", f"{needed / 113:.0f}x"
-        else:  # Monte Carlo's error falls as N^-1/2: extrapolate from the largest subset
-            estimate = largest * (error / target) ** 2
-            shown, ratio = f"> {largest} (~{estimate:.0e} by N^-1/2)", f"~{estimate / 113:.0e}x"
-        print(f"| {name} | {check.max():.1e} | {target:.1e} | {shown} | {ratio} |")
-
-
-def complete(path: Path) -> bool:
-    if not path.exists():
-        return False
-    with ResultStore.open(path) as store:
-        return store.pending().size == 0
-
-
 def ensure_results(results: Path) -> None:
-    """Run the campaigns whose results file is missing (a partial file is resumed)."""
-    for name in ["mc-normal"] + [f"grid-{rule}-l{level}" for rule in ("gh", "gk") for level in (1, 2, 3, 4)]:
+    """Run the campaigns whose results file is missing or incomplete (a partial file is resumed)."""
+    for name in ["rqmc-normal"] + [f"grid-gh-l{level}" for level in LEVELS]:
         path = results / f"{name}.h5"
-        if not complete(path):
-            print(f"running campaigns/{name}.yaml into {path} ...", flush=True)
-            run_campaign(load_campaign(CAMPAIGNS / f"{name}.yaml", jsbsim_probe), out=path)
+        if path.exists():
+            with ResultStore.open(path) as store:
+                if store.pending().size == 0:
+                    continue
+        print(f"running campaigns/{name}.yaml into {path} ...", flush=True)
+        run_campaign(load_campaign(CAMPAIGNS / f"{name}.yaml", jsbsim_probe), out=path)
+
+
+def monte_carlo_floor(reference, name: str, n: int) -> np.ndarray:
+    """max over time of the eps_v floor a Monte Carlo reference of n runs would have (its moments)."""
+    out = reference.outputs[name]
+    fourth = _fourth_central(reference.path, name)
+    return floors_from_moments(out.mean, out.variance, fourth, n)["eps_v_floor"].max()
+
+
+def mark(value: float, floor: float) -> str:
+    """An error, with ~ when it is below 2 floors of the reference (within its noise)."""
+    return f"~{value:.1e}" if value < 2 * floor else f"{value:.1e}"
+
+
+def _fourth_central(path: str, name: str) -> np.ndarray:
+    with ResultStore.open(path) as store:
+        Y = store.output_matrix(name)
+    return ((Y - Y.mean(axis=0)) ** 4).mean(axis=0)
 
 
 def main():
@@ -117,9 +77,63 @@ def main():
     parser.add_argument("--results", type=Path, default=Path("results"))
     args = parser.parse_args()
     ensure_results(args.results)
-    reference = analyse(args.results / "mc-normal.h5", options=FAST)
-    method_table(args.results, reference)
-    runs_per_accuracy(args.results, reference)
+    reference = analyse(args.results / "rqmc-normal.h5", options=FAST)
+    floor_v = {name: reference.outputs[name].replicate_moments[1].std(axis=0, ddof=1).max()
+               / np.sqrt(reference.replicates) / reference.outputs[name].variance.max() for name in OUTPUTS}
+    floor_m = {name: reference.outputs[name].replicate_moments[0].std(axis=0, ddof=1).max()
+               / np.sqrt(reference.replicates) / np.abs(reference.outputs[name].mean).max() for name in OUTPUTS}
+
+    print("## Floors: the errors a reference's own noise makes (max over time of eps_m / eps_v)\n")
+    print("| reference | " + " | ".join(OUTPUTS) + " |")
+    print("|---|" + "---|" * len(OUTPUTS))
+    print(f"| RQMC {reference.replicates} × {reference.completed // reference.replicates} "
+          f"({reference.completed} runs) | " + " | ".join(f"{floor_m[n]:.1e} / {floor_v[n]:.1e}" for n in OUTPUTS) + " |")
+    mc = {n_runs: {name: monte_carlo_floor(reference, name, n_runs) for name in OUTPUTS} for n_runs in (10**4, 10**5)}
+    for n_runs, floors in mc.items():
+        mean_floor = {name: np.sqrt(reference.outputs[name].variance / n_runs).max()
+                      / np.abs(reference.outputs[name].mean).max() for name in OUTPUTS}
+        print(f"| Monte Carlo 10^{int(np.log10(n_runs))} (from the same moments) | "
+              + " | ".join(f"{mean_floor[n]:.1e} / {floors[n]:.1e}" for n in OUTPUTS) + " |")
+
+    print("\n## max over time of eps_m / eps_v against the RQMC reference (~: below 2 floors)\n")
+    print("| grid | runs | method | " + " | ".join(OUTPUTS) + " |")
+    print("|---|---|---|" + "---|" * len(OUTPUTS))
+    best: dict[str, list[tuple[int, dict]]] = {kind: [] for kind, _ in METHODS}
+    for level in LEVELS:
+        path = args.results / f"grid-gh-l{level}.h5"
+        with ResultStore.open(path) as store:
+            runs = store.status.size
+        for kind, _ in METHODS:
+            order = level  # the largest order a level-L Gauss-Hermite grid projects (degree 2L + 1)
+            try:
+                stats = analyse(path, options=FAST, method={"kind": kind, "order": order})
+            except BadInput as exc:
+                print(f"| GH level {level} | {runs} | {kind} {order} | refused: {str(exc).split(': ', 2)[-1][:90]} |")
+                continue
+            cells, row = [], {}
+            for name in OUTPUTS:
+                eps_m, eps_v = relative_errors(stats.outputs[name].mean, stats.outputs[name].variance,
+                                               reference.outputs[name].mean, reference.outputs[name].variance)
+                row[name] = eps_v.max()
+                cells.append(f"{mark(eps_m.max(), floor_m[name])} / {mark(eps_v.max(), floor_v[name])}")
+            best[kind].append((runs, row))
+            print(f"| GH level {level} | {runs} | {kind} {order} | " + " | ".join(cells) + " |")
+
+    print("\n## Runs for the accuracy of Monte Carlo with 10^4 and 10^5 runs (max eps_v)\n")
+    print("| method | " + " | ".join(f"{name}: 10^4 / 10^5" for name in OUTPUTS) + " |")
+    print("|---|" + "---|" * len(OUTPUTS))
+    for kind, rows in best.items():
+        cells = []
+        for name in OUTPUTS:
+            needs = []
+            for n_runs in (10**4, 10**5):
+                fewest = next((runs for runs, row in rows if row[name] <= mc[n_runs][name]), None)
+                unresolved = mc[n_runs][name] < 2 * floor_v[name]
+                needs.append("-" if fewest is None else f"{fewest}" + ("?" if unresolved else ""))
+            cells.append(" / ".join(needs))
+        print(f"| {kind} | " + " | ".join(cells) + " |")
+    print("\n(-: no grid up to 2437 runs reaches it; ?: that Monte Carlo error is within 2 floors of the "
+          "RQMC reference, so the comparison is at the reference's resolution)")
 
 
 if __name__ == "__main__":

@@ -124,8 +124,8 @@ def main() -> None:
     assert not failures, failures
     prior = prior_summaries(surrogate.parameters)
     given = {} if args.infer_noise else NOISE
-    print(f"truth: " + ", ".join(f"{n} = {v:.6g}" for n, v in truth.items()))
-    print(f"noise: " + ", ".join(f"{o} {s:g}" for o, s in NOISE.items()) + ("(inferred)" if args.infer_noise else
+    print("truth: " + ", ".join(f"{n} = {v:.6g}" for n, v in truth.items()))
+    print("noise: " + ", ".join(f"{o} {s:g}" for o, s in NOISE.items()) + ("(inferred)" if args.infer_noise else
                                                                            " (given)"))
 
     rows = study("A: fixed truth (CL0 +1.5 sd, k2 -1.2 sd, others nominal), noise seeds", args, surrogate,
