@@ -396,8 +396,15 @@ class WorkerPool:
         self.slots: list[WorkerProcess] = []
 
     def probe(self, kappa: np.ndarray):
-        """(time, outputs, units, seconds of a nominal flight), from a worker."""
+        """(time, outputs, units, seconds of a nominal flight), from a worker. Every worker of the pool
+        is started and flies the nominal at once, so all are warm (imports, aircraft, the Newton trim's
+        nominal) when the chunks start; the first one's answer is used."""
         slot = self._slot()
+        while len(self.slots) < self.workers:
+            self.slots.append(WorkerProcess())
+        for other in self.slots[1:]:
+            if not other.send(("probe", self.spec, kappa)):
+                self._drop(other)
         if not slot.send(("probe", self.spec, kappa)):
             raise WorkerError(death_reason(self._drop(slot)))
         if not wait_connections([slot.conn], timeout=self.timeout):
@@ -409,6 +416,12 @@ class WorkerPool:
             raise WorkerError(death_reason(self._drop(slot)) + " during the nominal flight") from None
         if kind != "probe":
             raise WorkerError(str(payload))
+        for other in list(self.slots[1:]):  # the others' answers (a worker that failed is replaced later)
+            try:
+                if not wait_connections([other.conn], timeout=self.timeout) or other.conn.recv()[0] != "probe":
+                    self._drop(other, dead=False)
+            except (EOFError, OSError):
+                self._drop(other)
         return payload
 
     def run(self, tasks, n_times: int, outputs: list[str]):
