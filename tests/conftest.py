@@ -3,6 +3,7 @@ the numbers against. Test modules import these names (`from conftest import ...`
 from __future__ import annotations
 
 import json
+import os
 import subprocess
 import sys
 from pathlib import Path
@@ -19,6 +20,23 @@ UQFLIGHT = str(Path(sys.executable).with_name("uqflight"))
 def cli(*args, cwd=None, timeout: float = 300) -> subprocess.CompletedProcess:
     """`uqflight ARGS...` in a fresh process, its output captured."""
     return subprocess.run([UQFLIGHT, *map(str, args)], cwd=cwd, capture_output=True, text=True, timeout=timeout)
+
+
+def cli_in_process(*args, cwd=None) -> subprocess.CompletedProcess:
+    """`uqflight ARGS...` run in this process (no interpreter start-up: for tests that call the
+    command many times); the same exit code, stdout and stderr as `cli`."""
+    from typer.testing import CliRunner
+
+    from uqflight.cli import app
+
+    here = os.getcwd()
+    try:
+        if cwd is not None:
+            os.chdir(cwd)
+        result = CliRunner().invoke(app, [str(a) for a in args])
+    finally:
+        os.chdir(here)
+    return subprocess.CompletedProcess(list(args), result.exit_code, result.stdout, result.stderr)
 
 
 def read_results(path) -> dict[str, np.ndarray]:

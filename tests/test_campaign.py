@@ -4,7 +4,7 @@ from pathlib import Path
 
 import pytest
 
-from conftest import ROOT, cli
+from conftest import ROOT, cli, cli_in_process
 from uqflight.campaign import CampaignError, load_campaign, parse_campaign
 from uqflight.simulators.jsbsim_probe import jsbsim_probe
 
@@ -88,7 +88,7 @@ def test_a_bad_file_gets_one_message_naming_file_field_and_expectation(name):
 
 
 def uqflight(*args, cwd):
-    return cli(*args, cwd=cwd)
+    return cli_in_process(*args, cwd=cwd)
 
 
 @pytest.mark.parametrize("name", CLI_BAD)
@@ -160,7 +160,7 @@ def test_a_python_model_from_the_package_validates():
 
 
 def test_a_python_file_is_found_relative_to_the_campaign_not_the_working_directory(tmp_path):
-    result = uqflight("run", DATA / "good_python_file.yaml", "--out", tmp_path / "r.h5", cwd=tmp_path)
+    result = cli("run", DATA / "good_python_file.yaml", "--out", tmp_path / "r.h5", cwd=tmp_path)
     assert result.returncode == 0, result.stderr
     assert (tmp_path / "r.h5").is_file()
 

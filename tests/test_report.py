@@ -9,7 +9,7 @@ import h5py
 import numpy as np
 import pytest
 
-from conftest import UQFLIGHT, cli, read_summary
+from conftest import UQFLIGHT, cli, cli_in_process, read_summary
 from uqflight.campaign import parse_campaign
 from uqflight.simulators.jsbsim_probe import jsbsim_probe
 from uqflight.execution import run_campaign
@@ -234,14 +234,14 @@ def test_check_refuses_bad_input_with_exit_2_and_one_line(files, baseline, tmp_p
     for name, (text, message) in cases.items():
         path = tmp_path / f"{name.replace(' ', '_')}.json"
         path.write_text(text)
-        result = cli("check", files["pg"], "--baseline", path)
+        result = cli_in_process("check", files["pg"], "--baseline", path)
         assert result.returncode == 2, (name, result.stdout, result.stderr)
         assert message in result.stderr, (name, result.stderr)
         assert "Traceback" not in result.stderr and len(result.stderr.strip().splitlines()) == 1, (name, result.stderr)
     for args, message in (((files["pg"], "--baseline", tmp_path / "missing.json"), "cannot read the baseline"),
                           ((tmp_path / "missing.h5", "--baseline", baseline), "no such results file"),
                           ((baseline, "--baseline", baseline), "cannot analyse the results file")):
-        result = cli("check", *args)
+        result = cli_in_process("check", *args)
         assert result.returncode == 2 and message in result.stderr and "Traceback" not in result.stderr, result.stderr
 
 

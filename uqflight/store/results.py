@@ -272,8 +272,10 @@ class ResultStore:
         for name, rows in values.items():
             if self._raw:
                 self._file["outputs"][_key(name)][idx] = np.where(ok[:, None], rows, np.nan)
-            if "tsvd" in self._file:
-                append_rows(self._file["tsvd"][_key(name)], rows[ok], idx[ok])
+            if "tsvd" in self._file:  # a run the factors already hold (rerun after its raw rows were lost) stays out
+                group = self._file["tsvd"][_key(name)]
+                new = ok & ~np.isin(idx, self._held_runs(group))
+                append_rows(group, rows[new], idx[new])
         self._flush(sync=True)
         self._file["samples/reason"][idx] = reasons
         self._file["samples/status"][idx] = status
@@ -295,17 +297,27 @@ class ResultStore:
 
     def _repair_lost_runs(self, block: int = 1000) -> int:
         """Mark pending again the ok runs whose raw histories did not reach the disk (a write that
-        failed late, e.g. a full disk hit by HDF5's cache at flush), so that a resume reruns them;
-        returns how many."""
+        failed late, e.g. a full disk hit by HDF5's cache at flush, or a chunk a kill left half written,
+        whose checksum fails: it is overwritten), so that a resume reruns them; returns how many."""
         status = self.status
         lost = np.zeros(status.size, dtype=bool)
         if self._raw:
             for key in self._file["outputs"]:
                 data = self._file["outputs"][key]
-                for start in range(0, status.size, block):
-                    ok = status[start:start + block] == Status.OK
+                rows = data.chunks[0] if data.chunks else block  # whole chunks: a torn one is rewritten whole
+                step = max(rows, block - block % rows)
+                for start in range(0, status.size, step):
+                    stop = min(start + step, status.size)
+                    ok = status[start:stop] == Status.OK
+                    try:
+                        values = data[start:stop]
+                    except OSError:  # a chunk a kill tore (its checksum fails): its runs are rerun
+                        for first in range(start, stop, rows):
+                            data[first:min(first + rows, stop)] = np.nan
+                        lost[start:stop] |= ok
+                        continue
                     if ok.any():
-                        lost[start:start + block] |= ok & ~np.isfinite(data[start:start + block]).all(axis=1)
+                        lost[start:stop] |= ok & ~np.isfinite(values).all(axis=1)
         elif "tsvd" in self._file:  # ok runs neither in the factors nor in the buffer (their order in the
             for key in self._file["tsvd"]:  # factors then follows the rerun: equal data, other rounding)
                 group = self._file["tsvd"][key]
@@ -320,6 +332,11 @@ class ResultStore:
             self._file["samples/reason"][index] = [""] * index.size
             self._flush(sync=True)
         return int(lost.sum())
+
+    def _held_runs(self, group) -> np.ndarray:
+        """The runs an output's tSVD factors or buffer hold."""
+        n = group["buffer_index"].shape[0]
+        return np.union1d(group["columns"][()], group["buffer_index"][:n])
 
     def batch_bytes(self, n: int) -> int:
         """An upper estimate of the bytes the next batch of `n` runs may add to the file: its rows
