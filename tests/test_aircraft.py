@@ -75,6 +75,7 @@ def test_trim_at_each_end_of_the_table1_intervals(flight, nominal, name, sign):
     assert max(changed) > 1e-6, f"setting {name} changed nothing"
 
 
+@pytest.mark.slow
 def test_trim_succeeds_for_1000_normal_draws(flight, nominal):
     rng = np.random.default_rng(2026)
     nom = np.array([nominal[p] for p in UQ])

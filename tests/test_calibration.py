@@ -288,6 +288,7 @@ def test_the_sampler_is_reproducible_from_its_seed():
     assert not np.array_equal(runs[0], runs[2])
 
 
+@pytest.mark.slow
 def test_surrogate_error_measured_at_the_posterior_is_added_when_larger(tmp_path):
     # x(t) = exp(-a t), a ~ N(1, 0.2²), order-2 PCE from 30 points: fine near the prior, 6x worse than
     # its LOO estimate at a = 1.75 (3.75σ), where the data are. The check at the posterior draws sees

@@ -117,6 +117,7 @@ def test_exp_decay_moments_over_time_from_a_sparse_grid(tmp_path, method):
     np.testing.assert_array_equal(out.time, DECAY_TIME)
 
 
+@pytest.mark.slow
 def test_exp_decay_moments_from_monte_carlo(tmp_path):
     # 20,000 runs: the standard error of the mean is sigma_x / sqrt(N) and of the variance about
     # var * sqrt(2 / N) (~1 %); 5 standard errors bound the check.

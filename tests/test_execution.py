@@ -90,6 +90,7 @@ def test_a_file_of_another_campaign_is_refused_unless_forced(tmp_path):
     assert run_campaign(other, out=tmp_path / "r.h5", force=True).ran == 3
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("storage", ["raw", "tsvd"])
 def test_resume_after_sigkill_equals_an_uninterrupted_run(tmp_path, storage):
     text = JSBSIM_CAMPAIGN.format(samples=160, duration=20)

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 import uqflight
-from conftest import cli
+from conftest import cli, cli_in_process
 from uqflight.campaign import parse_campaign
 from uqflight.execution import run_campaign
 from uqflight.methods.basis import orthonormal_basis
@@ -43,15 +43,15 @@ def results(tmp_path_factory) -> Path:
 def test_version_and_short_help():
     result = cli("--version")
     assert result.returncode == 0 and result.stdout.strip() == f"uqflight {uqflight.__version__}"
-    short, long = cli("-h"), cli("--help")
+    short, long = cli_in_process("-h"), cli_in_process("--help")
     assert short.returncode == 0 and short.stdout == long.stdout and "-h, --help" in short.stdout
-    for command in ("report", "design", "simulate"):
-        assert cli(command, "-h").returncode == 0
+    for command in ("report", "design", "simulate", "calibrate", "aircraft"):
+        assert cli_in_process(command, "-h").returncode == 0
     assert "surrogate" in short.stdout and "design" in short.stdout
 
 
 def test_units_are_visible_in_simulate_help():
-    text = " ".join(cli("simulate", "--help").stdout.split())
+    text = " ".join(cli_in_process("simulate", "--help").stdout.split())
     for unit in ("altitude [ft]", "airspeed [kt]", "amplitude [deg]", "start [s]", "[Hz]"):
         assert unit in text, (unit, text)
 
@@ -71,6 +71,7 @@ def test_report_writes_next_to_the_results_file_by_default(results):
     assert not [p for p in results.parent.iterdir() if p.name.startswith(".decay-report")]
 
 
+@pytest.mark.slow
 def test_a_report_that_fails_midway_leaves_nothing(results, tmp_path, monkeypatch):
     import uqflight.report as report
 
@@ -93,6 +94,7 @@ def test_a_report_that_fails_midway_leaves_nothing(results, tmp_path, monkeypatc
     assert not (old / "keep.txt").exists() and (old / "report.html") in written
 
 
+@pytest.mark.slow
 def test_several_methods_over_the_same_runs(results, tmp_path):
     out = tmp_path / "methods"
     result = cli("report", results, "--method", "pseudo_galerkin:2", "--method", "least_squares:1",

@@ -77,6 +77,7 @@ def test_samples_that_kill_their_worker_are_failed_runs_with_any_number_of_worke
     assert_same_results(tmp_path / "w1.h5", tmp_path / "w2.h5")
 
 
+@pytest.mark.slow
 def test_a_worker_death_on_dask_is_a_failed_run(tmp_path):
     pytest.importorskip("dask.distributed")
     summary = run_campaign(campaign("crashing", samples=16), out=tmp_path / "d.h5", workers=2, executor="dask")
@@ -421,6 +422,7 @@ def test_sigint_to_the_runner_alone_stops_it_cleanly(tmp_path):
     assert wait_for(lambda: not any(alive(pid) for pid in workers), 10)
 
 
+@pytest.mark.slow
 def test_the_cli_exits_2_when_the_disk_fills_past_the_check(tmp_path, small_disk):
     """The free-space check bypassed (another process fills the disk): exit 2, never 0 or 139."""
     out = small_disk / "r.h5"

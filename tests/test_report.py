@@ -86,6 +86,7 @@ def read_csv(path: Path) -> list[dict]:
         return list(csv.DictReader(fh))
 
 
+@pytest.mark.slow
 def test_report_of_several_files_against_a_reference(files, tmp_path):
     out = tmp_path / "report"
     result = cli("report", files["pg"], files["int"], "--reference", files["mc"], "--out", out, "--times", "1,2.5,end")
@@ -124,6 +125,7 @@ def test_report_of_several_files_against_a_reference(files, tmp_path):
     assert "Errors against the reference" in page and "decay-int: Int order 1, 3 runs" in page
 
 
+@pytest.mark.slow
 def test_pce_against_pick_freeze_and_two_monte_carlo_files(files, tmp_path):
     out = tmp_path / "report"
     write_report([files["ishigami_pce"], files["ishigami_pf"]], out)
@@ -144,6 +146,7 @@ def test_pce_against_pick_freeze_and_two_monte_carlo_files(files, tmp_path):
     assert [row["inputs"] for row in read_csv(mc / "tables" / "files.csv")] == ["normal", "uniform"]
 
 
+@pytest.mark.slow
 def test_report_of_a_jsbsim_campaign_and_its_check(tmp_path):
     results = run(JSBSIM, tmp_path / "jsbsim.h5", probe=jsbsim_probe)
     baseline = tmp_path / "baseline.json"
@@ -261,6 +264,7 @@ def test_split_form_is_ignored_by_the_kinds_that_fit_their_constant_term(tmp_pat
     np.testing.assert_allclose(split.outputs["x"].variance, plain.outputs["x"].variance, rtol=1e-12)
 
 
+@pytest.mark.slow
 def test_method_override_reports_another_method_on_the_same_runs(files, tmp_path):
     result = subprocess.run([UQFLIGHT, "report", str(files["pg"]), "--method", "least_squares", "--order", "3",
                              "--out", str(tmp_path / "ls")], capture_output=True, text=True)
