@@ -1,16 +1,21 @@
 """The CLI and report for people (issue 14): --version, -h, units in --help, the report's default
-folder and its temp-dir-then-move, repeatable --method, `design --csv`, `surrogate export`."""
+folder and its temp-dir-then-move, repeatable --method, `design --csv`, `surrogate export`, --restart,
+`check` against another campaign, "did you mean", the progress bar."""
 import csv
+import io
 import json
+import re
+import time
 from pathlib import Path
 
+import h5py
 import numpy as np
 import pytest
 
 import uqflight
 from conftest import cli, cli_in_process
 from uqflight.campaign import parse_campaign
-from uqflight.execution import run_campaign
+from uqflight.execution import Progress, run_campaign
 from uqflight.methods.basis import orthonormal_basis
 from uqflight.report import write_report
 from uqflight.statistics import analyse
@@ -164,3 +169,46 @@ def test_surrogate_export_round_trip(results, tmp_path):
     assert near.shape == time.shape
     mc = cli("surrogate", "export", results, "--out", tmp_path / "mc.json", "--method", "monte_carlo")
     assert mc.returncode == 2 and "needs a sampled design" in mc.stderr and not (tmp_path / "mc.json").exists()
+
+
+def test_restart_starts_a_same_campaign_file_over_and_force_keeps_its_meaning(tmp_path):
+    campaign = tmp_path / "decay.yaml"
+    campaign.write_text(DECAY)
+    out = tmp_path / "d.h5"
+    assert cli("run", campaign, "--out", out).returncode == 0
+    with h5py.File(out, "r") as f:
+        created = f.attrs["created"]
+    again = cli("run", campaign, "--out", out, "--force")  # a file of this campaign: resumed, nothing to do
+    assert again.returncode == 0 and "0 run now" in again.stdout
+    time.sleep(1.1)  # `created` has a resolution of a second
+    restarted = cli("run", campaign, "--out", out, "--restart")
+    assert restarted.returncode == 0 and "already done" in restarted.stdout and " 0 already done" in restarted.stdout
+    with h5py.File(out, "r") as f:
+        assert f.attrs["created"] != created
+
+
+def test_check_against_another_campaigns_baseline_exits_2(results, tmp_path):
+    baseline = tmp_path / "baseline.json"
+    assert cli_in_process("report", results, "--out", tmp_path / "r", "--write-baseline", baseline).returncode == 0
+    data = json.loads(baseline.read_text())
+    data["campaign_hash"] = "0" * 64
+    baseline.write_text(json.dumps(data))
+    checked = cli_in_process("check", results, "--baseline", baseline)
+    assert checked.returncode == 2 and "comes from another campaign" in checked.stderr
+
+
+def test_a_mistyped_property_gets_a_did_you_mean():
+    result = cli_in_process("simulate", "--set", "aero/uq/CLO=0.2", "--duration-s", "1")
+    assert result.returncode == 2 and "did you mean aero/uq/CL0" in result.stderr
+
+
+def test_the_progress_counts_resumed_runs_and_fits_the_terminal(monkeypatch):
+    monkeypatch.setenv("COLUMNS", "60")  # a terminal of 60 columns
+    buffer = io.StringIO()
+    buffer.isatty = lambda: True
+    progress = Progress(100, done=40, stream=buffer)
+    progress.advance(10)
+    progress.close()
+    screen = buffer.getvalue()
+    assert "50/100" in screen and "runs/s" in screen
+    assert max(len(line) for line in re.sub(r"\x1b\[[0-9;?]*[A-Za-z]", "", screen).splitlines()) <= 60

@@ -200,6 +200,8 @@ def run(
                                                        "without it, a LocalCluster."),
     force: bool = typer.Option(False, help="Overwrite a results file made from another campaign (never a file "
                                            "another run holds, nor one that is not a uqflight results file)."),
+    restart: bool = typer.Option(False, help="Start a results file of this same campaign over instead of resuming "
+                                             "it (never a file another run holds)."),
 ):
     """Run a campaign into its HDF5 results file; rerunning resumes where it stopped.
 
@@ -220,7 +222,7 @@ def run(
     previous = _stop_on_sigterm()
     try:
         summary = run_campaign(spec, out=out, workers=workers, executor=executor, scheduler=scheduler,
-                               force=force, progress=True)
+                               force=force, progress=True, restart=restart)
     except DiskFull as exc:
         typer.echo(f"\nerror: {exc.strerror}", err=True)
         _exit_now(2)
@@ -514,8 +516,10 @@ def check(
         typer.echo(f"error: {exc}", err=True)
         raise typer.Exit(2)
     if expected.get("campaign_hash") and expected["campaign_hash"] != attrs.get("campaign_hash"):
-        typer.echo(f"note: {results} comes from another campaign (sha256 {str(attrs.get('campaign_hash'))[:12]}) "
-                   f"than the baseline ({str(expected['campaign_hash'])[:12]})")
+        typer.echo(f"error: {results} comes from another campaign (sha256 {str(attrs.get('campaign_hash'))[:12]}) "
+                   f"than the baseline {baseline} ({str(expected['campaign_hash'])[:12]}): compare a results file "
+                   "with the baseline of its own campaign", err=True)
+        raise typer.Exit(2)
     if comparison.drifts:
         typer.echo(f"drift: {len(comparison.drifts)} of {comparison.compared} values outside "
                    f"rtol={rtol:g}, atol={atol:g}")

@@ -98,7 +98,8 @@ def versions() -> dict[str, str]:
     return found
 
 
-def prepare_store(campaign: Campaign, design: Design, out: Path, force: bool, probed=None) -> ResultStore:
+def prepare_store(campaign: Campaign, design: Design, out: Path, force: bool, probed=None,
+                  restart: bool = False) -> ResultStore:
     """Open the campaign's results file to resume it, or create it with the design and provenance.
     `probed` = (time, outputs, units) from a worker (`WorkerPool.probe`); measured here in a worker
     process when not given."""
@@ -121,7 +122,7 @@ def prepare_store(campaign: Campaign, design: Design, out: Path, force: bool, pr
         attrs["aircraft_hash"] = aircraft_hash(flight_setup_from(campaign.simulator))
     out.parent.mkdir(parents=True, exist_ok=True)
     return open_for_campaign(
-        out, campaign_text=campaign.text, force=force, xi=design.xi, kappa=kappa, weights=design.weights,
+        out, campaign_text=campaign.text, force=force, restart=restart, xi=design.xi, kappa=kappa, weights=design.weights,
         parameter_names=[p.name for p in campaign.parameters], outputs=outputs, time=time_grid,
         raw=campaign.storage["raw"], tsvd=campaign.storage.get("tsvd"), attrs=attrs, units=units)
 
@@ -176,9 +177,10 @@ def is_disk_full(exc: BaseException) -> bool:
 
 def run_campaign(campaign: Campaign, out: Path | None = None, workers: int | None = None,
                  executor: str | None = None, scheduler: str | None = None, force: bool = False,
-                 progress: bool = False) -> RunSummary:
+                 progress: bool = False, restart: bool = False) -> RunSummary:
     """Run every pending sample of the campaign into its results file; returns a summary.
-    `progress` shows a progress bar (a terminal) or log lines (otherwise) on stderr.
+    `progress` shows a progress bar (a terminal) or log lines (otherwise) on stderr. `restart` starts a
+    results file of this campaign over (a resume otherwise); `force` replaces another campaign's.
 
     Raises LockHeld (another run writes the file), FileExistsError (a file that is not this
     campaign's), DiskFull (stopped cleanly, resumable), WorkerError (no simulator could be built)."""
@@ -211,7 +213,8 @@ def run_campaign(campaign: Campaign, out: Path | None = None, workers: int | Non
         # depend on where a resume starts (the same limit for every fold makes them bit-identical).
         with threadpool_limits(limits=1):
             try:
-                store = prepare_store(campaign, design, out, force, probed=(time_grid, outputs, units))
+                store = prepare_store(campaign, design, out, force, probed=(time_grid, outputs, units),
+                                      restart=restart)
             except (OSError, RuntimeError) as exc:
                 if is_disk_full(exc) and not isinstance(exc, FileExistsError):
                     raise DiskFull(errno.ENOSPC, disk_full_message(out, 0)) from exc
@@ -248,7 +251,7 @@ def _run_pending(store, campaign, pool, spec, chunk, workers, executor, schedule
     kappa = store.kappa
     n_times, outputs = store.time.size, store.output_names
     summary = RunSummary(out, total, 0, total - pending.size, 0.0)
-    bar = Progress(pending.size, quiet=not progress)
+    bar = Progress(total, done=total - pending.size, quiet=not progress)
     # A chunk with some samples already stored (impossible with this writer, but a file
     # written elsewhere may have one) is rerun whole; only its pending rows are written.
     tasks = [Task(c, kappa[c]) for c in chunks]
@@ -256,20 +259,22 @@ def _run_pending(store, campaign, pool, spec, chunk, workers, executor, schedule
         results = _execute_dask(tasks, spec, n_times, outputs, workers, scheduler, timeout)
     else:
         results = pool.run(tasks, n_times, outputs)
-    for indices, status, reasons, values in results:
-        keep = store.status[indices] == Status.PENDING
-        ensure_space(out, store.batch_bytes(int(keep.sum())), total - store.pending().size)
-        try:
-            store.write_batch(indices[keep], status[keep], np.asarray(reasons, dtype=object)[keep],
-                              {k: v[keep] for k, v in values.items()})
-        except (OSError, RuntimeError) as exc:
-            if is_disk_full(exc):
-                raise DiskFull(errno.ENOSPC, disk_full_message(out, total - store.pending().size)) from exc
-            raise
-        summary.ran += int(keep.sum())
-        summary.failures.update(r for r, s in zip(np.asarray(reasons)[keep], status[keep]) if s != 0)
-        bar.advance(int(keep.sum()))
-    bar.close()
+    try:
+        for indices, status, reasons, values in results:
+            keep = store.status[indices] == Status.PENDING
+            ensure_space(out, store.batch_bytes(int(keep.sum())), total - store.pending().size)
+            try:
+                store.write_batch(indices[keep], status[keep], np.asarray(reasons, dtype=object)[keep],
+                                  {k: v[keep] for k, v in values.items()})
+            except (OSError, RuntimeError) as exc:
+                if is_disk_full(exc):
+                    raise DiskFull(errno.ENOSPC, disk_full_message(out, total - store.pending().size)) from exc
+                raise
+            summary.ran += int(keep.sum())
+            summary.failures.update(r for r, s in zip(np.asarray(reasons)[keep], status[keep]) if s != 0)
+            bar.advance(int(keep.sum()))
+    finally:
+        bar.close()  # a rich bar gives the terminal back, also on Ctrl-C
     return summary
 
 
@@ -568,32 +573,44 @@ def _execute_dask(tasks, spec, n_times, outputs, workers: int, scheduler: str | 
 
 
 class Progress:
-    """A progress bar with rate and ETA on a terminal; a log line every ~10 % otherwise."""
+    """Runs done out of the design's (resumed ones included), the rate of this session and the ETA: a
+    rich progress bar fitted to the terminal on a terminal, a log line every ~10 % otherwise."""
 
-    def __init__(self, total: int, quiet: bool = False, stream=sys.stderr):
-        self.total, self.done, self.quiet, self.stream = total, 0, quiet, stream
-        self.start = time.perf_counter()
-        self.tty = stream.isatty()
-        self._next_log = 0.1
+    def __init__(self, total: int, done: int = 0, quiet: bool = False, stream=sys.stderr):
+        self.total, self.done, self.quiet, self.stream = total, done, quiet, stream
+        self.start, self.first = time.perf_counter(), done
+        self._next_log = done / total + 0.1 if total else 1.0
+        self._bar = None
+        if stream.isatty() and not quiet and total:
+            from rich.console import Console
+            from rich.progress import (BarColumn, MofNCompleteColumn, TextColumn, TimeElapsedColumn,
+                                       TimeRemainingColumn)
+            from rich.progress import Progress as Bar
+
+            self._bar = Bar(TextColumn("runs"), BarColumn(), MofNCompleteColumn(), TextColumn("{task.fields[rate]}"),
+                            TimeElapsedColumn(), TextColumn("ETA"), TimeRemainingColumn(),
+                            console=Console(file=stream), transient=False)
+            self._bar.start()
+            self._task = self._bar.add_task("runs", total=total, completed=done, rate="")
 
     def advance(self, n: int) -> None:
         self.done += n
         if self.quiet or self.total == 0:
             return
         elapsed = time.perf_counter() - self.start
-        rate = self.done / elapsed if elapsed > 0 else 0.0
-        eta = (self.total - self.done) / rate if rate > 0 else float("inf")
+        rate = (self.done - self.first) / elapsed if elapsed > 0 else 0.0
+        if self._bar is not None:
+            self._bar.update(self._task, completed=self.done, rate=f"{rate:.1f} runs/s")
+            return
         fraction = self.done / self.total
-        if self.tty:
-            bar = "#" * int(30 * fraction)
-            self.stream.write(f"\r[{bar:<30}] {self.done}/{self.total} {rate:6.1f} runs/s ETA {eta:6.0f} s")
-            self.stream.flush()
-        elif fraction >= self._next_log or self.done == self.total:
+        if fraction >= self._next_log or self.done == self.total:
+            eta = (self.total - self.done) / rate if rate > 0 else float("inf")
             self.stream.write(f"{self.done}/{self.total} runs ({100 * fraction:.0f} %), {rate:.1f} runs/s, "
                               f"ETA {eta:.0f} s\n")
             self._next_log = fraction + 0.1
 
     def close(self) -> None:
-        if self.tty and not self.quiet and self.total:
-            self.stream.write("\n")
+        if self._bar is not None:
+            self._bar.stop()
+            self._bar = None
 

@@ -201,9 +201,19 @@ class JSBSimFlight:
         node = self._nodes.get(name)
         if node is None:
             if not self.has_property(name):
-                raise KeyError(f"property {name!r} does not exist in aircraft {self.setup.aircraft!r}")
+                raise KeyError(f"property {name!r} does not exist in aircraft {self.setup.aircraft!r}"
+                               f"{self.property_hint(name)}")
             node = self._nodes[name] = self._pm.get_node(name)
         return node
+
+    def property_hint(self, name: str) -> str:
+        """'; did you mean ...?' with the aircraft's properties closest to `name` (any case), or ''."""
+        import difflib
+
+        names = [line.rsplit(" (", 1)[0] for line in self.fdm.query_property_catalog("").splitlines()]
+        by_lower = {n.lower(): n for n in names}
+        close = difflib.get_close_matches(name.lower(), by_lower, n=3, cutoff=0.8)
+        return f"; did you mean {' or '.join(by_lower[c] for c in close)}?" if close else ""
 
     def property_value(self, name: str) -> float | None:
         """The value of `name` as loaded (None when the aircraft has no such property)."""

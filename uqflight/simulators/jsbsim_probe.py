@@ -1,7 +1,6 @@
 """The aircraft as campaign validation sees it: property names, values and writability, with hints."""
 from __future__ import annotations
 
-import difflib
 
 import jsbsim
 
@@ -23,8 +22,6 @@ class AircraftProperties:
         fdm = self._flight.fdm
         fdm["ic/h-sl-ft"] = setup.altitude_ft  # as JSBSimFlight.trim sets them
         fdm["ic/vt-kts"] = setup.airspeed_ktas
-        names = [line.rsplit(" (", 1)[0] for line in fdm.query_property_catalog("").splitlines()]  # "name (RW)"
-        self._names = {name.lower(): name for name in names}  # for hints, whatever the case typed
 
     def value(self, name: str) -> float | None:
         """The property's value (None when the aircraft has no such property)."""
@@ -35,8 +32,7 @@ class AircraftProperties:
 
     def hint(self, name: str) -> str:
         """'; did you mean ...?' with the aircraft's properties closest to `name`, or ''."""
-        close = difflib.get_close_matches(name.lower(), self._names, n=3, cutoff=0.8)
-        return f"; did you mean {' or '.join(self._names[c] for c in close)}?" if close else ""
+        return self._flight.property_hint(name)
 
 
 def jsbsim_probe(simulator: dict) -> AircraftProperties:

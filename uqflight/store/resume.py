@@ -9,14 +9,15 @@ import h5py
 from .results import ResultStore, text_hash
 
 
-def open_for_campaign(path, *, campaign_text: str, force: bool = False, **create_args) -> ResultStore:
+def open_for_campaign(path, *, campaign_text: str, force: bool = False, restart: bool = False,
+                      **create_args) -> ResultStore:
     """Resume `path` when it holds this campaign, else create it (see ResultStore.create).
 
     A file holding another campaign (a different campaign_hash), or made with other aircraft files
     (attrs["aircraft_hash"]), is refused unless `force`, which deletes and recreates it. `force`
     never deletes what is not a uqflight results file (a directory, a text file, another HDF5 file):
     those are refused, with how to remove them. (The caller holds the file's lock: `force` never
-    touches a file another run writes.)
+    touches a file another run writes.) `restart` starts a results file of this same campaign over.
     """
     path = Path(path)
     aircraft = (create_args.get("attrs") or {}).get("aircraft_hash")
@@ -46,8 +47,10 @@ def open_for_campaign(path, *, campaign_text: str, force: bool = False, **create
             raise FileExistsError(f"{path} is an HDF5 file but not a uqflight results file (no campaign_hash "
                                   "or /samples/status); uqflight never overwrites it, even with --force: "
                                   f"remove it yourself (rm {path}) or choose another results file")
-        if stored == text_hash(campaign_text) and stored_aircraft == aircraft:
+        if stored == text_hash(campaign_text) and stored_aircraft == aircraft and not restart:
             return ResultStore.open(path, "a")
+        if restart and stored == text_hash(campaign_text):
+            force = True
         if not force:
             if stored == text_hash(campaign_text):
                 raise FileExistsError(f"{path} was made with other aircraft files (sha256 {stored_aircraft}); "
