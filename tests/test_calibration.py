@@ -125,6 +125,7 @@ def test_posterior_matches_the_closed_form(results):
     assert flat[:, 2].std() == pytest.approx(1 / math.sqrt(3), rel=0.1)
 
 
+@pytest.mark.slow
 def test_calibrate_end_to_end(results, tmp_path):
     data = tmp_path / "flight.csv"
     write_csv(data, TIME, synthetic(1))
