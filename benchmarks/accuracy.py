@@ -14,6 +14,8 @@ Tables:
 2. The floors: RQMC 16 × 1024 against Monte Carlo with 10^4 and 10^5 runs.
 3. Runs per accuracy: the fewest grid runs whose max eps_v lies below the error Monte Carlo makes
    with 10^4 and with 10^5 runs (its floor at that N), per method.
+4. When results/mc-normal-1e5.h5 exists (campaigns/mc-normal-1e5.yaml, about 35 minutes on 2 cores):
+   its floor measured from its own runs, and its distance from the RQMC reference.
 
 Uses results/rqmc-normal.h5 and results/grid-gh-l*.h5 in --results, running the missing campaigns
 first (about 12 minutes on 2 quiet cores).
@@ -61,6 +63,24 @@ def monte_carlo_floor(reference, name: str, n: int) -> np.ndarray:
     return floors_from_moments(out.mean, out.variance, fourth, n)["eps_v_floor"].max()
 
 
+def compare_references(monte_carlo, reference) -> None:
+    """The 10^5-run Monte Carlo reference (when run): its own floor, measured from its runs, and its
+    distance from the RQMC reference against the two floors together."""
+    print(f"\n## Monte Carlo reference, {monte_carlo.completed} runs (campaigns/mc-normal-1e5.yaml)\n")
+    print("| | " + " | ".join(OUTPUTS) + " |")
+    print("|---|" + "---|" * len(OUTPUTS))
+    floors, distance = {}, {}
+    for name in OUTPUTS:
+        out = monte_carlo.outputs[name]
+        floors[name] = floors_from_moments(out.mean, out.variance, out.fourth_central, monte_carlo.completed)
+        distance[name] = relative_errors(out.mean, out.variance, reference.outputs[name].mean,
+                                         reference.outputs[name].variance)
+    print("| its floor, max eps_m / eps_v | " + " | ".join(
+        f"{floors[n]['eps_m_floor'].max():.1e} / {floors[n]['eps_v_floor'].max():.1e}" for n in OUTPUTS) + " |")
+    print("| its distance from RQMC, max eps_m / eps_v | " + " | ".join(
+        f"{distance[n][0].max():.1e} / {distance[n][1].max():.1e}" for n in OUTPUTS) + " |")
+
+
 def mark(value: float, floor: float) -> str:
     """An error, with ~ when it is below 2 floors of the reference (within its noise)."""
     return f"~{value:.1e}" if value < 2 * floor else f"{value:.1e}"
@@ -94,6 +114,10 @@ def main():
                       / np.abs(reference.outputs[name].mean).max() for name in OUTPUTS}
         print(f"| Monte Carlo 10^{int(np.log10(n_runs))} (from the same moments) | "
               + " | ".join(f"{mean_floor[n]:.1e} / {floors[n]:.1e}" for n in OUTPUTS) + " |")
+
+    monte_carlo = args.results / "mc-normal-1e5.h5"
+    if monte_carlo.exists():
+        compare_references(analyse(monte_carlo, options=FAST), reference)
 
     print("\n## max over time of eps_m / eps_v against the RQMC reference (~: below 2 floors)\n")
     print("| grid | runs | method | " + " | ".join(OUTPUTS) + " |")
