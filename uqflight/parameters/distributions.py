@@ -8,13 +8,14 @@ listed in DISTRIBUTIONS.
 from __future__ import annotations
 
 import math
+from abc import ABC, abstractmethod
 
 import numpy as np
 
 INTERVAL_SIGMAS = 3.0  # the interval spans ±3σ: the paper's 99.7 % range
 
 
-class Distribution:
+class Distribution(ABC):
     """A law on [lower, upper]; subclasses set `name` and `germ` and the four maps."""
 
     name: str
@@ -31,19 +32,23 @@ class Distribution:
         """Why the interval does not suit the law, or None."""
         return None
 
+    @abstractmethod
     def to_physical(self, xi: np.ndarray) -> np.ndarray:
-        raise NotImplementedError
+        """κ from ξ."""
 
+    @abstractmethod
     def to_standard(self, kappa: np.ndarray) -> np.ndarray:
-        raise NotImplementedError
+        """ξ from κ."""
 
     @property
+    @abstractmethod
     def mean(self) -> float:
-        raise NotImplementedError
+        """E[κ]."""
 
     @property
+    @abstractmethod
     def std(self) -> float:
-        raise NotImplementedError
+        """The standard deviation of κ."""
 
 
 class Normal(Distribution):

@@ -7,26 +7,28 @@ default, and its nested cousin). Adding a germ is one class here plus its rules 
 """
 from __future__ import annotations
 
+from abc import ABC, abstractmethod
+
 import numpy as np
 from scipy import special
 
 _OPEN_UNIT = (2.0**-53, 1.0 - 2.0**-53)  # keeps Φ⁻¹ finite at u = 0
 
 
-class Germ:
+class Germ(ABC):
     """A standard variable: its name, quantile, polynomial recurrence and default rules."""
 
     name: str
     default_rule: str  # the Gauss rule of the germ's law
     nested_rule: str  # the nested rule that `design.nested: true` swaps in
 
+    @abstractmethod
     def quantile(self, u: np.ndarray) -> np.ndarray:
         """ξ from uniforms u in [0, 1)."""
-        raise NotImplementedError
 
+    @abstractmethod
     def recurrence_beta(self, n: np.ndarray) -> np.ndarray:
         """β_n of the orthonormal recurrence x p_n = β_{n+1} p_{n+1} + β_n p_{n−1}."""
-        raise NotImplementedError
 
 
 class NormalGerm(Germ):
