@@ -441,3 +441,25 @@ def test_the_cli_exits_2_when_the_disk_fills_past_the_check(tmp_path, small_disk
                            capture_output=True, text=True, timeout=300)
     assert whole.returncode == 0, whole.stderr
     assert_same_results(out, tmp_path / "whole.h5")
+
+
+def test_an_idle_worker_gets_its_next_chunk_before_the_runner_writes(tmp_path):
+    """The pool hands a finished chunk to its caller (who writes it to HDF5) only once the worker
+    that flew it has its next chunk: workers never wait for the writer."""
+    from uqflight.execution import Task, WorkerPool, nominal_kappa, worker_spec
+    from uqflight.parameters import to_physical
+
+    spec = campaign("slow", samples=6, chunk=2)
+    kappa = to_physical(spec.parameters, spec.design().xi)
+    tasks = [Task(np.arange(i, i + 2), kappa[i:i + 2]) for i in (0, 2, 4)]
+    pool = WorkerPool(worker_spec(spec), 1, 60.0)
+    try:
+        time_grid, outputs = pool.probe(nominal_kappa(spec))[:2]
+        results = pool.run(tasks, len(time_grid), outputs)
+        first = next(results)
+        assert first[0].tolist() == [0, 1] and pool.slots[0].task is tasks[1]
+        assert [r[0].tolist() for r in results] == [[2, 3], [4, 5]]
+    finally:
+        pool.close()
+    with h5py.File(run_campaign(spec, out=tmp_path / "r.h5").path) as f:  # the runner's chunk = HDF5's
+        assert f["outputs/y"].chunks[0] == 2

@@ -35,7 +35,8 @@ def make_pending(path, runs):
     with h5py.File(path, "r+") as f:
         f["samples/status"][runs] = -1
         for name in f["outputs"]:
-            f["outputs"][name][runs] = np.nan
+            data = f["outputs"][name]
+            data[runs] = np.full((len(runs), data.shape[1]), np.nan)  # h5py broadcasts no index list across chunks
 
 
 @pytest.fixture(scope="module")

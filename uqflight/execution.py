@@ -124,7 +124,8 @@ def prepare_store(campaign: Campaign, design: Design, out: Path, force: bool, pr
     return open_for_campaign(
         out, campaign_text=campaign.text, force=force, restart=restart, xi=design.xi, kappa=kappa, weights=design.weights,
         parameter_names=[p.name for p in campaign.parameters], outputs=outputs, time=time_grid,
-        raw=campaign.storage["raw"], tsvd=campaign.storage.get("tsvd"), attrs=attrs, units=units)
+        raw=campaign.storage["raw"], tsvd=campaign.storage.get("tsvd"), attrs=attrs, units=units,
+        batch_rows=campaign.execution["chunk"])
 
 
 def nominal_kappa(campaign: Campaign) -> np.ndarray:
@@ -190,7 +191,6 @@ def run_campaign(campaign: Campaign, out: Path | None = None, workers: int | Non
     scheduler = scheduler or execution.get("scheduler")
     chunk = execution["chunk"]
     out = Path(out or campaign.storage["path"])
-    design = campaign.design()
     started = time.perf_counter()
     spec = worker_spec(campaign)
     out.parent.mkdir(parents=True, exist_ok=True)
@@ -205,7 +205,9 @@ def run_campaign(campaign: Campaign, out: Path | None = None, workers: int | Non
     try:
         pool = WorkerPool(spec, workers if executor == "local" else 1,
                           execution.get("timeout_s") or PROBE_TIMEOUT_S)
-        time_grid, outputs, units, seconds = pool.probe(nominal_kappa(campaign))
+        pool.start_probe(nominal_kappa(campaign))
+        design = campaign.design()  # built while the workers start
+        time_grid, outputs, units, seconds = pool.probe_answer()
         timeout = execution.get("timeout_s") or default_timeout(seconds)
         pool.timeout = timeout
         # One BLAS thread here, for the folds on opening too: the workers keep every core busy, a
@@ -401,9 +403,15 @@ class WorkerPool:
         self.slots: list[WorkerProcess] = []
 
     def probe(self, kappa: np.ndarray):
-        """(time, outputs, units, seconds of a nominal flight), from a worker. Every worker of the pool
-        is started and flies the nominal at once, so all are warm (imports, aircraft, the Newton trim's
-        nominal) when the chunks start; the first one's answer is used."""
+        """(time, outputs, units, seconds of a nominal flight), from a worker: `start_probe`, then
+        `probe_answer`."""
+        self.start_probe(kappa)
+        return self.probe_answer()
+
+    def start_probe(self, kappa: np.ndarray) -> None:
+        """Start every worker of the pool and ask each to fly the nominal `kappa`, so that all are warm
+        (imports, aircraft, the Newton trim's nominal) when the chunks start. Returns at once: the
+        caller may work meanwhile, then call `probe_answer`."""
         slot = self._slot()
         while len(self.slots) < self.workers:
             self.slots.append(WorkerProcess())
@@ -412,6 +420,11 @@ class WorkerPool:
                 self._drop(other)
         if not slot.send(("probe", self.spec, kappa)):
             raise WorkerError(death_reason(self._drop(slot)))
+
+    def probe_answer(self):
+        """The first worker's answer to `start_probe` (the others' are awaited, and a worker that
+        failed is dropped, to be replaced later)."""
+        slot = self.slots[0]
         if not wait_connections([slot.conn], timeout=self.timeout):
             self._drop(slot, dead=False)
             raise WorkerError(f"the nominal flight did not finish within {self.timeout:g} s")
@@ -434,11 +447,12 @@ class WorkerPool:
         yielded once, whatever its samples do to the workers."""
         queue = deque(tasks)
         busy: list[WorkerProcess] = []
-        while queue or busy:
+        finished: deque = deque()  # results held back until every idle worker has its next chunk
+        while queue or busy or finished:
             while queue and len(busy) < self.workers:
                 task = queue.popleft()
                 if task.settled:
-                    yield task.result(None, n_times, outputs)
+                    finished.append(task.result(None, n_times, outputs))
                     continue
                 slot = self._idle_slot(busy)
                 slot.task, slot.row, slot.since = task, None, time.monotonic()
@@ -447,6 +461,8 @@ class WorkerPool:
                     self._lost(slot, busy, queue, death_reason(self._drop(slot)), Status.WORKER_DIED)
                     continue
                 busy.append(slot)
+            while finished:  # the caller writes them while the workers fly on
+                yield finished.popleft()
             if not busy:
                 continue
             deadline = min(slot.since + self._limit(slot) for slot in busy)
@@ -465,7 +481,7 @@ class WorkerPool:
                         task = slot.task
                         slot.task = None
                         busy.remove(slot)
-                        yield task.result(payload, n_times, outputs)
+                        finished.append(task.result(payload, n_times, outputs))
                         break
                     else:
                         raise WorkerError(str(payload))

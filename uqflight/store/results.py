@@ -84,11 +84,13 @@ class ResultStore:
     @classmethod
     def create(cls, path, *, campaign_text: str, xi, kappa, weights, parameter_names, outputs, time,
                raw: bool = True, tsvd: dict | None = None, attrs: dict | None = None,
-               units: dict | None = None) -> ResultStore:
+               units: dict | None = None, batch_rows: int | None = None) -> ResultStore:
         """A new file (refused if `path` exists) holding the design, with every run pending.
 
         `tsvd` = {"tol": ..., "batch": ...} turns on compression (batch defaults to the paper's 1000
         samples); `attrs` become root attributes (dicts as JSON text); `units` maps output name → unit.
+        `batch_rows`: the runs the writer stores at a time (the runner's chunk): raw chunks of at most
+        that many rows, so that a batch fills whole HDF5 chunks instead of rewriting part-filled ones.
         """
         xi, kappa = np.atleast_2d(xi).astype(float), np.atleast_2d(kappa).astype(float)
         weights, time = np.asarray(weights, dtype=float), np.asarray(time, dtype=float)
@@ -122,9 +124,10 @@ class ResultStore:
         f.create_dataset("time", data=time, **CHECKED).attrs["units"] = "s"
         if raw:
             group = f.create_group("outputs", track_order=True)
+            rows = min(chunk_rows(time.size, n), batch_rows or n)
             for name in outputs:
                 ds = group.create_dataset(_key(name), shape=(n, time.size), dtype="f8", fillvalue=np.nan,
-                                          chunks=(chunk_rows(time.size, n), time.size), fletcher32=True)
+                                          chunks=(rows, time.size), fletcher32=True)
                 ds.attrs.update({"units": units.get(name, ""), "dimensions": ["sample", "time"]})
         if tsvd is not None:
             group = f.create_group("tsvd", track_order=True)
