@@ -161,3 +161,21 @@ def test_resuming_with_changed_aircraft_files_is_refused_unless_forced(tmp_path)
     with pytest.raises(FileExistsError, match="other aircraft files"):
         run_campaign(jsbsim_campaign(samples=2), out=tmp_path / "r.h5")
     assert run_campaign(jsbsim_campaign(samples=2), out=tmp_path / "r.h5", force=True).ran == 2
+
+
+@pytest.mark.parametrize("total, chunk", [(589, 16), (64, 16), (65, 16), (80, 16), (10, 16), (12, 4), (1, 1), (1000, 7)])
+def test_chunks_cover_the_design_and_taper_at_its_end(total, chunk):
+    """Design-order chunks of `chunk` samples, the last TAPER x chunk samples in chunks a TAPER-th
+    the size (so that the workers finish together); every sample in exactly one chunk."""
+    from uqflight.execution import TAPER, chunk_starts, pending_chunks
+
+    starts = chunk_starts(total, chunk)
+    sizes = np.diff(starts)
+    assert starts[0] == 0 and starts[-1] == total and np.all(sizes >= 1) and np.all(sizes <= chunk)
+    small = max(1, chunk // TAPER)
+    tail = starts[:-1] > total - (TAPER + 1) * chunk  # TAPER chunks' worth, from a chunk boundary
+    assert np.all(sizes[tail][:-1] == small) and np.all(sizes[~tail] == chunk)
+    assert sizes[tail].sum() >= min(total, TAPER * chunk)
+    chunks = pending_chunks(np.arange(total), chunk, total)
+    assert np.array_equal(np.concatenate(chunks), np.arange(total))
+    assert [c.tolist() for c in pending_chunks(np.array([total - 1]), chunk, total)] == [chunks[-1].tolist()]

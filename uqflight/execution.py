@@ -1,6 +1,7 @@
 """Run a campaign's samples in worker processes (local or Dask) and stream them to HDF5.
 
-The design is cut into fixed chunks of consecutive samples (`execution.chunk`). A worker keeps
+The design is cut into fixed chunks of consecutive samples (`execution.chunk`, smaller ones at the
+design's end: `chunk_starts`). A worker keeps
 its simulator between chunks and restarts it at the start of each chunk, so every sample's
 result depends only on its chunk: results are identical whatever the number of workers, the
 executor, or an interruption. Chunks are written to the store as they finish, so a killed run
@@ -54,6 +55,7 @@ TIMEOUT_FLIGHTS = 50
 PROBE_TIMEOUT_S = 600.0          # the nominal flight that measures the cost (no limit known yet)
 STARTUP_GRACE_S = 60.0           # a chunk's limit before its first sample (worker start, simulator build)
 SPACE_MARGIN_BYTES = 1 << 20     # free space kept beyond a batch's estimate (HDF5 metadata)
+TAPER = 4                        # the design's last TAPER chunks are flown in chunks TAPER times smaller
 
 
 class DiskFull(OSError):
@@ -143,9 +145,21 @@ def worker_spec(campaign: Campaign) -> WorkerSpec:
                       bundle=make_bundle(campaign.simulator, properties, base))  # files travel with the task
 
 
+def chunk_starts(total: int, chunk: int) -> np.ndarray:
+    """The first sample of every chunk, then `total`: design-order chunks of `chunk` samples, except
+    the design's last TAPER x `chunk` samples, cut in chunks of `chunk` // TAPER so that the workers
+    finish together instead of all but one waiting for a last long chunk. A function of the design
+    and `chunk` only, never of the workers: results stay the same whatever runs them."""
+    small = max(1, chunk // TAPER)
+    head = max(0, total - TAPER * chunk) // chunk * chunk
+    return np.unique(np.r_[np.arange(0, head, chunk), np.arange(head, total, small), total]).astype(np.int64)
+
+
 def pending_chunks(pending: np.ndarray, chunk: int, total: int) -> list[np.ndarray]:
-    """The fixed design-order chunks [c*chunk, (c+1)*chunk) ∩ [0, total) that hold pending samples."""
-    return [np.arange(c * chunk, min((c + 1) * chunk, total)) for c in np.unique(pending // chunk)]
+    """The fixed design-order chunks (`chunk_starts`) that hold pending samples, whole."""
+    starts = chunk_starts(total, chunk)
+    held = np.unique(np.searchsorted(starts, pending, side="right") - 1)
+    return [np.arange(starts[c], starts[c + 1]) for c in held]
 
 
 def default_timeout(flight_seconds: float) -> float:
@@ -422,8 +436,8 @@ class WorkerPool:
             raise WorkerError(death_reason(self._drop(slot)))
 
     def probe_answer(self):
-        """The first worker's answer to `start_probe` (the others' are awaited, and a worker that
-        failed is dropped, to be replaced later)."""
+        """The first worker's answer to `start_probe`. The others' answers are not awaited: `run`
+        reads them before their workers' first chunk, so that no worker waits for the slowest start."""
         slot = self.slots[0]
         if not wait_connections([slot.conn], timeout=self.timeout):
             self._drop(slot, dead=False)
@@ -434,12 +448,6 @@ class WorkerPool:
             raise WorkerError(death_reason(self._drop(slot)) + " during the nominal flight") from None
         if kind != "probe":
             raise WorkerError(str(payload))
-        for other in list(self.slots[1:]):  # the others' answers (a worker that failed is replaced later)
-            try:
-                if not wait_connections([other.conn], timeout=self.timeout) or other.conn.recv()[0] != "probe":
-                    self._drop(other, dead=False)
-            except (EOFError, OSError):
-                self._drop(other)
         return payload
 
     def run(self, tasks, n_times: int, outputs: list[str]):
@@ -477,6 +485,8 @@ class WorkerPool:
                         break
                     if kind == "start":
                         slot.row, slot.since = payload, time.monotonic()
+                    elif kind == "probe":  # the warm-up `start_probe` asked for
+                        pass
                     elif kind == "done":
                         task = slot.task
                         slot.task = None
