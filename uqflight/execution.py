@@ -278,7 +278,7 @@ def _run_pending(store, campaign, pool, spec, chunk, workers, executor, schedule
     try:
         for indices, status, reasons, values in results:
             keep = store.status[indices] == Status.PENDING
-            ensure_space(out, store.batch_bytes(int(keep.sum())), total - store.pending().size)
+            ensure_space(out, store.batch_bytes(int(keep.sum())), summary.skipped + summary.ran)
             try:
                 store.write_batch(indices[keep], status[keep], np.asarray(reasons, dtype=object)[keep],
                                   {k: v[keep] for k, v in values.items()})

@@ -344,7 +344,7 @@ class ResultStore:
     def batch_bytes(self, n: int) -> int:
         """An upper estimate of the bytes the next batch of `n` runs may add to the file: its rows
         (a new chunk per output at worst), and for tSVD a staged copy of the factors and buffer."""
-        n_times, total = self.time.size, self._file["samples/status"].shape[0]
+        n_times, total = self._file["time"].shape[0], self._file["samples/status"].shape[0]
         estimate = 64 * 1024 + n * 1024
         if self._raw:
             for ds in self._file["outputs"].values():
@@ -390,7 +390,7 @@ class ResultStore:
         idx, status = idx[order], np.asarray(status, dtype=np.int8).ravel()[order]
         reasons = np.asarray(reasons, dtype=object).ravel()[order]
         stored = self.status
-        n, n_samples, n_times = idx.size, stored.size, self.time.size
+        n, n_samples, n_times = idx.size, stored.size, self._file["time"].shape[0]
         if status.size != n or reasons.size != n:
             raise ValueError(f"batch of {n} indices with {status.size} statuses and {reasons.size} reasons")
         if np.any(np.diff(idx) == 0) or (n and (idx[0] < 0 or idx[-1] >= n_samples)):
