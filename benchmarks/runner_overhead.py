@@ -132,13 +132,8 @@ def measure(rows: dict, repeats: int) -> dict[str, list[float]]:
     return seconds
 
 
-def main():
-    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("--samples", type=int, default=200)
-    parser.add_argument("--repeats", type=int, default=5)
-    args = parser.parse_args()
-
-    spec = campaign(args.samples, "overhead")
+def overhead(samples: int, repeats: int) -> None:
+    spec = campaign(samples, "overhead")
     kappa = to_physical(spec.parameters, spec.design().xi)
     properties = [p.property for p in spec.parameters]
 
@@ -148,16 +143,18 @@ def main():
         return time.perf_counter() - t0
 
     seconds = measure({"bare jsbsim loop": bare, "uqflight run, 1 worker": lambda: timed_run(spec, 1)},
-                      args.repeats)
+                      repeats)
     (b, bare_s), (r, run_s) = seconds.items()
     ratios = [x / y for x, y in zip(run_s, bare_s)]
-    print(f"## Runner overhead ({args.samples} samples, {args.repeats} repeats)\n")
+    print(f"## Runner overhead ({samples} samples, {repeats} repeats)\n")
     print("| loop | s per sample, median | best |\n|---|---|---|")
     for name, values in seconds.items():
-        print(f"| {name} | {statistics.median(values) / args.samples:.4f} | {min(values) / args.samples:.4f} |")
+        print(f"| {name} | {statistics.median(values) / samples:.4f} | {min(values) / samples:.4f} |")
     print(f"\nratio run / bare: median of the repeats {statistics.median(ratios):.3f}, of the best runs "
           f"{min(run_s) / min(bare_s):.3f}, per repeat {', '.join(f'{x:.3f}' for x in ratios)} (target <= 1.05)\n")
 
+
+def scaling(repeats: int) -> None:
     spec = load_campaign(CAMPAIGNS / "grid-gh-l3.yaml", jsbsim_probe)
     runs = len(spec.design().xi)
     rows = {"bare processes, 1": lambda: bare_processes(spec, 1),
@@ -165,8 +162,8 @@ def main():
             "local, 1 worker": lambda: timed_run(spec, 1),
             "local, 2 workers": lambda: timed_run(spec, 2),
             "dask LocalCluster, 2 workers": lambda: timed_run(spec, 2, "dask")}
-    seconds = measure(rows, args.repeats)
-    print(f"## Parallel scaling (grid-gh-l3, {runs} runs, wall clock with start-up, {args.repeats} repeats)\n")
+    seconds = measure(rows, repeats)
+    print(f"## Parallel scaling (grid-gh-l3, {runs} runs, wall clock with start-up, {repeats} repeats)\n")
     print("| executor | runs/s, median | speed-up, median | per repeat | best run's speed-up |")
     print("|---|---|---|---|---|")
     for name, values in seconds.items():
@@ -175,6 +172,18 @@ def main():
         print(f"| {name} | {runs / statistics.median(values):.1f} | {statistics.median(per_repeat):.2f} | "
               f"{', '.join(f'{x:.2f}' for x in per_repeat)} | {min(one) / min(values):.2f} |")
     print("\nbare processes: the machine's own ceiling, the same chunks with no runner and no HDF5.")
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--samples", type=int, default=200)
+    parser.add_argument("--repeats", type=int, default=5)
+    parser.add_argument("--part", choices=("overhead", "scaling", "both"), default="both")
+    args = parser.parse_args()
+    if args.part in ("overhead", "both"):
+        overhead(args.samples, args.repeats)
+    if args.part in ("scaling", "both"):
+        scaling(args.repeats)
 
 
 if __name__ == "__main__":
