@@ -18,8 +18,10 @@ Run: .venv/bin/python benchmarks/runner_overhead.py [--samples 200] [--repeats 5
 from __future__ import annotations
 
 import argparse
-import multiprocessing
+import pickle
 import statistics
+import subprocess
+import sys
 import tempfile
 import time
 from pathlib import Path
@@ -96,31 +98,36 @@ def timed_run(spec, workers: int, executor: str = "local") -> float:
     return elapsed
 
 
-def _fly_share(spec, kappa, share: list, n_times: int, outputs: list[str]) -> None:
-    from uqflight.worker import run_chunk
-
-    for chunk in share:
-        run_chunk(spec, chunk, kappa[chunk], n_times, outputs)
+FLY_SHARE = """
+import pickle, sys
+from uqflight.worker import run_chunk
+with open(sys.argv[1], "rb") as f:
+    spec, kappa, share, n_times, outputs = pickle.load(f)
+for chunk in share:
+    run_chunk(spec, chunk, kappa[chunk], n_times, outputs)
+"""
 
 
 def bare_processes(campaign_spec, processes: int) -> float:
-    """Seconds for `processes` fresh Python processes to fly the campaign's chunks, dealt out in turn."""
+    """Seconds for `processes` fresh Python processes (importing what a worker imports) to fly the
+    campaign's chunks, dealt out in turn."""
     from uqflight.execution import nominal_kappa, pending_chunks, worker_spec
     from uqflight.worker import probe
 
     spec, kappa = worker_spec(campaign_spec), to_physical(campaign_spec.parameters, campaign_spec.design().xi)
     time_grid, outputs = probe(spec, nominal_kappa(campaign_spec))[:2]
     chunks = pending_chunks(np.arange(len(kappa)), campaign_spec.execution["chunk"], len(kappa))
-    context = multiprocessing.get_context("spawn")
-    t0 = time.perf_counter()
-    jobs = [context.Process(target=_fly_share, args=(spec, kappa, chunks[i::processes], len(time_grid), outputs))
-            for i in range(processes)]
-    for job in jobs:
-        job.start()
-    for job in jobs:
-        job.join()
-    assert all(job.exitcode == 0 for job in jobs)
-    return time.perf_counter() - t0
+    with tempfile.TemporaryDirectory() as tmp:
+        shares = []
+        for i in range(processes):
+            shares.append(Path(tmp) / f"share{i}.pickle")
+            shares[-1].write_bytes(pickle.dumps((spec, kappa, chunks[i::processes], len(time_grid), outputs)))
+        t0 = time.perf_counter()
+        jobs = [subprocess.Popen([sys.executable, "-c", FLY_SHARE, str(share)]) for share in shares]
+        codes = [job.wait() for job in jobs]
+        elapsed = time.perf_counter() - t0
+    assert codes == [0] * processes, codes
+    return elapsed
 
 
 def measure(rows: dict, repeats: int) -> dict[str, list[float]]:
