@@ -461,5 +461,6 @@ def test_an_idle_worker_gets_its_next_chunk_before_the_runner_writes(tmp_path):
         assert [r[0].tolist() for r in results] == [[2, 3], [4, 5]]
     finally:
         pool.close()
-    with h5py.File(run_campaign(spec, out=tmp_path / "r.h5").path) as f:  # the runner's chunk = HDF5's
+    long_runs = campaign("long_histories", samples=6, chunk=2)  # 40 kB per run
+    with h5py.File(run_campaign(long_runs, out=tmp_path / "r.h5").path) as f:  # the runner's chunk = HDF5's
         assert f["outputs/y"].chunks[0] == 2

@@ -327,10 +327,11 @@ if __name__ == "__main__":
         sys.stdin.readline()  # wait to be killed: the test's kill must find a live writer
 
 
-@pytest.mark.parametrize("batch_rows, rows", [(16, 16), (None, 240), (1000, 240)])
+@pytest.mark.parametrize("batch_rows, rows", [(16, 21), (24, 24), (None, 240), (1000, 240)])
 def test_raw_chunks_hold_whole_batches_of_at_most_a_mebibyte(tmp_path, batch_rows, rows):
     """A batch of the runner's chunk fills whole HDF5 chunks (no read-modify-write of part-filled
-    ones); chunks stay under 1 MiB (400 times x 8 B: 327 rows) and within the design (240 runs)."""
+    ones); chunks stay under 1 MiB (400 times x 8 B: 327 rows), within the design (240 runs) and
+    above 64 KiB (21 rows)."""
     path = tmp_path / "r.h5"
     ResultStore.create(path, campaign_text=CAMPAIGN, batch_rows=batch_rows, **create_args()).close()
     with h5py.File(path, "r") as f:

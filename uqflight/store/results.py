@@ -59,6 +59,7 @@ def text_hash(text: str) -> str:
     return hashlib.sha256(text.encode("utf-8")).hexdigest()
 
 
+MIN_CHUNK_BYTES = 64 * 1024  # raw chunks hold whole batches, but no fewer bytes than this (tiny runs)
 CHECKED = {"chunks": True, "fletcher32": True}  # every fixed-size dataset: chunked and checksummed
 
 
@@ -89,8 +90,9 @@ class ResultStore:
 
         `tsvd` = {"tol": ..., "batch": ...} turns on compression (batch defaults to the paper's 1000
         samples); `attrs` become root attributes (dicts as JSON text); `units` maps output name → unit.
-        `batch_rows`: the runs the writer stores at a time (the runner's chunk): raw chunks of at most
-        that many rows, so that a batch fills whole HDF5 chunks instead of rewriting part-filled ones.
+        `batch_rows`: the runs the writer stores at a time (the runner's chunk): raw chunks of that many
+        rows (at least 64 KiB, at most ~1 MiB), so that a batch fills whole HDF5 chunks instead of
+        rewriting part-filled ones.
         """
         xi, kappa = np.atleast_2d(xi).astype(float), np.atleast_2d(kappa).astype(float)
         weights, time = np.asarray(weights, dtype=float), np.asarray(time, dtype=float)
@@ -124,7 +126,7 @@ class ResultStore:
         f.create_dataset("time", data=time, **CHECKED).attrs["units"] = "s"
         if raw:
             group = f.create_group("outputs", track_order=True)
-            rows = min(chunk_rows(time.size, n), batch_rows or n)
+            rows = min(chunk_rows(time.size, n), max(batch_rows or n, -(-MIN_CHUNK_BYTES // (8 * time.size))))
             for name in outputs:
                 ds = group.create_dataset(_key(name), shape=(n, time.size), dtype="f8", fillvalue=np.nan,
                                           chunks=(rows, time.size), fletcher32=True)
