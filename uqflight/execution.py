@@ -105,10 +105,9 @@ def prepare_store(campaign: Campaign, design: Design, out: Path, force: bool, pr
     """Open the campaign's results file to resume it, or create it with the design and provenance.
     `probed` = (time, outputs, units) from a worker (`WorkerPool.probe`); measured here in a worker
     process when not given."""
-    spec = worker_spec(campaign)
     kappa = to_physical(campaign.parameters, design.xi)
     if probed is None:
-        pool = WorkerPool(spec, 1, PROBE_TIMEOUT_S)
+        pool = WorkerPool(worker_spec(campaign), 1, PROBE_TIMEOUT_S)
         try:
             probed = pool.probe(nominal_kappa(campaign))[:3]
         finally:
