@@ -161,14 +161,19 @@ def test_a_zero_mean_is_reported_without_a_crash_and_its_cov_is_null(tmp_path):
     assert y["cov"] == [None] and y["sobol_first"]["x"] == [pytest.approx(1.0)]
 
 
-def test_errors_carry_the_reference_noise_floor(tmp_path):
-    reference = run_python_campaign(tmp_path, campaign("ref", "sum_of_squares", NORMAL_2D,
-                                                       "{kind: monte_carlo, samples: 400}"), "ref")
+def exact_grid_errors_against(tmp_path, reference_design: str, tag: str):
+    """(errors of an exact PG grid on sum_of_squares against a reference of that design, the reference's
+    runs): what is left of the errors is the reference's own noise."""
+    reference = run_python_campaign(tmp_path, campaign(tag, "sum_of_squares", NORMAL_2D, reference_design), tag)
     grid = run_python_campaign(tmp_path, campaign("pg", "sum_of_squares", NORMAL_2D, "{kind: tensor_grid, points: 4}",
                                                   "method: {kind: pseudo_galerkin, order: 2}\n"), "pg")
     errors = analyse(grid, reference=str(reference)).outputs["y"].errors
     with h5py.File(reference) as f:
-        Y = f["outputs/y"][()]
+        return errors, f["outputs/y"][()]
+
+
+def test_errors_carry_the_reference_noise_floor(tmp_path):
+    errors, Y = exact_grid_errors_against(tmp_path, "{kind: monte_carlo, samples: 400}", "ref")
     # σ/√N of the reference's mean and the distribution-free standard error of its variance,
     # √((μ4 − (N−3)/(N−1) σ⁴)/N), in Eq. 49's normalisation, recomputed here from the runs
     n, variance = len(Y), Y.var(axis=0, ddof=1)
@@ -181,13 +186,8 @@ def test_errors_carry_the_reference_noise_floor(tmp_path):
 
 
 def test_a_randomised_qmc_reference_takes_its_floor_from_the_replicates(tmp_path):
-    reference = run_python_campaign(tmp_path, campaign("rqmc", "sum_of_squares", NORMAL_2D,
-                                                       "{kind: sobol, samples: 64, replicates: 8}"), "rqmc")
-    grid = run_python_campaign(tmp_path, campaign("pg", "sum_of_squares", NORMAL_2D, "{kind: tensor_grid, points: 4}",
-                                                  "method: {kind: pseudo_galerkin, order: 2}\n"), "pg")
-    errors = analyse(grid, reference=str(reference)).outputs["y"].errors
-    with h5py.File(reference) as f:
-        Y = f["outputs/y"][()].reshape(8, 64, -1)
+    errors, runs = exact_grid_errors_against(tmp_path, "{kind: sobol, samples: 64, replicates: 8}", "rqmc")
+    Y = runs.reshape(8, 64, -1)
     means = Y.mean(axis=1)
     np.testing.assert_allclose(errors["eps_m_floor"], means.std(axis=0, ddof=1) / np.sqrt(8) / means.mean(axis=0).max(),
                                rtol=1e-9)
