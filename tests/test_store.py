@@ -232,16 +232,18 @@ def test_resume_after_sigkill_equals_an_uninterrupted_file(tmp_path, reference, 
     assert_same_results(path, reference)
 
 
-@pytest.mark.parametrize("tsvd", [False, True])
-def test_a_torn_chunk_is_rewritten_and_its_runs_rerun_on_resume(tmp_path, tsvd):
-    """A kill during HDF5's write of a chunk leaves it failing its checksum: a resume reruns its runs,
-    which restores their raw rows bit for bit (the tSVD factors, which hold them already, stay as they are)."""
+@pytest.mark.parametrize("dataset, tsvd", [("outputs/alpha_deg", False), ("outputs/alpha_deg", True),
+                                           ("samples/reason", True)])
+def test_a_torn_chunk_is_rewritten_and_its_runs_rerun_on_resume(tmp_path, dataset, tsvd):
+    """A kill during HDF5's write of a chunk leaves it failing its checksum: a resume reruns its runs
+    (the ok runs of an output chunk, the failed runs of a reason chunk), which restores the file bit for
+    bit (the tSVD factors, which hold the ok runs already, stay as they are)."""
     reference, path = tmp_path / "whole.h5", tmp_path / "torn.h5"
     for target in (reference, path):
         with ResultStore.create(target, campaign_text=CAMPAIGN, **create_args(tsvd=tsvd)) as store:
             write_runs(store, shuffled_batches(4))
     with h5py.File(path, "r") as f:
-        offset = f["outputs/alpha_deg"].id.get_chunk_info(0).byte_offset
+        offset = f[dataset].id.get_chunk_info(0).byte_offset
     with open(path, "r+b") as fh:  # one byte of the first chunk's data changed, as a torn write leaves it
         fh.seek(offset + 3)
         byte = fh.read(1)
@@ -249,8 +251,65 @@ def test_a_torn_chunk_is_rewritten_and_its_runs_rerun_on_resume(tmp_path, tsvd):
         fh.write(bytes([byte[0] ^ 0x10]))
     with ResultStore.open(path, "a") as store:
         assert store.repaired > 0 and store.pending().size == store.repaired
+        if dataset == "samples/reason":  # the chunk holds all 240 runs: exactly the failed ones are rerun
+            np.testing.assert_array_equal(store.pending(), np.flatnonzero(expected_runs(np.arange(N))[0] > 0))
         write_runs(store, [store.pending()])
     assert_same_results(path, reference)
+
+
+def test_reasons_are_checksummed_fixed_length_strings_cut_at_a_character(tmp_path):
+    """No variable-length strings: their global heap has no checksum, and a kill can leave the dataset
+    pointing at heap objects that never reached the disk (HDF5 then fails or crashes on the next write).
+    A reason longer than 256 bytes is cut before a whole character and ends in "…"."""
+    long_reason = "é" * 200  # 400 bytes: 126 characters (252 bytes) and "…" (3) fit in 256
+    with ResultStore.create(tmp_path / "r.h5", campaign_text=CAMPAIGN, **create_args()) as store:
+        status, reasons, outputs = expected_runs(np.arange(8))
+        reasons[4] = long_reason
+        store.write_batch(np.arange(8), status, reasons, outputs)
+        assert store.reasons[:8] == [""] * 4 + ["é" * 126 + "…"] + [""] * 2 + ["udot not trimmable"]
+        data = store._file["samples/reason"]
+        assert h5py.check_string_dtype(data.dtype).length == 256 and data.fletcher32
+    assert uqflight.store.results.fit_reason("abc", 3) == b"abc"
+    assert uqflight.store.results.fit_reason("abcd", 3) == "…".encode()
+
+
+def test_reasons_of_runs_left_pending_by_a_crash_are_cleared_on_resume(tmp_path, reference, monkeypatch):
+    """A crash after the data and reasons reached the disk but before the status: the runs stay pending,
+    their reasons are cleared on reopening, and the resume gives the uninterrupted file."""
+    path, flush = tmp_path / "crashed.h5", ResultStore._flush
+
+    def crash_after_the_first_flush(store, sync):
+        flush(store, sync)
+        raise Crash
+
+    with ResultStore.create(path, campaign_text=CAMPAIGN, **create_args()) as store:
+        write_runs(store, [np.arange(0, 8)])
+        monkeypatch.setattr(ResultStore, "_flush", crash_after_the_first_flush)
+        with pytest.raises(Crash):
+            write_runs(store, [np.arange(8, 40)])  # runs 13, 20, 22, 31 and 33 fail
+        monkeypatch.undo()
+        assert store.reasons[13] == "NaN in alpha"
+    with ResultStore.open(path, "a") as store:
+        np.testing.assert_array_equal(store.pending(), np.arange(8, N))
+        assert store.reasons == expected_runs(np.arange(8))[1] + [""] * (N - 8)
+        write_runs(store, [store.pending()])
+    assert_same_results(path, reference)
+
+
+def test_a_file_with_variable_length_reasons_still_reads_and_resumes(tmp_path):
+    """Files written before the reasons became fixed-length hold them in HDF5's heap."""
+    path = tmp_path / "old.h5"
+    with ResultStore.create(path, campaign_text=CAMPAIGN, **create_args(tsvd=False)) as store:
+        pass
+    with h5py.File(path, "r+") as f:
+        del f["samples/reason"]
+        f["samples"].create_dataset("reason", shape=(N,), dtype=h5py.string_dtype())
+    with ResultStore.open(path, "a") as store:
+        write_runs(store, [np.arange(0, 40)])
+    with ResultStore.open(path, "a") as store:
+        write_runs(store, [store.pending()])
+        status, reasons, _ = expected_runs(np.arange(N))
+        assert store.reasons == reasons and store.pending().size == 0
 
 
 class Crash(Exception):

@@ -3,7 +3,7 @@
 
 Layout (fixed by DESIGN.md; N runs, d parameters, T recorded times):
     /samples/xi (N, d)  /samples/kappa (N, d; attr names)  /samples/weight (N)
-    /samples/status (N int8, see Status)  /samples/reason (N str, "" when ok)
+    /samples/status (N int8, see Status)  /samples/reason (N str of at most 256 UTF-8 bytes, "" when ok)
     /time (T)
     /outputs/<name> (N, T)  raw histories, NaN rows where not run or failed
     /tsvd/<name>/U (T, r), s (r), V (n, r), columns (n)   A_:c ≈ U diag(s) V_c: is sample columns[c]
@@ -11,7 +11,8 @@ Layout (fixed by DESIGN.md; N runs, d parameters, T recorded times):
     root attributes: campaign (YAML text), campaign_hash (its sha256), created, and the caller's
     (versions, aircraft_hash, ...)
 
-Crash safety: every batch writes its data first, flushes and fsyncs, then writes the status,
+Crash safety: every batch writes its data and the failed runs' reasons first, flushes and fsyncs, then
+writes the status,
 flushes and fsyncs again (one flush would let HDF5 write its cached chunks in its own order, and a
 kill or full disk could then leave a status without its data), so a killed process loses at most
 the batch in flight and `pending()` tells exactly what to rerun. The factors
@@ -25,7 +26,9 @@ fold runs with one BLAS thread (threadpoolctl), whoever calls it, so a resume gi
 
 Integrity: every dataset is chunked with HDF5's fletcher32 checksum, so a flipped byte is reported
 on reading (`CorruptFile`) instead of read back as a valid value; status codes outside `Status`
-are refused on opening.
+are refused on opening. The reasons are fixed-length strings: variable-length ones live in HDF5's
+global heap, which takes no checksum and which a kill can leave pointing at heap objects that never
+reached the disk (HDF5 then fails, or crashes, on the next write).
 """
 from __future__ import annotations
 
@@ -60,6 +63,8 @@ def text_hash(text: str) -> str:
 
 
 MIN_CHUNK_BYTES = 64 * 1024  # raw chunks hold whole batches, but no fewer bytes than this (tiny runs)
+REASON_BYTES = 256  # a failure's reason is stored in at most this many UTF-8 bytes, longer ones cut with "…"
+REASON_ROWS = 256  # reasons per HDF5 chunk (64 KiB); only chunks holding a failed run are ever written
 CHECKED = {"chunks": True, "fletcher32": True}  # every fixed-size dataset: chunked and checksummed
 
 
@@ -73,6 +78,35 @@ def read_error(exc: BaseException) -> str:
     if "filter" in text.lower() or "checksum" in text.lower():
         return f"data corrupted: a checksum (fletcher32) does not match ({text})"
     return text
+
+
+def fit_reason(reason: str, size: int) -> bytes:
+    """`reason` in UTF-8, cut to at most `size` bytes (ending in "…" when cut, never inside a character)."""
+    data = reason.encode("utf-8")
+    if len(data) <= size:
+        return data
+    return data[:size - 3].decode("utf-8", "ignore").encode("utf-8") + "…".encode("utf-8")
+
+
+def _no_reasons(data: h5py.Dataset, n: int):
+    """n empty reasons, in the form the reason dataset takes (fixed-length, or variable in older files)."""
+    return [""] * n if h5py.check_string_dtype(data.dtype).length is None else np.zeros(n, dtype=data.dtype)
+
+
+def _chunk_blocks(data: h5py.Dataset, block: int, fill) -> Iterator[tuple[int, int, np.ndarray | None]]:
+    """(start, stop, rows) over `data` in blocks of whole chunks; a block that fails its checksum (a chunk
+    a kill tore) is overwritten with `fill`, chunk by chunk, and comes as (start, stop, None)."""
+    rows = data.chunks[0] if data.chunks else block
+    step = max(rows, block - block % rows)
+    for start in range(0, data.shape[0], step):
+        stop = min(start + step, data.shape[0])
+        try:
+            values = data[start:stop]
+        except OSError:
+            for first in range(start, stop, rows):
+                data[first:min(first + rows, stop)] = fill
+            values = None
+        yield start, stop, values
 
 
 class ResultStore:
@@ -121,8 +155,8 @@ class ResultStore:
         samples.create_dataset("weight", data=weights, **CHECKED)
         samples.create_dataset("status", shape=(n,), dtype="i1", fillvalue=Status.PENDING,
                                **CHECKED).attrs["codes"] = json.dumps({s.name.lower(): s.value for s in Status})
-        # variable-length strings take no HDF5 filter: the reasons are the one unchecked dataset
-        samples.create_dataset("reason", shape=(n,), dtype=h5py.string_dtype())
+        samples.create_dataset("reason", shape=(n,), dtype=h5py.string_dtype("utf-8", REASON_BYTES),
+                               chunks=(min(n, REASON_ROWS),), fletcher32=True)
         f.create_dataset("time", data=time, **CHECKED).attrs["units"] = "s"
         if raw:
             group = f.create_group("outputs", track_order=True)
@@ -269,11 +303,13 @@ class ResultStore:
         """Store finished runs, in any order: outputs[name] is (n, T) for the n `indices`.
 
         Rows of failed runs are stored as NaN (their values are ignored); ok rows must be finite.
-        Data first, status last, then a flush; then the completed design-order prefix is folded
-        into the tSVD factors.
+        Data and reasons first, status last, each followed by a flush; then the completed
+        design-order prefix is folded into the tSVD factors.
         """
         idx, status, reasons, values = self._checked_batch(indices, status, reasons, outputs)
         ok = status == Status.OK
+        if not ok.all():  # ok runs keep the fill value "": a campaign without failures writes no reason
+            self._write_reasons(idx[~ok], reasons[~ok])
         for name, rows in values.items():
             if self._raw:
                 self._file["outputs"][_key(name)][idx] = np.where(ok[:, None], rows, np.nan)
@@ -282,7 +318,6 @@ class ResultStore:
                 new = ok & ~np.isin(idx, self._held_runs(group))
                 append_rows(group, rows[new], idx[new])
         self._flush(sync=True)
-        self._file["samples/reason"][idx] = reasons
         self._file["samples/status"][idx] = status
         self._flush(sync=True)
         if "tsvd" in self._file:
@@ -301,28 +336,18 @@ class ResultStore:
                 os.close(fd)
 
     def _repair_lost_runs(self, block: int = 1000) -> int:
-        """Mark pending again the ok runs whose raw histories did not reach the disk (a write that
-        failed late, e.g. a full disk hit by HDF5's cache at flush, or a chunk a kill left half written,
-        whose checksum fails: it is overwritten), so that a resume reruns them; returns how many."""
+        """Mark pending again the runs a resume must fly again, and return how many: ok runs whose raw
+        histories did not reach the disk (a write that failed late, e.g. a full disk hit by HDF5's cache
+        at flush), and the runs of a chunk a kill left half written, whose checksum fails (it is
+        overwritten: ok runs of a torn output chunk, failed runs of a torn reason chunk, whose rerun
+        gives their reason again). Reasons written for runs that are pending are cleared."""
         status = self.status
         lost = np.zeros(status.size, dtype=bool)
         if self._raw:
             for key in self._file["outputs"]:
-                data = self._file["outputs"][key]
-                rows = data.chunks[0] if data.chunks else block  # whole chunks: a torn one is rewritten whole
-                step = max(rows, block - block % rows)
-                for start in range(0, status.size, step):
-                    stop = min(start + step, status.size)
+                for start, stop, values in _chunk_blocks(self._file["outputs"][key], block, np.nan):
                     ok = status[start:stop] == Status.OK
-                    try:
-                        values = data[start:stop]
-                    except OSError:  # a chunk a kill tore (its checksum fails): its runs are rerun
-                        for first in range(start, stop, rows):
-                            data[first:min(first + rows, stop)] = np.nan
-                        lost[start:stop] |= ok
-                        continue
-                    if ok.any():
-                        lost[start:stop] |= ok & ~np.isfinite(values).all(axis=1)
+                    lost[start:stop] |= ok if values is None else ok & ~np.isfinite(values).all(axis=1)
         elif "tsvd" in self._file:  # ok runs neither in the factors nor in the buffer (their order in the
             for key in self._file["tsvd"]:  # factors then follows the rerun: equal data, other rounding)
                 group = self._file["tsvd"][key]
@@ -331,12 +356,26 @@ class ResultStore:
                 held = np.zeros(status.size, dtype=bool)
                 held[np.union1d(group["columns"][()], index).astype(np.int64)] = True
                 lost |= (status == Status.OK) & ~held
-        if lost.any():
-            index = np.flatnonzero(lost)
-            self._file["samples/status"][index] = Status.PENDING
-            self._file["samples/reason"][index] = [""] * index.size
+        reasons = self._file["samples/reason"]
+        stale = np.zeros(status.size, dtype=bool)
+        for start, stop, values in _chunk_blocks(reasons, block, _no_reasons(reasons, 1)[0]):
+            if values is None:
+                lost[start:stop] |= status[start:stop] > Status.OK
+            else:
+                stale[start:stop] = np.asarray(values, dtype=bytes) != b""
+        stale &= (status == Status.PENDING) | lost
+        if lost.any() or stale.any():
+            self._file["samples/status"][np.flatnonzero(lost)] = Status.PENDING
+            self._file["samples/reason"][np.flatnonzero(stale)] = _no_reasons(reasons, int(stale.sum()))
             self._flush(sync=True)
         return int(lost.sum())
+
+    def _write_reasons(self, idx: np.ndarray, reasons) -> None:
+        """Store the reasons of the runs `idx` (ascending), cut to what the dataset holds."""
+        data = self._file["samples/reason"]
+        length = h5py.check_string_dtype(data.dtype).length
+        data[idx] = [str(r) for r in reasons] if length is None else \
+            np.array([fit_reason(str(r), length) for r in reasons], dtype=data.dtype)
 
     def _held_runs(self, group) -> np.ndarray:
         """The runs an output's tSVD factors or buffer hold."""
