@@ -1,5 +1,8 @@
 """Trial loops for issue 17 (not collected by pytest: run `python tests/reliability_trials.py`).
 
+- writer: SIGKILL the results file's writer (the store test's writer: failed runs with reasons, raw
+  chunks of 21 or 240 rows, and tSVD) at a random step of a random batch, resume, compare with an
+  uninterrupted file.
 - kill: SIGKILL the runner (`uqflight run`, 2 workers, JSBSim) at a random point, resume, compare
   every dataset with an uninterrupted run (raw and tSVD storage).
 - crash: a campaign whose samples exit or segfault their worker, flown with 1 and 2 workers and
@@ -18,6 +21,7 @@ import time
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).parent))
+import test_store  # noqa: E402
 from test_execution import JSBSIM_CAMPAIGN  # noqa: E402
 from test_reliability import UQFLIGHT, assert_same_results, campaign_text  # noqa: E402
 
@@ -33,6 +37,34 @@ def same(a, b) -> bool:
     except AssertionError as exc:
         print("    differs:", str(exc).splitlines()[0][:200])
         return False
+
+
+def writer_trials(root: Path, n: int) -> tuple[int, int]:
+    identical = 0
+    for batch_rows in (16, None):
+        args = dict(campaign_text=test_store.CAMPAIGN, batch_rows=batch_rows, **test_store.create_args())
+        whole = root / f"writer-whole-{batch_rows}.h5"
+        with ResultStore.create(whole, **args) as store:
+            test_store.write_runs(store, test_store.in_design_order(8))
+        for trial in range(n // 2):
+            out = root / f"writer-{trial}.h5"
+            ResultStore.create(out, **args).close()
+            batches, delay = random.randint(1, 25), random.uniform(0.0, 0.012)
+            test_store.kill_writer_midway(out, batches, delay)
+            try:
+                with ResultStore.open(out, "a") as store:
+                    remaining, repaired = store.pending().size, store.repaired
+                    if remaining:
+                        test_store.write_runs(store, [store.pending()])
+                ok = same(out, whole)
+            except Exception as exc:
+                remaining, repaired, ok = f"({type(exc).__name__}: {exc})", 0, False
+            identical += ok
+            print(f"writer {batch_rows or 'all'}-row batches {trial}: killed {delay * 1e3:.1f} ms after batch "
+                  f"{batches}, {remaining} pending ({repaired} repaired), {'identical' if ok else 'DIFFERENT'}",
+                  flush=True)
+            out.unlink()
+    return n // 2 * 2, identical
 
 
 def kill_trials(root: Path, n: int) -> tuple[int, int]:
@@ -130,7 +162,8 @@ if __name__ == "__main__":
     random.seed(int(os.environ.get("SEED", "17")))
     with tempfile.TemporaryDirectory() as tmp:
         root = Path(tmp)
-        totals = {"kill": kill_trials(root, int(os.environ.get("KILLS", "20"))),
+        totals = {"writer": writer_trials(root, int(os.environ.get("WRITER_KILLS", "100"))),
+                  "kill": kill_trials(root, int(os.environ.get("KILLS", "20"))),
                   "crash": crash_trials(root, int(os.environ.get("CRASHES", "5"))),
                   "enospc": enospc_trials(root, int(os.environ.get("ENOSPC", "4")))}
     for kind, (n, same_count) in totals.items():
