@@ -227,7 +227,7 @@ def run(
         typer.echo(f"\nerror: {exc.strerror}", err=True)
         _exit_now(2)
     except CorruptFile as exc:
-        typer.echo(f"error: {exc}", err=True)
+        typer.echo(f"error: {exc}; `{resume} --restart` starts it over", err=True)
         raise typer.Exit(2)
     except IncompleteFile as exc:
         typer.echo(f"error: {exc}", err=True)

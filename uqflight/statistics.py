@@ -41,7 +41,7 @@ from .methods.basis import orthonormal_basis
 from .methods.loo import relative_loo_error
 from .methods.validity import method_problem
 from .parameters.germs import draw_germs
-from .store import ResultStore, Status
+from .store import CorruptFile, ResultStore, Status
 
 PDF_POINTS = 120
 TIME_BLOCK = 100  # recorded times whose runs or surrogate draws are rebuilt at once
@@ -142,6 +142,8 @@ def read_statistics(path, method: dict | None = None, partial: bool = False,
         return analyse(path, method=method, partial=partial, allow_aliasing=allow_aliasing), attrs
     except BadInput:
         raise
+    except CorruptFile as exc:
+        raise BadInput(str(exc) if str(exc).startswith(f"{path}:") else f"{path}: {exc}") from exc
     except (OSError, ValueError, KeyError) as exc:
         reason = " ".join(str(exc).split())  # one line, whatever h5py or the analysis said
         raise BadInput(f"{path}: cannot analyse the results file ({reason})") from exc
@@ -235,8 +237,16 @@ def output_basis(store: ResultStore, name: str, ok: np.ndarray) -> tuple[np.ndar
     """The ok runs of `name` as basis @ scale: raw (Y, None), or tSVD (V rows, diag(s) Uᵀ)."""
     factors = store.output_factors(name)
     if factors is None:
-        return store.output_matrix(name, np.flatnonzero(ok)), None
+        runs = np.flatnonzero(ok)
+        histories = store.output_matrix(name, runs)
+        bad = runs[~np.isfinite(histories).all(axis=1)]
+        if bad.size:
+            raise CorruptFile(f"output {name}: {bad.size} runs with status ok hold values that are not finite "
+                              f"(e.g. run {bad[0]}): the file is damaged (`uqflight info` lists its problems)")
+        return histories, None
     U, s, V, columns = factors
+    if not (np.isfinite(U).all() and np.isfinite(s).all() and np.isfinite(V).all()):
+        raise CorruptFile(f"output {name}: its tSVD factors hold values that are not finite: the file is damaged")
     row_of = np.full(ok.size, -1)
     row_of[columns] = np.arange(columns.size)
     return V[row_of[np.flatnonzero(ok)]], s[:, None] * U.T

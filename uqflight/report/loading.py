@@ -59,8 +59,11 @@ def method_label(method: dict) -> str:
 
 def input_distributions(campaign_text: str) -> str:
     """The campaign's input distribution(s), e.g. "normal" or "normal, uniform"."""
-    parameters = (yaml.safe_load(campaign_text) or {}).get("parameters") or {}
-    return ", ".join(dict.fromkeys(str(spec.get("distribution", "?")) for spec in parameters.values()))
+    parameters = campaign_settings(campaign_text).get("parameters")
+    if not isinstance(parameters, dict) or not parameters:
+        return "?"
+    return ", ".join(dict.fromkeys(str(spec.get("distribution", "?")) if isinstance(spec, dict) else "?"
+                                   for spec in parameters.values()))
 
 
 def campaign_settings(campaign_text: str) -> dict:

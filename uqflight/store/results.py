@@ -46,6 +46,7 @@ from threadpoolctl import threadpool_limits
 from ..simulators.base import Status
 from ..tsvd import IncrementalSVD, iter_column_blocks
 from .compressed import append_rows, apply_staged, buffer_rows, chunk_rows, commit, ingest, write_state
+from .layout import layout_problems
 
 
 def _key(name: str) -> str:
@@ -191,10 +192,19 @@ class ResultStore:
             raise ValueError(f"{path} is not a uqflight results file (no /samples/status)")
         store = cls(f)
         try:
+            if mode == "a" and isinstance(f.get("tsvd"), h5py.Group):  # finish or drop a step a killed
+                for group in f["tsvd"].values():                      # writer left half done, first
+                    if isinstance(group, h5py.Group):
+                        apply_staged(group)
+            problems = layout_problems(f)
             status = store.status
         except OSError as exc:
             f.close()
             raise CorruptFile(f"{path}: {read_error(exc)}") from exc
+        if problems:
+            f.close()
+            raise CorruptFile(f"{path}: {'; '.join(problems[:3])}{' (and more)' if len(problems) > 3 else ''}: "
+                              "the file is damaged or was not written by uqflight")
         unknown = np.setdiff1d(np.unique(status), [s.value for s in Status])
         if unknown.size:
             f.close()
@@ -209,9 +219,8 @@ class ResultStore:
                 raise CorruptFile(f"{path}: {read_error(exc)}") from exc
             status = store.status
         if mode == "a" and "tsvd" in f:
-            for name in f["tsvd"]:
-                apply_staged(f["tsvd"][_key(name)])
-                store._fold_ready(name, status)
+            for key in f["tsvd"]:
+                store._fold_ready(_name(key), status)
             f.flush()
         return store
 
@@ -260,7 +269,7 @@ class ResultStore:
     @property
     def units(self) -> dict[str, str]:
         group = self._file["outputs" if self._raw else "tsvd"]
-        return {_name(key): str(group[key].attrs["units"]) for key in group}
+        return {_name(key): str(group[key].attrs.get("units", "")) for key in group}
 
     @property
     def campaign_text(self) -> str:
@@ -351,7 +360,6 @@ class ResultStore:
         elif "tsvd" in self._file:  # ok runs neither in the factors nor in the buffer (their order in the
             for key in self._file["tsvd"]:  # factors then follows the rerun: equal data, other rounding)
                 group = self._file["tsvd"][key]
-                apply_staged(group)
                 _, index, _ = buffer_rows(group, status)
                 held = np.zeros(status.size, dtype=bool)
                 held[np.union1d(group["columns"][()], index).astype(np.int64)] = True

@@ -1,0 +1,146 @@
+"""Damaged and foreign results files: every reader refuses them with one line naming the file and what
+is wrong (exit 2), never a traceback, never a report. Real HDF5 files from a real campaign, then cut."""
+import shutil
+
+import h5py
+import numpy as np
+import pytest
+from conftest import DATA, cli_in_process
+
+from uqflight.campaign import parse_campaign
+from uqflight.execution import run_campaign
+from uqflight.report.loading import load_entries
+from uqflight.statistics import BadInput, read_statistics
+from uqflight.store import CorruptFile, ResultStore
+
+N, T = 12, 5000
+CAMPAIGN = f"""
+name: damaged
+seed: 5
+simulator: {{kind: python, function: "{DATA / 'hostile_model.py'}:long_histories"}}
+parameters:
+  x: {{distribution: uniform, lower: -2, upper: 2}}
+design: {{kind: monte_carlo, samples: {N}}}
+execution: {{workers: 1, chunk: 4}}
+"""
+BASELINE = DATA.parent / "baselines" / "ci-small.json"  # any sound baseline: the results file is refused first
+TSVD = "storage: {raw: false, tsvd: {tol: 1.0e-10, batch: 4}}\n"
+
+
+@pytest.fixture(scope="module")
+def sound(tmp_path_factory):
+    """A raw and a tSVD-only results file of 12 runs."""
+    root = tmp_path_factory.mktemp("sound")
+    files = {}
+    for storage, extra in (("raw", ""), ("tsvd", TSVD)):
+        files[storage] = root / f"{storage}.h5"
+        run_campaign(parse_campaign(CAMPAIGN + extra, str(DATA / "damaged.yaml")), out=files[storage])
+    return files
+
+
+def replaced(path, data, **attrs):
+    def damage(f):
+        kept = dict(f[path].attrs)
+        del f[path]
+        f.create_dataset(path, data=data).attrs.update({**kept, **attrs})
+    return damage
+
+
+def assign(path, index, value):
+    def damage(f):
+        f[path][index] = value
+    return damage
+
+
+DAMAGES = {  # name: (storage, damage, what the message says)
+    "status of floats": ("raw", replaced("samples/status", np.zeros(N)), "/samples/status holds float64"),
+    "status too short": ("raw", replaced("samples/status", np.zeros(N - 1, "i1")), r"expected \(11, any\)"),
+    "reasons of integers": ("raw", replaced("samples/reason", np.zeros(N, int)), "/samples/reason holds int64"),
+    "reasons too short": ("raw", replaced("samples/reason", np.array([b""] * (N - 2))),
+                          r"/samples/reason has shape \(10,\), expected \(12,\)"),
+    "weights too short": ("raw", replaced("samples/weight", np.ones(N - 1)), "/samples/weight has shape"),
+    "a NaN weight": ("raw", assign("samples/weight", 3, np.nan), "/samples/weight holds 1 values that are not finite"),
+    "a NaN in the design": ("raw", assign("samples/xi", (2, 0), np.nan), "/samples/xi holds 1 values"),
+    "an infinite physical value": ("raw", assign("samples/kappa", (0, 0), np.inf), "/samples/kappa holds 1"),
+    "parameter names missing": ("raw", lambda f: f["samples/kappa"].attrs.__delitem__("names"),
+                                "attribute names lists 0 parameters, expected 1"),
+    "no design": ("raw", lambda f: f.__delitem__("samples/xi"), "/samples/xi is missing"),
+    "no times": ("raw", lambda f: f.__delitem__("time"), "/time is missing"),
+    "times of another length": ("raw", replaced("time", np.linspace(0, 1, T - 1)),
+                                r"/outputs/y has shape \(12, 5000\), expected \(12, 4999\)"),
+    "times decreasing": ("raw", replaced("time", np.linspace(1, 0, T)), "strictly increasing"),
+    "times in two columns": ("raw", replaced("time", np.zeros((T, 2))), r"/time has shape \(5000, 2\)"),
+    "histories of strings": ("raw", replaced("outputs/y", np.full((N, 3), b"a")), "/outputs/y holds |S1"),
+    "no outputs": ("raw", lambda f: f.__delitem__("outputs"), "no outputs: neither /outputs nor /tsvd"),
+    "an empty outputs group": ("raw", lambda f: [f.__delitem__("outputs/y")], "/outputs must be a group of at least"),
+    "no campaign": ("raw", lambda f: f.attrs.__delitem__("campaign"), "the root attribute campaign"),
+    "factors of another rank": ("tsvd", lambda f: replaced("tsvd/y/s", np.ones(f["tsvd/y/s"].shape[0] + 1))(f),
+                                "/tsvd/y/s has shape"),
+    "factors for a run outside the design": ("tsvd", assign("tsvd/y/columns", 0, N + 5),
+                                             r"/tsvd/y/columns must name distinct runs in \[0, 12\)"),
+    "a run held twice": ("tsvd", lambda f: assign("tsvd/y/columns", 1, f["tsvd/y/columns"][0])(f),
+                         "must name distinct runs"),
+    "a tSVD tolerance of NaN": ("tsvd", lambda f: f["tsvd"].attrs.__setitem__("tol", np.nan), "tol must be a finite"),
+}
+
+
+@pytest.mark.parametrize("name", DAMAGES)
+def test_a_damaged_file_is_refused_by_every_reader_naming_what_is_wrong(sound, tmp_path, name):
+    storage, damage, message = DAMAGES[name]
+    path = tmp_path / "damaged.h5"
+    shutil.copy(sound[storage], path)
+    with h5py.File(path, "r+") as f:
+        damage(f)
+    for mode in ("r", "a"):
+        with pytest.raises(CorruptFile, match=message):
+            ResultStore.open(path, mode)
+    with pytest.raises(BadInput, match=message):
+        read_statistics(path)
+    for command in (["info", path], ["report", path, "--out", tmp_path / "report"], ["check", path, "--baseline", BASELINE]):
+        result = cli_in_process(*command)
+        assert result.returncode == 2, (command, result.stdout, result.stderr)
+        assert f"{path}:" in result.stderr and "Traceback" not in result.stderr + result.stdout
+    assert not (tmp_path / "report").exists()
+
+
+@pytest.mark.parametrize("storage", ["raw", "tsvd"])
+def test_a_sound_file_passes(sound, storage):
+    with ResultStore.open(sound[storage]) as store:
+        assert store.pending().size == 0 and store.verify() == []
+    assert read_statistics(sound[storage])[0].runs == N
+
+
+def test_an_ok_run_without_finite_values_is_refused_by_the_analysis(sound, tmp_path):
+    """The layout is sound but a run with status ok holds an infinity: no statistics from it."""
+    path = tmp_path / "inf.h5"
+    shutil.copy(sound["raw"], path)
+    with h5py.File(path, "r+") as f:
+        f["outputs/y"][4, 10] = np.inf
+    with pytest.raises(BadInput, match=r"inf\.h5: output y: 1 runs with status ok hold values that are not "
+                                        r"finite \(e\.g\. run 4\)"):
+        read_statistics(path)
+    assert cli_in_process("info", path).returncode == 2
+
+
+def test_a_garbled_campaign_text_does_not_stop_the_report(sound, tmp_path):
+    """The campaign text is shown ("?" for its distributions), not computed with (the method and germs
+    are attributes of their own)."""
+    path = tmp_path / "garbled.h5"
+    shutil.copy(sound["raw"], path)
+    with h5py.File(path, "r+") as f:
+        f.attrs["campaign"] = "{{{: ["
+    (entry,), _ = load_entries([path], None)
+    assert entry.inputs == "?" and entry.stats.runs == N
+
+
+def test_run_refuses_to_resume_a_damaged_file_and_restart_starts_it_over(sound, tmp_path):
+    yaml, path = tmp_path / "damaged.yaml", tmp_path / "damaged.h5"
+    yaml.write_text(CAMPAIGN)
+    shutil.copy(sound["raw"], path)
+    with h5py.File(path, "r+") as f:
+        f["samples/weight"][0] = np.nan
+    refused = cli_in_process("run", yaml, "--out", path)
+    assert refused.returncode == 2 and "/samples/weight holds 1 values that are not finite" in refused.stderr
+    assert f"uqflight run {yaml} --out {path} --restart" in refused.stderr
+    assert cli_in_process("run", yaml, "--out", path, "--restart").returncode == 0
+    assert read_statistics(path)[0].runs == N

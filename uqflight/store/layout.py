@@ -1,0 +1,114 @@
+"""The structure a results file must have before any of it is read as numbers: every dataset of the
+layout (results.py) present, of its kind (float, integer, string) and of the shape the others imply
+(N runs, d parameters, T times), the design and the times finite, the times increasing.
+
+A file that fails is damaged or was not written by uqflight; reading it anyway would give shapes that
+disagree deep inside an analysis (a traceback) or, worse, numbers from the wrong rows.
+"""
+from __future__ import annotations
+
+import h5py
+import numpy as np
+
+KINDS = {"float": "f", "integer": "iu"}
+
+
+def _dataset(f: h5py.File, path: str, kind: str, shape: tuple, problems: list[str]) -> h5py.Dataset | None:
+    """The dataset `path` if it exists, is of `kind` ("float", "integer", "string") and has `shape`
+    (None entries: any length); else None, with the problem appended."""
+    item = f.get(path)
+    if not isinstance(item, h5py.Dataset):
+        problems.append(f"/{path} is missing" if item is None else f"/{path} is a group, not a dataset")
+        return None
+    is_kind = h5py.check_string_dtype(item.dtype) is not None if kind == "string" else \
+        item.dtype.kind in KINDS[kind]
+    if not is_kind:
+        problems.append(f"/{path} holds {item.dtype}, expected {kind} values")
+        return None
+    if len(item.shape) != len(shape) or any(want is not None and got != want for got, want in zip(item.shape, shape)):
+        expected = "(" + ", ".join("any" if n is None else str(n) for n in shape) + ("," if len(shape) == 1 else "") + ")"
+        problems.append(f"/{path} has shape {item.shape}, expected {expected}")
+        return None
+    return item
+
+
+def _finite(data: h5py.Dataset, problems: list[str]) -> None:
+    values = data[()]
+    if not np.isfinite(values).all():
+        problems.append(f"{data.name} holds {int(np.size(values) - np.isfinite(values).sum())} values that are "
+                        "not finite")
+
+
+def layout_problems(f: h5py.File) -> list[str]:
+    """What is wrong with the structure of the open results file `f` (empty when it is sound)."""
+    problems: list[str] = []
+    status = _dataset(f, "samples/status", "integer", (None,), problems)
+    if status is None:
+        return problems
+    n = status.shape[0]
+    xi = _dataset(f, "samples/xi", "float", (n, None), problems)
+    if xi is not None:
+        d = xi.shape[1]
+        _finite(xi, problems)
+        kappa = _dataset(f, "samples/kappa", "float", (n, d), problems)
+        if kappa is not None:
+            _finite(kappa, problems)
+            names = kappa.attrs.get("names")
+            if names is None or np.ndim(names) != 1 or len(names) != d:
+                problems.append(f"/samples/kappa's attribute names lists {0 if names is None else np.size(names)} "
+                                f"parameters, expected {d}")
+    weight = _dataset(f, "samples/weight", "float", (n,), problems)
+    if weight is not None:
+        _finite(weight, problems)
+    _dataset(f, "samples/reason", "string", (n,), problems)
+    time = _dataset(f, "time", "float", (None,), problems)
+    if time is not None:
+        values = time[()]
+        if values.size == 0 or not np.isfinite(values).all() or np.any(np.diff(values) <= 0):
+            problems.append(f"/time must hold at least one finite time, strictly increasing ({values.size} values)")
+    if not isinstance(f.attrs.get("campaign"), str):
+        problems.append("the root attribute campaign (the campaign's text) is missing")
+    n_times = None if time is None else time.shape[0]
+    raw, compressed = f.get("outputs"), f.get("tsvd")
+    if raw is None and compressed is None:
+        problems.append("no outputs: neither /outputs nor /tsvd")
+    for group in (raw, compressed):
+        if group is not None and (not isinstance(group, h5py.Group) or not len(group)):
+            problems.append(f"{group.name} must be a group of at least one output")
+    if isinstance(raw, h5py.Group):
+        for key in raw:
+            _dataset(f, f"outputs/{key}", "float", (n, n_times), problems)
+    if isinstance(compressed, h5py.Group):
+        _tsvd_problems(f, compressed, n, n_times, problems)
+        if isinstance(raw, h5py.Group) and set(raw) != set(compressed):
+            problems.append(f"/outputs ({', '.join(raw)}) and /tsvd ({', '.join(compressed)}) name other outputs")
+    return problems
+
+
+def _tsvd_problems(f: h5py.File, group: h5py.Group, n: int, n_times, problems: list[str]) -> None:
+    tol, batch = group.attrs.get("tol"), group.attrs.get("batch")
+    if not (np.ndim(tol) == 0 and np.isreal(tol) and np.isfinite(tol) and tol >= 0):
+        problems.append(f"/tsvd's attribute tol must be a finite number ≥ 0, got {tol!r}")
+    if not (np.ndim(batch) == 0 and np.issubdtype(np.asarray(batch).dtype, np.integer) and batch >= 1):
+        problems.append(f"/tsvd's attribute batch must be an integer ≥ 1, got {batch!r}")
+    for key in group:
+        if not isinstance(group[key], h5py.Group):
+            problems.append(f"/tsvd/{key} is not a group of factors")
+            continue
+        path = f"tsvd/{key}"
+        if "next" in group[key] and not {"U", "s", "V"} <= set(group[key]):
+            problems.append(f"/{path} is half replaced (its writer was killed): resume the run to finish the step")
+            continue
+        U = _dataset(f, f"{path}/U", "float", (n_times, None), problems)
+        rank = None if U is None else U.shape[1]
+        _dataset(f, f"{path}/s", "float", (rank,), problems)
+        V = _dataset(f, f"{path}/V", "float", (None, rank), problems)
+        columns = _dataset(f, f"{path}/columns", "integer", (None if V is None else V.shape[0],), problems)
+        _dataset(f, f"{path}/buffer", "float", (None, n_times), problems)
+        index = _dataset(f, f"{path}/buffer_index", "integer", (None,), problems)
+        if columns is not None:
+            runs = columns[()]
+            if np.any((runs < 0) | (runs >= n)) or np.unique(runs).size != runs.size:
+                problems.append(f"/{path}/columns must name distinct runs in [0, {n})")
+        if index is not None and np.any((index[()] < -1) | (index[()] >= n)):
+            problems.append(f"/{path}/buffer_index must name runs in [0, {n}) (or -1)")
