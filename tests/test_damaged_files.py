@@ -144,3 +144,18 @@ def test_run_refuses_to_resume_a_damaged_file_and_restart_starts_it_over(sound, 
     assert f"uqflight run {yaml} --out {path} --restart" in refused.stderr
     assert cli_in_process("run", yaml, "--out", path, "--restart").returncode == 0
     assert read_statistics(path)[0].runs == N
+
+
+def test_a_time_grid_the_reader_would_refuse_is_refused_before_any_run(tmp_path):
+    (tmp_path / "model.py").write_text(
+        "import numpy as np\n"
+        "def backwards(p):\n"
+        "    return {'time': np.array([2.0, 1.0, 0.0]), 'y': np.full(3, p['x'])}\n")
+    yaml = tmp_path / "c.yaml"
+    yaml.write_text(CAMPAIGN.replace(f"{DATA / 'hostile_model.py'}:long_histories", "model.py:backwards"))
+    refused = cli_in_process("run", yaml, "--out", tmp_path / "r.h5")
+    assert refused.returncode == 2 and "'time' must be finite and strictly increasing" in refused.stderr
+    assert not (tmp_path / "r.h5").exists()
+    with pytest.raises(ValueError, match="finite and strictly increasing"):
+        ResultStore.create(tmp_path / "direct.h5", campaign_text="x", xi=np.zeros((2, 1)), kappa=np.zeros((2, 1)),
+                           weights=np.ones(2), parameter_names=["x"], outputs=["y"], time=np.array([0.0, 0.0]))

@@ -77,6 +77,8 @@ class PythonSimulator:
         time = np.asarray(raw["time"], dtype=float) if "time" in raw else np.arange(length, dtype=float)
         if time.shape != (length,):
             raise ValueError(f"simulator.function: 'time' has {time.size} entries, the outputs {length}")
+        if not np.isfinite(time).all() or np.any(np.diff(time) <= 0):
+            raise ValueError("simulator.function: 'time' must be finite and strictly increasing")
         self.outputs = list(names)
         return time, self.outputs
 

@@ -138,6 +138,8 @@ class ResultStore:
                              f"weights {weights.shape}, {len(parameter_names)} parameter names")
         if time.ndim != 1 or not outputs or len(set(outputs)) != len(outputs):
             raise ValueError(f"need a 1-D time and distinct output names, got time {time.shape}, outputs {outputs}")
+        if time.size == 0 or not np.isfinite(time).all() or np.any(np.diff(time) <= 0):
+            raise ValueError("the recorded times must be finite and strictly increasing")
         if not raw and tsvd is None:
             raise ValueError("nothing would be stored: turn on raw storage or tsvd compression")
         if tsvd is not None:
