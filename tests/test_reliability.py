@@ -14,7 +14,7 @@ from conftest import DATA, UQFLIGHT, assert_same_results
 
 from uqflight.campaign import parse_campaign
 from uqflight.execution import run_campaign
-from uqflight.store import CorruptFile, ResultStore, Status
+from uqflight.store import CorruptFile, LockHeld, ResultStore, Status
 
 
 
@@ -160,6 +160,19 @@ def test_a_stale_lock_is_taken_over(tmp_path):
     lock = tmp_path / "s.h5.lock"
     lock.write_text(f'{{"pid": {dead.pid}, "host": "{os.uname().nodename}", "started": null}}')
     assert run_campaign(campaign("slow", samples=2), out=tmp_path / "s.h5").ran == 2
+    assert not lock.exists()
+
+
+@pytest.mark.parametrize("content", ["", "[1]", '"text"', '{"pid": "x"}', '{"pid": 99999999999999999999}',
+                                     "[" * 100000, "x" * 100000])
+def test_a_lock_that_is_not_ours_is_refused_while_fresh_and_taken_over_once_old(tmp_path, content):
+    """Empty (a kill while the lock was written), foreign or damaged lock files: never a traceback."""
+    lock, out = tmp_path / "s.h5.lock", tmp_path / "s.h5"
+    lock.write_text(content)
+    with pytest.raises(LockHeld, match=r"a run whose lock file is unreadable.*remove .*s\.h5\.lock"):
+        run_campaign(campaign("slow", samples=1), out=out)
+    os.utime(lock, (time.time() - 60, time.time() - 60))
+    assert run_campaign(campaign("slow", samples=1), out=out).ran == 1
     assert not lock.exists()
 
 

@@ -45,11 +45,21 @@ def _alive(pid: int, started: str | None) -> bool:
     return started is None or now is None or now == started
 
 
+LOCK_BYTES = 4096  # a lock we write is ~150 bytes: more is not ours
+
+
 def read_holder(path) -> dict | None:
+    """The lock's holder {pid, host, started, since, command}, or None when the lock is unreadable or
+    not one a run of ours wrote (empty, being written, foreign, damaged)."""
     try:
-        return json.loads(lock_path(path).read_text())
-    except (OSError, ValueError):
+        with open(lock_path(path), "rb") as fh:
+            holder = json.loads(fh.read(LOCK_BYTES + 1))
+    except (OSError, ValueError, RecursionError):
         return None
+    pid = holder.get("pid") if isinstance(holder, dict) else None
+    if type(pid) is not int or not 0 < pid < 2**31:
+        return None
+    return holder
 
 
 def live_holder(path) -> dict | None:
