@@ -1,5 +1,6 @@
 """Nothing lost, nothing hung: worker deaths and hangs are failed runs, a full disk stops cleanly and
 resumes, one writer per file, no orphans, corruption reported (issue 17). Real processes, real HDF5."""
+import json
 import os
 import signal
 import subprocess
@@ -14,7 +15,7 @@ from conftest import DATA, UQFLIGHT, assert_same_results
 
 from uqflight.campaign import parse_campaign
 from uqflight.execution import run_campaign
-from uqflight.store import CorruptFile, LockHeld, ResultStore, Status
+from uqflight.store import CorruptFile, LockHeld, ResultsLock, ResultStore, Status
 
 
 
@@ -170,9 +171,10 @@ def test_a_lock_that_is_not_ours_is_refused_while_fresh_and_taken_over_once_old(
     lock, out = tmp_path / "s.h5.lock", tmp_path / "s.h5"
     lock.write_text(content)
     with pytest.raises(LockHeld, match=r"a run whose lock file is unreadable.*remove .*s\.h5\.lock"):
-        run_campaign(campaign("slow", samples=1), out=out)
+        ResultsLock(out).acquire()
     os.utime(lock, (time.time() - 60, time.time() - 60))
-    assert run_campaign(campaign("slow", samples=1), out=out).ran == 1
+    with ResultsLock(out):
+        assert json.loads(lock.read_text())["pid"] == os.getpid()
     assert not lock.exists()
 
 
