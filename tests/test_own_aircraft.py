@@ -1,10 +1,13 @@
 """Any aircraft: locating, hashing, patching functions (exactly), campaign keys, stock aircraft."""
 import hashlib
+import re
 import shutil
+from pathlib import Path
 
 import jsbsim
 import numpy as np
 import pytest
+from conftest import cli_in_process
 
 from uqflight.campaign import CampaignError, load_campaign
 from uqflight.simulators.aircraft import AircraftFiles, AircraftNotFound, locate
@@ -109,3 +112,39 @@ def test_stock_aircraft_trim_and_hold_level_flight_for_50_s(aircraft):
     drift = [np.max(np.abs(out[k] - out[k][0])) for k in ("h_ft", "theta_deg", "vtas_kt")]
     print(aircraft, drift)
     assert all(d < lim for d, lim in zip(drift, HOLD[aircraft]))
+
+
+def _broken_c172p(tmp_path, edit) -> str:
+    """A copy of JSBSim's c172p under tmp_path/planes/c172x with `edit` applied to its main file."""
+    copy = tmp_path / "planes" / "c172x"
+    shutil.copytree(Path(jsbsim.get_default_root_dir()) / "aircraft" / "c172p", copy)
+    (copy / "c172p.xml").rename(copy / "c172x.xml")
+    (copy / "c172x.xml").write_text(edit((copy / "c172x.xml").read_text()))
+    return "planes/c172x"
+
+
+@pytest.mark.parametrize("edit, message", [
+    (lambda xml: xml.replace("aero/qbar-psf", "aero/qbar-typo", 1),
+     ".*JSBSim kills the process that loads aircraft 'c172x' .*The property aero/qbar-typo does not exist"),
+    (lambda xml: xml[:len(xml) // 2], r".*c172x\.xml is not well-formed XML \(no element found"),
+])
+def test_an_aircraft_that_would_kill_the_process_is_refused_with_exit_2(tmp_path, edit, message):
+    """JSBSim aborts (std::terminate in FGFDMExec's destructor) the process that loaded an aircraft
+    whose function reads a property nobody defines: the load is tried in a throw-away process first."""
+    aircraft = _broken_c172p(tmp_path, edit)
+    text = (CAMPAIGNS / "c172p-scale-l2.yaml").read_text().replace("aircraft: c172p", f"aircraft: {aircraft}")
+    (tmp_path / "c.yaml").write_text(text)
+    with pytest.raises(CampaignError, match="simulator.aircraft: " + message):
+        load_campaign(tmp_path / "c.yaml", probe=jsbsim_probe)  # in this process: it survives
+    for command in (["plan", tmp_path / "c.yaml"], ["aircraft", aircraft]):
+        result = cli_in_process(*command, cwd=tmp_path)
+        assert result.returncode == 2 and re.search(message, result.stderr), result.stderr
+
+
+def test_a_sound_aircraft_is_checked_once_per_version(tmp_path):
+    setup = flight_setup_from({"aircraft": "c172p"})
+    markers = tmp_path / "cache" / "loads"
+    JSBSimFlight(setup)
+    assert len(list(markers.iterdir())) == 1
+    JSBSimFlight(setup)
+    assert len(list(markers.iterdir())) == 1

@@ -93,12 +93,12 @@ def simulate(
             outputs=tuple(DEFAULT_OUTPUTS) + tuple(output))
         flight = JSBSimFlight(setup)
         result = flight.fly(settings)
-    except (ValueError, KeyError, FileNotFoundError) as exc:
-        typer.echo(f"error: {exc.args[0]}", err=True)
-        raise typer.Exit(2)
     except FlightError as exc:
         typer.echo(f"flight failed: {exc}", err=True)
         raise typer.Exit(1)
+    except (ValueError, KeyError, FileNotFoundError, RuntimeError) as exc:  # bad input; an aircraft JSBSim refuses
+        typer.echo(f"error: {exc.args[0]}", err=True)
+        raise typer.Exit(2)
     typer.echo(result.trim.describe())
     for name, values in result.outputs.items():
         typer.echo(f"{name:>12}: start {values[0]:12.4f}  min {values.min():12.4f}  max {values.max():12.4f}")
@@ -119,10 +119,15 @@ def simulate(
 
 def _prepared(aircraft: str, scale: list[str], offset: list[str]):
     """The aircraft of `simulate`/`aircraft`, patched for --scale/--offset; `.settings` holds the
-    patch properties' values. Raises ValueError (a bad pair or function) or FileNotFoundError."""
+    patch properties' values. Raises ValueError (a bad pair or function, an aircraft file that is not
+    XML) or FileNotFoundError."""
+    from .simulators.aircraft import AircraftUnreadable
     from .simulators.patch import PreparedAircraft, patch_property, resolve_function
 
-    plain = PreparedAircraft(aircraft, Path.cwd())
+    try:
+        plain = PreparedAircraft(aircraft, Path.cwd())
+    except AircraftUnreadable as exc:
+        raise ValueError(str(exc)) from None
     pairs = []
     for kind, items in (("scale", scale), ("offset", offset)):
         for name, value in parse_settings(items).items():

@@ -33,6 +33,10 @@ class AircraftNotFound(FileNotFoundError):
     """No aircraft of that name or path; the message lists where it looked and close names."""
 
 
+class AircraftUnreadable(RuntimeError):
+    """An aircraft whose main file is not well-formed XML."""
+
+
 def cache_dir(*parts: str) -> Path:
     """uqflight's cache: $UQFLIGHT_CACHE, else $XDG_CACHE_HOME/uqflight, else ~/.cache/uqflight."""
     base = os.environ.get("UQFLIGHT_CACHE")
@@ -115,12 +119,8 @@ def locate(aircraft: str | os.PathLike, base: Path | None = None) -> AircraftLoc
 
 
 # -- the files an aircraft consists of -----------------------------------------------------
-def _referenced(xml: bytes) -> dict[str, list[str]]:
+def _referenced(tree: ET.Element) -> dict[str, list[str]]:
     """File names the aircraft XML refers to: engines/thrusters and systems."""
-    try:
-        tree = ET.fromstring(xml)
-    except ET.ParseError:
-        return {"engine": [], "systems": []}
     engines = [e.get("file") for tag in ("engine", "thruster") for e in tree.iter(tag) if e.get("file")]
     systems = [e.get("file") for tag in ("system", "flight_control", "autopilot") for e in tree.iter(tag)
                if e.get("file")]
@@ -140,7 +140,12 @@ class AircraftFiles:
         folder = location.folder
         files = {p.relative_to(folder).as_posix(): p.read_bytes()
                  for p in sorted(folder.rglob("*.xml")) if p.is_file()}
-        refs = _referenced(files.get(f"{location.name}.xml", b""))
+        main = f"{location.name}.xml"
+        try:
+            refs = _referenced(ET.fromstring(files.get(main, b"")))
+        except ET.ParseError as exc:
+            raise AircraftUnreadable(f"{folder / main} is not well-formed XML ({exc}); JSBSim cannot load "
+                                     "it either") from None
         for kind, subfolder in (("engine", "Engines"), ("systems", "Systems")):
             for name in refs[kind]:
                 file = name if name.endswith(".xml") else name + ".xml"

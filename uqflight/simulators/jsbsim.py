@@ -17,6 +17,7 @@ import numpy as np
 
 from .base import DivergenceError, FlightError, TrimError
 from .engines import prepare_engines
+from .preflight import check_loads
 
 REPO_ROOT = Path(__file__).resolve().parents[2]  # the source tree (aircraft/bacm)
 
@@ -178,6 +179,7 @@ class JSBSimFlight:
     def __init__(self, setup: FlightSetup = FlightSetup()):
         if not setup.aircraft_file.is_file():
             raise FileNotFoundError(f"aircraft {setup.aircraft!r}: no file {setup.aircraft_file}")
+        check_loads(setup.root, setup.aircraft)  # JSBSim may abort the process that loads a broken aircraft
         quiet_jsbsim()
         self.setup = setup
         self.fdm = jsbsim.FGFDMExec(str(setup.root))
