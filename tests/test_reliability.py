@@ -338,6 +338,26 @@ def test_a_long_flight_is_refused_by_its_memory_or_disk():
     refused(limited(duration="1e9"), r"more than limits.max_(memory|disk)_gb")
 
 
+def test_more_worker_processes_than_memory_allows_are_refused():
+    """A local worker process takes ~52 MB (measured; counted as 60): 1000 of them pass 8 GB."""
+    refused(limited() + "execution: {workers: 1000}\n",
+            r"design: .* GB of memory .*1000 worker processes of 60 MB\), more than limits.max_memory_gb = 8")
+    refused(limited() + "execution: {workers: 1000, executor: dask}\n", r"1000 worker processes")  # a LocalCluster
+    parse_campaign(limited() + "execution: {workers: 1000, executor: dask, scheduler: 'tcp://10.0.0.1:8786'}\n",
+                   "cluster.yaml")  # another machine's processes
+
+
+def test_workers_asked_on_the_command_line_are_refused_beyond_memory_and_capped_at_the_chunks(tmp_path):
+    from uqflight.execution import local_workers
+
+    spec = campaign("slow", samples=15, chunk=16)  # chunks of 4 at the design's end: 0, 4, 8, 12
+    assert spec.runs == 15 and local_workers(spec, 50, 16) == 4 and local_workers(spec, 3, 16) == 3
+    with pytest.raises(ValueError, match=r"100000 workers would need about 6e\+03 GB of memory \(60 MB each\), "
+                                         r"more than limits.max_memory_gb = 8"):
+        run_campaign(spec, out=tmp_path / "r.h5", workers=100000)
+    assert not (tmp_path / "r.h5").exists()
+
+
 def test_a_huge_pce_order_is_refused():
     refused(limited(design="{kind: sparse_grid, rule: gauss_hermite, level: 2}",
                     method="{kind: integration, order: 1000}"), r"method.order: .* more than limits.max_pce_terms")

@@ -44,6 +44,7 @@ import numpy as np
 from threadpoolctl import threadpool_limits
 
 from .campaign import Campaign
+from .campaign.schema import WORKER_BYTES
 from .designs import Design
 from .parameters import to_physical
 from .store import ResultStore, Status, compact, open_for_campaign
@@ -144,6 +145,19 @@ def worker_spec(campaign: Campaign) -> WorkerSpec:
                       bundle=make_bundle(campaign.simulator, properties, base))  # files travel with the task
 
 
+def local_workers(campaign: Campaign, workers: int, chunk: int) -> int:
+    """The worker processes to start for `workers`: at most one per chunk of the design (more would
+    only idle); ValueError when their memory exceeds the campaign's limits.max_memory_gb."""
+    need = workers * WORKER_BYTES / 1e9
+    if need > campaign.limits["max_memory_gb"]:
+        raise ValueError(f"{workers} workers would need about {need:.3g} GB of memory "
+                         f"({WORKER_BYTES / 1e6:.0f} MB each), more than limits.max_memory_gb = "
+                         f"{campaign.limits['max_memory_gb']:g}; this machine has {os.cpu_count()} cores")
+    if campaign.runs:
+        workers = min(workers, len(chunk_starts(campaign.runs, chunk)) - 1)
+    return max(1, workers)
+
+
 def chunk_starts(total: int, chunk: int) -> np.ndarray:
     """The first sample of every chunk, then `total`: design-order chunks of `chunk` samples, except
     the design's last TAPER x `chunk` samples, cut in chunks of `chunk` // TAPER so that the workers
@@ -199,10 +213,12 @@ def run_campaign(campaign: Campaign, out: Path | None = None, workers: int | Non
     Raises LockHeld (another run writes the file), FileExistsError (a file that is not this
     campaign's), DiskFull (stopped cleanly, resumable), WorkerError (no simulator could be built)."""
     execution = campaign.execution
-    workers = workers or execution["workers"]
     executor = executor or execution["executor"]
     scheduler = scheduler or execution.get("scheduler")
     chunk = execution["chunk"]
+    workers = workers or execution["workers"]
+    if executor == "local" or not scheduler:  # processes on this machine (dask's own LocalCluster too)
+        workers = local_workers(campaign, workers, chunk)
     out = Path(out or campaign.storage["path"])
     started = time.perf_counter()
     spec = worker_spec(campaign)

@@ -35,6 +35,8 @@ class Campaign:
     execution: dict
     storage: dict
     analysis: dict = field(default_factory=dict)
+    limits: dict = field(default_factory=lambda: dict(schema.DEFAULT_LIMITS))
+    runs: int | None = None  # the design's size, known once validated
 
     @property
     def germs(self) -> list[str]:
@@ -103,7 +105,7 @@ def parse_campaign(text: str, source: str = "<campaign>", probe: PropertyProbe |
     if isinstance(data["design"], dict):  # sizes from the campaign alone, before building anything
         schema.check_size(check, data, simulator, parameters, method, execution, storage, limits)
     campaign = Campaign(source, text, name, seed, simulator, parameters, data["design"], method,
-                        execution, storage, analysis)
+                        execution, storage, analysis, limits)
     try:
         design = campaign.design()
     except ValueError as exc:
@@ -113,6 +115,7 @@ def parse_campaign(text: str, source: str = "<campaign>", probe: PropertyProbe |
             raise CampaignError(source, field_path, rest) from exc
         raise CampaignError(source, "design", message) from exc
     schema.check_method_fits_design(check, method, design, campaign.germs)
+    campaign.runs = len(design.weights)
     return campaign
 
 

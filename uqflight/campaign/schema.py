@@ -34,6 +34,7 @@ TSVD_KEYS = ("tol", "batch")
 DEFAULT_ORDER = 2
 ANALYSIS_KEYS = ("band_samples", "bootstrap", "quantiles")
 # Refused before anything is built (see `check_size`); a campaign raises them under `limits:`.
+WORKER_BYTES = 60e6  # memory of one local worker process: Python, numpy, JSBSim, the aircraft (52 MB measured)
 DEFAULT_LIMITS = {"max_runs": 1_000_000, "max_memory_gb": 8.0, "max_disk_gb": 100.0, "max_pce_terms": MAX_TERMS}
 LIMIT_KEYS = tuple(DEFAULT_LIMITS)
 MAX_FILE_BYTES = 1 << 20  # a campaign file is at most 1 MiB
@@ -480,6 +481,9 @@ def check_size(check: Checker, data: dict, simulator: dict, parameters: list, me
     memory = 8.0 * (n * (3 * d + 6)                                    # the design, status, merging
                     + execution["workers"] * execution["chunk"] * times * n_outputs * 3  # chunks in flight
                     + n_outputs * times * execution["chunk"] * 4)      # results being written
+    on_this_machine = execution.get("executor", "local") == "local" or not execution.get("scheduler")
+    processes = execution["workers"] if on_this_machine else 0  # dask without a scheduler: a LocalCluster
+    memory += processes * WORKER_BYTES
     tsvd = storage.get("tsvd")
     if tsvd:
         memory += 8.0 * 4 * times * (tsvd["batch"] + rank) + 8.0 * n * rank
@@ -489,7 +493,8 @@ def check_size(check: Checker, data: dict, simulator: dict, parameters: list, me
     figures["memory_gb"], figures["disk_gb"] = memory / 1e9, disk / 1e9
     if memory / 1e9 > limits["max_memory_gb"]:
         check.fail("design", f"the campaign needs about {memory / 1e9:.3g} GB of memory ({n:.4g} runs of "
-                             f"{times:.4g} times x {n_outputs} outputs), more than limits.max_memory_gb = "
+                             f"{times:.4g} times x {n_outputs} outputs, {processes} worker processes of "
+                             f"{WORKER_BYTES / 1e6:.0f} MB), more than limits.max_memory_gb = "
                              f"{limits['max_memory_gb']:g}")
     if disk / 1e9 > limits["max_disk_gb"]:
         check.fail("storage", f"the results file would take about {disk / 1e9:.3g} GB ({n:.4g} runs of "
