@@ -178,6 +178,15 @@ def test_a_lock_that_is_not_ours_is_refused_while_fresh_and_taken_over_once_old(
     assert not lock.exists()
 
 
+@pytest.mark.parametrize("where", ["a file/r.h5", "/proc/uqflight-test.h5"])
+def test_a_results_path_that_cannot_be_written_is_refused(tmp_path, where):
+    """A file where a folder should be; a filesystem that takes no new files (procfs)."""
+    (tmp_path / "a file").write_text("not a folder")
+    with pytest.raises(ValueError, match=r"cannot write the results file .*r?\.h5 \((File exists|No such file)"
+                                         r".*\); choose another path with --out or storage.path"):
+        run_campaign(campaign("slow", samples=1), out=tmp_path / where)
+
+
 def test_no_orphan_workers_after_the_runner_is_killed(tmp_path):
     yaml = write_campaign(tmp_path, "slow", samples=400, chunk=4, workers=2)
     out = tmp_path / "r.h5"

@@ -48,7 +48,7 @@ from .campaign.schema import WORKER_BYTES
 from .designs import Design
 from .parameters import to_physical
 from .store import ResultStore, Status, compact, open_for_campaign
-from .store.lock import ResultsLock
+from .store.lock import LockHeld, ResultsLock
 from .worker import WorkerSpec
 
 DEFAULT_TIMEOUT_FLOOR_S = 60.0   # default timeout: max(this, TIMEOUT_FLIGHTS x one nominal flight)
@@ -65,6 +65,11 @@ class DiskFull(OSError):
 
 class IncompleteFile(OSError):
     """Runs counted as done did not reach the file (a write failed late); a resume reruns them."""
+
+
+class Unwritable(ValueError):
+    """The results file cannot be written where it was asked for (no such folder, a file in the way,
+    a read-only or virtual filesystem)."""
 
 
 class WorkerError(RuntimeError):
@@ -222,14 +227,18 @@ def run_campaign(campaign: Campaign, out: Path | None = None, workers: int | Non
     out = Path(out or campaign.storage["path"])
     started = time.perf_counter()
     spec = worker_spec(campaign)
-    out.parent.mkdir(parents=True, exist_ok=True)
     lock = ResultsLock(out)
     try:
+        out.parent.mkdir(parents=True, exist_ok=True)
         lock.acquire()
+    except LockHeld:
+        raise
     except OSError as exc:
         if is_disk_full(exc) and not isinstance(exc, FileExistsError):
             raise DiskFull(errno.ENOSPC, disk_full_message(out, _stored_runs(out) if out.is_file() else 0)) from exc
-        raise
+        where = f": {exc.filename}" if exc.filename else ""
+        raise Unwritable(f"cannot write the results file {out} ({exc.strerror or exc}{where}); choose "
+                         "another path with --out or storage.path") from exc
     pool = None
     try:
         pool = WorkerPool(spec, workers if executor == "local" else 1,
