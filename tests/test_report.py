@@ -276,3 +276,38 @@ def test_method_override_reports_another_method_on_the_same_runs(files, tmp_path
     bad = subprocess.run([UQFLIGHT, "report", str(files["pg"]), "--method", "galerkin", "--out", str(tmp_path / "b")],
                          capture_output=True, text=True)
     assert bad.returncode == 2 and "Traceback" not in bad.stderr
+
+
+@pytest.mark.parametrize("occupant", ["a folder with a user's file", "a file", "a report folder with a user's file",
+                                      "a symlink to a report"])
+def test_report_never_replaces_what_is_not_an_earlier_report(files, tmp_path, occupant):
+    out = tmp_path / "out"
+    if occupant == "a file":
+        out.write_text("precious")
+    elif occupant == "a symlink to a report":
+        (tmp_path / "real").mkdir()
+        (tmp_path / "real" / "report.html").write_text("<html>")
+        out.symlink_to(tmp_path / "real")
+    else:
+        (out / "plots").mkdir(parents=True)
+        (out / "report.html").write_text("<html>")
+        kept = out / ("thesis.txt" if occupant == "a folder with a user's file" else "plots/notes.txt")
+        kept.write_text("precious")
+    before = sorted(str(p) for p in tmp_path.rglob("*"))
+    result = cli_in_process("report", files["pg"], "--out", out)
+    assert result.returncode == 2
+    assert f"{out} exists and is not a uqflight report" in result.stderr and "choose another --out" in result.stderr
+    assert sorted(str(p) for p in tmp_path.rglob("*")) == before
+
+
+def test_an_empty_folder_or_an_earlier_report_may_be_replaced(tmp_path):
+    from uqflight.report import check_replaceable
+
+    empty, earlier = tmp_path / "empty", tmp_path / "earlier"
+    empty.mkdir()
+    for name in ("plots/alpha.png", "tables/statistics.csv", "summaries/a.json", "report.html", "report.md",
+                 "summary.json"):
+        (earlier / name).parent.mkdir(parents=True, exist_ok=True)
+        (earlier / name).write_text("x")
+    for folder in (empty, earlier, tmp_path / "absent"):
+        check_replaceable(folder)

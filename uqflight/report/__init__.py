@@ -15,6 +15,7 @@ report that fails or is interrupted leaves OUT as it was (no half-written direct
 """
 from __future__ import annotations
 
+import os
 import shutil
 import tempfile
 from pathlib import Path
@@ -46,7 +47,8 @@ def write_report(paths: list[Path], out_dir: Path | None = None, reference: Path
     in the plots), or None (each campaign's own). `progress(text)` is told each stage. `partial`,
     `allow_aliasing`: see statistics.analyse. Everything is written into a temporary folder first and
     moved into place at the end; nothing is written when a file is refused (statistics.BadInput)."""
-    out_dir = Path(out_dir) if out_dir is not None else default_out_dir(paths[0])
+    out_dir = Path(os.path.abspath(out_dir if out_dir is not None else default_out_dir(paths[0])))
+    check_replaceable(out_dir)
     tell = progress or (lambda text: None)
     entries, ref = load_entries(paths, reference, method, progress=tell, partial=partial,
                                 allow_aliasing=allow_aliasing)
@@ -82,6 +84,32 @@ def _write_into(out_dir: Path, entries: list[Entry], ref: Entry | None, times, t
     title = f"uqflight report: {entries[0].label}" + (f" and {len(entries) - 1} more" if len(entries) > 1 else "")
     _write_text(out_dir / "report.html", render_html(title, sections, out_dir))
     _write_text(out_dir / "report.md", render_markdown(title, sections))
+
+
+REPORT_FILES = {"report.html": None, "report.md": None, "summary.json": None,  # what a report writes, and
+                "plots": ".png", "tables": ".csv", "summaries": ".json"}      # its folders' file types
+
+
+def check_replaceable(out_dir: Path) -> None:
+    """Refuse (FileExistsError) to replace anything at `out_dir` but nothing, an empty folder or an
+    earlier report: a folder holding only what a report writes (a user's file there is never deleted)."""
+    if not out_dir.exists() and not out_dir.is_symlink():
+        return
+    if out_dir.is_dir() and not out_dir.is_symlink():
+        entries = list(out_dir.iterdir())
+        if not entries or (out_dir / "report.html").is_file() and all(_written_by_a_report(e) for e in entries):
+            return
+    raise FileExistsError(f"{out_dir} exists and is not a uqflight report (it holds other files, or is not a "
+                          "folder); a report replaces only an earlier report: choose another --out, or move it away")
+
+
+def _written_by_a_report(entry: Path) -> bool:
+    if entry.name not in REPORT_FILES or entry.is_symlink():
+        return False
+    suffix = REPORT_FILES[entry.name]
+    if suffix is None:
+        return entry.is_file()
+    return entry.is_dir() and all(f.is_file() and not f.is_symlink() and f.suffix == suffix for f in entry.iterdir())
 
 
 def _replace_dir(staging: Path, out_dir: Path) -> None:
