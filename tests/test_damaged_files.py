@@ -52,6 +52,14 @@ def assign(path, index, value):
     return damage
 
 
+def declared(path, shape, dtype="f8"):
+    """`path` replaced by a chunked dataset that declares `shape` and holds nothing (a few bytes on disk)."""
+    def damage(f):
+        del f[path]
+        f.create_dataset(path, shape=shape, dtype=dtype, chunks=(1,) * (len(shape) - 1) + (1000,))
+    return damage
+
+
 DAMAGES = {  # name: (storage, damage, what the message says)
     "status of floats": ("raw", replaced("samples/status", np.zeros(N)), "/samples/status holds float64"),
     "status too short": ("raw", replaced("samples/status", np.zeros(N - 1, "i1")), r"expected \(11, any\)"),
@@ -80,6 +88,11 @@ DAMAGES = {  # name: (storage, damage, what the message says)
                                              r"/tsvd/y/columns must name distinct runs in \[0, 12\)"),
     "a run held twice": ("tsvd", lambda f: assign("tsvd/y/columns", 1, f["tsvd/y/columns"][0])(f),
                          "must name distinct runs"),
+    "a status declaring 10^12 runs": ("raw", declared("samples/status", (10**12,), "i1"),
+                                      "/samples/status declares 1000000000000 runs, more than any campaign"),
+    "times declaring 10^11 values": ("raw", declared("time", (10**11,)), "/time declares 100000000000 times"),
+    "a design declaring 10^9 parameters": ("raw", declared("samples/xi", (N, 10**9)), "declares 1000000000 parameters"),
+    "factors declaring a rank of 10^6": ("tsvd", declared("tsvd/y/U", (T, 10**6)), "declares rank 1000000"),
     "a tSVD tolerance of NaN": ("tsvd", lambda f: f["tsvd"].attrs.__setitem__("tol", np.nan), "tol must be a finite"),
 }
 

@@ -11,6 +11,9 @@ import h5py
 import numpy as np
 
 KINDS = {"float": "f", "integer": "iu"}
+# Beyond any campaign (limits.max_runs defaults to 10^6), and beyond what a reader can hold in memory:
+# a damaged or hostile file declaring such sizes is refused before anything is read.
+MAX_RUNS, MAX_PARAMETERS, MAX_TIMES, MAX_DESIGN_VALUES = 10**8, 10**4, 10**7, 2 * 10**8
 
 
 def _dataset(f: h5py.File, path: str, kind: str, shape: tuple, problems: list[str]) -> h5py.Dataset | None:
@@ -46,7 +49,12 @@ def layout_problems(f: h5py.File) -> list[str]:
     if status is None:
         return problems
     n = status.shape[0]
+    if n > MAX_RUNS:
+        return [f"/samples/status declares {n} runs, more than any campaign ({MAX_RUNS})"]
     xi = _dataset(f, "samples/xi", "float", (n, None), problems)
+    if xi is not None and (xi.shape[1] > MAX_PARAMETERS or xi.size > MAX_DESIGN_VALUES):
+        return problems + [f"/samples/xi declares {xi.shape[1]} parameters for {n} runs, more than a reader "
+                           f"holds ({MAX_PARAMETERS} parameters, {MAX_DESIGN_VALUES} values)"]
     if xi is not None:
         d = xi.shape[1]
         _finite(xi, problems)
@@ -62,6 +70,8 @@ def layout_problems(f: h5py.File) -> list[str]:
         _finite(weight, problems)
     _dataset(f, "samples/reason", "string", (n,), problems)
     time = _dataset(f, "time", "float", (None,), problems)
+    if time is not None and time.shape[0] > MAX_TIMES:
+        return problems + [f"/time declares {time.shape[0]} times, more than a reader holds ({MAX_TIMES})"]
     if time is not None:
         values = time[()]
         if values.size == 0 or not np.isfinite(values).all() or np.any(np.diff(values) <= 0):
@@ -104,8 +114,16 @@ def _tsvd_problems(f: h5py.File, group: h5py.Group, n: int, n_times, problems: l
         _dataset(f, f"{path}/s", "float", (rank,), problems)
         V = _dataset(f, f"{path}/V", "float", (None, rank), problems)
         columns = _dataset(f, f"{path}/columns", "integer", (None if V is None else V.shape[0],), problems)
-        _dataset(f, f"{path}/buffer", "float", (None, n_times), problems)
+        buffer = _dataset(f, f"{path}/buffer", "float", (None, n_times), problems)
         index = _dataset(f, f"{path}/buffer_index", "integer", (None,), problems)
+        sizes = {"rank": (rank, min(n, n_times or n)), "runs": (None if V is None else V.shape[0], n),
+                 "buffered runs": (None if buffer is None else buffer.shape[0], 2 * n + 1000),
+                 "buffer_index entries": (None if index is None else index.shape[0], 2 * n + 1000)}
+        too_large = [f"{what} {size} (at most {most})" for what, (size, most) in sizes.items()
+                     if size is not None and size > most]
+        if too_large:  # not read: a declared size is no proof of data, and could exhaust the memory
+            problems.append(f"/{path} declares {', '.join(too_large)} for {n} runs of {n_times} times")
+            continue
         if columns is not None:
             runs = columns[()]
             if np.any((runs < 0) | (runs >= n)) or np.unique(runs).size != runs.size:

@@ -199,7 +199,7 @@ class ResultStore:
                     if isinstance(group, h5py.Group):
                         apply_staged(group)
             problems = layout_problems(f)
-            status = store.status
+            status = None if problems else store.status
         except OSError as exc:
             f.close()
             raise CorruptFile(f"{path}: {read_error(exc)}") from exc
