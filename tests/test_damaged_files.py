@@ -93,6 +93,10 @@ DAMAGES = {  # name: (storage, damage, what the message says)
     "times declaring 10^11 values": ("raw", declared("time", (10**11,)), "/time declares 100000000000 times"),
     "a design declaring 10^9 parameters": ("raw", declared("samples/xi", (N, 10**9)), "declares 1000000000 parameters"),
     "factors declaring a rank of 10^6": ("tsvd", declared("tsvd/y/U", (T, 10**6)), "declares rank 1000000"),
+    "a design linked from another file": ("raw", lambda f: (f.__delitem__("samples/xi"), f["samples"].__setitem__(
+        "xi", h5py.ExternalLink("elsewhere.h5", "/xi"))), "/samples/xi is a ExternalLink, not data stored in this file"),
+    "a status linked inside the file": ("raw", lambda f: (f.__delitem__("samples/status"), f["samples"].__setitem__(
+        "status", h5py.SoftLink("/samples/weight"))), "/samples/status is a SoftLink"),
     "a tSVD tolerance of NaN": ("tsvd", lambda f: f["tsvd"].attrs.__setitem__("tol", np.nan), "tol must be a finite"),
 }
 

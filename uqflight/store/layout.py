@@ -19,9 +19,16 @@ MAX_RUNS, MAX_PARAMETERS, MAX_TIMES, MAX_DESIGN_VALUES = 10**8, 10**4, 10**7, 2 
 def _dataset(f: h5py.File, path: str, kind: str, shape: tuple, problems: list[str]) -> h5py.Dataset | None:
     """The dataset `path` if it exists, is of `kind` ("float", "integer", "string") and has `shape`
     (None entries: any length); else None, with the problem appended."""
+    link = f.get(path, getlink=True) if path.rsplit("/", 1)[0] in f or "/" not in path else None
+    if link is not None and not isinstance(link, h5py.HardLink):
+        problems.append(f"/{path} is a {type(link).__name__}, not data stored in this file")
+        return None
     item = f.get(path)
     if not isinstance(item, h5py.Dataset):
         problems.append(f"/{path} is missing" if item is None else f"/{path} is a group, not a dataset")
+        return None
+    if item.is_virtual:
+        problems.append(f"/{path} is a virtual dataset (data from other files), not data stored in this file")
         return None
     is_kind = h5py.check_string_dtype(item.dtype) is not None if kind == "string" else \
         item.dtype.kind in KINDS[kind]
