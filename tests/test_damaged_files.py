@@ -97,6 +97,10 @@ DAMAGES = {  # name: (storage, damage, what the message says)
         "xi", h5py.ExternalLink("elsewhere.h5", "/xi"))), "/samples/xi is a ExternalLink, not data stored in this file"),
     "a status linked inside the file": ("raw", lambda f: (f.__delitem__("samples/status"), f["samples"].__setitem__(
         "status", h5py.SoftLink("/samples/weight"))), "/samples/status is a SoftLink"),
+    "a resolution of another length": ("raw", lambda f: f.create_group("resolution").create_dataset("y", data=[1.0]),
+                                       r"/resolution/y has shape \(1,\), expected \(5000,\)"),
+    "a negative resolution": ("raw", lambda f: f.create_group("resolution").create_dataset("y", data=-np.ones(T)),
+                              "/resolution/y must hold finite values ≥ 0"),
     "a tSVD tolerance of NaN": ("tsvd", lambda f: f["tsvd"].attrs.__setitem__("tol", np.nan), "tol must be a finite"),
 }
 

@@ -129,6 +129,9 @@ def test_tsvd_storage_and_property_outputs(tmp_path):
         for name in raw.output_names:
             exact = raw.output_matrix(name)
             np.testing.assert_allclose(compressed.output_matrix(name), exact, rtol=0, atol=1e-9 * np.abs(exact).max())
+            # the trims' drift (tests/test_trim_repeatability.py) is recorded for every output, property ones too
+            assert raw.resolution(name).shape == raw.time.shape
+            np.testing.assert_array_equal(compressed.resolution(name), raw.resolution(name))
 
 
 def test_an_unreadable_results_file_is_refused_unless_forced(tmp_path):

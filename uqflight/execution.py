@@ -109,16 +109,16 @@ def versions() -> dict[str, str]:
 def prepare_store(campaign: Campaign, design: Design, out: Path, force: bool, probed=None,
                   restart: bool = False) -> ResultStore:
     """Open the campaign's results file to resume it, or create it with the design and provenance.
-    `probed` = (time, outputs, units) from a worker (`WorkerPool.probe`); measured here in a worker
-    process when not given."""
+    `probed` = (time, outputs, units, seconds, trim repeatability) from a worker (`WorkerPool.probe`);
+    measured here in a worker process when not given."""
     kappa = to_physical(campaign.parameters, design.xi)
     if probed is None:
         pool = WorkerPool(worker_spec(campaign), 1, PROBE_TIMEOUT_S)
         try:
-            probed = pool.probe(nominal_kappa(campaign))[:3]
+            probed = pool.probe(nominal_kappa(campaign))
         finally:
             pool.close()
-    time_grid, outputs, units = probed[:3]
+    time_grid, outputs, units, _, repeatability = probed
     attrs = {"versions": json.dumps(versions()), "campaign_name": campaign.name,
              "campaign_path": str(Path(campaign.source).resolve()),
              "method": json.dumps(campaign.method), "germs": json.dumps(campaign.germs),
@@ -132,7 +132,7 @@ def prepare_store(campaign: Campaign, design: Design, out: Path, force: bool, pr
         out, campaign_text=campaign.text, force=force, restart=restart, xi=design.xi, kappa=kappa, weights=design.weights,
         parameter_names=[p.name for p in campaign.parameters], outputs=outputs, time=time_grid,
         raw=campaign.storage["raw"], tsvd=campaign.storage.get("tsvd"), attrs=attrs, units=units,
-        batch_rows=campaign.execution["chunk"])
+        batch_rows=campaign.execution["chunk"], repeatability=repeatability)
 
 
 def nominal_kappa(campaign: Campaign) -> np.ndarray:
@@ -245,7 +245,8 @@ def run_campaign(campaign: Campaign, out: Path | None = None, workers: int | Non
                           execution.get("timeout_s") or PROBE_TIMEOUT_S)
         pool.start_probe(nominal_kappa(campaign))
         design = campaign.design()  # built while the workers start
-        time_grid, outputs, units, seconds = pool.probe_answer()
+        probed = pool.probe_answer()
+        seconds = probed[3]
         timeout = execution.get("timeout_s") or default_timeout(seconds)
         pool.timeout = timeout
         # One BLAS thread here, for the folds on opening too: the workers keep every core busy, a
@@ -253,8 +254,7 @@ def run_campaign(campaign: Campaign, out: Path | None = None, workers: int | Non
         # depend on where a resume starts (the same limit for every fold makes them bit-identical).
         with threadpool_limits(limits=1):
             try:
-                store = prepare_store(campaign, design, out, force, probed=(time_grid, outputs, units),
-                                      restart=restart)
+                store = prepare_store(campaign, design, out, force, probed=probed, restart=restart)
             except (OSError, RuntimeError) as exc:
                 if is_disk_full(exc) and not isinstance(exc, FileExistsError):
                     raise DiskFull(errno.ENOSPC, disk_full_message(out, 0)) from exc
@@ -441,8 +441,8 @@ class WorkerPool:
         self.slots: list[WorkerProcess] = []
 
     def probe(self, kappa: np.ndarray):
-        """(time, outputs, units, seconds of a nominal flight), from a worker: `start_probe`, then
-        `probe_answer`."""
+        """(time, outputs, units, seconds of a nominal flight, trim repeatability or None), from a worker:
+        `start_probe`, then `probe_answer`."""
         self.start_probe(kappa)
         return self.probe_answer()
 

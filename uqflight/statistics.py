@@ -11,7 +11,8 @@ or flagged (`Statistics.notes`, `null` in summary.json):
 * failed runs: sampled designs give statistics conditional on success (noted); grids refuse the
   projections and weighted sums, and the fits are made on the successful runs after a rank check;
 * a method the points cannot carry is refused (`methods.validity`), aliasing only when allowed;
-* Sobol' indices of a variance at rounding noise, and an undefined CoV, are NaN here and null in JSON.
+* Sobol' indices of a variance at rounding noise or below the simulator's own resolution (the file's
+  /resolution: two valid trims' drift), and an undefined CoV, are NaN here and null in JSON.
 
 Every method is linear in the runs, so with tSVD storage (Y = V diag(s) Uᵀ) the method is applied to V
 (N × r) and the result multiplied by diag(s) Uᵀ: statistics come from the factors without rebuilding
@@ -79,7 +80,7 @@ class OutputStatistics:
     pdf_support: np.ndarray
     pdf_density: np.ndarray
     cov: np.ndarray  # NaN where undefined (a mean that is zero at every time)
-    resolved: np.ndarray  # bool (T,): the variance is above rounding noise (analysis.resolution)
+    resolved: np.ndarray  # bool (T,): the variance is above rounding noise and the simulator's resolution
     quantiles: dict[float, np.ndarray] = field(default_factory=dict)
     skewness: np.ndarray | None = None
     kurtosis: np.ndarray | None = None
@@ -289,8 +290,10 @@ def _output_statistics(store: ResultStore, name: str, method: dict, germs: list[
                                len(store.parameter_names) if pick_freeze else 0, options, from_runs)
     magnitude = np.max(np.sqrt(mean**2 + np.maximum(variance, 0.0)))  # the output's own size over its history
     rtol = JSBSIM_RESOLUTION if "aircraft_hash" in store.attrs else RESOLUTION_RTOL
+    repeatability = store.resolution(name)  # the simulator's own resolution: its two valid trims' drift
+    atol = truncation if repeatability is None else np.maximum(truncation, repeatability)
     resolved = resolved_variance(variance, mean, scale=magnitude, rtol=rtol, n=int(ok.sum()),
-                                 weights=None if from_runs else weights, atol=truncation)
+                                 weights=None if from_runs else weights, atol=atol)
     stats = OutputStatistics(name, store.units.get(name, ""), store.time, mean, variance, blocks["band"],
                              blocks["support"], blocks["density"], modified_cov(mean, np.sqrt(np.maximum(variance, 0))),
                              resolved, quantiles=dict(zip(options.quantiles, blocks["quantiles"])),

@@ -92,17 +92,20 @@ def run_chunk(spec: WorkerSpec, indices: np.ndarray, kappa: np.ndarray, n_times:
 
 
 def probe(spec: WorkerSpec, kappa: np.ndarray):
-    """(time, output names, units, seconds of one flight at `kappa`): what the runner needs to create
-    the results file and derive the default per-run time limit, measured here, not in the runner."""
+    """(time, output names, units, seconds of one flight at `kappa`, the simulator's trim repeatability
+    at `kappa` or None): what the runner needs to create the results file and derive the default per-run
+    time limit, measured here, not in the runner."""
     simulator = spec.build()
     time_grid, outputs = simulator.probe(kappa)
     started = time.perf_counter()
     try:
-        simulator.evaluate(kappa)
+        flown = simulator.evaluate(kappa)
     except Exception:  # a failed nominal flight still measures the cost of a flight
-        pass
+        flown = None
     seconds = time.perf_counter() - started
-    return np.asarray(time_grid, dtype=float), list(outputs), dict(getattr(simulator, "units", {}) or {}), seconds
+    repeatability = getattr(simulator, "trim_repeatability", None)
+    return (np.asarray(time_grid, dtype=float), list(outputs), dict(getattr(simulator, "units", {}) or {}), seconds,
+            repeatability(kappa, flown) if repeatability and flown is not None else None)
 
 
 def _die_with_parent(parent: int) -> None:

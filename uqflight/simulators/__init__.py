@@ -5,6 +5,7 @@ Both kinds offer `probe(kappa) -> (time, output names)`, `evaluate(kappa) -> {na
 """
 from __future__ import annotations
 
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -32,6 +33,22 @@ class JSBSimSimulator:
     def evaluate(self, kappa: np.ndarray) -> dict[str, np.ndarray]:
         self._flown = True
         return self.flight.fly(dict(zip(self.properties, map(float, kappa)))).outputs
+
+    def trim_repeatability(self, kappa: np.ndarray, ours: dict[str, np.ndarray] | None = None
+                           ) -> dict[str, np.ndarray] | None:
+        """{output: (T,)}: how far the flight of `kappa` with the campaign's trim (`ours`, the outputs
+        `evaluate(kappa)` gave, flown here when None) and with the other trim (Newton's, JSBSim's) have
+        drifted apart so far, max over t' ≤ t of |y₁(t') − y₂(t')|. Both trims pass the same acceptance
+        checks, so a spread of the outputs below this is the trims' residual dynamics, not the inputs':
+        the simulator does not resolve it. None when either trim fails."""
+        other = replace(self.setup, trim="jsbsim" if self.setup.trim == "newton" else "newton")
+        settings = dict(zip(self.properties, map(float, kappa)))
+        try:
+            ours = ours if ours is not None else JSBSimFlight(self.setup).fly(settings).outputs
+            theirs = JSBSimFlight(other).fly(settings).outputs
+        except FlightError:
+            return None
+        return {name: np.maximum.accumulate(np.abs(ours[name] - theirs[name])) for name in ours}
 
     def restart(self) -> None:
         """Reload the aircraft (about 2 ms), so that a chunk's results do not depend on what

@@ -95,6 +95,14 @@ def layout_problems(f: h5py.File) -> list[str]:
     if isinstance(raw, h5py.Group):
         for key in raw:
             _dataset(f, f"outputs/{key}", "float", (n, n_times), problems)
+    resolution = f.get("resolution")
+    if resolution is not None and not isinstance(resolution, h5py.Group):
+        problems.append("/resolution must be a group of per-output resolutions")
+    elif resolution is not None:
+        for key in resolution:
+            data = _dataset(f, f"resolution/{key}", "float", (n_times,), problems)
+            if data is not None and not (np.isfinite(data[()]).all() and (data[()] >= 0).all()):
+                problems.append(f"/resolution/{key} must hold finite values ≥ 0")
     if isinstance(compressed, h5py.Group):
         _tsvd_problems(f, compressed, n, n_times, problems)
         if isinstance(raw, h5py.Group) and set(raw) != set(compressed):

@@ -8,6 +8,9 @@ Layout (fixed by DESIGN.md; N runs, d parameters, T recorded times):
     /outputs/<name> (N, T)  raw histories, NaN rows where not run or failed
     /tsvd/<name>/U (T, r), s (r), V (n, r), columns (n)   A_:c ≈ U diag(s) V_c: is sample columns[c]
     /tsvd/<name>/buffer (m, T), buffer_index (m)          ok runs not folded into the factors yet
+    /resolution/<name> (T)  optional: the simulator's own resolution of the output (its trim
+                            repeatability, see JSBSimSimulator.trim_repeatability); a spread below it
+                            is not the inputs'
     root attributes: campaign (YAML text), campaign_hash (its sha256), created, and the caller's
     (versions, aircraft_hash, ...)
 
@@ -120,14 +123,15 @@ class ResultStore:
     @classmethod
     def create(cls, path, *, campaign_text: str, xi, kappa, weights, parameter_names, outputs, time,
                raw: bool = True, tsvd: dict | None = None, attrs: dict | None = None,
-               units: dict | None = None, batch_rows: int | None = None) -> ResultStore:
+               units: dict | None = None, batch_rows: int | None = None,
+               repeatability: dict | None = None) -> ResultStore:
         """A new file (refused if `path` exists) holding the design, with every run pending.
 
         `tsvd` = {"tol": ..., "batch": ...} turns on compression (batch defaults to the paper's 1000
         samples); `attrs` become root attributes (dicts as JSON text); `units` maps output name → unit.
         `batch_rows`: the runs the writer stores at a time (the runner's chunk): raw chunks of that many
         rows (at least 64 KiB, at most ~1 MiB), so that a batch fills whole HDF5 chunks instead of
-        rewriting part-filled ones.
+        rewriting part-filled ones. `repeatability` maps output name → (T,) the simulator's own resolution.
         """
         xi, kappa = np.atleast_2d(xi).astype(float), np.atleast_2d(kappa).astype(float)
         weights, time = np.asarray(weights, dtype=float), np.asarray(time, dtype=float)
@@ -161,6 +165,13 @@ class ResultStore:
         samples.create_dataset("reason", shape=(n,), dtype=h5py.string_dtype("utf-8", REASON_BYTES),
                                chunks=(min(n, REASON_ROWS),), fletcher32=True)
         f.create_dataset("time", data=time, **CHECKED).attrs["units"] = "s"
+        if repeatability:
+            group = f.create_group("resolution", track_order=True)
+            group.attrs["description"] = ("per output and time, how far the nominal flights with two trims that "
+                                          "both pass the checks drift apart (max so far): a spread below this is "
+                                          "not resolved by the simulator")
+            for name in outputs:
+                group.create_dataset(_key(name), data=np.asarray(repeatability[name], dtype=float), **CHECKED)
         if raw:
             group = f.create_group("outputs", track_order=True)
             rows = min(chunk_rows(time.size, n), max(batch_rows or n, -(-MIN_CHUNK_BYTES // (8 * time.size))))
@@ -272,6 +283,12 @@ class ResultStore:
     def units(self) -> dict[str, str]:
         group = self._file["outputs" if self._raw else "tsvd"]
         return {_name(key): str(group[key].attrs.get("units", "")) for key in group}
+
+    def resolution(self, name: str) -> np.ndarray | None:
+        """(T,) the simulator's own resolution of output `name` (its trim repeatability), None when the
+        file holds none (a Python simulator, a file from before it was recorded)."""
+        group = self._file.get("resolution")
+        return None if group is None or _key(name) not in group else group[_key(name)][()]
 
     @property
     def campaign_text(self) -> str:
