@@ -88,15 +88,17 @@ def test_a_report_that_fails_midway_leaves_nothing(results, tmp_path, monkeypatc
     with pytest.raises(RuntimeError, match="disk on fire"):
         write_report([results], out)
     assert list(out.parent.iterdir()) == []
-    old = tmp_path / "old"
-    old.mkdir()
-    (old / "keep.txt").write_text("previous report")
+    old = tmp_path / "old"  # an earlier report: the one thing a report replaces (test_report.py)
+    (old / "tables").mkdir(parents=True)
+    (old / "report.html").write_text("previous report")
+    (old / "tables" / "stale.csv").write_text("x")
     with pytest.raises(RuntimeError):
         write_report([results], old)
-    assert [p.name for p in old.iterdir()] == ["keep.txt"] and len(list(tmp_path.iterdir())) == 2
+    assert sorted(p.name for p in old.rglob("*")) == ["report.html", "stale.csv", "tables"]
+    assert (old / "report.html").read_text() == "previous report" and len(list(tmp_path.iterdir())) == 2
     monkeypatch.undo()
     written = write_report([results], old)
-    assert not (old / "keep.txt").exists() and (old / "report.html") in written
+    assert not (old / "tables" / "stale.csv").exists() and (old / "report.html") in written
 
 
 @pytest.mark.slow
