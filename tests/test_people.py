@@ -62,7 +62,7 @@ def test_units_are_visible_in_simulate_help():
 
 
 def test_report_writes_next_to_the_results_file_by_default(results):
-    result = cli("report", results)
+    result = cli_in_process("report", results)
     assert result.returncode == 0, result.stderr
     out = results.with_name("decay-report")
     files = [p for p in out.rglob("*") if p.is_file()]
@@ -104,7 +104,7 @@ def test_a_report_that_fails_midway_leaves_nothing(results, tmp_path, monkeypatc
 @pytest.mark.slow
 def test_several_methods_over_the_same_runs(results, tmp_path):
     out = tmp_path / "methods"
-    result = cli("report", results, "--method", "pseudo_galerkin:2", "--method", "least_squares:1",
+    result = cli_in_process("report", results, "--method", "pseudo_galerkin:2", "--method", "least_squares:1",
                  "--method", "regression", "--order", "2", "--out", out)
     assert result.returncode == 0, result.stderr
     labels = [row["label"] for row in csv.DictReader(open(out / "tables" / "files.csv"))]
@@ -120,7 +120,7 @@ def test_several_methods_over_the_same_runs(results, tmp_path):
     for bad, message in ((["--method", "galerkin:2"], "expected KIND[:ORDER]"),
                          (["--method", "least_squares:two"], "integer ORDER"),
                          (["--order", "2"], "--order needs --method")):
-        refused = cli("report", results, *bad, "--out", tmp_path / "bad")
+        refused = cli_in_process("report", results, *bad, "--out", tmp_path / "bad")
         assert refused.returncode == 2 and message in refused.stderr and "Traceback" not in refused.stderr, bad
         assert not (tmp_path / "bad").exists()
 
@@ -129,7 +129,7 @@ def test_design_csv(tmp_path):
     campaign = tmp_path / "decay.yaml"
     campaign.write_text(DECAY)
     out = tmp_path / "design.csv"
-    result = cli("design", campaign, "--csv", out)
+    result = cli_in_process("design", campaign, "--csv", out)
     assert result.returncode == 0, result.stderr
     rows = list(csv.DictReader(open(out)))
     design = parse_campaign(DECAY, str(campaign)).design()
@@ -142,14 +142,14 @@ def test_design_csv(tmp_path):
     kappa = np.array([[float(r["a"]), float(r["b"])] for r in rows])
     np.testing.assert_allclose(kappa[:, 0], 1.0 + xi[:, 0] / 6, rtol=1e-14)  # normal: ±3σ on [0.5, 1.5]
     np.testing.assert_allclose(kappa[:, 1], 1.5 + 0.5 * xi[:, 1], rtol=1e-14)  # uniform on [1, 2]
-    missing = cli("design", tmp_path / "missing.yaml", "--csv", out)
+    missing = cli_in_process("design", tmp_path / "missing.yaml", "--csv", out)
     assert missing.returncode == 2 and "Traceback" not in missing.stderr
 
 
 @pytest.mark.slow
 def test_surrogate_export_round_trip(results, tmp_path):
     out = tmp_path / "pce.json"
-    result = cli("surrogate", "export", results, "--out", out)
+    result = cli_in_process("surrogate", "export", results, "--out", out)
     assert result.returncode == 0, result.stderr
     assert result.stdout.strip() == f"wrote {out}"
     data = json.loads(out.read_text(), parse_constant=lambda c: pytest.fail(f"not strict JSON: {c}"))
@@ -170,7 +170,7 @@ def test_surrogate_export_round_trip(results, tmp_path):
     time = np.asarray(data["time"])
     near = surrogate.evaluate([[1.0, 1.5]])["x"][0]
     assert near.shape == time.shape
-    mc = cli("surrogate", "export", results, "--out", tmp_path / "mc.json", "--method", "monte_carlo")
+    mc = cli_in_process("surrogate", "export", results, "--out", tmp_path / "mc.json", "--method", "monte_carlo")
     assert mc.returncode == 2 and "needs a sampled design" in mc.stderr and not (tmp_path / "mc.json").exists()
 
 
@@ -179,14 +179,14 @@ def test_restart_starts_a_same_campaign_file_over_and_force_keeps_its_meaning(tm
     campaign = tmp_path / "decay.yaml"
     campaign.write_text(DECAY)
     out = tmp_path / "d.h5"
-    assert cli("run", campaign, "--out", out).returncode == 0
+    assert cli_in_process("run", campaign, "--out", out).returncode == 0
     with h5py.File(out, "a") as f:
         f.attrs["marker"] = "the first run's file"
-    again = cli("run", campaign, "--out", out, "--force")  # a file of this campaign: resumed, nothing to do
+    again = cli_in_process("run", campaign, "--out", out, "--force")  # a file of this campaign: resumed, nothing to do
     assert again.returncode == 0 and " 0 run now" in again.stdout
     with h5py.File(out, "r") as f:
         assert "marker" in f.attrs
-    restarted = cli("run", campaign, "--out", out, "--restart")
+    restarted = cli_in_process("run", campaign, "--out", out, "--restart")
     assert restarted.returncode == 0 and " 0 already done" in restarted.stdout
     with h5py.File(out, "r") as f:
         assert "marker" not in f.attrs  # a new file

@@ -11,7 +11,7 @@ from pathlib import Path
 import h5py
 import numpy as np
 import pytest
-from conftest import DATA, UQFLIGHT, assert_same_results
+from conftest import DATA, UQFLIGHT, assert_same_results, cli_in_process
 
 from uqflight.campaign import parse_campaign
 from uqflight.execution import run_campaign
@@ -247,8 +247,7 @@ def test_a_full_disk_stops_cleanly_and_the_resume_equals_an_uninterrupted_run(tm
                              timeout=300)
     assert resumed.returncode == 0, resumed.stderr
     assert f"{kept} already done" in resumed.stdout
-    whole = subprocess.run([UQFLIGHT, "run", str(yaml), "--out", str(tmp_path / "whole.h5")],
-                           capture_output=True, text=True, timeout=300)
+    whole = cli_in_process("run", yaml, "--out", tmp_path / "whole.h5")
     assert whole.returncode == 0, whole.stderr
     assert_same_results(out, tmp_path / "whole.h5")
 
@@ -263,7 +262,7 @@ def test_a_flipped_byte_is_reported(tmp_path):
         byte = fh.read(1)
         fh.seek(offset + 3)
         fh.write(bytes([byte[0] ^ 0x10]))
-    info = subprocess.run([UQFLIGHT, "info", str(out)], capture_output=True, text=True)
+    info = cli_in_process("info", out)
     assert info.returncode == 2
     assert "data corrupted: a checksum (fletcher32) does not match" in info.stderr
 
@@ -275,7 +274,7 @@ def test_an_unknown_status_code_is_an_error(tmp_path):
         f["samples/status"][1] = 9
     with pytest.raises(CorruptFile, match=r"unknown status codes \[9\]"):
         ResultStore.open(out)
-    info = subprocess.run([UQFLIGHT, "info", str(out)], capture_output=True, text=True)
+    info = cli_in_process("info", out)
     assert info.returncode == 2 and "unknown status codes [9]" in info.stderr
 
 
@@ -401,7 +400,7 @@ def test_refusals_through_the_cli_exit_2(tmp_path):
     path = tmp_path / "c.yaml"
     path.write_text(limited(design="{kind: monte_carlo, samples: 1000000000000}"))
     for command in ("plan", "run"):
-        done = subprocess.run([UQFLIGHT, command, str(path)], capture_output=True, text=True, timeout=60)
+        done = cli_in_process(command, path)
         assert done.returncode == 2 and "limits.max_runs" in done.stderr, done.stderr
 
 
@@ -481,8 +480,7 @@ def test_the_cli_exits_2_when_the_disk_fills_past_the_check(tmp_path, small_disk
     resumed = subprocess.run([UQFLIGHT, "run", str(yaml), "--out", str(out)], capture_output=True, text=True,
                              timeout=300)
     assert resumed.returncode == 0, resumed.stderr[-2000:]
-    whole = subprocess.run([UQFLIGHT, "run", str(yaml), "--out", str(tmp_path / "whole.h5")],
-                           capture_output=True, text=True, timeout=300)
+    whole = cli_in_process("run", yaml, "--out", tmp_path / "whole.h5")
     assert whole.returncode == 0, whole.stderr
     assert_same_results(out, tmp_path / "whole.h5")
 

@@ -156,7 +156,7 @@ def test_report_of_a_jsbsim_campaign_and_its_check(tmp_path):
     assert list(summary["outputs"]) == ["alpha_deg", "h_ft"] and len(summary["outputs"]["h_ft"]["time"]) == 51
     with h5py.File(results, "r") as f:
         assert json.loads(baseline.read_text())["campaign_hash"] == f.attrs["campaign_hash"]
-    checked = cli("check", results, "--baseline", baseline)
+    checked = cli_in_process("check", results, "--baseline", baseline)
     assert checked.returncode == 0, checked.stdout + checked.stderr
     assert checked.stdout.startswith("no drift: ")
 
@@ -169,7 +169,7 @@ def baseline(files, tmp_path_factory) -> Path:
 
 
 def test_check_passes_on_the_exact_baseline(files, baseline):
-    result = cli("check", files["pg"], "--baseline", baseline)
+    result = cli_in_process("check", files["pg"], "--baseline", baseline)
     assert result.returncode == 0, result.stdout + result.stderr
     n = 51 * 6  # mean, variance, two band bounds, first and total index of a
     assert result.stdout.strip() == f"no drift: {n} values within rtol=1e-06/atol=1e-09"
@@ -180,13 +180,13 @@ def test_check_reports_a_moved_mean_with_exit_1(files, baseline, tmp_path):
     data["outputs"]["x"]["mean"][20] += 1e-3
     moved = tmp_path / "moved.json"
     moved.write_text(json.dumps(data))
-    result = cli("check", files["pg"], "--baseline", moved)
+    result = cli_in_process("check", files["pg"], "--baseline", moved)
     assert result.returncode == 1, result.stdout + result.stderr
     assert result.stdout.startswith("drift: 1 of 306 values outside rtol=1e-06, atol=1e-09")
     row = next(line.split() for line in result.stdout.splitlines() if line.startswith("x "))
     assert row[:3] == ["x", "mean", "2"]
     assert float(row[4]) == pytest.approx(data["outputs"]["x"]["mean"][20])
-    assert cli("check", files["pg"], "--baseline", moved, "--atol", "0.01").returncode == 0
+    assert cli_in_process("check", files["pg"], "--baseline", moved, "--atol", "0.01").returncode == 0
 
 
 def edited(data: dict, edit) -> str:
@@ -249,7 +249,7 @@ def test_check_refuses_bad_input_with_exit_2_and_one_line(files, baseline, tmp_p
 
 
 def test_report_refuses_an_unreadable_results_file(tmp_path):
-    result = cli("report", tmp_path / "missing.h5", "--out", tmp_path / "report")
+    result = cli_in_process("report", tmp_path / "missing.h5", "--out", tmp_path / "report")
     assert result.returncode == 2
     assert result.stderr.strip() == f"error: {tmp_path / 'missing.h5'}: no such results file"
 

@@ -5,7 +5,7 @@ import json
 import h5py
 import numpy as np
 import pytest
-from conftest import DATA, cli, read_summary, run_python_campaign
+from conftest import DATA, cli_in_process, read_summary, run_python_campaign
 
 from uqflight.check import write_baseline
 from uqflight.statistics import BadInput, analyse, summary_json
@@ -54,15 +54,15 @@ def test_pending_runs_refuse_report_and_check_with_the_resume_command(tmp_path):
                                                      "method: {kind: pseudo_galerkin, order: 2}\n"), "pend")
     baseline = write_baseline(analyse(results), "", tmp_path / "baseline.json")
     make_pending(results, [11, 12, 13, 14, 15])
-    report = cli("report", results)
+    report = cli_in_process("report", results)
     assert report.returncode == 2
     message = report.stderr
     assert "5 of 16 runs are pending" in message, message
     assert f"uqflight run {tmp_path / 'pend.yaml'} --out {results}" in message
     assert not list(tmp_path.glob("*report*")), "a refused report must write nothing"
-    checked = cli("check", results, "--baseline", baseline)
+    checked = cli_in_process("check", results, "--baseline", baseline)
     assert checked.returncode == 2 and "pending" in checked.stderr
-    partial = cli("report", results, "--partial", "--out", tmp_path / "r")
+    partial = cli_in_process("report", results, "--partial", "--out", tmp_path / "r")
     assert partial.returncode == 2 and "needs every run of the grid" in partial.stderr
     assert not (tmp_path / "r").exists()
 
@@ -72,7 +72,7 @@ def test_partial_monte_carlo_is_reported_on_its_completed_runs_and_labelled(tmp_
     with h5py.File(results) as f:
         y = f["outputs/y"][:, 0]
     make_pending(results, np.arange(60, 100))
-    done = cli("report", results, "--partial", "--out", tmp_path / "r")
+    done = cli_in_process("report", results, "--partial", "--out", tmp_path / "r")
     assert done.returncode == 0, done.stderr
     summary = read_summary(tmp_path / "r" / "summary.json")
     assert summary["partial"] is True and (summary["completed"], summary["pending"]) == (60, 40)
@@ -98,7 +98,7 @@ def test_the_failure_probability_interval_contains_the_true_fraction(tmp_path):
 def test_a_grid_with_a_failed_run_refuses_projections_and_fits_the_rest_exactly(grid, tmp_path):
     with pytest.raises(BadInput, match="1 of 16 runs are missing; use least_squares or regression"):
         analyse(grid)
-    refused = cli("report", grid, "--out", tmp_path / "r")
+    refused = cli_in_process("report", grid, "--out", tmp_path / "r")
     assert refused.returncode == 2 and "pseudo_galerkin" in refused.stderr and not (tmp_path / "r").exists()
     stats = analyse(grid, method={"kind": "least_squares", "order": 2})
     out = stats.outputs["y"]
@@ -114,18 +114,18 @@ def test_plan_refuses_a_projection_the_grid_cannot_integrate(tmp_path):
     text = campaign("alias", "sum_of_squares", NORMAL_2D, "{kind: sparse_grid, level: 1}",
                     "method: {kind: pseudo_galerkin, order: 2}\n")
     (tmp_path / "a.yaml").write_text(text)
-    plan = cli("plan", tmp_path / "a.yaml")
+    plan = cli_in_process("plan", tmp_path / "a.yaml")
     assert plan.returncode == 2
     assert "method.order" in plan.stderr and "exact to degree 3" in plan.stderr
     assert "largest order it can project is 1" in plan.stderr
     (tmp_path / "b.yaml").write_text(text.replace("order: 2}", "order: 2, allow_aliasing: true}"))
-    assert cli("plan", tmp_path / "b.yaml").returncode == 0
+    assert cli_in_process("plan", tmp_path / "b.yaml").returncode == 0
 
 
 def test_report_refuses_an_aliased_order_unless_allowed(grid, tmp_path):
     results = run_python_campaign(tmp_path, campaign("l1", "sum_of_squares", NORMAL_2D,
                                                      "{kind: sparse_grid, level: 1}"))
-    refused = cli("report", results, "--method", "pseudo_galerkin", "--order", "4", "--out", tmp_path / "r")
+    refused = cli_in_process("report", results, "--method", "pseudo_galerkin", "--order", "4", "--out", tmp_path / "r")
     assert refused.returncode == 2 and "exact to degree 3" in refused.stderr
     allowed = analyse(results, method={"kind": "pseudo_galerkin", "order": 4}, allow_aliasing=True)
     assert any("aliasing allowed" in note for note in allowed.notes)
@@ -136,7 +136,7 @@ def test_plan_refuses_a_rank_deficient_least_squares_fit(tmp_path):
     (tmp_path / "r.yaml").write_text(campaign("rank", "sum_of_squares", uniform,
                                               "{kind: sparse_grid, level: 2, rule: gauss_legendre}",
                                               "method: {kind: least_squares, order: 3}\n"))
-    plan = cli("plan", tmp_path / "r.yaml")
+    plan = cli_in_process("plan", tmp_path / "r.yaml")
     assert plan.returncode == 2 and "rank 19" in plan.stderr and "method.order" in plan.stderr
 
 
@@ -154,7 +154,7 @@ def test_sobol_indices_are_null_where_the_variance_is_rounding_noise(tmp_path):
 def test_a_zero_mean_is_reported_without_a_crash_and_its_cov_is_null(tmp_path):
     results = run_python_campaign(tmp_path, campaign("id", "identity", NORMAL_X, "{kind: tensor_grid, points: 5}",
                                                      "method: {kind: pseudo_galerkin, order: 1}\n"))
-    done = cli("report", results, "--out", tmp_path / "r")
+    done = cli_in_process("report", results, "--out", tmp_path / "r")
     assert done.returncode == 0, done.stderr
     y = read_summary(tmp_path / "r" / "summary.json")["outputs"]["y"]
     assert abs(y["mean"][0]) < 1e-15 and y["variance"][0] == pytest.approx(1.0)
