@@ -5,7 +5,7 @@ import shutil
 import h5py
 import numpy as np
 import pytest
-from conftest import DATA, cli_in_process
+from conftest import DATA, cli_in_process, run_python_campaign
 
 from uqflight.campaign import parse_campaign
 from uqflight.execution import run_campaign
@@ -180,3 +180,56 @@ def test_a_time_grid_the_reader_would_refuse_is_refused_before_any_run(tmp_path)
     with pytest.raises(ValueError, match="finite and strictly increasing"):
         ResultStore.create(tmp_path / "direct.h5", campaign_text="x", xi=np.zeros((2, 1)), kappa=np.zeros((2, 1)),
                            weights=np.ones(2), parameter_names=["x"], outputs=["y"], time=np.array([0.0, 0.0]))
+
+
+SURROGATE_DAMAGES = {  # name: (edit of the parsed JSON, what the message says)
+    "no germs": (lambda s: s.pop("germs"), "KeyError: 'germs'"),
+    "an unknown germ": (lambda s: s.update(germs=["cauchy"]), r"germs: unknown \['cauchy'\]"),
+    "multi-indices of another width": (lambda s: s.update(multi_indices=[[0], [1]]), "multi_indices: expected rows of 2"),
+    "a negative degree": (lambda s: s["multi_indices"].__setitem__(1, [-1, 0]), "multi_indices"),
+    "coefficients of another shape": (lambda s: s["outputs"]["y"].update(coefficients=[[1.0]]),
+                                      r"outputs.y.coefficients: expected 6 x 5 finite numbers, got shape \(1, 1\)"),
+    "a null coefficient": (lambda s: s["outputs"]["y"]["coefficients"][0].__setitem__(0, None), "with nulls"),
+    "a parameter without bounds": (lambda s: s["parameters"][0].pop("lower"), "parameters: expected 2 entries"),
+    "a parameter of an unknown law": (lambda s: s["parameters"][0].update(distribution="cauchy"), "unknown distribution"),
+    "outputs as a list": (lambda s: s.update(outputs=[1, 2]), "outputs: expected a mapping"),
+}
+
+
+@pytest.fixture(scope="module")
+def surrogate_text(tmp_path_factory):
+    """The order-2 PCE of y = 15000 + t (x1² + x2²) (5 times) on a 4x4 grid, exported."""
+    from test_trust import NORMAL_2D, campaign
+
+    from uqflight.surrogate import export
+
+    folder = tmp_path_factory.mktemp("surrogate")
+    results = run_python_campaign(folder, campaign("sq", "sum_of_squares", NORMAL_2D, "{kind: tensor_grid, points: 4}",
+                                                   "method: {kind: pseudo_galerkin, order: 2}\n"))
+    return export(results, folder / "pce.json").read_text()
+
+
+@pytest.mark.parametrize("name", SURROGATE_DAMAGES)
+def test_a_damaged_surrogate_file_is_refused_naming_what_is_wrong(surrogate_text, tmp_path, name):
+    import json
+
+    from uqflight.surrogate import SurrogateError, load
+
+    edit, message = SURROGATE_DAMAGES[name]
+    data = json.loads(surrogate_text)
+    assert load_ok(surrogate_text, tmp_path)
+    edit(data)
+    path = tmp_path / "pce.json"
+    path.write_text(json.dumps(data))
+    with pytest.raises(SurrogateError, match=rf"pce\.json: malformed surrogate \(.*{message}"):
+        load(path)
+    path.write_text('{"format": "uqflight-pce", "germs": ' + "[" * 100000)
+    with pytest.raises(SurrogateError, match="cannot read the surrogate"):
+        load(path)
+
+
+def load_ok(text, folder) -> bool:
+    from uqflight.surrogate import load
+
+    (folder / "sound.json").write_text(text)
+    return load(folder / "sound.json").evaluate(xi=[[0.3, -0.2]])["y"].shape == (1, 5)

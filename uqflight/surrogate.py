@@ -22,6 +22,7 @@ import numpy as np
 
 FORMAT = "uqflight-pce"
 VERSION = 1
+MAX_FILE_BYTES = 1 << 30  # a surrogate of 10^4 terms x 10^4 times is ~2 GB of JSON: beyond that, not ours
 
 
 class SurrogateError(ValueError):
@@ -140,16 +141,57 @@ def export(results, out, method: dict | None = None) -> Path:
 
 
 def load(path) -> Surrogate:
-    """The surrogate written by `export` (or `uqflight surrogate export`)."""
+    """The surrogate written by `export` (or `uqflight surrogate export`); SurrogateError, naming the
+    file and what is wrong, for anything else (a damaged or hand-edited file is never evaluated)."""
     try:
-        data = json.loads(Path(path).read_text(encoding="utf-8"))
-    except (OSError, ValueError) as exc:
+        with open(path, "rb") as fh:
+            text = fh.read(MAX_FILE_BYTES + 1)
+        if len(text) > MAX_FILE_BYTES:
+            raise ValueError(f"larger than {MAX_FILE_BYTES >> 30} GiB")
+        data = json.loads(text)
+    except (OSError, ValueError, RecursionError) as exc:
         raise SurrogateError(f"{path}: cannot read the surrogate ({exc})") from exc
     if not isinstance(data, dict) or data.get("format") != FORMAT:
         raise SurrogateError(f"{path}: not a uqflight PCE surrogate (format {FORMAT!r})")
-    coefficients = {name: np.array([[np.nan if v is None else v for v in row] for row in o["coefficients"]],
-                                   dtype=float) for name, o in data["outputs"].items()}
-    return Surrogate(data["parameters"], data["germs"], np.array(data["multi_indices"], dtype=int).reshape(
-        -1, len(data["germs"])), np.array(data["time"], dtype=float), coefficients,
-        {name: o.get("units", "") for name, o in data["outputs"].items()},
-        {"kind": data["method"], "order": data["order"], "split": data.get("split", False)}, data.get("campaign", ""))
+    try:
+        return _checked(data)
+    except (KeyError, TypeError, ValueError, AttributeError) as exc:
+        raise SurrogateError(f"{path}: malformed surrogate ({type(exc).__name__}: {exc})") from exc
+
+
+def _checked(data: dict) -> Surrogate:
+    """The Surrogate a parsed file describes, every shape and value checked (ValueError naming the key)."""
+    from .parameters import Parameter
+    from .parameters.germs import GERMS
+
+    germs = [str(g) for g in data["germs"]]
+    unknown = [g for g in germs if g not in GERMS]
+    if unknown:
+        raise ValueError(f"germs: unknown {unknown} (known: {', '.join(GERMS)})")
+    d = len(germs)
+    parameters = data["parameters"]
+    if not isinstance(parameters, list) or len(parameters) != d or not all(
+            isinstance(p, dict) and {"name", "distribution", "lower", "upper", "nominal"} <= set(p) for p in parameters):
+        raise ValueError(f"parameters: expected {d} entries with name, distribution, lower, upper, nominal")
+    for p in parameters:  # their laws map κ to ξ: built once here so that a bad one is refused now
+        Parameter(p["name"], p.get("property", p["name"]), p["distribution"], p["nominal"], p["lower"], p["upper"])
+    indices = np.array(data["multi_indices"], dtype=np.int64)
+    if indices.ndim != 2 or indices.shape[1] != d or not len(indices) or (indices < 0).any() or indices.max() > 1000:
+        raise ValueError(f"multi_indices: expected rows of {d} integers in [0, 1000], got shape {indices.shape}")
+    time = np.array(data["time"], dtype=float)
+    if time.ndim != 1 or not np.isfinite(time).all():
+        raise ValueError("time: expected a list of finite numbers")
+    outputs = data["outputs"]
+    if not isinstance(outputs, dict) or not outputs:
+        raise ValueError("outputs: expected a mapping of at least one output")
+    coefficients = {}
+    for name, output in outputs.items():
+        values = np.array(output["coefficients"], dtype=float)  # null → NaN, refused below
+        if values.shape != (len(indices), time.size) or not np.isfinite(values).all():
+            raise ValueError(f"outputs.{name}.coefficients: expected {len(indices)} x {time.size} finite numbers, "
+                             f"got shape {values.shape}{'' if np.isfinite(values).all() else ' with nulls'}")
+        coefficients[name] = values
+    return Surrogate(parameters, germs, indices, time, coefficients,
+                     {name: str(o.get("units", "")) for name, o in outputs.items()},
+                     {"kind": str(data["method"]), "order": int(data["order"]), "split": bool(data.get("split", False))},
+                     str(data.get("campaign", "")))
