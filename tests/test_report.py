@@ -300,6 +300,13 @@ def test_report_never_replaces_what_is_not_an_earlier_report(files, tmp_path, oc
     assert sorted(str(p) for p in tmp_path.rglob("*")) == before
 
 
+def test_a_relative_out_counts_the_files_written(files, tmp_path):
+    result = cli_in_process("report", files["pg"], "--out", "rel", cwd=tmp_path)
+    assert result.returncode == 0, result.stderr
+    written = sum(1 for p in (tmp_path / "rel").rglob("*") if p.is_file())
+    assert written > 10 and f"wrote {written} files to rel: open rel/report.html" in result.stdout
+
+
 def test_an_empty_folder_or_an_earlier_report_may_be_replaced(tmp_path):
     from uqflight.report import check_replaceable
 

@@ -396,7 +396,7 @@ def report(
     except KeyboardInterrupt:
         typer.echo(f"\ninterrupted: no report written ({out} unchanged)", err=True)
         raise typer.Exit(130)
-    in_report = [p for p in written if out in p.parents]
+    in_report = [p for p in written if Path(os.path.abspath(out)) in p.parents]  # written paths are absolute
     typer.echo(f"wrote {len(in_report)} files to {out}: open {out / 'report.html'}")
     if write_baseline:
         typer.echo(f"wrote baseline {write_baseline}")
