@@ -453,8 +453,8 @@ class WorkerPool:
         slot = self._slot()
         while len(self.slots) < self.workers:
             self.slots.append(WorkerProcess())
-        for other in self.slots[1:]:
-            if not other.send(("probe", self.spec, kappa)):
+        for other in self.slots[1:]:  # a warm-up only: the trims' drift is measured once, by the first
+            if not other.send(("probe", self.spec, kappa, False)):
                 self._drop(other)
         if not slot.send(("probe", self.spec, kappa)):
             raise WorkerError(death_reason(self._drop(slot)))

@@ -91,10 +91,11 @@ def run_chunk(spec: WorkerSpec, indices: np.ndarray, kappa: np.ndarray, n_times:
     return indices, status, reasons, values
 
 
-def probe(spec: WorkerSpec, kappa: np.ndarray):
+def probe(spec: WorkerSpec, kappa: np.ndarray, resolution: bool = True):
     """(time, output names, units, seconds of one flight at `kappa`, the simulator's trim repeatability
     at `kappa` or None): what the runner needs to create the results file and derive the default per-run
-    time limit, measured here, not in the runner."""
+    time limit, measured here, not in the runner. `resolution` false: no repeatability (None), for a
+    worker that only warms up."""
     simulator = spec.build()
     time_grid, outputs = simulator.probe(kappa)
     started = time.perf_counter()
@@ -105,7 +106,7 @@ def probe(spec: WorkerSpec, kappa: np.ndarray):
     seconds = time.perf_counter() - started
     repeatability = getattr(simulator, "trim_repeatability", None)
     return (np.asarray(time_grid, dtype=float), list(outputs), dict(getattr(simulator, "units", {}) or {}), seconds,
-            repeatability(kappa, flown) if repeatability and flown is not None else None)
+            repeatability(kappa, flown) if resolution and repeatability and flown is not None else None)
 
 
 def _die_with_parent(parent: int) -> None:
