@@ -42,6 +42,11 @@ def _dataset(f: h5py.File, path: str, kind: str, shape: tuple, problems: list[st
     return item
 
 
+def is_time_grid(values: np.ndarray) -> bool:
+    """At least one time, all finite, strictly increasing: the recorded times a results file holds."""
+    return values.size > 0 and bool(np.isfinite(values).all()) and not np.any(np.diff(values) <= 0)
+
+
 def _finite(data: h5py.Dataset, problems: list[str]) -> None:
     values = data[()]
     if not np.isfinite(values).all():
@@ -80,9 +85,8 @@ def layout_problems(f: h5py.File) -> list[str]:
     if time is not None and time.shape[0] > MAX_TIMES:
         return problems + [f"/time declares {time.shape[0]} times, more than a reader holds ({MAX_TIMES})"]
     if time is not None:
-        values = time[()]
-        if values.size == 0 or not np.isfinite(values).all() or np.any(np.diff(values) <= 0):
-            problems.append(f"/time must hold at least one finite time, strictly increasing ({values.size} values)")
+        if not is_time_grid(time[()]):
+            problems.append(f"/time must hold at least one finite time, strictly increasing ({time.size} values)")
     if not isinstance(f.attrs.get("campaign"), str):
         problems.append("the root attribute campaign (the campaign's text) is missing")
     n_times = None if time is None else time.shape[0]

@@ -49,7 +49,7 @@ from threadpoolctl import threadpool_limits
 from ..simulators.base import Status
 from ..tsvd import IncrementalSVD, iter_column_blocks
 from .compressed import append_rows, apply_staged, buffer_rows, chunk_rows, commit, ingest, write_state
-from .layout import layout_problems
+from .layout import is_time_grid, layout_problems
 
 
 def _key(name: str) -> str:
@@ -142,7 +142,7 @@ class ResultStore:
                              f"weights {weights.shape}, {len(parameter_names)} parameter names")
         if time.ndim != 1 or not outputs or len(set(outputs)) != len(outputs):
             raise ValueError(f"need a 1-D time and distinct output names, got time {time.shape}, outputs {outputs}")
-        if time.size == 0 or not np.isfinite(time).all() or np.any(np.diff(time) <= 0):
+        if not is_time_grid(time):
             raise ValueError("the recorded times must be finite and strictly increasing")
         if not raw and tsvd is None:
             raise ValueError("nothing would be stored: turn on raw storage or tsvd compression")
