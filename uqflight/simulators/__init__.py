@@ -44,8 +44,8 @@ class JSBSimSimulator:
         other = replace(self.setup, trim="jsbsim" if self.setup.trim == "newton" else "newton")
         settings = dict(zip(self.properties, map(float, kappa)))
         try:
-            ours = ours if ours is not None else JSBSimFlight(self.setup).fly(settings).outputs
-            theirs = JSBSimFlight(other).fly(settings).outputs
+            ours = ours if ours is not None else JSBSimFlight(self.setup, preflight=False).fly(settings).outputs
+            theirs = JSBSimFlight(other, preflight=False).fly(settings).outputs  # same files as __init__ checked
         except FlightError:
             return None
         return {name: np.maximum.accumulate(np.abs(ours[name] - theirs[name])) for name in ours}
@@ -56,7 +56,7 @@ class JSBSimSimulator:
         moves trims in the 13th digit. Chunks are fixed by design order, so results are
         bit-identical whatever the number of workers or the executor."""
         if self._flown:
-            self.flight = JSBSimFlight(self.setup)
+            self.flight = JSBSimFlight(self.setup, preflight=False)  # checked by __init__
             self._flown = False
 
 

@@ -176,10 +176,13 @@ def quiet_jsbsim() -> None:
 class JSBSimFlight:
     """A loaded aircraft that flies any number of samples: reset, set, trim, excite, record."""
 
-    def __init__(self, setup: FlightSetup = FlightSetup()):
+    def __init__(self, setup: FlightSetup = FlightSetup(), preflight: bool = True):
+        """`preflight` false: the caller reloads an aircraft this process has already loaded (and so
+        checked, see preflight.py); the check would only hash its files again."""
         if not setup.aircraft_file.is_file():
             raise FileNotFoundError(f"aircraft {setup.aircraft!r}: no file {setup.aircraft_file}")
-        check_loads(setup.root, setup.aircraft)  # JSBSim may abort the process that loads a broken aircraft
+        if preflight:  # JSBSim may abort the process that loads a broken aircraft
+            check_loads(setup.root, setup.aircraft)
         quiet_jsbsim()
         self.setup = setup
         self.fdm = jsbsim.FGFDMExec(str(setup.root))
