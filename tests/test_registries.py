@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from uqflight.designs import REGISTRY as DESIGNS
-from uqflight.designs import build_design
+from uqflight.designs import build_design, design_size
 from uqflight.designs.rules import RULE_TABLE, nodes_weights
 from uqflight.methods import METHODS, fit
 from uqflight.methods.basis import orthonormal_basis, orthonormal_polynomials, total_degree_indices
@@ -67,6 +67,41 @@ def test_a_design_has_weights_summing_to_one_and_is_random_only_if_sampled(kind)
     assert one.xi.shape == (len(one.weights), 2) and one.weights.sum() == pytest.approx(1.0)
     assert np.all(np.abs(one.xi[:, 1]) <= 1.0)  # the uniform germ's support
     assert (not np.array_equal(one.xi, other.xi)) == DESIGNS[kind].sampled
+
+
+SIZE_CASES = [  # more than each kind's example: replicates, nested and non-nested, linear and exponential growth
+    {"kind": "sobol", "samples": 12, "replicates": 3},
+    {"kind": "sparse_grid", "level": 3, "rule": "gauss_hermite", "nested": False},
+    {"kind": "sparse_grid", "level": 3, "rule": "clenshaw_curtis", "growth": "exponential"},
+    {"kind": "tensor_grid", "points": 3, "rule": "gauss_legendre"},
+]
+
+
+def _tensor_points_before_merging(spec: dict, germs: list[str]) -> int:
+    """What the combination technique builds before merging: Σ over its multi-indices of the product of
+    the 1-D rules' sizes, counted one tensor rule at a time (not by the registry's polynomial product)."""
+    from uqflight.designs import rules
+    from uqflight.designs.smolyak import multi_indices
+
+    level, growth = spec["level"], spec.get("growth", "linear")
+    by_dimension = rules.rules_by_dimension(spec.get("rule"), germs, spec.get("nested"))
+    sizes = [rules.level_sizes(rule, growth, level + 1) for rule in by_dimension]
+    return sum(int(np.prod([sizes[k][j[k]] for k in range(len(germs))])) for j in multi_indices(len(germs), level))
+
+
+@pytest.mark.parametrize("spec", [entry.example for entry in DESIGNS.values()] + SIZE_CASES,
+                         ids=lambda spec: "-".join(f"{v}" for v in spec.values()))
+def test_a_design_states_its_own_size_before_building(spec):
+    """The size the campaign's limits use (designs.design_size) is the built design's: its runs, or for a
+    sparse grid the points built before merging (its runs are at most that)."""
+    germs = {"clenshaw_curtis": ["uniform"] * 3, "gauss_legendre": ["uniform"] * 3,
+             "gauss_hermite": ["normal"] * 3}.get(spec.get("rule"), ["normal", "uniform", "normal"])
+    stated = design_size(spec, germs)
+    built = len(build_design(spec, germs, 5).weights)
+    if spec["kind"] == "sparse_grid":
+        assert stated == _tensor_points_before_merging(spec, germs) >= built
+    else:
+        assert stated == built
 
 
 def _polynomial_case():

@@ -88,9 +88,7 @@ def test_a_worker_death_on_dask_is_a_failed_run(tmp_path):
 
 
 def test_a_hung_sample_is_stopped_by_its_timeout(tmp_path):
-    started = time.monotonic()
     summary = run_campaign(campaign("hanging", extra=", timeout_s: 1"), out=tmp_path / "h.h5", workers=2)
-    assert time.monotonic() - started < 30
     with ResultStore.open(tmp_path / "h.h5") as store:
         x, status, reasons = store.kappa[:, 0], store.status, np.array(store.reasons)
     hung = x > 1.7
@@ -297,14 +295,12 @@ def refused(text, match, source="limits.yaml"):
     from uqflight.campaign import CampaignError
 
     tracemalloc.start()
-    started = time.perf_counter()
     try:
         with pytest.raises(CampaignError, match=match) as info:
             parse_campaign(text, source)
         _, peak = tracemalloc.get_traced_memory()
     finally:
         tracemalloc.stop()
-    assert time.perf_counter() - started < 3.0
     assert peak < 50e6, f"{peak / 1e6:.0f} MB allocated before refusing"
     assert len(str(info.value)) < 2500
     return str(info.value)
@@ -317,6 +313,7 @@ def limited(name="lim", duration=5, design="{kind: monte_carlo, samples: 10}",
 
 @pytest.mark.parametrize("design", ["{kind: monte_carlo, samples: 1000000000000}",
                                     "{kind: sobol, samples: 1000000000}",
+                                    "{kind: sobol, samples: 1000, replicates: 2000}",
                                     "{kind: pick_freeze, samples: 400000000}"])
 def test_too_many_samples_are_refused_up_front(design):
     refused(limited(design=design), r"design: .* runs \(points built\), more than limits.max_runs = 1000000")
@@ -385,10 +382,8 @@ def test_a_huge_campaign_file_is_refused(tmp_path):
 
     path = tmp_path / "big.yaml"
     path.write_text(limited() + "description: " + "x" * (2 << 20) + "\n")
-    started = time.perf_counter()
     with pytest.raises(CampaignError, match="larger than 1024 KiB"):
         load_campaign(path)
-    assert time.perf_counter() - started < 3.0
 
 
 @pytest.mark.parametrize("name", ["../../x", "a/b", ".hidden", "x" * 101, "spaces here"])

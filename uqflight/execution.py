@@ -463,9 +463,11 @@ class WorkerPool:
         """The first worker's answer to `start_probe`. The others' answers are not awaited: `run`
         reads them before their workers' first chunk, so that no worker waits for the slowest start."""
         slot = self.slots[0]
-        if not wait_connections([slot.conn], timeout=self.timeout):
+        limit = self.timeout + STARTUP_GRACE_S  # the worker starts, imports and builds its simulator first
+        if not wait_connections([slot.conn], timeout=limit):
             self._drop(slot, dead=False)
-            raise WorkerError(f"the nominal flight did not finish within {self.timeout:g} s")
+            raise WorkerError(f"the nominal flight did not finish within {limit:g} s (execution.timeout_s "
+                              f"{self.timeout:g} s plus {STARTUP_GRACE_S:g} s for the worker's start)")
         try:
             kind, payload = slot.conn.recv()
         except (EOFError, OSError):

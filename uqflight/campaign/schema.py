@@ -8,10 +8,9 @@ import re
 from collections.abc import Hashable
 from pathlib import Path
 
-import numpy as np
 import yaml
 
-from ..designs import Design, is_sampled
+from ..designs import Design, design_size, is_sampled
 from ..methods import METHOD_KINDS, method_entry
 from ..methods.exactness import exact_total_degree, max_projection_order
 from ..methods.validity import MAX_TERMS, method_problem
@@ -38,7 +37,6 @@ WORKER_BYTES = 60e6  # memory of one local worker process: Python, numpy, JSBSim
 DEFAULT_LIMITS = {"max_runs": 1_000_000, "max_memory_gb": 8.0, "max_disk_gb": 100.0, "max_pce_terms": MAX_TERMS}
 LIMIT_KEYS = tuple(DEFAULT_LIMITS)
 MAX_FILE_BYTES = 1 << 20  # a campaign file is at most 1 MiB
-MAX_LEVEL = 1000          # sparse grid levels beyond this are refused before any estimate
 NAME_PATTERN = re.compile(r"[A-Za-z0-9_][A-Za-z0-9_.-]{0,99}")
 
 
@@ -409,58 +407,17 @@ def limits(check: Checker, value) -> dict:
     return found
 
 
-def _points_bound(check: Checker, design: dict, germs: list[str]) -> float | None:
-    """The number of points the design builds (for a sparse grid: before merging the tensor rules'
-    shared points, an upper bound on the runs and the size of the arrays built), computed without
-    building anything; None when the design's own checks should speak first."""
-    from ..designs import rules as rule_catalog
-
-    kind, d = design.get("kind"), len(germs)
-
-    def count(key):
-        value = design.get(key)
-        return value if isinstance(value, int) and not isinstance(value, bool) and value >= 1 else None
-
-    if kind in ("monte_carlo", "sobol", "halton", "latin_hypercube"):
-        return count("samples")
-    if kind == "pick_freeze":
-        n = count("samples")
-        return None if n is None else float(n) * (d + 2)
-    if kind == "tensor_grid":
-        n = count("points")
-        return None if n is None else float(n) ** d
-    if kind == "sparse_grid":
-        level = design.get("level")
-        if not isinstance(level, int) or isinstance(level, bool) or level < 0:
-            return None
-        if level > MAX_LEVEL:
-            check.fail("design.level", f"expected at most {MAX_LEVEL}, got {level}")
-        try:
-            rules = rule_catalog.rules_by_dimension(design.get("rule"), germs, design.get("nested"))
-            growth = design.get("growth") or "linear"
-            sizes = {}
-            for rule in dict.fromkeys(rules):
-                top = rule_catalog.max_level(rule, growth)
-                if top is not None and level + 1 > top:
-                    return None
-                sizes[rule] = np.array(rule_catalog.level_sizes(rule, growth, level + 1), dtype=float)
-        except (ValueError, KeyError, TypeError):
-            return None
-        # polynomial product over dimensions: coefficient s = sum over |j| = s of prod sizes[j_k]
-        total = np.array([1.0])
-        for rule in rules:
-            total = np.convolve(total, sizes[rule])[: level + 1]
-        return float(total[max(0, level - d + 1): level + 1].sum())
-    return None
-
-
 def check_size(check: Checker, data: dict, simulator: dict, parameters: list, method: dict, execution: dict,
                storage: dict, limits: dict) -> dict:
     """The design's size, its memory and disk estimate and the PCE size, from the campaign alone
     (nothing built): refused beyond `limits` (CampaignError naming the figure and the limit).
     Returns the figures {"runs", "memory_gb", "disk_gb", "pce_terms"}."""
     d = len(parameters)
-    points = _points_bound(check, data["design"], [p.germ for p in parameters])
+    try:  # the design kind's own size (designs.DesignKind.size); an unknown kind is refused when built
+        points = design_size(data["design"], [p.germ for p in parameters])
+    except ValueError as exc:
+        field_path, _, message = str(exc).partition(": ")
+        check.fail(field_path, message)
     figures = {"runs": points}
     if points is not None and points > limits["max_runs"]:
         check.fail("design", f"{points:.4g} runs (points built), more than limits.max_runs = {limits['max_runs']}; "

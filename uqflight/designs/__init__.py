@@ -15,32 +15,37 @@ from typing import Callable
 import numpy as np
 
 from ..parameters.germs import check_germs
-from .montecarlo import halton_design, latin_hypercube_design, monte_carlo_design, sobol_design
-from .pickfreeze import pick_freeze_design
-from .smolyak import sparse_grid_design
+from .montecarlo import (halton_design, latin_hypercube_design, monte_carlo_design, samples_size, sobol_design,
+                         sobol_size)
+from .pickfreeze import pick_freeze_design, pick_freeze_size
+from .smolyak import sparse_grid_design, sparse_grid_size
 from .spec import is_integer
-from .tensor import tensor_grid_design
+from .tensor import tensor_grid_design, tensor_grid_size
 
 
 @dataclass(frozen=True)
 class DesignKind:
-    """A registered design: its builder (spec, germs, seed) -> (xi, weights, info), and whether its
-    points are random draws (`sampled`: moments are sample averages, valid on any subset of runs)
-    or a quadrature grid (its weights are valid only all together)."""
+    """A registered design: its builder (spec, germs, seed) -> (xi, weights, info); its size (spec,
+    germs) -> the runs it builds, from the spec alone and without building anything (for the campaign's
+    limits; a sparse grid's points before merging; None when the spec is malformed, so that the
+    builder's own checks speak); and whether its points are random draws (`sampled`: moments are sample
+    averages, valid on any subset of runs) or a quadrature grid (its weights are valid only all together)."""
 
     build: Callable
+    size: Callable
     sampled: bool
     example: dict  # a small `design:` mapping of this kind (help text and tests)
 
 
 REGISTRY: dict[str, DesignKind] = {
-    "monte_carlo": DesignKind(monte_carlo_design, True, {"kind": "monte_carlo", "samples": 64}),
-    "sobol": DesignKind(sobol_design, True, {"kind": "sobol", "samples": 64}),
-    "halton": DesignKind(halton_design, True, {"kind": "halton", "samples": 64}),
-    "latin_hypercube": DesignKind(latin_hypercube_design, True, {"kind": "latin_hypercube", "samples": 64}),
-    "sparse_grid": DesignKind(sparse_grid_design, False, {"kind": "sparse_grid", "level": 2}),
-    "tensor_grid": DesignKind(tensor_grid_design, False, {"kind": "tensor_grid", "points": 4}),
-    "pick_freeze": DesignKind(pick_freeze_design, True, {"kind": "pick_freeze", "samples": 16}),
+    "monte_carlo": DesignKind(monte_carlo_design, samples_size, True, {"kind": "monte_carlo", "samples": 64}),
+    "sobol": DesignKind(sobol_design, sobol_size, True, {"kind": "sobol", "samples": 64}),
+    "halton": DesignKind(halton_design, samples_size, True, {"kind": "halton", "samples": 64}),
+    "latin_hypercube": DesignKind(latin_hypercube_design, samples_size, True,
+                                  {"kind": "latin_hypercube", "samples": 64}),
+    "sparse_grid": DesignKind(sparse_grid_design, sparse_grid_size, False, {"kind": "sparse_grid", "level": 2}),
+    "tensor_grid": DesignKind(tensor_grid_design, tensor_grid_size, False, {"kind": "tensor_grid", "points": 4}),
+    "pick_freeze": DesignKind(pick_freeze_design, pick_freeze_size, True, {"kind": "pick_freeze", "samples": 16}),
 }
 DESIGN_KINDS = tuple(REGISTRY)
 SAMPLED_DESIGNS = tuple(kind for kind, entry in REGISTRY.items() if entry.sampled)
@@ -59,6 +64,15 @@ class Design:
     xi: np.ndarray  # (N, d) standard variables, in the order the runs are made
     weights: np.ndarray  # (N,), summing to 1 for the input distribution; may be negative
     info: dict = field(default_factory=dict)  # facts for people: level, rule, degree, n_base, ...
+
+
+def design_size(spec: dict, germs: list[str]) -> float | None:
+    """The runs the design `spec` builds, from its registry entry (see DesignKind.size); None for a spec
+    whose kind or keys the builder will refuse. Raises ValueError ("design.KEY: ...") beyond a kind's limit."""
+    kind = spec.get("kind") if isinstance(spec, dict) else None
+    if not isinstance(kind, str) or kind not in REGISTRY:
+        return None
+    return REGISTRY[kind].size(spec, germs)
 
 
 def build_design(spec: dict, germs: list[str], seed: int) -> Design:

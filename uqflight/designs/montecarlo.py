@@ -8,7 +8,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..parameters.germs import draw_germs, germ_quantiles
-from .spec import check_keys, integer, optional_boolean
+from .spec import check_keys, given_count, integer, optional_boolean
 
 
 def equal_weights(n: int) -> np.ndarray:
@@ -26,6 +26,18 @@ def sobol_points(n: int, d: int, scramble: bool, seed: int) -> np.ndarray:
     skip = 0 if scramble else 1
     engine = qmc.Sobol(d, scramble=scramble, rng=seed)
     return engine.random_base2((n + skip - 1).bit_length())[skip : n + skip]
+
+
+def samples_size(spec: dict, germs: list[str]) -> int | None:
+    """Runs of `monte_carlo`, `halton` and `latin_hypercube`: `samples`."""
+    return given_count(spec, "samples")
+
+
+def sobol_size(spec: dict, germs: list[str]) -> int | None:
+    """Runs of `sobol`: samples × replicates."""
+    n = given_count(spec, "samples")
+    replicates = given_count(spec, "replicates") if "replicates" in spec else 1
+    return None if n is None or replicates is None else n * replicates
 
 
 def monte_carlo_design(spec: dict, germs: list[str], seed: int):

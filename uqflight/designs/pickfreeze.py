@@ -5,7 +5,7 @@ import numpy as np
 
 from ..parameters.germs import germ_quantiles
 from .montecarlo import equal_weights, sobol_points
-from .spec import check_keys, integer
+from .spec import check_keys, given_count, integer
 
 
 def pick_freeze_rows(a: np.ndarray, b: np.ndarray) -> np.ndarray:
@@ -15,6 +15,12 @@ def pick_freeze_rows(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     columns = np.arange(d)
     ab[columns, :, columns] = b.T
     return np.concatenate([a, b, ab.reshape(d * n, d)])
+
+
+def pick_freeze_size(spec: dict, germs: list[str]) -> int | None:
+    """Runs of `pick_freeze`: n(d + 2)."""
+    n = given_count(spec, "samples")
+    return None if n is None else n * (len(germs) + 2)
 
 
 def pick_freeze_design(spec: dict, germs: list[str], seed: int):

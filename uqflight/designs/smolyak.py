@@ -16,10 +16,11 @@ from math import comb
 import numpy as np
 
 from . import rules as rule_catalog
-from .spec import check_keys, integer, optional_boolean, optional_choice
+from .spec import check_keys, integer, is_integer, optional_boolean, optional_choice
 from .tensor import tensor_product
 
 MERGE_TOLERANCE = 1e-12  # relative: 1-D nodes closer than this are one point
+MAX_LEVEL = 1000  # levels beyond this are refused before any size is estimated
 
 
 def multi_indices(d: int, level: int) -> np.ndarray:
@@ -89,6 +90,33 @@ def smolyak_degree(degrees, level: int) -> int:
         cost = np.searchsorted(np.asarray(sequence), evens).astype(float)
         worst = np.array([np.max(worst[: e + 1][::-1] + cost[: e + 1]) for e in range(len(evens))])
     return int(evens[np.argmax(worst > level)]) - 1
+
+
+def sparse_grid_size(spec: dict, germs: list[str]) -> float | None:
+    """The points the combination technique builds before merging the tensor rules' shared points
+    (an upper bound on the runs, and the size of the arrays built), computed without building anything:
+    Σ over the multi-indices of Π_k size_k(j_k), a polynomial product over the dimensions."""
+    level = spec.get("level")
+    if not is_integer(level) or level < 0:
+        return None
+    if level > MAX_LEVEL:
+        raise ValueError(f"design.level: expected at most {MAX_LEVEL}, got {level}")
+    try:
+        rules = rule_catalog.rules_by_dimension(spec.get("rule"), germs, spec.get("nested"))
+        growth = spec.get("growth") or "linear"
+        sizes = {}
+        for rule in dict.fromkeys(rules):
+            top = rule_catalog.max_level(rule, growth)
+            if top is not None and level + 1 > top:
+                return None
+            sizes[rule] = np.array(rule_catalog.level_sizes(rule, growth, level + 1), dtype=float)
+    except (ValueError, KeyError, TypeError):
+        return None
+    # coefficient s of the product polynomial = the points of all tensor rules with |j| = s
+    total = np.array([1.0])
+    for rule in rules:
+        total = np.convolve(total, sizes[rule])[: level + 1]
+    return float(total[max(0, level - len(germs) + 1): level + 1].sum())
 
 
 def sparse_grid_design(spec: dict, germs: list[str], seed: int):

@@ -29,6 +29,12 @@ def integer(spec: dict, key: str, kind: str, minimum: int) -> int:
     return int(value)
 
 
+def given_count(spec: dict, key: str) -> int | None:
+    """spec[key] when it is an integer >= 1, else None (the builder's own checks then speak)."""
+    value = spec.get(key)
+    return value if is_integer(value) and value >= 1 else None
+
+
 def optional_boolean(spec: dict, key: str, default: bool | None) -> bool | None:
     if key not in spec:
         return default

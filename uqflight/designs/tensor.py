@@ -6,7 +6,7 @@ from functools import reduce
 import numpy as np
 
 from . import rules as rule_catalog
-from .spec import check_keys, integer
+from .spec import check_keys, given_count, integer
 
 
 def tensor_product(node_sets, weight_sets) -> tuple[np.ndarray, np.ndarray]:
@@ -15,6 +15,12 @@ def tensor_product(node_sets, weight_sets) -> tuple[np.ndarray, np.ndarray]:
     points = np.stack([grid.ravel() for grid in grids], axis=1)
     weights = reduce(np.multiply.outer, weight_sets).ravel()
     return points, weights
+
+
+def tensor_grid_size(spec: dict, germs: list[str]) -> float | None:
+    """Runs of `tensor_grid`: points^d (a float: it may be far beyond any integer a run could reach)."""
+    n = given_count(spec, "points")
+    return None if n is None else float(n) ** len(germs)
 
 
 def tensor_grid_design(spec: dict, germs: list[str], seed: int):
