@@ -34,7 +34,7 @@ def test_a_germs_quantile_maps_uniforms_to_its_law(germ):
         assert np.mean(xi**power) == pytest.approx(weights @ nodes**power, abs=5e-3)
 
 
-@pytest.mark.parametrize("name", list(DISTRIBUTIONS))
+@pytest.mark.parametrize("name", [name for name, law in DISTRIBUTIONS.items() if law.polynomial])
 def test_a_distributions_maps_invert_and_its_moments_match_quadrature(name):
     parameter = make_parameter("p", "p", name, 2.0, interval_pct=30.0)
     nodes, weights = nodes_weights(GERMS[parameter.germ].default_rule, 60)
@@ -45,6 +45,26 @@ def test_a_distributions_maps_invert_and_its_moments_match_quadrature(name):
     mean = weights @ kappa  # a 60-point rule: the moments of these smooth maps to ~1e-10
     assert mean == pytest.approx(parameter.mean, rel=1e-9)
     assert math.sqrt(weights @ (kappa - mean) ** 2) == pytest.approx(parameter.std, rel=1e-7)
+
+
+@pytest.mark.parametrize("name", [name for name, law in DISTRIBUTIONS.items() if not law.polynomial])
+def test_a_seed_law_gives_every_integer_seed_equally_often(name):
+    """κ = ⌊(ξ + 1)/2 · n⌋ on ξ ~ U(−1, 1): integers 0 .. n − 1, each slice of ξ of width 2/n mapping to one
+    seed, the inverse landing in its own slice; the mean and std are the discrete uniform law's."""
+    from uqflight.parameters.distributions import SEED_COUNT
+
+    law = DISTRIBUTIONS[name]()
+    edges = -1.0 + 2.0 * np.array([0, 1, 2**20, SEED_COUNT - 1]) / SEED_COUNT
+    kappa = law.to_physical(np.concatenate([edges, edges + 1e-12, [1.0 - 1e-16, 1.0]]))
+    np.testing.assert_array_equal(kappa, [0, 1, 2**20, SEED_COUNT - 1] * 2 + [SEED_COUNT - 1] * 2)
+    seeds = np.array([0.0, 7.0, 123456789.0, SEED_COUNT - 1.0])
+    np.testing.assert_array_equal(law.to_physical(law.to_standard(seeds)), seeds)
+    u = np.random.default_rng(0).random(200000)
+    drawn = law.to_physical(2 * u - 1)
+    assert np.all(drawn == np.floor(drawn)) and drawn.min() >= 0 and drawn.max() <= SEED_COUNT - 1
+    # 200,000 draws: the sample mean is within 4 standard errors of the law's
+    assert abs(drawn.mean() - law.mean) < 4 * law.std / math.sqrt(u.size)
+    assert law.std == pytest.approx(drawn.std(), rel=0.01)
 
 
 @pytest.mark.parametrize("name", list(RULE_TABLE))

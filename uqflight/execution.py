@@ -124,6 +124,9 @@ def prepare_store(campaign: Campaign, design: Design, out: Path, force: bool, pr
              "method": json.dumps(campaign.method), "germs": json.dumps(campaign.germs),
              "analysis": json.dumps(campaign.analysis),
              "design_kind": design.kind, "design_info": json.dumps(design.info, default=str)}
+    seeds = [p.name for p in campaign.parameters if not p.law.polynomial]
+    if seeds:  # written only when there are any: files of other campaigns keep their attributes
+        attrs["seeds"] = json.dumps(seeds)
     if campaign.simulator["kind"] == "jsbsim":
         from .simulators.jsbsim import aircraft_hash, flight_setup_from
         attrs["aircraft_hash"] = aircraft_hash(flight_setup_from(campaign.simulator))

@@ -41,6 +41,7 @@ from .methods import PCE, METHODS, method_entry
 from .methods.basis import orthonormal_basis
 from .methods.loo import relative_loo_error
 from .methods.validity import method_problem
+from .parameters.distributions import SEED_REFUSAL
 from .parameters.germs import draw_germs
 from .store import CorruptFile, ResultStore, Status
 
@@ -121,6 +122,7 @@ class Statistics:
     reference: str | None = None
     from_runs: bool = False  # statistics of the runs themselves (a sampled design), not of a PCE
     replicates: int = 1  # independent randomised-QMC replicates of the design
+    seeds: list[str] = field(default_factory=list)  # parameters that are random streams' seeds
 
 
 def campaign_facts(store: ResultStore) -> tuple[dict, list[str], dict]:
@@ -179,6 +181,10 @@ def analyse(path, reference: str | None = None, options: Options | None = None, 
         _check_runs(store, stats, sampled, partial)
         problem = method_problem(method["kind"], method["order"], store.xi[ok], store.weights[ok], germs, sampled,
                                  missing=int(status.size - ok.sum()), allow_aliasing=allow_aliasing)
+        seeds = json.loads(store.attrs.get("seeds", "[]"))
+        if seeds and not (sampled and method_entry(method["kind"]).runs_on_sampled):
+            problem = f"parameter {seeds[0]} is a seed: {SEED_REFUSAL}"
+        stats.seeds = seeds
         if problem:
             raise BadInput(f"{path}: method {method['kind']} order {method['order']}: {problem}")
         _note_runs(store, stats, sampled, allow_aliasing)
@@ -454,6 +460,20 @@ def json_ready(value):
     return value
 
 
+def variance_split(out: OutputStatistics, seed: str) -> dict:
+    """The shares of the variance due to the seed's random stream (aleatory) and to the other inputs
+    (epistemic), first-order and total, with the pick-freeze intervals: the others' first-order share is the
+    closed index of the complement, 1 − S_T(seed), and their total share 1 − S(seed)."""
+    first, total = out.sobol_first[seed], out.sobol_total[seed]
+    (first_low, first_high), (total_low, total_high) = out.sobol_first_ci[seed], out.sobol_total_ci[seed]
+    return {"seed": seed,
+            "seeds": {"first": first, "total": total, "first_ci": {"lower": first_low, "upper": first_high},
+                      "total_ci": {"lower": total_low, "upper": total_high}},
+            "other_parameters": {"first": 1 - total, "total": 1 - first,
+                                 "first_ci": {"lower": 1 - total_high, "upper": 1 - total_low},
+                                 "total_ci": {"lower": 1 - first_high, "upper": 1 - first_low}}}
+
+
 def summary_json(stats: Statistics) -> dict:
     """summary.json: the fixed schema of DESIGN.md plus the run counts, the failure probability, the
     notes, and per output std, CoV, quantiles, skewness, kurtosis, resolution, the fits' leave-one-out
@@ -471,6 +491,8 @@ def summary_json(stats: Statistics) -> dict:
         if out.sobol_first_ci:
             entry["sobol_first_ci"] = {k: {"lower": v[0], "upper": v[1]} for k, v in out.sobol_first_ci.items()}
             entry["sobol_total_ci"] = {k: {"lower": v[0], "upper": v[1]} for k, v in out.sobol_total_ci.items()}
+        if stats.seeds and out.sobol_first_ci:
+            entry["variance_split"] = variance_split(out, stats.seeds[0])
         if out.loo_error is not None:
             entry["loo_error"] = out.loo_error
         if out.convergence is not None:

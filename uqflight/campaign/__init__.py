@@ -98,6 +98,10 @@ def parse_campaign(text: str, source: str = "<campaign>", probe: PropertyProbe |
     design_kind = data["design"].get("kind") if isinstance(data["design"], dict) else None
     default_method = "monte_carlo" if design_kind in SAMPLED_DESIGNS else "integration"
     method = schema.method(check, data.get("method", {"kind": default_method}))
+    schema.check_seeds(check, parameters, design_kind, method)
+    seeds = [p.name for p in parameters if not p.law.polynomial]
+    if seeds and simulator["kind"] == "python":
+        simulator["seed_parameters"] = seeds
     execution = schema.execution(check, data.get("execution", {}))
     storage = schema.storage(check, data.get("storage", {}), name)
     analysis = schema.analysis(check, data.get("analysis", {}))

@@ -10,11 +10,12 @@ from pathlib import Path
 
 import yaml
 
-from ..designs import Design, design_size, is_sampled
+from ..designs import DESIGN_KINDS, SAMPLED_DESIGNS, Design, design_size, is_sampled
 from ..methods import METHOD_KINDS, method_entry
 from ..methods.exactness import exact_total_degree, max_projection_order
 from ..methods.validity import MAX_TERMS, method_problem
 from ..parameters import DISTRIBUTIONS, Parameter, make_parameter
+from ..parameters.distributions import SEED_REFUSAL
 from ..simulators.jsbsim import Excitation, FlightSetup
 from ..simulators.python import PluginError, load_function
 
@@ -254,6 +255,9 @@ def parameters(check: Checker, value, kind: str, aircraft) -> list[Parameter]:
         path = f"parameters.{name}"
         spec = check.mapping(spec, path, PARAMETER_KEYS, required=("distribution",))
         distribution = check.string(spec["distribution"], f"{path}.distribution", DISTRIBUTIONS)
+        if not DISTRIBUTIONS[distribution].polynomial:
+            parameters.append(seed_parameter(check, spec, path, str(name), kind, owners))
+            continue
         function = None
         if "function" in spec or "perturbation" in spec:
             function = function_property(check, spec, path, kind, aircraft)
@@ -300,6 +304,42 @@ def parameters(check: Checker, value, kind: str, aircraft) -> list[Parameter]:
         except ValueError as exc:
             check.fail(path, str(exc).removeprefix(f"parameter {str(name)!r}: "))
     return parameters
+
+
+def seed_parameter(check: Checker, spec: dict, path: str, name: str, kind: str, owners: dict) -> Parameter:
+    """`distribution: seed`: the integer seed of a random stream (e.g. atmosphere/randomseed), over its
+    fixed range; only `property` goes with it."""
+    from ..parameters.distributions import SEED_COUNT
+
+    for key in spec:
+        if key not in ("property", "distribution"):
+            check.fail(f"{path}.{key}", f"has no meaning for a seed (its seeds are 0 to {SEED_COUNT - 1}, drawn "
+                                        "from the campaign's seed and each run's design index): give only property")
+    if kind == "jsbsim" and "property" not in spec:
+        check.fail(f"{path}.property", "is required: the JSBSim property the seed sets, e.g. atmosphere/randomseed")
+    prop = check.string(spec.get("property", name), f"{path}.property")
+    if prop in owners:
+        check.fail(f"{path}.property", f"expected each property once, but {prop!r} is already set by "
+                                       f"parameters.{owners[prop]}")
+    owners[prop] = name
+    return make_parameter(name, prop, "seed", 0.0, lower=0.0, upper=float(SEED_COUNT))
+
+
+def check_seeds(check: Checker, parameters: list[Parameter], design_kind, method: dict) -> None:
+    """A seed's random stream has no polynomial expansion: refuse grids and PCE methods over it, and more
+    than one seed (the split of the variance between seeds and the other inputs needs them as one input)."""
+    seeds = [p.name for p in parameters if not p.law.polynomial]
+    if not seeds:
+        return
+    if len(seeds) > 1:
+        check.fail(f"parameters.{seeds[1]}.distribution", f"one seed parameter per campaign, but "
+                                                          f"{', '.join(seeds)} are seeds")
+    where = f"parameters.{seeds[0]}.distribution"
+    if isinstance(design_kind, str) and design_kind in DESIGN_KINDS and not is_sampled(design_kind):
+        check.fail(where, f"a seed needs a sampled design ({', '.join(SAMPLED_DESIGNS)}), not {design_kind}: "
+                          "a random stream has no polynomial expansion for a grid to integrate")
+    if not method_entry(method["kind"]).runs_on_sampled:  # it would fit a PCE in the seed's ξ
+        check.fail(where, f"{SEED_REFUSAL} ({method['kind']})")
 
 
 def function_property(check: Checker, spec: dict, path: str, kind: str, aircraft) -> str:

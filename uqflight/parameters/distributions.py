@@ -20,6 +20,7 @@ class Distribution(ABC):
 
     name: str
     germ: str
+    polynomial = True  # κ(ξ) is smooth: a PCE in ξ can represent what it drives
 
     def __init__(self, lower: float, upper: float):
         self.lower, self.upper = float(lower), float(upper)
@@ -164,5 +165,43 @@ class Lognormal(Distribution):
         return math.exp(location + 0.5 * scale**2) * math.sqrt(math.expm1(scale**2))
 
 
+SEED_COUNT = 2**31  # seeds 0 .. 2^31 − 1: what JSBSim's atmosphere/randomseed (an int) holds
+SEED_REFUSAL = ("a seed's random stream cannot be expanded in polynomials: use method monte_carlo, and a "
+                "pick_freeze design for the share of the variance due to the seed")
+
+
+class Seed(Uniform):
+    """A random stream's integer seed, drawn uniformly from 0 .. 2^31 − 1: κ = ⌊(ξ + 1)/2 · 2^31⌋. Its
+    interval is fixed (no interval_pct, lower or upper); every κ is an integer, exact in float64. Designs
+    draw, freeze and swap its ξ like any input's, so a run's seed follows from the campaign's seed and the
+    run's design index alone. A seed has no polynomial expansion (`polynomial` false): grids and PCE
+    methods over it are refused."""
+
+    name, germ, polynomial = "seed", "uniform", False
+
+    def __init__(self, lower: float = 0.0, upper: float = float(SEED_COUNT)):
+        super().__init__(lower, upper)
+
+    def check(self):
+        if (self.lower, self.upper) != (0.0, float(SEED_COUNT)):
+            return f"a seed takes no interval (its seeds are 0 to {SEED_COUNT - 1}), got [{self.lower}, {self.upper}]"
+        return None
+
+    def to_physical(self, xi):
+        u = 0.5 * (np.asarray(xi, dtype=float) + 1.0)
+        return np.clip(np.floor(u * SEED_COUNT), 0, SEED_COUNT - 1)
+
+    def to_standard(self, kappa):  # the middle of the seed's slice of ξ
+        return 2.0 * (np.asarray(kappa, dtype=float) + 0.5) / SEED_COUNT - 1.0
+
+    @property
+    def mean(self):  # of the discrete uniform law on 0 .. n − 1
+        return 0.5 * (SEED_COUNT - 1)
+
+    @property
+    def std(self):
+        return math.sqrt((float(SEED_COUNT) ** 2 - 1.0) / 12.0)
+
+
 DISTRIBUTIONS: dict[str, type[Distribution]] = {
-    law.name: law for law in (Normal, Uniform, TruncatedNormal, Lognormal)}
+    law.name: law for law in (Normal, Uniform, TruncatedNormal, Lognormal, Seed)}

@@ -1,6 +1,6 @@
 """Any Python callable as the simulator: closed-form models for tests, other models for users.
 
-The callable gets a dict {parameter name: value} and returns a dict {output name: array or
+The callable gets a dict {parameter name: value} (a float; an int for a `distribution: seed`) and returns a dict {output name: array or
 scalar}; an optional "time" entry gives the time of the array outputs (otherwise the steps are
 numbered 0, 1, 2, ...). A scalar output has one time point.
 """
@@ -59,6 +59,7 @@ class PythonSimulator:
     def __init__(self, config: dict, parameter_names: list[str], base: Path):
         self.function = load_function(config["function"], base)
         self.names = list(parameter_names)
+        self.seeds = set(config.get("seed_parameters", ()))  # given to the function as Python ints
         self.outputs = config.get("outputs")
         self.units: dict[str, str] = {}
 
@@ -97,7 +98,8 @@ class PythonSimulator:
         """Nothing to reload: a Python function keeps no state between samples."""
 
     def _call(self, kappa: np.ndarray) -> dict:
-        raw = self.function(dict(zip(self.names, map(float, kappa))))
+        raw = self.function({name: int(value) if name in self.seeds else float(value)
+                             for name, value in zip(self.names, kappa)})
         if not isinstance(raw, dict):
             raise FlightError(f"the function returned {type(raw).__name__}, expected a dict of outputs")
         return raw
