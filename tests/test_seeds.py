@@ -113,3 +113,13 @@ def test_report_refuses_a_pce_method_over_a_seed(tmp_path):
     summary = summary_json(analyse(results))  # monte_carlo on a Monte Carlo design: sample moments
     assert summary["outputs"]["y"]["variance"][1] == pytest.approx(1.25, rel=0.5)
     assert "variance_split" not in summary["outputs"]["y"]  # Sobol' shares need a pick_freeze design
+
+
+def test_a_jsbsim_seed_must_be_a_property_of_the_aircraft(tmp_path):
+    text = ("name: s\nsimulator: {kind: jsbsim, aircraft: bacm, duration_s: 5}\nparameters:\n"
+            "  turbulence: {property: atmosphere/randomseedx, distribution: seed}\n"
+            "design: {kind: monte_carlo, samples: 4}\n")
+    (tmp_path / "s.yaml").write_text(text)
+    done = cli_in_process("plan", tmp_path / "s.yaml")
+    assert done.returncode == 2, done.stderr
+    assert "parameters.turbulence.property" in done.stderr and "did you mean atmosphere/randomseed" in done.stderr

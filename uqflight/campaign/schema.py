@@ -256,7 +256,7 @@ def parameters(check: Checker, value, kind: str, aircraft) -> list[Parameter]:
         spec = check.mapping(spec, path, PARAMETER_KEYS, required=("distribution",))
         distribution = check.string(spec["distribution"], f"{path}.distribution", DISTRIBUTIONS)
         if not DISTRIBUTIONS[distribution].polynomial:
-            parameters.append(seed_parameter(check, spec, path, str(name), kind, owners))
+            parameters.append(seed_parameter(check, spec, path, str(name), kind, owners, aircraft))
             continue
         function = None
         if "function" in spec or "perturbation" in spec:
@@ -306,7 +306,8 @@ def parameters(check: Checker, value, kind: str, aircraft) -> list[Parameter]:
     return parameters
 
 
-def seed_parameter(check: Checker, spec: dict, path: str, name: str, kind: str, owners: dict) -> Parameter:
+def seed_parameter(check: Checker, spec: dict, path: str, name: str, kind: str, owners: dict,
+                   aircraft) -> Parameter:
     """`distribution: seed`: the integer seed of a random stream (e.g. atmosphere/randomseed), over its
     fixed range; only `property` goes with it."""
     from ..parameters.distributions import SEED_COUNT
@@ -322,7 +323,10 @@ def seed_parameter(check: Checker, spec: dict, path: str, name: str, kind: str, 
         check.fail(f"{path}.property", f"expected each property once, but {prop!r} is already set by "
                                        f"parameters.{owners[prop]}")
     owners[prop] = name
-    return make_parameter(name, prop, "seed", 0.0, lower=0.0, upper=float(SEED_COUNT))
+    if aircraft is not None and (aircraft.value(prop) is None or not aircraft.writable(prop)):
+        check.fail(f"{path}.property", f"expected a property the simulator can set in aircraft "
+                                       f"{aircraft.aircraft!r}, got {prop!r}{aircraft.hint(prop)}")
+    return make_parameter(name, prop, "seed", SEED_COUNT // 2, lower=0.0, upper=float(SEED_COUNT))  # nominal: κ(ξ = 0)
 
 
 def check_seeds(check: Checker, parameters: list[Parameter], design_kind, method: dict) -> None:
