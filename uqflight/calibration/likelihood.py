@@ -21,6 +21,8 @@ from typing import Callable
 
 import numpy as np
 
+from ..parameters.germs import GERMS
+
 
 class DataError(ValueError):
     """Flight data or a noise setting that cannot be used; the message names the file or option."""
@@ -135,7 +137,6 @@ def error_factors_of(curves: np.ndarray, rtol: float = 1e-10) -> np.ndarray:
 
 
 LOG_SIGMA_RANGE = (-30.0, 10.0)  # log(σ / S) of an inferred noise: the support of its (cut) prior
-GERM_LOG_DENSITY = {"normal": -0.5 * math.log(2 * math.pi), "uniform": math.log(0.5)}
 
 
 @dataclass
@@ -184,9 +185,10 @@ class LogPosterior:
         self.inferred = [term for term in terms if term.sigma is None]
         self.labels = self.names + [f"sigma_{term.name}" for term in self.inferred]
         self.ndim = len(self.labels)
-        self._uniform = np.array([g == "uniform" for g in germs])
-        self._normal = ~self._uniform
-        self._constant = sum(GERM_LOG_DENSITY[g] for g in germs)
+        self._laws = [GERMS[g] for g in germs]
+        self._lower = np.array([law.support[0] for law in self._laws])
+        self._upper = np.array([law.support[1] for law in self._laws])
+        self._bounded = bool(np.isfinite(self._lower).any() or np.isfinite(self._upper).any())
 
     @classmethod
     def build(cls, surrogate_time, coefficients: dict, error_factors: dict, germs, names, basis,
@@ -213,8 +215,8 @@ class LogPosterior:
     def log_prior(self, theta: np.ndarray) -> np.ndarray:
         theta = np.atleast_2d(theta)
         xi = theta[:, :len(self.germs)]
-        lp = self._constant - 0.5 * (xi[:, self._normal] ** 2).sum(axis=1)
-        outside = (np.abs(xi[:, self._uniform]) > 1.0).any(axis=1)
+        lp = sum(law.log_density(xi[:, k]) for k, law in enumerate(self._laws))  # −inf outside a support
+        outside = ~np.isfinite(lp)
         for j, term in enumerate(self.inferred):
             log_sigma = theta[:, len(self.germs) + j]
             # half-Cauchy(scale) on σ, with the Jacobian dσ/dlogσ = σ; log(1 + (σ/S)²) without overflow
@@ -242,9 +244,8 @@ class LogPosterior:
         determinant of that covariance (its eigenvalues are σ² + λ_k along U and σ² elsewhere)."""
         theta = np.atleast_2d(theta)
         xi = theta[:, :len(self.germs)]
-        if self._uniform.any():  # the basis of a uniform germ is only defined on [-1, 1]
-            xi = xi.copy()
-            xi[:, self._uniform] = np.clip(xi[:, self._uniform], -1.0, 1.0)
+        if self._bounded:  # a bounded germ's basis is only defined on its support
+            xi = np.clip(xi, self._lower, self._upper)
         B = self.basis(xi)
         sigmas = self.sigmas(theta)
         ll = np.zeros(len(theta))

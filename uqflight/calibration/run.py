@@ -12,6 +12,8 @@ from pathlib import Path
 import numpy as np
 from threadpoolctl import threadpool_limits
 
+from ..parameters.germs import GERMS
+
 from .likelihood import DataError, LogPosterior, interpolate_in_time, parse_noise, read_flight_csv
 from .outputs import (OUTPUT_FILES, calibrated_campaign, corner_plot, marginal, marginals_plot, predictive_plot,
                       write_json, write_posterior)
@@ -73,7 +75,7 @@ def _calibrate(results, data, out, outputs, noise, seed, walkers, steps, method,
     fitted = clock.perf_counter()
 
     def prior_draw(rng, n):
-        xi = np.column_stack([rng.standard_normal(n) if g == "normal" else rng.uniform(-1, 1, n) for g in germs])
+        xi = np.column_stack([GERMS[g].sample(rng, n) for g in germs])
         rest = np.tile(posterior.start()[len(germs):], (n, 1))
         return np.hstack([xi, rest])
 

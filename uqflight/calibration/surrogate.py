@@ -21,6 +21,7 @@ from ..methods.loo import loo_residuals, relative_loo_error
 from ..parameters import Parameter
 from ..parameters import to_physical as _to_physical
 from ..parameters import to_standard as _to_standard
+from ..parameters.germs import GERMS
 from ..simulators import make_simulator
 from ..simulators.base import FlightError
 from ..simulators.jsbsim_probe import jsbsim_probe
@@ -199,15 +200,11 @@ def simulate(campaign: Campaign, kappa: np.ndarray, outputs: list[str]):
     return np.asarray(time, dtype=float), values, failures
 
 
-GERM_CI95 = {"normal": 1.959963984540054, "uniform": 0.95}  # 97.5 % quantile of N(0, 1) and of U(-1, 1)
-
-
 def prior_summaries(parameters) -> dict[str, dict]:
     """Prior mean, std and central 95 % interval of every parameter, in physical units."""
     out = {}
     for p in parameters:
-        q = GERM_CI95[p.germ]
-        lower, upper = (float(v) for v in p.to_physical(np.array([-q, q])))
+        lower, upper = (float(v) for v in p.to_physical(GERMS[p.germ].quantile(np.array([0.025, 0.975]))))
         out[p.name] = {"mean": float(p.mean), "std": float(p.std), "ci95": [lower, upper]}
     return out
 

@@ -30,11 +30,12 @@ def orthonormal_polynomials(germ: str, x: np.ndarray, order: int) -> np.ndarray:
     x = np.asarray(x, dtype=float)
     values = np.empty((x.size, order + 1))
     values[:, 0] = 1.0
-    if order >= 1:
+    if order >= 1:  # x p_n = β_{n+1} p_{n+1} + α_n p_n + β_n p_{n−1}, p_{−1} = 0
+        alpha = GERMS[germ].recurrence_alpha(np.arange(order, dtype=float))
         beta = GERMS[germ].recurrence_beta(np.arange(1, order + 1, dtype=float))
-        values[:, 1] = x / beta[0]
+        values[:, 1] = (x - alpha[0]) / beta[0]
         for n in range(1, order):
-            values[:, n + 1] = (x * values[:, n] - beta[n - 1] * values[:, n - 1]) / beta[n]
+            values[:, n + 1] = ((x - alpha[n]) * values[:, n] - beta[n - 1] * values[:, n - 1]) / beta[n]
     return values
 
 
