@@ -26,7 +26,7 @@ TOP_KEYS = ("name", "description", "seed", "simulator", "parameters", "design", 
 JSBSIM_KEYS = ("kind", "aircraft", "flight", "excitation", "duration_s", "output_rate_hz", "outputs", "trim")
 PYTHON_KEYS = ("kind", "function", "outputs")
 PARAMETER_KEYS = ("property", "function", "perturbation", "distribution", "nominal", "interval_pct", "lower", "upper")
-PERTURBATIONS = ("scale", "offset")
+PERTURBATIONS = ("scale", "offset", "offset_value")
 METHOD_KEYS = ("kind", "order", "split", "allow_aliasing")
 EXECUTION_KEYS = ("workers", "executor", "scheduler", "chunk", "timeout_s")
 STORAGE_KEYS = ("path", "raw", "tsvd")
@@ -307,7 +307,7 @@ def parameters(check: Checker, value, kind: str, aircraft) -> list[Parameter]:
 def function_property(check: Checker, spec: dict, path: str, kind: str, aircraft) -> str:
     """The property that scales or offsets `spec["function"]` (aero/uq/scale/NAME), checked
     against the aircraft's aerodynamic functions when the aircraft is known."""
-    from ..simulators.patch import PatchError, patch_property, resolve_function
+    from ..simulators.patch import PatchError, check_perturbation, patch_property, resolve_function
 
     if kind != "jsbsim":
         check.fail(f"{path}.function", "is for JSBSim aircraft; a python simulator's parameters have no functions")
@@ -320,7 +320,7 @@ def function_property(check: Checker, spec: dict, path: str, kind: str, aircraft
     if "perturbation" not in spec:
         check.fail(f"{path}.perturbation", f"is required with function: expected one of {', '.join(PERTURBATIONS)}")
     perturbation = check.string(spec["perturbation"], f"{path}.perturbation", PERTURBATIONS)
-    if "interval_pct" in spec and perturbation == "offset":
+    if "interval_pct" in spec and perturbation != "scale":
         check.fail(f"{path}.interval_pct", "has no meaning for an offset (nominal 0): give lower and upper")
     functions = getattr(aircraft, "functions", None)
     if functions is None:
@@ -329,6 +329,10 @@ def function_property(check: Checker, spec: dict, path: str, kind: str, aircraft
         full = resolve_function(function, functions)
     except PatchError as exc:
         check.fail(f"{path}.function", f"{exc} (aircraft {aircraft.aircraft!r})")
+    try:
+        check_perturbation(full, perturbation, getattr(aircraft, "references", {}))
+    except PatchError as exc:
+        check.fail(f"{path}.perturbation", f"{exc} (aircraft {aircraft.aircraft!r})")
     return patch_property(full, perturbation, functions)
 
 
