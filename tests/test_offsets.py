@@ -4,11 +4,13 @@ The patched copies are flown by plain JSBSim (jsbsim.FGFDMExec on the patched ro
 import re
 import xml.etree.ElementTree as ET
 
+import h5py
 import jsbsim
 import pytest
 from conftest import cli_in_process
 
 from uqflight.campaign import CampaignError, load_campaign
+from uqflight.execution import run_campaign
 from uqflight.simulators.aircraft import AircraftFiles
 from uqflight.simulators.jsbsim import REPO_ROOT, quiet_jsbsim
 from uqflight.simulators.jsbsim_probe import jsbsim_probe
@@ -182,3 +184,19 @@ def test_aircraft_command_prints_each_function_unit_and_reference_factor(tmp_pat
                         shown.stdout)
     qs, qsc, qsb = (float(g) for g in factors.groups())
     assert qsc == pytest.approx(qs * 4.9, rel=1e-5) and qsb == pytest.approx(qs * 35.8, rel=1e-5)  # c̄, b of c172p
+
+
+def test_a_campaign_with_an_offset_records_the_patched_copy_flown(tmp_path):
+    # The results file keys a resume by aircraft_hash: it is the patched copy's (the patch text
+    # included), so a file made when offsets were in lbf (it recorded the unpatched aircraft's
+    # hash) is refused, not resumed into a mix of two models.
+    path = _campaign(tmp_path, "  CD: {function: aero/coefficient/CDo, perturbation: offset, distribution: normal, "
+                               "lower: -0.002, upper: 0.002}\n")
+    text = path.read_text().replace("duration_s: 50", "duration_s: 1").replace("order: 2", "order: 1")
+    path.write_text(text.replace("results/c172p-scale-l2.h5", str(tmp_path / "r.h5")))
+    campaign = load_campaign(path, probe=jsbsim_probe)
+    summary = run_campaign(campaign, workers=1)
+    with h5py.File(summary.path, "r") as f:
+        recorded, status = f.attrs["aircraft_hash"], f["samples/status"][:]
+    patched = PreparedAircraft("c172p", properties=["aero/uq/offset/CDo"])
+    assert (status == 0).all() and recorded == patched.hash != PreparedAircraft("c172p").hash
