@@ -146,6 +146,16 @@ def test_campaign_parameters_name_the_offset_kinds(tmp_path):
         ("aero/uq/offset/CDo", 0.0), ("aero/uq/offset_value/Cmo", 0.0)]
 
 
+def test_a_patch_property_written_directly_is_checked_as_a_function_parameter(tmp_path):
+    path = _campaign(tmp_path, "  CD: {property: aero/uq/offset/CDo, distribution: normal, lower: -0.002, upper: 0.002}\n"
+                               "  CL: {property: aero/uq/scale/CLwbh, distribution: normal, lower: 0.9, upper: 1.1}\n")
+    campaign = load_campaign(path, probe=jsbsim_probe)
+    assert [p.nominal for p in campaign.parameters] == [0.0, 1.0]
+    path = _campaign(tmp_path, "  G: {property: aero/uq/offset/kCLge, distribution: normal, lower: -0.01, upper: 0.01}\n")
+    with pytest.raises(CampaignError, match=r"parameters\.G\.property: .*aero/function/kCLge.*offset_value"):
+        load_campaign(path, probe=jsbsim_probe)
+
+
 def test_a_copy_patched_to_the_old_lbf_semantics_has_another_cache_key():
     # Before, `offset` wrote <sum> aero/uq/offset/F BODY </sum> (lbf). That text is today's
     # offset_value patch with the property renamed; the cache key is the hash of the patched text.

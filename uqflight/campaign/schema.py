@@ -17,6 +17,7 @@ from ..methods.exactness import exact_total_degree, max_projection_order
 from ..methods.validity import MAX_TERMS, method_problem
 from ..parameters import DISTRIBUTIONS, Parameter, make_parameter
 from ..simulators.jsbsim import Excitation, FlightSetup
+from ..simulators.patch import patch_kind
 from ..simulators.python import PluginError, load_function
 
 SIMULATOR_KINDS = ("jsbsim", "python")
@@ -283,6 +284,8 @@ def parameters(check: Checker, value, kind: str, aircraft) -> list[Parameter]:
             from ..simulators.patch import NOMINAL
 
             nominal = NOMINAL[spec["perturbation"]] if nominal is None else nominal
+        elif aircraft is not None and aircraft.value(prop) is None and patch_kind(prop):
+            nominal = patch_nominal(check, prop, f"{path}.property", aircraft) if nominal is None else nominal
         elif aircraft is not None:
             known = aircraft.value(prop)
             if known is None:
@@ -302,6 +305,19 @@ def parameters(check: Checker, value, kind: str, aircraft) -> list[Parameter]:
         except ValueError as exc:
             check.fail(path, str(exc).removeprefix(f"parameter {str(name)!r}: "))
     return parameters
+
+
+def patch_nominal(check: Checker, prop: str, path: str, aircraft) -> float:
+    """The nominal of a property that asks for a patch itself (`aero/uq/offset/CDo`), checked as
+    `function:` with `perturbation:` is."""
+    from ..simulators.patch import NOMINAL, PatchError, check_perturbation, patch_request
+
+    try:
+        function, perturbation = patch_request(prop, aircraft.functions)
+        check_perturbation(function, perturbation, getattr(aircraft, "references", {}))
+    except PatchError as exc:
+        check.fail(path, f"{exc} (aircraft {aircraft.aircraft!r})")
+    return NOMINAL[perturbation]
 
 
 def function_property(check: Checker, spec: dict, path: str, kind: str, aircraft) -> str:

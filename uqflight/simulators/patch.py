@@ -77,9 +77,9 @@ def check_perturbation(function: str, kind: str, refs: dict[str, Reference]) -> 
     ref = refs.get(function)
     if kind == "offset" and ref is not None and ref.refusal:
         unit = f" ({ref.unit})" if ref.unit else ""
-        raise PatchError(f"perturbation: offset adds a coefficient increment times the function's reference "
-                         f"factor, and {function!r} has none: {ref.refusal}; give perturbation: offset_value "
-                         f"(--offset-value) to add a value in its own unit{unit}")
+        raise PatchError(f"an offset is a coefficient increment, added times the function's reference factor, "
+                         f"and {function!r} has none: {ref.refusal}; give perturbation: offset_value "
+                         f"(--offset-value on the command line) to add a value in its own unit{unit}")
 
 
 def _wrapper(kind: str, prop: str, ref: Reference) -> ET.Element:
@@ -145,13 +145,22 @@ def patched_files(files: AircraftFiles, patches: list[tuple[str, str]]) -> Aircr
 def patches_from_properties(properties, functions: list[str], existing=lambda p: False) -> list[tuple[str, str]]:
     """The patches that the properties `aero/uq/KIND/NAME` ask for (KIND one of KINDS;
     properties the aircraft already defines are its own and ask for nothing)."""
-    patches = []
-    for prop in properties:
-        for kind in KINDS:
-            head = f"{PREFIX}{kind}/"
-            if prop.startswith(head) and not existing(prop):
-                patches.append((resolve_function(prop[len(head):], functions), kind))
-    return patches
+    return [patch for prop in properties if not existing(prop)
+            for patch in [patch_request(prop, functions)] if patch is not None]
+
+
+def patch_kind(prop: str) -> str | None:
+    """KIND when `prop` is a patch property `aero/uq/KIND/NAME`, else None."""
+    return next((kind for kind in KINDS if prop.startswith(f"{PREFIX}{kind}/")), None)
+
+
+def patch_request(prop: str, functions: list[str]) -> tuple[str, str] | None:
+    """(function, kind) when `prop` is a patch property `aero/uq/KIND/NAME`, else None; raises
+    PatchError when NAME is none of `functions`."""
+    kind = patch_kind(prop)
+    if kind is None:
+        return None
+    return resolve_function(prop[len(f"{PREFIX}{kind}/"):], functions), kind
 
 
 def declared_properties(xml: bytes) -> set[str]:
