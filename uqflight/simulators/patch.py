@@ -35,7 +35,8 @@ PREFIX = "aero/uq/"
 
 
 class PatchError(ValueError):
-    """An unknown function or kind; the message suggests the closest function names."""
+    """An unknown function or kind (the message suggests the closest function names), or an
+    offset on a function without a reference factor."""
 
 
 def patch_property(function: str, kind: str, functions: list[str] | None = None) -> str:
