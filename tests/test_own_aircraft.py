@@ -63,7 +63,7 @@ def test_the_patch_is_exact(aircraft):
     functions = [f for f in plain.functions if f.rsplit("/", 1)[-1] in ("CLwbh", "CLalpha", "CDwbh", "CD0", "Cmalpha")]
     original = _function_values(plain.root, aircraft, {}, functions)
     assert np.all(original != 0.0)
-    patched = PreparedAircraft(aircraft, patches=[(f, k) for f in functions for k in ("scale", "offset")])
+    patched = PreparedAircraft(aircraft, patches=[(f, k) for f in functions for k in ("scale", "offset_value")])
     assert patched.root != plain.root and patched.hash != plain.hash
     short = [f.rsplit("/", 1)[-1] for f in functions]
     nominal = _function_values(patched.root, aircraft, {}, functions)
@@ -71,7 +71,7 @@ def test_the_patch_is_exact(aircraft):
     s, o = 1.0 + np.arange(1, len(functions) + 1) * 0.037, np.arange(1, len(functions) + 1) * 0.0011
     scaled = _function_values(patched.root, aircraft, {f"aero/uq/scale/{n}": x for n, x in zip(short, s)}, functions)
     np.testing.assert_allclose(scaled, s * original, rtol=1e-12, atol=0)
-    offset = _function_values(patched.root, aircraft, {f"aero/uq/offset/{n}": x for n, x in zip(short, o)}, functions)
+    offset = _function_values(patched.root, aircraft, {f"aero/uq/offset_value/{n}": x for n, x in zip(short, o)}, functions)
     np.testing.assert_allclose(offset, original + o, rtol=1e-12, atol=1e-15)
 
 

@@ -62,7 +62,10 @@ def simulate(
     set_: List[str] = typer.Option([], "--set", metavar="PROPERTY=VALUE", help="PROPERTY=VALUE set before the trim, e.g. aero/uq/CL0=0.25 (repeatable)."),
     scale: List[str] = typer.Option([], "--scale", metavar="FUNCTION=FACTOR", help="FUNCTION=FACTOR: multiply an aerodynamic function of the "
                                                         "aircraft, e.g. aero/coefficient/CLwbh=1.1 (repeatable)."),
-    offset: List[str] = typer.Option([], "--offset", metavar="FUNCTION=VALUE", help="FUNCTION=VALUE: add to an aerodynamic function (repeatable)."),
+    offset: List[str] = typer.Option([], "--offset", metavar="FUNCTION=DELTA", help="FUNCTION=DELTA: add a coefficient increment to an aerodynamic "
+                                                          "function (DELTA times its reference factor qbar·S, qbar·S·c̄ or qbar·S·b; repeatable)."),
+    offset_value: List[str] = typer.Option([], "--offset-value", metavar="FUNCTION=VALUE", help="FUNCTION=VALUE: add VALUE in the "
+                                                          "function's own unit (lbf, lbf·ft, a helper's own; repeatable)."),
     altitude_ft: Optional[float] = typer.Option(None, help="Trim altitude [ft] (default: the aircraft's, 15000 for bacm)."),
     airspeed_ktas: Optional[float] = typer.Option(None, help="Trim true airspeed [kt] (default: the aircraft's, 200 for bacm)."),
     excitation: str = typer.Option("pulse", help="Elevator excitation: pulse, step, doublet or none."),
@@ -80,7 +83,7 @@ def simulate(
     """Trim one flight in level flight, excite the elevator and record the outputs."""
     settings = parse_settings(set_)
     try:
-        located = _prepared(aircraft, scale, offset)
+        located = _prepared(aircraft, scale, offset, offset_value)
         settings.update(located.settings)
         condition = default_condition(located.name)
         altitude_ft = condition["altitude_ft"] if altitude_ft is None else altitude_ft
@@ -100,6 +103,8 @@ def simulate(
         typer.echo(f"error: {exc.args[0]}", err=True)
         raise typer.Exit(2)
     typer.echo(result.trim.describe())
+    for line in _offset_lines(located, flight):
+        typer.echo(line)
     for name, values in result.outputs.items():
         typer.echo(f"{name:>12}: start {values[0]:12.4f}  min {values.min():12.4f}  max {values.max():12.4f}")
     if out:
@@ -117,10 +122,25 @@ def simulate(
         typer.echo(f"wrote {plot}")
 
 
-def _prepared(aircraft: str, scale: list[str], offset: list[str]):
-    """The aircraft of `simulate`/`aircraft`, patched for --scale/--offset; `.settings` holds the
-    patch properties' values. Raises ValueError (a bad pair or function, an aircraft file that is not
-    XML) or FileNotFoundError."""
+def _offset_lines(located, flight) -> list[str]:
+    """What each --offset added at the trimmed state: ΔC, the reference factor and their product."""
+    from .simulators.reference import references
+
+    refs = references(located.files.main)
+    lines = []
+    for function, kind, prop, value in located.pairs:
+        if kind == "offset":
+            ref = refs[function]
+            factor = float(np.prod([flight.property_value(p) for p in ref.factor]))
+            lines.append(f"offset {function}: {value:g} x {ref.symbol} = {value:g} x {factor:.6g} = "
+                         f"{value * factor:.6g} {ref.unit} at the trim")
+    return lines
+
+
+def _prepared(aircraft: str, scale: list[str], offset: list[str], offset_value: list[str] = ()):
+    """The aircraft of `simulate`/`aircraft`, patched for --scale/--offset/--offset-value; `.settings`
+    holds the patch properties' values, `.pairs` (function, kind, property, value). Raises ValueError
+    (a bad pair or function, an aircraft file that is not XML) or FileNotFoundError."""
     from .simulators.aircraft import AircraftUnreadable
     from .simulators.patch import PreparedAircraft, patch_property, resolve_function
 
@@ -129,12 +149,13 @@ def _prepared(aircraft: str, scale: list[str], offset: list[str]):
     except AircraftUnreadable as exc:
         raise ValueError(str(exc)) from None
     pairs = []
-    for kind, items in (("scale", scale), ("offset", offset)):
+    for kind, items in (("scale", scale), ("offset", offset), ("offset_value", offset_value)):
         for name, value in parse_settings(items).items():
             function = resolve_function(name, plain.functions)
             pairs.append((function, kind, patch_property(function, kind, plain.functions), value))
     prepared = PreparedAircraft(aircraft, Path.cwd(), patches=[(f, k) for f, k, _, _ in pairs]) if pairs else plain
     prepared.settings = {prop: value for _, _, prop, value in pairs}
+    prepared.pairs = pairs
     return prepared
 
 
@@ -544,6 +565,7 @@ def aircraft_command(
     """An aircraft's aerodynamic functions (axis, name, description), engines and nominal trim."""
     from .simulators.aircraft import AircraftFiles, aero_functions, known_aircraft
     from .simulators.engines import engine_kinds
+    from .simulators.reference import factor_values, references
 
     if list_ or aircraft is None:
         for origin, names in known_aircraft().items():
@@ -558,9 +580,13 @@ def aircraft_command(
     typer.echo(f"aircraft: {located.name} ({located.location.origin}: {located.location.folder})")
     typer.echo(f"files: {len(files.files)} XML, sha256 {files.hash()}")
     functions = aero_functions(files.main)
-    typer.echo(f"aerodynamic functions ({len(functions)}; perturb with function: NAME, perturbation: scale|offset):")
+    refs = references(files.main)
+    typer.echo(f"aerodynamic functions ({len(functions)}; perturb with function: NAME, perturbation: "
+               "scale|offset|offset_value; unit, and the factor an offset ΔC is multiplied by):")
     for f in functions:
-        typer.echo(f"  {f.axis or '-':<6} {f.name:<40} {f.description[:70]}")
+        ref = refs[f.name]
+        factor = f"ΔC x {ref.symbol}" if not ref.refusal else "offset_value only"
+        typer.echo(f"  {f.axis or '-':<6} {f.name:<40} {ref.unit or 'own':<6} {factor:<17} {f.description[:60]}")
     condition = default_condition(located.name)
     condition.update({k: v for k, v in (("altitude_ft", altitude_ft), ("airspeed_ktas", airspeed_ktas)) if v is not None})
     setup = FlightSetup(aircraft=located.name, root=located.root, excitation=Excitation(kind="none"), **condition)
@@ -580,3 +606,5 @@ def aircraft_command(
     except FlightError as exc:
         typer.echo(f"trim failed: {exc}")
         raise typer.Exit(1)
+    typer.echo("reference factors at the trim (an offset ΔC adds ΔC times its function's): " + ", ".join(
+        f"{symbol} = {number:.6g} {unit}" for symbol, number, unit in factor_values(flight.property_value)))

@@ -129,7 +129,8 @@ def prepare_store(campaign: Campaign, design: Design, out: Path, force: bool, pr
         attrs["seeds"] = json.dumps(seeds)
     if campaign.simulator["kind"] == "jsbsim":
         from .simulators.jsbsim import aircraft_hash, flight_setup_from
-        attrs["aircraft_hash"] = aircraft_hash(flight_setup_from(campaign.simulator))
+        flown = flight_setup_from(campaign.simulator, properties=[p.property for p in campaign.parameters])
+        attrs["aircraft_hash"] = aircraft_hash(flown)  # the patched copy's, when parameters patch functions
     out.parent.mkdir(parents=True, exist_ok=True)
     return open_for_campaign(
         out, campaign_text=campaign.text, force=force, restart=restart, xi=design.xi, kappa=kappa, weights=design.weights,

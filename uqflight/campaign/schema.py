@@ -17,6 +17,7 @@ from ..methods.validity import MAX_TERMS, method_problem
 from ..parameters import DISTRIBUTIONS, Parameter, make_parameter
 from ..parameters.distributions import SEED_REFUSAL
 from ..simulators.jsbsim import Excitation, FlightSetup
+from ..simulators.patch import patch_kind
 from ..simulators.python import PluginError, load_function
 
 SIMULATOR_KINDS = ("jsbsim", "python")
@@ -26,7 +27,7 @@ TOP_KEYS = ("name", "description", "seed", "simulator", "parameters", "design", 
 JSBSIM_KEYS = ("kind", "aircraft", "flight", "excitation", "duration_s", "output_rate_hz", "outputs", "trim")
 PYTHON_KEYS = ("kind", "function", "outputs")
 PARAMETER_KEYS = ("property", "function", "perturbation", "distribution", "nominal", "interval_pct", "lower", "upper")
-PERTURBATIONS = ("scale", "offset")
+PERTURBATIONS = ("scale", "offset", "offset_value")
 METHOD_KEYS = ("kind", "order", "split", "allow_aliasing")
 EXECUTION_KEYS = ("workers", "executor", "scheduler", "chunk", "timeout_s")
 STORAGE_KEYS = ("path", "raw", "tsvd")
@@ -285,6 +286,8 @@ def parameters(check: Checker, value, kind: str, aircraft) -> list[Parameter]:
             from ..simulators.patch import NOMINAL
 
             nominal = NOMINAL[spec["perturbation"]] if nominal is None else nominal
+        elif aircraft is not None and aircraft.value(prop) is None and patch_kind(prop):
+            nominal = patch_nominal(check, prop, f"{path}.property", aircraft) if nominal is None else nominal
         elif aircraft is not None:
             known = aircraft.value(prop)
             if known is None:
@@ -344,12 +347,23 @@ def check_seeds(check: Checker, parameters: list[Parameter], design_kind, method
                           "a random stream has no polynomial expansion for a grid to integrate")
     if not method_entry(method["kind"]).runs_on_sampled:  # it would fit a PCE in the seed's ξ
         check.fail(where, f"{SEED_REFUSAL} ({method['kind']})")
+def patch_nominal(check: Checker, prop: str, path: str, aircraft) -> float:
+    """The nominal of a property that asks for a patch itself (`aero/uq/offset/CDo`), checked as
+    `function:` with `perturbation:` is."""
+    from ..simulators.patch import NOMINAL, PatchError, check_perturbation, patch_request
+
+    try:
+        function, perturbation = patch_request(prop, aircraft.functions)
+        check_perturbation(function, perturbation, getattr(aircraft, "references", {}))
+    except PatchError as exc:
+        check.fail(path, f"{exc} (aircraft {aircraft.aircraft!r})")
+    return NOMINAL[perturbation]
 
 
 def function_property(check: Checker, spec: dict, path: str, kind: str, aircraft) -> str:
     """The property that scales or offsets `spec["function"]` (aero/uq/scale/NAME), checked
     against the aircraft's aerodynamic functions when the aircraft is known."""
-    from ..simulators.patch import PatchError, patch_property, resolve_function
+    from ..simulators.patch import PatchError, check_perturbation, patch_property, resolve_function
 
     if kind != "jsbsim":
         check.fail(f"{path}.function", "is for JSBSim aircraft; a python simulator's parameters have no functions")
@@ -362,7 +376,7 @@ def function_property(check: Checker, spec: dict, path: str, kind: str, aircraft
     if "perturbation" not in spec:
         check.fail(f"{path}.perturbation", f"is required with function: expected one of {', '.join(PERTURBATIONS)}")
     perturbation = check.string(spec["perturbation"], f"{path}.perturbation", PERTURBATIONS)
-    if "interval_pct" in spec and perturbation == "offset":
+    if "interval_pct" in spec and perturbation != "scale":
         check.fail(f"{path}.interval_pct", "has no meaning for an offset (nominal 0): give lower and upper")
     functions = getattr(aircraft, "functions", None)
     if functions is None:
@@ -371,6 +385,10 @@ def function_property(check: Checker, spec: dict, path: str, kind: str, aircraft
         full = resolve_function(function, functions)
     except PatchError as exc:
         check.fail(f"{path}.function", f"{exc} (aircraft {aircraft.aircraft!r})")
+    try:
+        check_perturbation(full, perturbation, getattr(aircraft, "references", {}))
+    except PatchError as exc:
+        check.fail(f"{path}.perturbation", f"{exc} (aircraft {aircraft.aircraft!r})")
     return patch_property(full, perturbation, functions)
 
 

@@ -14,10 +14,13 @@ class AircraftProperties:
 
     def __init__(self, simulator: dict):
         from .aircraft import aero_functions
+        from .reference import references
 
         setup = flight_setup_from({**simulator, "outputs": []})  # raises AircraftNotFound (a FileNotFoundError)
         self.aircraft = setup.aircraft
-        self.functions = [f.name for f in aero_functions(setup.aircraft_file.read_bytes())]
+        xml = setup.aircraft_file.read_bytes()
+        self.functions = [f.name for f in aero_functions(xml)]
+        self.references = references(xml)  # each function's unit and reference factor
         self._flight = JSBSimFlight(setup)
         fdm = self._flight.fdm
         fdm["ic/h-sl-ft"] = setup.altitude_ft  # as JSBSimFlight.trim sets them

@@ -2,17 +2,24 @@
 
 A patch `(function, kind)` rewrites the aircraft's `<function name="FUNCTION">BODY</function>` as
 
-    scale:  <product> <property> aero/uq/scale/NAME </property> BODY </product>
-    offset: <sum> <property> aero/uq/offset/NAME </property> BODY </sum>
+    scale:        <product> <property> aero/uq/scale/NAME </property> BODY </product>
+    offset_value: <sum> <property> aero/uq/offset_value/NAME </property> BODY </sum>
+    offset:       <sum> <product> <property> aero/uq/offset/NAME </property> REFERENCE </product> BODY </sum>
 
-(both: the sum around the product), and declares the new properties in `<aerodynamics>` with
-their nominal values (scale 1, offset 0). NAME is the function's last path component
+where REFERENCE is the function's reference factor as properties (`aero/qbar-psf`
+`metrics/Sw-sqft`, and `metrics/cbarw-ft` or `metrics/bw-ft` for moments; see reference.py):
+an `offset` is a coefficient increment ΔC, an `offset_value` a value in the function's own unit
+(lbf, lbf·ft, or whatever a helper function outside the axes holds). `offset` on a function
+without a reference factor is refused. Several kinds nest in the order scale, offset_value,
+offset (the sum around the product), and the new properties are declared in `<aerodynamics>`
+with their nominal values (scale 1, offsets 0). NAME is the function's last path component
 (`aero/coefficient/CLwbh` -> `aero/uq/scale/CLwbh`), or the whole function name when two
 functions share it. JSBSim's product and sum evaluate their arguments left to right, so the
-patched function is s * f and o + f in floating point: exactly what the parameter says.
+patched function is s * f, v + f and ((o * qbar) * S) [* c̄] + f in floating point.
 
 The patched aircraft is written as a copy (a JSBSim root) in uqflight's cache, keyed by the
-hash of its files; the user's folder is never written.
+hash of its files, the patched text included: a copy patched to other semantics is another
+text, so another key. The user's folder is never written.
 """
 from __future__ import annotations
 
@@ -20,14 +27,16 @@ import difflib
 import xml.etree.ElementTree as ET
 
 from .aircraft import AircraftFiles, aero_functions
+from .reference import Reference, references
 
-KINDS = ("scale", "offset")
-NOMINAL = {"scale": 1.0, "offset": 0.0}
+KINDS = ("scale", "offset_value", "offset")  # the order they nest in, innermost first
+NOMINAL = {"scale": 1.0, "offset_value": 0.0, "offset": 0.0}
 PREFIX = "aero/uq/"
 
 
 class PatchError(ValueError):
-    """An unknown function or kind; the message suggests the closest function names."""
+    """An unknown function or kind (the message suggests the closest function names), or an
+    offset on a function without a reference factor."""
 
 
 def patch_property(function: str, kind: str, functions: list[str] | None = None) -> str:
@@ -62,17 +71,39 @@ def resolve_function(name: str, functions: list[str]) -> str:
                      f"got {name!r}{function_hint(name, functions)}")
 
 
+def check_perturbation(function: str, kind: str, refs: dict[str, Reference]) -> None:
+    """Refuse an unknown kind, and `offset` on a function without a reference factor (naming it)."""
+    if kind not in KINDS:
+        raise PatchError(f"perturbation: expected one of {', '.join(KINDS)}, got {kind!r}")
+    ref = refs.get(function)
+    if kind == "offset" and ref is not None and ref.refusal:
+        unit = f" ({ref.unit})" if ref.unit else ""
+        raise PatchError(f"an offset is a coefficient increment, added times the function's reference factor, "
+                         f"and {function!r} has none: {ref.refusal}; give perturbation: offset_value "
+                         f"(--offset-value on the command line) to add a value in its own unit{unit}")
+
+
+def _wrapper(kind: str, prop: str, ref: Reference) -> ET.Element:
+    """The element that scales or offsets a function body by `prop` (the body is appended after)."""
+    wrapper = ET.Element("product" if kind == "scale" else "sum")
+    holder = ET.SubElement(wrapper, "product") if kind == "offset" else wrapper
+    for name in (prop, *(ref.factor if kind == "offset" else ())):
+        ET.SubElement(holder, "property").text = f" {name} "
+    return wrapper
+
+
 def patch_xml(xml: bytes, patches: list[tuple[str, str]]) -> bytes:
     """The aircraft XML with every (function, kind) patch applied (see the module doc)."""
     tree = ET.ElementTree(ET.fromstring(xml))
     root = tree.getroot()
     aero = root.find("aerodynamics")
     names = [f.name for f in aero_functions(xml)]
+    refs = references(xml)
     wanted: dict[str, set[str]] = {}
     for function, kind in patches:
-        if kind not in KINDS:
-            raise PatchError(f"perturbation: expected one of {', '.join(KINDS)}, got {kind!r}")
-        wanted.setdefault(resolve_function(function, names), set()).add(kind)
+        full = resolve_function(function, names)
+        check_perturbation(full, kind, refs)
+        wanted.setdefault(full, set()).add(kind)
     declared = []
     for element in aero.iter("function"):
         name = (element.get("name") or "").strip()
@@ -83,12 +114,10 @@ def patch_xml(xml: bytes, patches: list[tuple[str, str]]) -> bytes:
         if len(body) != 1:
             raise PatchError(f"function {name!r} has {len(body)} top-level elements, expected 1")
         node = body[0]
-        for kind in ("scale", "offset"):  # the product inside the sum: o + s * f
+        for kind in KINDS:  # the product inside the sums: o·qbar·S + (v + s * f)
             if kind in wanted[name]:
                 prop = patch_property(name, kind, names)
-                wrapper = ET.Element("product" if kind == "scale" else "sum")
-                ref = ET.SubElement(wrapper, "property")
-                ref.text = f" {prop} "
+                wrapper = _wrapper(kind, prop, refs[name])
                 wrapper.append(node)
                 node = wrapper
                 declared.append((prop, NOMINAL[kind]))
@@ -115,15 +144,24 @@ def patched_files(files: AircraftFiles, patches: list[tuple[str, str]]) -> Aircr
 
 
 def patches_from_properties(properties, functions: list[str], existing=lambda p: False) -> list[tuple[str, str]]:
-    """The patches that the properties `aero/uq/scale/NAME` and `aero/uq/offset/NAME` ask for
-    (properties the aircraft already defines are its own and ask for nothing)."""
-    patches = []
-    for prop in properties:
-        for kind in KINDS:
-            head = f"{PREFIX}{kind}/"
-            if prop.startswith(head) and not existing(prop):
-                patches.append((resolve_function(prop[len(head):], functions), kind))
-    return patches
+    """The patches that the properties `aero/uq/KIND/NAME` ask for (KIND one of KINDS;
+    properties the aircraft already defines are its own and ask for nothing)."""
+    return [patch for prop in properties if not existing(prop)
+            for patch in [patch_request(prop, functions)] if patch is not None]
+
+
+def patch_kind(prop: str) -> str | None:
+    """KIND when `prop` is a patch property `aero/uq/KIND/NAME`, else None."""
+    return next((kind for kind in KINDS if prop.startswith(f"{PREFIX}{kind}/")), None)
+
+
+def patch_request(prop: str, functions: list[str]) -> tuple[str, str] | None:
+    """(function, kind) when `prop` is a patch property `aero/uq/KIND/NAME`, else None; raises
+    PatchError when NAME is none of `functions`."""
+    kind = patch_kind(prop)
+    if kind is None:
+        return None
+    return resolve_function(prop[len(f"{PREFIX}{kind}/"):], functions), kind
 
 
 def declared_properties(xml: bytes) -> set[str]:
