@@ -23,3 +23,10 @@ def corner_campaign(name: str, design: str, method: str = "least_squares", order
             "  x2: {distribution: uniform, lower: -1, upper: 1}\n"
             f"design: {design}\nmethod: {{kind: {method}, order: {order}}}\n"
             "analysis: {band_samples: 2000, bootstrap: 0}\n")
+
+
+def fails_at_centre(p):
+    """y = a, failing only at a = 1.5: the nominal sample of a ~ U(1, 2)."""
+    if p["a"] == 1.5:
+        raise RuntimeError("centre node")
+    return {"y": p["a"]}
