@@ -40,20 +40,19 @@ class Method:
     "weights" (weighted sums of the runs) or "pce" (the expansion's). sampled_only: refuses grids.
     runs_on_sampled: on a sampled design its statistics are those of the runs themselves (no PCE).
     rule: "projection" (needs exactness 2p), "fit" (needs rank Z) or None. split: accepts x0.
-    partial: valid on a subset of a design's runs (failed or pending runs left out).
     failed_runs: what its statistics are when runs failed, on the designs that accept it (a key of
-    FAILED_RUNS).
+    FAILED_RUNS). partial: valid on a subset of a design's runs (failed or pending runs left out).
     """
 
     label: str
     pce: Callable | None
     moments: str
     rule: str | None
+    failed_runs: str
     sampled_only: bool = False
     runs_on_sampled: bool = False
     split: bool = False
     partial: bool = False
-    failed_runs: str = "conditional"
 
 
 # (what the statistics are, why) when runs failed; `failed_runs_note` fills in the counts.
@@ -86,14 +85,14 @@ def _least_squares(xi, weights, Y, germs, order, x0=None) -> PCE:
 
 
 METHODS: dict[str, Method] = {
-    "integration": Method("Int", pseudo_galerkin, "weights", "projection", runs_on_sampled=True, split=True),
-    "pseudo_galerkin": Method("PG", pseudo_galerkin, "pce", "projection", split=True, failed_runs="projected"),
-    "interpolation": Method("interpolation", pseudo_galerkin, "weights", "projection", split=True,
-                            failed_runs="projected"),
-    "regression": Method("regression", _regression, "pce", "fit", partial=True, failed_runs="extrapolated"),
-    "least_squares": Method("least squares", _least_squares, "pce", "fit", partial=True,
-                            failed_runs="extrapolated"),
-    "monte_carlo": Method("MC", None, "sample", None, sampled_only=True, runs_on_sampled=True, partial=True),
+    "integration": Method("Int", pseudo_galerkin, "weights", "projection", "conditional", runs_on_sampled=True,
+                          split=True),
+    "pseudo_galerkin": Method("PG", pseudo_galerkin, "pce", "projection", "projected", split=True),
+    "interpolation": Method("interpolation", pseudo_galerkin, "weights", "projection", "projected", split=True),
+    "regression": Method("regression", _regression, "pce", "fit", "extrapolated", partial=True),
+    "least_squares": Method("least squares", _least_squares, "pce", "fit", "extrapolated", partial=True),
+    "monte_carlo": Method("MC", None, "sample", None, "conditional", sampled_only=True, runs_on_sampled=True,
+                          partial=True),
 }
 METHOD_KINDS = tuple(METHODS)
 
