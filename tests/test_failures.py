@@ -1,4 +1,5 @@
-"""uqflight.analysis.failures: Wilson and Clopper–Pearson intervals, weighted designs, coverage."""
+"""uqflight.analysis.failures on sampled designs: Wilson and Clopper–Pearson intervals, coverage (grids:
+test_failure_probability.py)."""
 import numpy as np
 import pytest
 from scipy.stats import binom, binomtest
@@ -77,41 +78,8 @@ def test_monte_carlo_coverage_of_a_model_failing_on_a_known_fraction():
     assert abs(exact - 0.95) < 0.02
 
 
-def test_weighted_estimate_and_kish_effective_size():
-    failed = np.array([True, False, False, True])
-    weights = np.array([1.0, 1.0, 2.0, 2.0])
-    result = failure_probability(failed, weights)
-    assert result["estimate"] == pytest.approx(0.5)
-    assert result["n_effective"] == pytest.approx(36 / 10)  # (Σ|w|)² / Σw²
-    assert (result["lower"], result["upper"]) == pytest.approx(wilson_interval(0.5, 3.6))
-    assert "Kish" in result["method"]
-    # Equal weights (any scale) reproduce the unweighted interval.
-    equal = failure_probability(failures(3, 50), np.full(50, 7.0))
-    plain = failure_probability(failures(3, 50))
-    assert (equal["estimate"], equal["lower"], equal["upper"]) == pytest.approx(
-        (plain["estimate"], plain["lower"], plain["upper"]), rel=1e-12)
-
-
-def test_signed_sparse_grid_weights_clip_to_the_unit_interval():
-    design = build_design({"kind": "sparse_grid", "level": 2}, ["uniform"] * 3, 0)
-    assert (design.weights < 0).any()
-    failed = design.weights < 0  # only negative-weight points fail: a raw estimate below 0
-    result = failure_probability(failed, design.weights)
-    raw = design.weights[failed].sum() / design.weights.sum()
-    assert raw < 0 and result["estimate"] == 0.0 and "clipped" in result["method"]
-    n_eff = np.abs(design.weights).sum() ** 2 / np.square(design.weights).sum()
-    assert result["n_effective"] == pytest.approx(n_eff)
-    assert 0.0 <= result["lower"] <= result["upper"] <= 1.0
-    exact = failure_probability(failed, design.weights, method="clopper_pearson")
-    assert exact["lower"] == 0.0 and 0 < exact["upper"] < 1
-
-
 def test_undefined_and_invalid_inputs():
     empty = failure_probability(np.zeros(0, dtype=bool))
     assert np.isnan(empty["estimate"]) and (empty["lower"], empty["upper"]) == (0.0, 1.0)
     with pytest.raises(ValueError, match="method"):
         failure_probability(failures(1, 5), method="wald")
-    with pytest.raises(ValueError, match="sum"):
-        failure_probability(failures(1, 2), np.array([1.0, -1.0]))
-    with pytest.raises(ValueError, match="expected \\(3,\\)"):
-        failure_probability(failures(1, 3), np.ones(4))

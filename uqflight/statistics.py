@@ -8,8 +8,10 @@ Eq. 49 with the reference's own noise floor and the Kullback-Leibler divergence 
 A number here is right, refused (`BadInput` naming the file, the count or the order and what to do)
 or flagged (`Statistics.notes`, `null` in summary.json):
 * pending runs are refused unless `partial`, and then only where a subset of the runs is valid;
-* failed runs: sampled designs give statistics conditional on success (noted); grids refuse the
-  projections and weighted sums, and the fits are made on the successful runs after a rank check;
+* failed runs: a note says what the method's statistics are (`methods.FAILED_RUNS`: conditional on
+  success, or a fit extrapolated over the failed region); grids refuse the projections and weighted
+  sums, the fits are made on the successful runs after a rank check, and a grid's failure probability
+  has no interval (none at all with signed weights: `analysis.failures`);
 * a method the points cannot carry is refused (`methods.validity`), aliasing only when allowed;
 * Sobol' indices of a variance at rounding noise or below the simulator's own resolution (the file's
   /resolution: two valid trims' drift), and an undefined CoV, are NaN here and null in JSON.
@@ -30,14 +32,14 @@ import numpy as np
 from .analysis.density import pdf_over_time
 from .analysis.divergence import kl_divergence
 from .analysis.errors import error_summary, relative_errors
-from .analysis.failures import failure_probability
+from .analysis.failures import failure_probability, grid_failure_probability
 from .analysis.floors import central_moments, floors_from_moments, kld_floor
 from .analysis.moments import modified_cov, standardised_moments, weighted_moments, weighted_quantiles
 from .analysis.resolution import RESOLUTION_RTOL, resolved_variance
 from .analysis.sobol import pick_freeze_indices
 from .designs import REGISTRY as DESIGNS
 from .designs import is_sampled
-from .methods import PCE, METHODS, method_entry
+from .methods import PCE, METHODS, failed_runs_note, method_entry
 from .methods.basis import orthonormal_basis
 from .methods.loo import relative_loo_error
 from .methods.validity import method_problem
@@ -222,22 +224,28 @@ def _note_runs(store: ResultStore, stats: Statistics, sampled: bool, allow_alias
     status = store.status
     done = status != Status.PENDING
     failed = status[done] > 0
-    stats.failure_probability = failure_probability(failed, None if sampled else store.weights[done])
+    stats.failure_probability = (failure_probability(failed) if sampled
+                                 else grid_failure_probability(failed, store.weights[done]))
     if stats.failed:
         kappa, reasons, names = store.kappa, store.reasons, store.parameter_names
         stats.failures = [{"run": int(i), "status": Status(int(status[i])).name.lower(), "reason": reasons[i],
                            "parameters": dict(zip(names, map(float, kappa[i])))}
                           for i in np.flatnonzero(status > 0)]
-        if sampled:
-            stats.notes.append(f"{stats.failed} of {stats.runs - stats.pending} runs failed: the statistics are "
-                               "conditional on success (the failure probability is given apart)")
-        else:
-            stats.notes.append(f"{stats.failed} grid runs failed: {stats.method['kind']} is fitted on the "
-                               f"{stats.completed} successful runs")
+        stats.notes.append(failed_runs_note(stats.method["kind"], stats.failed, int(done.sum())))
+        if not sampled:
+            stats.notes.append("failure probability: " + _grid_failure_note(stats.failure_probability))
     if stats.pending:
         stats.notes.append(f"partial: {stats.completed} of {stats.runs} runs")
     if allow_aliasing and not sampled and method_entry(stats.method["kind"]).rule == "projection":
         stats.notes.append("aliasing allowed: the projection's order may exceed what the grid integrates exactly")
+
+
+def _grid_failure_note(probability: dict) -> str:
+    """What a grid says of the failure probability, in a few words (analysis.failures)."""
+    if math.isnan(probability["estimate"]):
+        return "not estimated from a grid with negative weights; a sampled design is needed"
+    return (f"{probability['estimate']:.3g}, the grid's quadrature of the failure indicator, without an interval "
+            "(the nodes are not random draws); a sampled design gives one")
 
 
 def output_basis(store: ResultStore, name: str, ok: np.ndarray) -> tuple[np.ndarray, np.ndarray | None]:

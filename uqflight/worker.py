@@ -24,6 +24,7 @@ from pathlib import Path
 import numpy as np
 
 from .simulators import FlightError, make_simulator
+from .simulators.base import NominalFailed
 from .simulators.bundle import localized
 
 
@@ -157,6 +158,8 @@ def main(argv=None) -> None:
                 conn.send(("error", f"unknown request {kind!r}"))
         except (BrokenPipeError, ConnectionResetError):
             os._exit(0)
+        except NominalFailed as exc:  # its message says it all
+            conn.send(("error", str(exc)))
         except Exception as exc:  # building the simulator failed: the runner reports it
             conn.send(("error", f"{type(exc).__name__}: {exc}"))
 

@@ -1,14 +1,25 @@
-"""Probability that a run fails, with a confidence interval that holds for small counts.
+"""Probability that a run fails: from random draws with a confidence interval that holds for small
+counts; from a quadrature grid only what its weights can say.
 
-Unweighted designs (Monte Carlo, QMC, Latin hypercube): k failures of n runs give p̂ = k/n and
-the Wilson score interval (default) or the exact Clopper–Pearson interval. Weighted designs
-(quadrature grids, possibly with negative weights): p̂ = Σ w_j 1[failed_j] / Σ w_j and the Wilson
-interval with Kish's effective sample size n_eff = (Σ|w|)² / Σw² in place of n, clipped to [0, 1].
+Sampled designs (Monte Carlo, QMC, Latin hypercube, pick-freeze): k failures of n runs give p̂ = k/n
+and the Wilson score interval (default) or the exact Clopper–Pearson interval.
+
+Grids (`grid_failure_probability`): the nodes are fixed, not drawn, so the failed count is no
+binomial sample and no interval has a coverage. With weights all ≥ 0 (tensor grids) Σ_failed w / Σw
+is the failure probability of the discrete law on the nodes, a quadrature of the failure indicator
+that converges as the grid is refined: it is the estimate, without an interval. With signed weights
+(sparse grids) that sum is no probability at all (a level-5 grid of a model failing on 13 % of its
+box gives 0.38): no estimate, and the sentence says a sampled design is needed.
+
+`n_effective` is Kish's effective number of runs (Σw)² / Σw², n for equal weights: how many equally
+weighted random draws the weights are worth (below 1 for a level-5 sparse grid); a fact about the
+weights, used for no interval.
 """
 import numpy as np
 from scipy import special
 
 METHODS = ("wilson", "clopper_pearson")
+SAMPLED = "monte_carlo, sobol, halton or latin_hypercube"
 
 
 def _two_sided_z(confidence: float) -> float:
@@ -42,17 +53,19 @@ def clopper_pearson_interval(k: float, n: float, confidence: float = 0.95) -> tu
     return lower, upper
 
 
-def failure_probability(failed, weights=None, confidence: float = 0.95, method: str = "wilson") -> dict:
-    """Estimate and two-sided interval of the probability that a run fails.
+def kish_effective_runs(weights) -> float:
+    """Kish's effective number of runs (Σw)² / Σw²: n for n equal weights, 0 when Σw = 0."""
+    weights = np.asarray(weights, dtype=float)
+    squares = float(np.square(weights).sum())
+    return float(weights.sum() ** 2 / squares) if squares > 0 else 0.0
 
-    failed: bool (N,), one entry per run of the design. weights: None for equally weighted runs,
-    else the design's weights (N,), any sign, with Σw > 0. method: "wilson" or "clopper_pearson".
 
-    Returns {"estimate", "lower", "upper", "n_effective", "method"}: floats, n_effective = N
-    unweighted or Kish's (Σ|w|)²/Σw², and a sentence saying how the numbers were computed. With
-    weights, the estimate Σ_failed w / Σw is clipped to [0, 1] (signed weights can push it out;
-    the sentence then gives the raw value) and the interval is computed from the clipped estimate
-    with n_effective trials. No runs (N = 0): estimate NaN, interval [0, 1].
+def failure_probability(failed, confidence: float = 0.95, method: str = "wilson") -> dict:
+    """Estimate and two-sided interval of the probability that a run fails, from a sampled design.
+
+    failed: bool (N,), one entry per run done. method: "wilson" or "clopper_pearson". Returns
+    {"estimate", "lower", "upper", "n_effective", "method"}: k/N, the interval, N, and a sentence
+    saying how they were computed. No runs (N = 0): estimate NaN, interval [0, 1].
     """
     if method not in METHODS:
         raise ValueError(f"method must be one of {', '.join(METHODS)}, got {method!r}")
@@ -62,28 +75,43 @@ def failure_probability(failed, weights=None, confidence: float = 0.95, method: 
         return {"estimate": float("nan"), "lower": 0.0, "upper": 1.0, "n_effective": 0.0,
                 "method": "no runs: the probability is undefined, the interval is [0, 1]"}
     name = "Wilson score" if method == "wilson" else "Clopper-Pearson exact"
-    level = f"{100 * confidence:g} %"
-    if weights is None:
-        k = int(failed.sum())
-        estimate = k / n
-        lower, upper = (wilson_interval(estimate, n, confidence) if method == "wilson"
-                        else clopper_pearson_interval(k, n, confidence))
-        return {"estimate": estimate, "lower": lower, "upper": upper, "n_effective": float(n),
-                "method": f"{k} of {n} runs failed; {level} {name} interval"}
+    k = int(failed.sum())
+    estimate = k / n
+    lower, upper = (wilson_interval(estimate, n, confidence) if method == "wilson"
+                    else clopper_pearson_interval(k, n, confidence))
+    return {"estimate": estimate, "lower": lower, "upper": upper, "n_effective": float(n),
+            "method": f"{k} of {n} runs failed; {100 * confidence:g} % {name} interval"}
 
+
+def grid_failure_probability(failed, weights) -> dict:
+    """What a quadrature grid's runs say about the probability that a run fails (module docstring).
+
+    failed: bool (N,), weights (N,) with Σw > 0, one per run done. Returns the keys of
+    `failure_probability`: lower and upper NaN (no interval exists); the estimate Σ_failed w / Σw
+    when every weight is ≥ 0, NaN when any is negative; n_effective Kish's; the sentence says which.
+    """
+    failed = np.asarray(failed, dtype=bool).reshape(-1)
+    n = failed.size
     weights = np.asarray(weights, dtype=float)
     if weights.shape != (n,):
         raise ValueError(f"weights have shape {weights.shape}, expected ({n},): one per run")
     total = weights.sum()
     if not total > 0:
-        raise ValueError(f"weights sum to {total}; a failure probability needs Σw > 0")
-    raw = float(weights[failed].sum() / total)
-    estimate = min(max(raw, 0.0), 1.0)
-    n_eff = float(np.abs(weights).sum() ** 2 / np.square(weights).sum())
-    lower, upper = (wilson_interval(estimate, n_eff, confidence) if method == "wilson"
-                    else clopper_pearson_interval(estimate * n_eff, n_eff, confidence))
-    clipped = "" if raw == estimate else f" (raw weighted estimate {raw:.6g} clipped to [0, 1])"
-    sentence = (f"{int(failed.sum())} of {n} runs failed; estimate Σ_failed w / Σ w = {estimate:.6g}{clipped}; "
-                f"{level} {name} interval with Kish's effective sample size (Σ|w|)²/Σw² = {n_eff:.6g} "
-                f"in place of the number of runs, clipped to [0, 1]")
-    return {"estimate": estimate, "lower": lower, "upper": upper, "n_effective": n_eff, "method": sentence}
+        raise ValueError(f"weights sum to {total}; a grid's weights must sum to a positive number")
+    counted = f"{int(failed.sum())} of {n} grid runs failed"
+    negative = int((weights < 0).sum())
+    result = {"estimate": float("nan"), "lower": float("nan"), "upper": float("nan"),
+              "n_effective": kish_effective_runs(weights)}
+    if negative:
+        result["method"] = (f"{counted}; not estimated: {negative} of the grid's {n} weights are negative, so "
+                            "the weighted failed fraction Σ_failed w / Σw is no probability (it can lie "
+                            f"outside [0, 1]); run a sampled design ({SAMPLED}) for a failure probability "
+                            "with an interval")
+        return result
+    result["estimate"] = float(weights[failed].sum() / total)
+    result["method"] = (f"{counted}; estimate Σ_failed w / Σw, the grid's quadrature of the failure indicator "
+                        "(the failure probability of the discrete law on its nodes), without an interval: the "
+                        "nodes are fixed, not random draws, and the error of a quadrature of a discontinuous "
+                        f"indicator is not bounded by the grid's degree; a sampled design ({SAMPLED}) gives "
+                        "an interval")
+    return result

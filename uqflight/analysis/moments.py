@@ -114,16 +114,30 @@ def quantile_band(Y, weights=None, level: float = 0.99) -> tuple[np.ndarray, np.
 
 
 def standardised_moments(Y, weights=None) -> tuple[np.ndarray, np.ndarray]:
-    """Skewness E[(Y − μ)³]/σ³ and kurtosis E[(Y − μ)⁴]/σ⁴ (Pearson's, 3 for a normal law) of each
-    column of Y (N, T) under the weights: each (T,), NaN where σ = 0."""
+    """Skewness and kurtosis (Pearson's, 3 for a normal law, not the excess) of each column of Y (N, T):
+    each (T,), NaN where σ = 0 or N is too small.
+
+    The convention of the sample moments, as for the variance (N − 1): equally weighted random draws
+    (weights None: Monte Carlo runs, or draws of a PCE) give the adjusted estimators, skewness
+    G1 = g1 √(N(N − 1))/(N − 2) (N ≥ 3) and kurtosis G2 + 3 with the excess
+    G2 = ((N + 1) g2 + 6)(N − 1)/((N − 2)(N − 3)) (N ≥ 4), from the plug-in g1 = m3/m2^1.5 and
+    g2 = m4/m2² − 3 (scipy.stats.skew and kurtosis with bias=False). Weights (a quadrature, or the
+    integration method's weighted sums) give the plug-in moments of the weighted law, g1 and g2 + 3:
+    they are sums, not samples, and have no bias to correct.
+    """
     Y = as_runs_by_time(Y)
-    w = probability_weights(weights, len(Y))
+    n = len(Y)
+    w = probability_weights(weights, n)
     deviation = Y - w @ Y
     variance = w @ deviation**2
     with np.errstate(invalid="ignore", divide="ignore"):
-        skewness = np.where(variance > 0, (w @ deviation**3) / variance**1.5, np.nan)
-        kurtosis = np.where(variance > 0, (w @ deviation**4) / variance**2, np.nan)
-    return skewness, kurtosis
+        g1 = np.where(variance > 0, (w @ deviation**3) / variance**1.5, np.nan)
+        g2 = np.where(variance > 0, (w @ deviation**4) / variance**2, np.nan) - 3.0
+    if weights is not None:
+        return g1, g2 + 3.0
+    skewness = g1 * np.sqrt(n * (n - 1.0)) / (n - 2.0) if n >= 3 else np.full_like(g1, np.nan)
+    excess = ((n + 1.0) * g2 + 6.0) * (n - 1.0) / ((n - 2.0) * (n - 3.0)) if n >= 4 else np.full_like(g2, np.nan)
+    return skewness, excess + 3.0
 
 
 def modified_cov(mean, std) -> np.ndarray:

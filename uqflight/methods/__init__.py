@@ -13,6 +13,11 @@ is built, the rule its points must satisfy before it runs, and how its mean and 
 
 Rules before anything runs (`validity.method_problem`): a projection of total order p needs a grid
 exact to degree 2p; a fit needs a design matrix of full rank Z on the actual points.
+
+What the statistics are when runs failed (`Method.failed_runs`, the sentence in `FAILED_RUNS`) is a
+fact of the method, said once here for every note and report: the statistics of the successful runs
+(conditional on success), a fit extrapolated over the failed region, or a projection of the successful
+runs, which is of neither law. A grid with failed runs accepts only the fits (`validity`).
 """
 from __future__ import annotations
 
@@ -35,17 +40,40 @@ class Method:
     "weights" (weighted sums of the runs) or "pce" (the expansion's). sampled_only: refuses grids.
     runs_on_sampled: on a sampled design its statistics are those of the runs themselves (no PCE).
     rule: "projection" (needs exactness 2p), "fit" (needs rank Z) or None. split: accepts x0.
-    partial: valid on a subset of a design's runs (failed or pending runs left out).
+    failed_runs: what its statistics are when runs failed, on the designs that accept it (a key of
+    FAILED_RUNS). partial: valid on a subset of a design's runs (failed or pending runs left out).
     """
 
     label: str
     pce: Callable | None
     moments: str
     rule: str | None
+    failed_runs: str
     sampled_only: bool = False
     runs_on_sampled: bool = False
     split: bool = False
     partial: bool = False
+
+
+# (what the statistics are, why) when runs failed; `failed_runs_note` fills in the counts.
+FAILED_RUNS = {
+    "conditional": ("statistics conditional on success",
+                    "they are those of the {ok} successful runs alone, not of the whole input law"),
+    "extrapolated": ("statistics of a fit extrapolated over the failed region",
+                     "{kind} fits its PCE on the {ok} successful runs and its statistics are the PCE's over the "
+                     "whole input law, including the region where the model has no value"),
+    "projected": ("statistics of a projection of the successful runs, of neither law",
+                  "{kind} projects the {ok} successful runs alone: its mean is the mean conditional on success, "
+                  "but its PCE (the bands, PDFs and Sobol' indices, and pseudo_galerkin's variance) is that of "
+                  "the output divided by the success rate where runs succeeded and 0 where they failed; use "
+                  "monte_carlo for statistics conditional on success or least_squares for a fit"),
+}
+
+
+def failed_runs_note(kind: str, failed: int, done: int) -> str:
+    """The note that says what `kind`'s statistics are when `failed` of the `done` runs failed."""
+    headline, why = FAILED_RUNS[method_entry(kind).failed_runs]
+    return f"{headline}: {failed} of {done} runs failed; {why.format(ok=done - failed, kind=kind)}"
 
 
 def _regression(xi, weights, Y, germs, order, x0=None) -> PCE:
@@ -57,12 +85,14 @@ def _least_squares(xi, weights, Y, germs, order, x0=None) -> PCE:
 
 
 METHODS: dict[str, Method] = {
-    "integration": Method("Int", pseudo_galerkin, "weights", "projection", runs_on_sampled=True, split=True),
-    "pseudo_galerkin": Method("PG", pseudo_galerkin, "pce", "projection", split=True),
-    "interpolation": Method("interpolation", pseudo_galerkin, "weights", "projection", split=True),
-    "regression": Method("regression", _regression, "pce", "fit", partial=True),
-    "least_squares": Method("least squares", _least_squares, "pce", "fit", partial=True),
-    "monte_carlo": Method("MC", None, "sample", None, sampled_only=True, runs_on_sampled=True, partial=True),
+    "integration": Method("Int", pseudo_galerkin, "weights", "projection", "conditional", runs_on_sampled=True,
+                          split=True),
+    "pseudo_galerkin": Method("PG", pseudo_galerkin, "pce", "projection", "projected", split=True),
+    "interpolation": Method("interpolation", pseudo_galerkin, "weights", "projection", "projected", split=True),
+    "regression": Method("regression", _regression, "pce", "fit", "extrapolated", partial=True),
+    "least_squares": Method("least squares", _least_squares, "pce", "fit", "extrapolated", partial=True),
+    "monte_carlo": Method("MC", None, "sample", None, "conditional", sampled_only=True, runs_on_sampled=True,
+                          partial=True),
 }
 METHOD_KINDS = tuple(METHODS)
 
@@ -105,4 +135,5 @@ def method_entry(kind: str) -> Method:
     return METHODS[kind]
 
 
-__all__ = ["METHODS", "METHOD_KINDS", "PCE", "Method", "Result", "fit", "method_entry"]
+__all__ = ["FAILED_RUNS", "METHODS", "METHOD_KINDS", "PCE", "Method", "Result", "failed_runs_note", "fit",
+           "method_entry"]

@@ -170,8 +170,18 @@ def failures_section(entries: list[Entry]) -> Section | None:
 
 
 def _probability(p: dict) -> str:
-    return (f"{p.get('estimate', float('nan')):.3g} (95 % interval {p.get('lower', float('nan')):.3g} to "
-            f"{p.get('upper', float('nan')):.3g}, {p.get('method', '')})")
+    """The failure probability as the page says it: the estimate and its interval where they exist
+    (a grid has no interval, and no estimate with signed weights), and how they were computed."""
+    estimate, lower, upper = (_finite(p.get(key)) for key in ("estimate", "lower", "upper"))
+    if estimate is None:
+        return f"not estimated ({p.get('method', '')})"
+    if lower is None or upper is None:
+        return f"{estimate:.3g}, no interval ({p.get('method', '')})"
+    return f"{estimate:.3g} (95 % interval {lower:.3g} to {upper:.3g}, {p.get('method', '')})"
+
+
+def _finite(value) -> float | None:
+    return None if value is None or not np.isfinite(value) else float(value)
 
 
 def inputs_section(entries: list[Entry], ref: Entry | None) -> Section:

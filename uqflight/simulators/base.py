@@ -41,6 +41,21 @@ class DivergenceError(FlightError):
     status = Status.DIVERGED
 
 
+class NominalFailed(RuntimeError):
+    """The nominal sample, which `probe` runs before any other to learn the outputs, failed: the
+    message names it, gives its values and says what to do; `run` stops there (exit 2)."""
+
+
+def nominal_failed(names, kappa, exc: Exception) -> NominalFailed:
+    """The NominalFailed that says sample `kappa` of the parameters `names` failed with `exc`."""
+    values = ", ".join(f"{name} = {float(value):.10g}" for name, value in zip(names, kappa))
+    return NominalFailed(
+        f"the nominal sample failed ({values}: the centre of every parameter's law, ξ = 0), which uqflight "
+        f"runs first to learn the outputs and the time grid: {type(exc).__name__}: {exc}. Make the simulator "
+        "succeed at these values (call simulator.function with them to see why), or move the parameters' "
+        "intervals (lower and upper, or nominal with interval_pct) so that their centre is an input it accepts")
+
+
 class Simulator(Protocol):
     """One object per worker that turns a row of physical values κ into outputs."""
 

@@ -15,7 +15,7 @@ from typing import Callable
 
 import numpy as np
 
-from .base import DivergenceError, FlightError
+from .base import DivergenceError, FlightError, nominal_failed
 
 
 class PluginError(ValueError):
@@ -64,8 +64,12 @@ class PythonSimulator:
         self.units: dict[str, str] = {}
 
     def probe(self, kappa: np.ndarray) -> tuple[np.ndarray, list[str]]:
-        """Time and output names, from one call at `kappa` (the nominal point)."""
-        raw = self._call(kappa)
+        """Time and output names, from one call at `kappa` (the nominal point); NominalFailed when the
+        function fails there."""
+        try:
+            raw = self._call(kappa)
+        except Exception as exc:  # the user's function: any error
+            raise nominal_failed(self.names, kappa, exc) from exc
         names = self.outputs or [k for k in raw if k != "time"]
         missing = [n for n in names if n not in raw]
         if missing:

@@ -1,0 +1,34 @@
+"""A failing nominal sample (the one `run` flies first, in a real worker process) stops the run with one
+message that names it, gives its values and says what to do; exit 2, no results file."""
+from conftest import DATA, cli_in_process
+
+MODEL = DATA / "failure_models.py"
+
+
+def run(tmp_path, outputs="", interval="lower: 1.0, upper: 2.0"):
+    (tmp_path / "c.yaml").write_text(
+        f"name: nominal\nsimulator: {{kind: python, function: \"{MODEL}:fails_at_centre\"{outputs}}}\n"
+        f"parameters:\n  a: {{distribution: uniform, {interval}, nominal: 1.4}}\n"
+        "design: {kind: monte_carlo, samples: 8}\n")
+    return cli_in_process("run", tmp_path / "c.yaml", "--out", tmp_path / "c.h5")
+
+
+def test_a_failing_nominal_sample_is_named_with_its_values_and_what_to_do(tmp_path):
+    done = run(tmp_path)
+    assert done.returncode == 2
+    lines = done.stderr.strip().splitlines()
+    assert len(lines) == 1 and "Traceback" not in done.stderr, done.stderr
+    message = lines[0]
+    # ξ = 0 is the law's centre, 1.5, not the campaign's `nominal: 1.4`: the message gives the value flown
+    assert message.startswith(f"error: {tmp_path / 'c.yaml'}: the nominal sample failed (a = 1.5: the centre")
+    assert "RuntimeError: centre node" in message
+    assert "call simulator.function with them" in message and "move the parameters' intervals" in message
+    assert not (tmp_path / "c.h5").exists()
+
+
+def test_a_campaign_error_found_at_the_nominal_is_not_called_a_failing_sample(tmp_path):
+    # the function succeeds at the nominal (2.5) but lacks the output the campaign asks for
+    done = run(tmp_path, ", outputs: [z]", "lower: 2.0, upper: 3.0")
+    assert done.returncode == 2
+    assert "simulator.outputs: the function returned no 'z'" in done.stderr
+    assert "nominal sample failed" not in done.stderr
