@@ -109,6 +109,20 @@ def test_absolute_drive_and_backslash_names_are_refused_too(name, tmp_path, home
         AircraftFiles.read(locate(folder))
 
 
+def test_an_output_directive_writing_outside_is_refused(tmp_path, home):
+    """JSBSim writes an aircraft's `<output name=FILE type="CSV">` itself, at any absolute path."""
+    folder = tmp_path / "planes" / "chatty"
+    shutil.copytree(BACM, folder)
+    (folder / "bacm.xml").rename(folder / "chatty.xml")
+    written = home / "written.csv"
+    xml = (folder / "chatty.xml").read_text().replace(
+        "</fdm_config>", f'<output name="{written}" type="CSV" rate="1"><property>velocities/vt-fps</property>'
+        "</output></fdm_config>")
+    (folder / "chatty.xml").write_text(xml)
+    stderr = plan_refused(tmp_path, "planes/chatty", "{property: aero/uq/CL0")
+    assert f'chatty.xml: <output name="{written}">' in stderr and "nor lets JSBSim write one" in stderr
+
+
 # -- symbolic links --------------------------------------------------------------------------
 @pytest.mark.parametrize("link", ["Engines/PW119B.xml", "Engines"])
 def test_a_symlink_leaving_the_aircraft_folder_is_refused_and_not_copied(link, tmp_path, home):

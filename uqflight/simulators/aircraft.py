@@ -129,6 +129,7 @@ def locate(aircraft: str | os.PathLike, base: Path | None = None) -> AircraftLoc
 MAX_FILES = 4096          # an aircraft's files, and a bundle's (the largest stock aircraft: 13 files)
 MAX_BYTES = 64 * 2**20    # their total size (the largest stock aircraft: 0.3 MB)
 ENGINE_TAGS, SYSTEM_TAGS = ("engine", "thruster"), ("system", "flight_control", "autopilot")
+NETWORK_OUTPUTS = ("SOCKET", "FLIGHTGEAR")  # `<output type=...>` whose name is a host, not a file
 
 
 class AircraftUnsafe(AircraftUnreadable):
@@ -169,18 +170,23 @@ def _folder_files(folder: Path) -> dict[str, Path]:
 
 
 def _file_names(xml: bytes, file: Path) -> list[tuple[str, str]]:
-    """(tag, file= value) of every element naming a file, each checked to stay in its folder."""
+    """(tag, file= value) of every element naming a file, each checked to stay in its folder (and
+    the file an `<output>` directive has JSBSim write: its name, unless it is a network output)."""
     names = []
     for element in ET.fromstring(xml).iter():
-        value = element.get("file")
-        if value is None:
-            continue
-        if relative_name(value) is None:
-            raise AircraftUnsafe(
-                f'{file}: <{element.tag} file="{value}">: expected a path relative to the aircraft\'s folder '
-                "(or to JSBSim's engine/ and systems/ folders), without / at the start, .. leading out of "
-                "it, a drive or a backslash; uqflight neither reads nor copies a file outside them")
-        names.append((element.tag, value))
+        attributes = ["file"]
+        if element.tag == "output" and (element.get("type") or "").upper() not in NETWORK_OUTPUTS:
+            attributes.append("name")
+        for attribute in attributes:
+            value = element.get(attribute)
+            if value is not None and relative_name(value) is None:
+                raise AircraftUnsafe(
+                    f'{file}: <{element.tag} {attribute}="{value}">: expected a path relative to the aircraft\'s '
+                    "folder (or to JSBSim's engine/ and systems/ folders), without / at the start, .. leading out "
+                    "of it, a drive or a backslash; uqflight neither reads nor copies a file outside them, nor "
+                    "lets JSBSim write one")
+        if element.get("file") is not None:
+            names.append((element.tag, element.get("file")))
     return names
 
 
