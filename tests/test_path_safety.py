@@ -206,6 +206,21 @@ def test_a_worker_process_refuses_the_bundle_and_the_runner_reports_it(tmp_path,
     assert_nothing_outside_the_cache(tmp_path, before)
 
 
+@pytest.mark.slow
+def test_a_dask_worker_refuses_the_bundle_and_the_client_gets_the_error(tmp_path, home):
+    """The same through Dask (a LocalCluster of worker processes): the client's `run` gets the
+    WorkerError (exit 2), and nothing was written outside the cache."""
+    from uqflight.execution import _execute_dask
+
+    bundle, message = hostile_bundles(home)["@root//abs key"]
+    before = files_outside_cache(tmp_path)
+    chunks = _execute_dask([Task(np.arange(1), np.zeros((1, 0)))], _spec(bundle), 11, ["alpha_deg"], 1, None, 60.0)
+    with pytest.raises(WorkerError, match="BundleRefused: worker: refusing the client's bundle") as refused:
+        list(chunks)
+    assert message in str(refused.value)
+    assert_nothing_outside_the_cache(tmp_path, before)
+
+
 def _bomb(size: int) -> bytes:
     """A zip of the c172p files plus one file of `size` zero bytes, written in 1 MiB pieces."""
     info = zipfile.ZipInfo("Systems/bomb.xml", date_time=(1980, 1, 1, 0, 0, 0))
