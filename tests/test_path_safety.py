@@ -131,7 +131,8 @@ def test_a_symlink_leaving_the_aircraft_folder_is_refused_and_not_copied(link, t
     (folder / "bacm.xml").rename(folder / "linky.xml")
     outside = tmp_path / "outside"
     shutil.copytree(BACM / "Engines", outside / "Engines")
-    (outside / "Engines" / "PW119B.xml").write_bytes(b"<!-- secret -->" + (outside / "Engines" / "PW119B.xml").read_bytes())
+    engine = outside / "Engines" / "PW119B.xml"
+    engine.write_bytes(b"<!-- secret -->" + engine.read_bytes())
     target = outside / link
     path = folder / link
     shutil.rmtree(path) if path.is_dir() else path.unlink()

@@ -11,7 +11,9 @@ An aircraft is flown from a *root*: a folder with `aircraft/NAME/NAME.xml`, and 
 `systems/` for the shared files it names. The aircraft's files are its folder's XML files plus
 the engines, thrusters and systems it names that live in the root's shared folders:
 `AircraftFiles` holds them as bytes (keyed by path), hashes them, and writes them out as a root
-of their own (the patched copies and the copies on remote workers are such roots).
+of their own (the patched copies and the copies on remote workers are such roots). Every name in
+those files (`file=` attributes, output files, symbolic links) must stay in the folders JSBSim
+looks in: `AircraftUnsafe` otherwise, before anything is read or written.
 """
 from __future__ import annotations
 
@@ -45,7 +47,7 @@ def cache_dir(*parts: str) -> Path:
     Each part is one folder or file name (ValueError otherwise): a cache key never leaves the cache."""
     for part in parts:
         if not single_name(part):
-            raise ValueError(f"cache key {part!r}: expected a single file name (no /, .. or NUL)")
+            raise ValueError(f"cache key {part!r}: expected a single file name (no /, \\, :, NUL, . or ..)")
     base = os.environ.get("UQFLIGHT_CACHE")
     if not base:
         base = str(Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache") / "uqflight")
@@ -142,7 +144,8 @@ def unsafe_key(key: str) -> str | None:
     relative path ending in .xml, or `@root/engine/...` / `@root/systems/...`."""
     rel = key[len(SHARED):] if isinstance(key, str) and key.startswith(SHARED) else key
     if not isinstance(key, str) or relative_name(rel) != rel:
-        return "expected a relative path inside the aircraft's folder (no leading /, no .. out of it, no backslash, drive or NUL)"
+        return ("expected a relative path inside the aircraft's folder (no leading /, no .. out of it, no "
+                "backslash, drive or NUL)")
     if not rel.endswith(".xml"):
         return "expected an .xml file"
     if key.startswith(SHARED) and rel.split("/", 1)[0] not in ("engine", "systems"):
@@ -259,7 +262,7 @@ class AircraftFiles:
         A name or key that would lead outside `root` is refused (AircraftUnsafe) before any write."""
         root = Path(root)
         if not single_name(self.name):
-            raise AircraftUnsafe(f"aircraft name {self.name!r}: expected a folder name (no / or ..)")
+            raise AircraftUnsafe(f"aircraft name {self.name!r}: expected a folder name (no /, \\, :, NUL, . or ..)")
         for key in self.files:
             if unsafe_key(key):
                 raise AircraftUnsafe(f"aircraft {self.name!r}: file {key!r}: {unsafe_key(key)}")
@@ -293,10 +296,6 @@ def length_prefixed_sha256(parts) -> str:
         digest.update(len(part).to_bytes(8, "big"))
         digest.update(part)
     return digest.hexdigest()
-
-
-def files_hash(location: AircraftLocation) -> str:
-    return AircraftFiles.read(location).hash()
 
 
 # -- what the aircraft holds: aerodynamic functions and engines ----------------------------

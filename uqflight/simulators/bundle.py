@@ -88,10 +88,10 @@ def _checked(bundle) -> dict:
         raise _refuse("expected a bundle of kind 'aircraft' or 'python'")
     if not isinstance(bundle.get("hash"), str) or not SHA256.fullmatch(bundle["hash"]):
         raise _refuse(f"hash {bundle.get('hash')!r}: expected 64 lowercase hexadecimal digits (a sha256)")
-    name = bundle.get("name")
-    if not single_name(name) or (bundle["kind"] == "python" and not name.endswith(".py")):
-        raise _refuse(f"name {name!r}: expected a single file name{' ending in .py' if bundle['kind'] == 'python' else ''}"
-                      " (no /, .., backslash or NUL)")
+    name, suffix = bundle.get("name"), ".py" if bundle["kind"] == "python" else ""
+    if not single_name(name) or not name.endswith(suffix):
+        raise _refuse(f"name {name!r}: expected a single file name{' ending in .py' if suffix else ''} "
+                      "(no /, \\, :, NUL, . or ..)")
     if bundle["kind"] == "python" and not (isinstance(bundle.get("attribute"), str)
                                            and bundle["attribute"].isidentifier()):
         raise _refuse(f"attribute {bundle.get('attribute')!r}: expected a Python name")
