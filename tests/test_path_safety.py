@@ -207,6 +207,16 @@ def test_a_worker_process_refuses_the_bundle_and_the_runner_reports_it(tmp_path,
     assert_nothing_outside_the_cache(tmp_path, before)
 
 
+def test_a_worker_refuses_to_fly_bundled_xml_whose_file_attribute_leads_out(tmp_path, home):
+    """Keys inside the cache, but the main XML names a file outside it: the worker's check of the
+    unpacked aircraft refuses it before JSBSim could read that file."""
+    files = AircraftFiles.read(locate("c172p")).files
+    main = files["c172p.xml"].replace(b"</fdm_config>", b'<system file="../../../../../../x"/></fdm_config>')
+    bundle = _c172p_bundle({"c172p.xml": main})
+    with pytest.raises(AircraftUnsafe, match=re.escape('c172p.xml: <system file="../../../../../../x">')):
+        localized(_spec(bundle))
+
+
 @pytest.mark.slow
 def test_a_dask_worker_refuses_the_bundle_and_the_client_gets_the_error(tmp_path, home):
     """The same through Dask (a LocalCluster of worker processes): the client's `run` gets the
