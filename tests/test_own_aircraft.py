@@ -35,12 +35,14 @@ def test_locate_project_jsbsim_and_path(tmp_path):
         locate("c172q")
 
 
-def test_bacm_hash_is_the_one_recorded_before():
+def test_bacm_hash_is_the_documented_length_prefixed_sha256():
+    """Recomputed by hand from README's definition: per file in key order, the 8-byte big-endian
+    length of its key, the key, the length of its bytes, the bytes."""
     digest = hashlib.sha256()
     folder = REPO_ROOT / "aircraft" / "bacm"
-    for path in sorted(folder.rglob("*.xml")):
-        digest.update(path.relative_to(folder).as_posix().encode())
-        digest.update(path.read_bytes())
+    for key in sorted(p.relative_to(folder).as_posix() for p in folder.rglob("*.xml")):
+        for part in (key.encode(), (folder / key).read_bytes()):
+            digest.update(len(part).to_bytes(8, "big") + part)
     assert AircraftFiles.read(locate("bacm")).hash() == digest.hexdigest()
 
 

@@ -11,18 +11,23 @@ An aircraft is flown from a *root*: a folder with `aircraft/NAME/NAME.xml`, and 
 `systems/` for the shared files it names. The aircraft's files are its folder's XML files plus
 the engines, thrusters and systems it names that live in the root's shared folders:
 `AircraftFiles` holds them as bytes (keyed by path), hashes them, and writes them out as a root
-of their own (the patched copies and the copies on remote workers are such roots).
+of their own (the patched copies and the copies on remote workers are such roots). Every name in
+those files (`file=` attributes, output files, symbolic links) must stay in the folders JSBSim
+looks in: `AircraftUnsafe` otherwise, before anything is read or written.
 """
 from __future__ import annotations
 
 import hashlib
 import os
 import re
+import shutil
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import jsbsim
+
+from .safe_paths import is_inside, outside_links, relative_name, single_name
 
 PACKAGE_ROOT = Path(__file__).resolve().parents[1]  # uqflight/: holds aircraft/bacm as package data
 SOURCE_ROOT = Path(__file__).resolve().parents[2]   # the repository, when run from the source tree
@@ -38,7 +43,11 @@ class AircraftUnreadable(RuntimeError):
 
 
 def cache_dir(*parts: str) -> Path:
-    """uqflight's cache: $UQFLIGHT_CACHE, else $XDG_CACHE_HOME/uqflight, else ~/.cache/uqflight."""
+    """uqflight's cache: $UQFLIGHT_CACHE, else $XDG_CACHE_HOME/uqflight, else ~/.cache/uqflight.
+    Each part is one folder or file name (ValueError otherwise): a cache key never leaves the cache."""
+    for part in parts:
+        if not single_name(part):
+            raise ValueError(f"cache key {part!r}: expected a single file name (no /, \\, :, NUL, . or ..)")
     base = os.environ.get("UQFLIGHT_CACHE")
     if not base:
         base = str(Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache") / "uqflight")
@@ -119,12 +128,69 @@ def locate(aircraft: str | os.PathLike, base: Path | None = None) -> AircraftLoc
 
 
 # -- the files an aircraft consists of -----------------------------------------------------
-def _referenced(tree: ET.Element) -> dict[str, list[str]]:
-    """File names the aircraft XML refers to: engines/thrusters and systems."""
-    engines = [e.get("file") for tag in ("engine", "thruster") for e in tree.iter(tag) if e.get("file")]
-    systems = [e.get("file") for tag in ("system", "flight_control", "autopilot") for e in tree.iter(tag)
-               if e.get("file")]
-    return {"engine": engines, "systems": systems}
+MAX_FILES = 4096          # an aircraft's files, and a bundle's (the largest stock aircraft: 13 files)
+MAX_BYTES = 64 * 2**20    # their total size (the largest stock aircraft: 0.3 MB)
+ENGINE_TAGS, SYSTEM_TAGS = ("engine", "thruster"), ("system", "flight_control", "autopilot")
+NETWORK_OUTPUTS = ("SOCKET", "FLIGHTGEAR")  # `<output type=...>` whose name is a host, not a file
+
+
+class AircraftUnsafe(AircraftUnreadable):
+    """A name in an aircraft's files that leads outside its folder (a `file=` attribute, a symbolic
+    link, a bundle key), or more files than uqflight reads: nothing of it is read or written."""
+
+
+def unsafe_key(key: str) -> str | None:
+    """Why `key` cannot name one of an aircraft's files (None when it can): a key is a normalized
+    relative path ending in .xml, or `@root/engine/...` / `@root/systems/...`."""
+    rel = key[len(SHARED):] if isinstance(key, str) and key.startswith(SHARED) else key
+    if not isinstance(key, str) or relative_name(rel) != rel:
+        return ("expected a relative path inside the aircraft's folder (no leading /, no .. out of it, no "
+                "backslash, drive or NUL)")
+    if not rel.endswith(".xml"):
+        return "expected an .xml file"
+    if key.startswith(SHARED) and rel.split("/", 1)[0] not in ("engine", "systems"):
+        return "expected @root/engine/... or @root/systems/..."
+    return None
+
+
+def _folder_files(folder: Path) -> dict[str, Path]:
+    """Key -> path of the .xml files under `folder`; refuses links leaving it and too many files."""
+    for link in outside_links(folder):
+        raise AircraftUnsafe(f"{link} is a symbolic link to {os.readlink(link)}, outside the aircraft folder "
+                             f"{folder}: uqflight neither follows nor copies it; put a copy of the file in the "
+                             "folder instead")
+    found: dict[str, Path] = {}
+    for top, dirs, names in os.walk(folder, followlinks=True):  # links inside the folder stay inside
+        here = os.path.realpath(top)
+        dirs[:] = sorted(d for d in dirs if not is_inside(here, os.path.join(top, d)))  # no loops
+        for name in sorted(names):
+            path = Path(top, name)
+            if name.endswith(".xml") and path.is_file():
+                found[path.relative_to(folder).as_posix()] = path
+        if len(found) > MAX_FILES:
+            raise AircraftUnsafe(f"{folder} holds more than {MAX_FILES} .xml files: expected an aircraft folder")
+    return found
+
+
+def _file_names(xml: bytes, file: Path) -> list[tuple[str, str]]:
+    """(tag, file= value) of every element naming a file, each checked to stay in its folder (and
+    the file an `<output>` directive has JSBSim write: its name, unless it is a network output)."""
+    names = []
+    for element in ET.fromstring(xml).iter():
+        attributes = ["file"]
+        if element.tag == "output" and (element.get("type") or "").upper() not in NETWORK_OUTPUTS:
+            attributes.append("name")
+        for attribute in attributes:
+            value = element.get(attribute)
+            if value is not None and relative_name(value) is None:
+                raise AircraftUnsafe(
+                    f'{file}: <{element.tag} {attribute}="{value}">: expected a path relative to the aircraft\'s '
+                    "folder (or to JSBSim's engine/ and systems/ folders), without / at the start, .. leading out "
+                    "of it, a drive or a backslash; uqflight neither reads nor copies a file outside them, nor "
+                    "lets JSBSim write one")
+        if element.get("file") is not None:
+            names.append((element.tag, element.get("file")))
+    return names
 
 
 @dataclass
@@ -137,23 +203,44 @@ class AircraftFiles:
 
     @classmethod
     def read(cls, location: AircraftLocation) -> "AircraftFiles":
+        """The folder's .xml files, and the root's engines, thrusters and systems any of them names
+        (where JSBSim finds them: the folder, its Engines/ or Systems/, then the root's engine/ or
+        systems/). Every `file=` attribute and symbolic link must stay in those folders
+        (AircraftUnsafe otherwise, naming the file and the attribute)."""
         folder = location.folder
-        files = {p.relative_to(folder).as_posix(): p.read_bytes()
-                 for p in sorted(folder.rglob("*.xml")) if p.is_file()}
+        paths = _folder_files(folder)
+        files, size = {}, 0
+        for key, path in paths.items():
+            files[key] = path.read_bytes()
+            size += len(files[key])
+            if size > MAX_BYTES:
+                raise AircraftUnsafe(f"{folder}: its .xml files exceed {MAX_BYTES / 2**20:.0f} MiB: expected an "
+                                     "aircraft folder")
         main = f"{location.name}.xml"
-        try:
-            refs = _referenced(ET.fromstring(files.get(main, b"")))
-        except ET.ParseError as exc:
-            raise AircraftUnreadable(f"{folder / main} is not well-formed XML ({exc}); JSBSim cannot load "
-                                     "it either") from None
-        for kind, subfolder in (("engine", "Engines"), ("systems", "Systems")):
-            for name in refs[kind]:
-                file = name if name.endswith(".xml") else name + ".xml"
-                if f"{subfolder}/{file}" in files or file in files:
-                    continue
-                shared = location.root / kind / file
-                if shared.is_file():
-                    files[f"{SHARED}{kind}/{file}"] = shared.read_bytes()
+        names = []
+        for key, data in files.items():
+            try:
+                names += _file_names(data, paths[key])
+            except ET.ParseError as exc:
+                if key == main:
+                    raise AircraftUnreadable(f"{folder / main} is not well-formed XML ({exc}); JSBSim cannot "
+                                             "load it either") from None
+        if main not in files:
+            raise AircraftUnreadable(f"{folder / main} is not well-formed XML (no element found); JSBSim "
+                                     "cannot load it either")
+        for tag, name in names:
+            if tag not in ENGINE_TAGS + SYSTEM_TAGS:
+                continue
+            kind, subfolder = ("engine", "Engines") if tag in ENGINE_TAGS else ("systems", "Systems")
+            file = relative_name(name if name.endswith(".xml") else name + ".xml")
+            if f"{subfolder}/{file}" in files or file in files:
+                continue
+            shared = location.root / kind / file
+            if shared.is_file() and f"{SHARED}{kind}/{file}" not in files:
+                if not is_inside(shared, location.root / kind):
+                    raise AircraftUnsafe(f"{shared} leads outside {location.root / kind} (a symbolic link): "
+                                         "uqflight neither follows nor copies it")
+                files[f"{SHARED}{kind}/{file}"] = shared.read_bytes()
         return cls(location.name, files)
 
     @property
@@ -161,25 +248,29 @@ class AircraftFiles:
         return self.files[f"{self.name}.xml"]
 
     def hash(self) -> str:
-        """sha256 over the files, each as its key then its bytes, keys sorted (for the project's
-        aircraft, the same value as before shared files were counted: they have none)."""
-        digest = hashlib.sha256()
-        for key in sorted(self.files):
-            digest.update(key.encode())
-            digest.update(self.files[key])
-        return digest.hexdigest()
+        """sha256 over the files in key order, each as the length (8 bytes, big-endian) and bytes of
+        its key, then of its contents: two different sets of files never hash alike."""
+        return length_prefixed_sha256(part for key in sorted(self.files)
+                                      for part in (key.encode(), self.files[key]))
 
     def with_main(self, xml: bytes) -> "AircraftFiles":
         return AircraftFiles(self.name, {**self.files, f"{self.name}.xml": xml})
 
     def write_root(self, root: Path) -> Path:
         """Write the files as a JSBSim root (`aircraft/NAME/...`, `engine/`, `systems/`); returns root.
-        Written into a temporary folder then renamed, so concurrent writers never see half a root."""
+        Written into a temporary folder then renamed, so concurrent writers never see half a root.
+        A name or key that would lead outside `root` is refused (AircraftUnsafe) before any write."""
         root = Path(root)
+        if not single_name(self.name):
+            raise AircraftUnsafe(f"aircraft name {self.name!r}: expected a folder name (no /, \\, :, NUL, . or ..)")
+        for key in self.files:
+            if unsafe_key(key):
+                raise AircraftUnsafe(f"aircraft {self.name!r}: file {key!r}: {unsafe_key(key)}")
         if (root / "aircraft" / self.name / f"{self.name}.xml").is_file():
             return root
         root.parent.mkdir(parents=True, exist_ok=True)
         tmp = root.parent / f".{root.name}.{os.getpid()}.tmp"
+        shutil.rmtree(tmp, ignore_errors=True)  # a killed writer's leftover (it may hold links)
         for key, data in self.files.items():
             rel = key[len(SHARED):] if key.startswith(SHARED) else f"aircraft/{self.name}/{key}"
             path = tmp / rel
@@ -190,8 +281,6 @@ class AircraftFiles:
         try:
             tmp.rename(root)
         except OSError:  # another process wrote it first
-            import shutil
-
             shutil.rmtree(tmp, ignore_errors=True)
         return root
 
@@ -200,8 +289,13 @@ class AircraftFiles:
         return self.write_root(cache_dir("aircraft", self.hash()[:24]))
 
 
-def files_hash(location: AircraftLocation) -> str:
-    return AircraftFiles.read(location).hash()
+def length_prefixed_sha256(parts) -> str:
+    """sha256 (hex) of byte strings, each preceded by its length as 8 big-endian bytes."""
+    digest = hashlib.sha256()
+    for part in parts:
+        digest.update(len(part).to_bytes(8, "big"))
+        digest.update(part)
+    return digest.hexdigest()
 
 
 # -- what the aircraft holds: aerodynamic functions and engines ----------------------------

@@ -7,33 +7,97 @@ into its own cache (`$UQFLIGHT_CACHE`, else `$XDG_CACHE_HOME/uqflight`, else ~/.
 keyed by the hash, and returns the spec's simulator mapping pointing there. Before a worker
 flies, it hashes the aircraft files it is about to load; files that differ from the client's
 (a stale or edited copy in its cache) are refused with an `AircraftMismatch`.
+
+Before unpacking anything, the worker checks the bundle (`BundleRefused` otherwise): its hash is
+a sha256, its name one file name, every key a relative path inside the aircraft's root (no
+leading `/`, `..`, `@root//...`, drive or backslash), at most MAX_FILES files and MAX_BYTES
+uncompressed, and the files hash to the bundle's hash.
 """
 from __future__ import annotations
 
 import hashlib
 import io
+import re
 import zipfile
+import zlib
 from dataclasses import replace
 from pathlib import Path
 
-from .aircraft import AircraftFiles, cache_dir
+from .aircraft import MAX_BYTES, MAX_FILES, AircraftFiles, AircraftUnsafe, cache_dir, unsafe_key
+from .safe_paths import single_name
+
+SHA256 = re.compile(r"[0-9a-f]{64}")
 
 
 class AircraftMismatch(RuntimeError):
     """The worker's aircraft files are not the client's: the worker refuses to fly them."""
 
 
+class BundleRefused(RuntimeError):
+    """A bundle with a name, key or hash that would lead outside the worker's cache, or more files
+    or bytes than an aircraft has (MAX_FILES, MAX_BYTES): refused before anything is unpacked."""
+
+
 def _zip(files: dict[str, bytes]) -> bytes:
     buffer = io.BytesIO()
-    with zipfile.ZipFile(buffer, "w", zipfile.ZIP_DEFLATED) as z:
+    with zipfile.ZipFile(buffer, "w") as z:
         for key in sorted(files):
-            z.writestr(zipfile.ZipInfo(key, date_time=(1980, 1, 1, 0, 0, 0)), files[key])
+            info = zipfile.ZipInfo(key, date_time=(1980, 1, 1, 0, 0, 0))
+            info.compress_type = zipfile.ZIP_DEFLATED  # a bare ZipInfo would store the file uncompressed
+            z.writestr(info, files[key])
     return buffer.getvalue()
 
 
-def _unzip(data: bytes) -> dict[str, bytes]:
-    with zipfile.ZipFile(io.BytesIO(data)) as z:
-        return {name: z.read(name) for name in z.namelist()}
+def _refuse(what: str) -> BundleRefused:
+    return BundleRefused(f"worker: refusing the client's bundle, nothing unpacked: {what}")
+
+
+def _unzip(data: bytes, unsafe) -> dict[str, bytes]:
+    """The bundle's files, once every name passes `unsafe(name)` (None, or why not) and their count and
+    declared total size are within the limits; reading stops at the declared sizes (zipfile checks
+    each file's length and CRC), so no file grows past what was checked."""
+    unreadable = (zipfile.BadZipFile, zlib.error, EOFError, ValueError, RuntimeError, NotImplementedError)
+    try:
+        archive = zipfile.ZipFile(io.BytesIO(data))
+    except unreadable as exc:
+        raise _refuse(f"not a readable zip ({type(exc).__name__}: {exc})") from None
+    with archive:
+        infos = archive.infolist()
+        if len(infos) > MAX_FILES:
+            raise _refuse(f"{len(infos)} files, more than {MAX_FILES}")
+        if len({info.filename for info in infos}) != len(infos):
+            raise _refuse("a file name appears twice")
+        for info in infos:
+            why = unsafe(info.orig_filename) or unsafe(info.filename)
+            if why:
+                raise _refuse(f"file {info.orig_filename!r}: {why}")
+            if info.compress_type not in (zipfile.ZIP_STORED, zipfile.ZIP_DEFLATED):
+                raise _refuse(f"file {info.filename!r}: compression method {info.compress_type}")
+        size = sum(info.file_size for info in infos)
+        if size > MAX_BYTES:
+            raise _refuse(f"{size} bytes uncompressed, more than {MAX_BYTES} ({MAX_BYTES / 2**20:.0f} MiB)")
+        try:
+            return {info.filename: archive.read(info) for info in infos}
+        except unreadable as exc:
+            raise _refuse(f"not a readable zip ({type(exc).__name__}: {exc})") from None
+
+
+def _checked(bundle) -> dict:
+    """The bundle, once its kind, name and hash are ones the worker can use as names in its cache."""
+    if not isinstance(bundle, dict) or bundle.get("kind") not in ("aircraft", "python"):
+        raise _refuse("expected a bundle of kind 'aircraft' or 'python'")
+    if not isinstance(bundle.get("hash"), str) or not SHA256.fullmatch(bundle["hash"]):
+        raise _refuse(f"hash {bundle.get('hash')!r}: expected 64 lowercase hexadecimal digits (a sha256)")
+    name, suffix = bundle.get("name"), ".py" if bundle["kind"] == "python" else ""
+    if not single_name(name) or not name.endswith(suffix):
+        raise _refuse(f"name {name!r}: expected a single file name{' ending in .py' if suffix else ''} "
+                      "(no /, \\, :, NUL, . or ..)")
+    if bundle["kind"] == "python" and not (isinstance(bundle.get("attribute"), str)
+                                           and bundle["attribute"].isidentifier()):
+        raise _refuse(f"attribute {bundle.get('attribute')!r}: expected a Python name")
+    if not isinstance(bundle.get("zip"), bytes):
+        raise _refuse("expected the files as zip bytes")
+    return bundle
 
 
 def make_bundle(simulator: dict, properties, base: str | Path) -> dict | None:
@@ -57,26 +121,38 @@ def make_bundle(simulator: dict, properties, base: str | Path) -> dict | None:
 
 def localized(spec):
     """The WorkerSpec with its simulator reading the bundle's files from this worker's cache
-    (unpacked on first use); raises AircraftMismatch when the files found there differ."""
+    (unpacked on first use); raises BundleRefused when the bundle's names, hash, size or file count
+    are unsafe (before unpacking anything), AircraftMismatch when the files differ from its hash."""
     bundle = getattr(spec, "bundle", None)
     if not bundle:
         return spec
+    bundle = _checked(bundle)
     simulator = dict(spec.simulator)
+    name, digest = bundle["name"], bundle["hash"]
     if bundle["kind"] == "aircraft":
-        files = AircraftFiles(bundle["name"], _unzip(bundle["zip"]))
-        root = files.write_root(cache_dir("aircraft", bundle["hash"][:24]))
-        check_aircraft(root, bundle["name"], bundle["hash"])
-        simulator.update(root=str(root), aircraft=bundle["name"])
+        files = AircraftFiles(name, _unzip(bundle["zip"], unsafe_key))
+        if f"{name}.xml" not in files.files or files.hash() != digest:
+            raise _refuse(f"the files of {name!r} do not hash to the bundle's sha256 {digest[:12]} "
+                          f"(or lack {name}.xml)")
+        try:
+            root = files.write_root(cache_dir("aircraft", digest[:24]))
+        except AircraftUnsafe as exc:
+            raise _refuse(str(exc)) from None
+        check_aircraft(root, name, digest)
+        simulator.update(root=str(root), aircraft=name)
         simulator.pop("aircraft_path", None)
     else:
-        folder = cache_dir("python", bundle["hash"][:24])
-        file = folder / bundle["name"]
+        data = _unzip(bundle["zip"], lambda key: None if key == name else f"expected only {name!r}")
+        if name not in data or hashlib.sha256(data[name]).hexdigest() != digest:
+            raise _refuse(f"{name!r} does not hash to the bundle's sha256 {digest[:12]}")
+        folder = cache_dir("python", digest[:24])
+        file = folder / name
         if not file.is_file():
             folder.mkdir(parents=True, exist_ok=True)
-            file.write_bytes(_unzip(bundle["zip"])[bundle["name"]])
-        if hashlib.sha256(file.read_bytes()).hexdigest() != bundle["hash"]:
-            raise AircraftMismatch(f"worker: {file} differs from the client's {bundle['name']} "
-                                   f"(sha256 {bundle['hash'][:12]}): refusing to run it; delete {folder}")
+            file.write_bytes(data[name])
+        if hashlib.sha256(file.read_bytes()).hexdigest() != digest:
+            raise AircraftMismatch(f"worker: {file} differs from the client's {name} "
+                                   f"(sha256 {digest[:12]}): refusing to run it; delete {folder}")
         simulator["function"] = f"{file}:{bundle['attribute']}"
     return replace(spec, simulator=simulator, bundle=None)
 

@@ -10,12 +10,11 @@ version of an aircraft costs one check (~0.3 s) per machine.
 """
 from __future__ import annotations
 
-import hashlib
 import subprocess
 import sys
 from pathlib import Path
 
-from .aircraft import AircraftUnreadable, cache_dir
+from .aircraft import AircraftUnreadable, cache_dir, length_prefixed_sha256
 
 CHILD = """
 import sys
@@ -31,13 +30,13 @@ TIMEOUT_S = 120
 
 
 def files_digest(root: Path, aircraft: str) -> str:
-    """sha256 over the XML files JSBSim may read for `aircraft` under `root`, with their paths."""
-    digest = hashlib.sha256(str(root.resolve()).encode())
+    """sha256 over the XML files JSBSim may read for `aircraft` under `root`, with their paths
+    (length-prefixed: no two sets of files hash alike)."""
+    parts = [str(root.resolve()).encode()]
     for folder in (root / "aircraft" / aircraft, root / "engine", root / "systems"):
         for path in sorted(folder.rglob("*.xml")) if folder.is_dir() else ():
-            digest.update(path.relative_to(root).as_posix().encode())
-            digest.update(path.read_bytes())
-    return digest.hexdigest()
+            parts += [path.relative_to(root).as_posix().encode(), path.read_bytes()]
+    return length_prefixed_sha256(parts)
 
 
 def check_loads(root: Path, aircraft: str) -> None:
