@@ -11,7 +11,7 @@ import pytest
 from conftest import cli, cli_in_process
 
 from uqflight.store import LockHeld, ResultsLock, ResultStore
-from uqflight.store.lock import _start_time, read_holder
+from uqflight.store.lock import start_time, read_holder
 
 CAMPAIGN = """
 name: locks
@@ -86,7 +86,7 @@ def test_a_lock_of_a_live_run_is_refused(tmp_path):
     holder = subprocess.Popen([sys.executable, "-c", "import time; time.sleep(60)"])
     try:
         lock = tmp_path / "r.h5.lock"
-        lock.write_text(a_lock(holder.pid, started=_start_time(holder.pid)))
+        lock.write_text(a_lock(holder.pid, started=start_time(holder.pid)))
         with pytest.raises(LockHeld, match=rf"being written by another run \(pid {holder.pid} on"):
             ResultsLock(tmp_path / "r.h5").acquire()
         assert read_holder(tmp_path / "r.h5")["pid"] == holder.pid
@@ -101,7 +101,7 @@ def test_a_lock_of_ours_whose_holder_is_gone_is_taken_over_by_run(tmp_path, gone
     if gone == "dead":
         content = a_lock(dead_pid(), started="12345")
     else:
-        content = a_lock(os.getpid(), started=str(int(_start_time(os.getpid())) + 1))
+        content = a_lock(os.getpid(), started=str(int(start_time(os.getpid())) + 1))
     lock, out = tmp_path / "r.h5.lock", tmp_path / "r.h5"
     lock.write_text(content)
     result = cli("run", write_campaign(tmp_path), "--out", out)
@@ -115,6 +115,6 @@ def test_the_lock_written_is_whole_and_removed_on_release(tmp_path):
     out = tmp_path / "r.h5"
     with ResultsLock(out):
         holder = read_holder(out)
-        assert holder["pid"] == os.getpid() and holder["started"] == _start_time(os.getpid())
+        assert holder["pid"] == os.getpid() and holder["started"] == start_time(os.getpid())
         assert sorted(p.name for p in tmp_path.iterdir()) == ["r.h5.lock"]  # no temporary file left
     assert not list(tmp_path.iterdir())

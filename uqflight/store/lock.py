@@ -34,7 +34,7 @@ def lock_path(path) -> Path:
     return path.with_name(path.name + ".lock")
 
 
-def _start_time(pid: int) -> str | None:
+def start_time(pid: int) -> str | None:
     """The process's start time in clock ticks since boot (/proc/PID/stat field 22), or None."""
     try:
         stat_line = Path(f"/proc/{pid}/stat").read_text()
@@ -43,7 +43,7 @@ def _start_time(pid: int) -> str | None:
     return stat_line.rsplit(")", 1)[1].split()[19]
 
 
-def _alive(pid: int, started: str | None) -> bool:
+def alive(pid: int, started: str | None) -> bool:
     """False only when no process `pid` runs, or the one that does started at another time."""
     if pid <= 0:
         return False
@@ -53,7 +53,7 @@ def _alive(pid: int, started: str | None) -> bool:
         return False
     except PermissionError:
         return True
-    now = _start_time(pid)
+    now = start_time(pid)
     return started is None or now is None or now == started
 
 
@@ -100,13 +100,13 @@ def read_holder(path) -> dict | None:
 
 def _gone(holder: dict) -> bool:
     """The holder is provably not running: on this host, and its pid dead or another process now."""
-    return holder["host"] == socket.gethostname() and not _alive(holder["pid"], holder["started"])
+    return holder["host"] == socket.gethostname() and not alive(holder["pid"], holder["started"])
 
 
 def live_holder(path) -> dict | None:
     """The holder of FILE's lock when it is a live run on this host (a run writing the file now), else None."""
     holder = read_holder(path)
-    if holder and holder["host"] == socket.gethostname() and _alive(holder["pid"], holder["started"]):
+    if holder and holder["host"] == socket.gethostname() and alive(holder["pid"], holder["started"]):
         return holder
     return None
 
@@ -127,7 +127,7 @@ class ResultsLock:
         self.held = False
 
     def acquire(self) -> None:
-        me = {"pid": os.getpid(), "host": socket.gethostname(), "started": _start_time(os.getpid()),
+        me = {"pid": os.getpid(), "host": socket.gethostname(), "started": start_time(os.getpid()),
               "since": time.strftime("%Y-%m-%d %H:%M:%S"), "command": "uqflight run"}
         for _ in range(3):
             if self._place(me):
