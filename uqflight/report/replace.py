@@ -154,7 +154,10 @@ def _turn(out_dir: Path):
     try:
         yield
     finally:
-        os.unlink(path)
+        try:
+            os.unlink(path)
+        except FileNotFoundError:  # removed by hand meanwhile
+            pass
         os.close(fd)
 
 
