@@ -44,6 +44,7 @@ import numpy as np
 from threadpoolctl import threadpool_limits
 
 from .campaign import Campaign
+from .campaign.reading import parameters_attribute
 from .campaign.schema import WORKER_BYTES
 from .designs import Design
 from .parameters import to_physical
@@ -120,7 +121,7 @@ def prepare_store(campaign: Campaign, design: Design, out: Path, force: bool, pr
             pool.close()
     time_grid, outputs, units, _, repeatability = probed
     attrs = {"versions": json.dumps(versions()), "campaign_name": campaign.name,
-             "campaign_path": str(Path(campaign.source).resolve()),
+             "campaign_path": str(Path(campaign.source).resolve()), "parameters": parameters_attribute(campaign),
              "method": json.dumps(campaign.method), "germs": json.dumps(campaign.germs),
              "analysis": json.dumps(campaign.analysis),
              "design_kind": design.kind, "design_info": json.dumps(design.info, default=str)}

@@ -103,9 +103,9 @@ def fit_surrogate(path, method: dict | None = None, partial: bool = False,
 
 def _parameters(store) -> list[dict]:
     """The parameters' laws from the stored campaign text (κ ↔ ξ), via the campaign parser."""
-    from .campaign import stored_parameters
+    from .campaign.reading import stored_parameters
 
-    found = stored_parameters(store.campaign_text)
+    found = stored_parameters(store.attrs)
     names = store.parameter_names
     if found is None or [p["name"] for p in found] != names:
         raise SurrogateError("cannot read the parameters' distributions from the campaign text in the results file")

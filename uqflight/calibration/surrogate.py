@@ -14,6 +14,7 @@ from pathlib import Path
 import numpy as np
 
 from ..campaign import Campaign, CampaignError, load_campaign, parse_campaign
+from ..campaign.reading import results_campaign
 from ..designs import is_sampled
 from ..methods import METHOD_KINDS
 from ..methods.basis import orthonormal_basis
@@ -100,19 +101,28 @@ def load_campaign_file(path) -> Campaign:
 
 
 def _campaign_of(store: ResultStore, results: Path, campaign_path: Path | None) -> Campaign:
-    """The campaign stored in the results file (a python model file is looked up beside the results
-    file), or the campaign file given, which must be the same text."""
-    text = store.campaign_text
+    """The campaign stored in the results file, read without running any of its code (a python model
+    is imported only by the predictive runs, from beside the results file), or from beside the campaign
+    file given, which must be the same text."""
+    source = str(results)
     if campaign_path is not None:
-        campaign = load_campaign_file(campaign_path)
-        if campaign.text != text:
+        try:
+            text = campaign_path.read_bytes().decode("utf-8")
+        except (OSError, UnicodeDecodeError) as exc:
+            raise SurrogateError(f"--campaign: cannot read {campaign_path} ({exc})") from exc
+        if text != store.campaign_text:
             raise SurrogateError(f"{campaign_path} is not the campaign {results} was run from (the texts differ)")
-        return campaign
+        source = str(campaign_path)
     try:
-        return parse_campaign(text, str(results), probe=jsbsim_probe)
+        campaign = results_campaign(store.attrs, source)
     except CampaignError as exc:
-        raise SurrogateError(f"cannot rebuild the campaign stored in {results}: {exc}; pass the campaign file "
-                             "with --campaign (a python model file is looked up beside it)") from exc
+        raise SurrogateError(f"cannot rebuild the campaign stored in {results}: {exc}") from exc
+    module, _, _ = campaign.simulator.get("function", "").partition(":")
+    if module.endswith(".py") and not (campaign_folder(campaign) / module).is_file():  # looked for, not imported
+        raise SurrogateError(f"the python model {module} that the posterior-predictive runs call is not beside "
+                             f"{source}; pass the campaign file with --campaign (its model file is looked up "
+                             "beside it)")
+    return campaign
 
 
 def fit_surrogate(results, method: str | None = None, order: int | None = None,

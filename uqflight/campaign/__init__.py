@@ -71,19 +71,11 @@ def load_campaign(path: str | Path, probe: PropertyProbe | None = None) -> Campa
 
 
 def parse_campaign(text: str, source: str = "<campaign>", probe: PropertyProbe | None = None) -> Campaign:
-    """Validate campaign text; see `load_campaign`."""
-    check = Checker(source)
-    if len(text) > schema.MAX_FILE_BYTES:
-        check.fail("", f"the text is longer than {schema.MAX_FILE_BYTES // 1024} KiB; a campaign is a few "
-                       "lines of YAML")
-    try:
-        data = yaml.load(text, Loader=CampaignLoader)
-    except yaml.YAMLError as exc:
-        raise CampaignError(source, "", yaml_error(exc)) from exc
-    data = check.mapping(data, "", TOP_KEYS, required=("name", "simulator", "parameters", "design"))
-    name = schema.campaign_name(check, data["name"])
-    seed = check.integer(data.get("seed", 0), "seed", 0)
-    simulator = schema.simulator(check, data["simulator"], source)
+    """Validate campaign text; see `load_campaign`. A python simulator's module is imported (its code
+    runs): this is for campaigns about to be planned or run; results are read with
+    `campaign.reading.results_campaign`, which never resolves the simulator."""
+    check, data, simulator = read_settings(text, source)
+    schema.resolve_simulator(check, simulator, source)
     aircraft = None
     if probe and simulator["kind"] == "jsbsim":
         try:
@@ -95,6 +87,44 @@ def parse_campaign(text: str, source: str = "<campaign>", probe: PropertyProbe |
                 check.fail(f"simulator.outputs[{i}]", f"expected one of {', '.join(NAMED_OUTPUTS)} or a JSBSim "
                            f"property of aircraft {aircraft.aircraft!r}, got {output!r}{aircraft.hint(output)}")
     parameters = schema.parameters(check, data["parameters"], simulator["kind"], aircraft)
+    campaign = build_campaign(check, data, simulator, parameters, text)
+    if isinstance(data["design"], dict):  # sizes from the campaign alone, before building anything
+        schema.check_size(check, data, simulator, parameters, campaign.method, campaign.execution,
+                          campaign.storage, campaign.limits)
+    try:
+        design = campaign.design()
+    except ValueError as exc:
+        message = str(exc)
+        field_path, sep, rest = message.partition(": ")
+        if sep and (field_path.startswith("design") or field_path == "seed"):
+            raise CampaignError(source, field_path, rest) from exc
+        raise CampaignError(source, "design", message) from exc
+    schema.check_method_fits_design(check, campaign.method, design, campaign.germs)
+    campaign.runs = len(design.weights)
+    return campaign
+
+
+def read_settings(text: str, source: str) -> tuple[Checker, dict, dict]:
+    """(checker, the YAML mapping, the checked `simulator:`) of campaign text: the name, seed and
+    simulator checked as written; nothing imported, located or built."""
+    check = Checker(source)
+    if len(text) > schema.MAX_FILE_BYTES:
+        check.fail("", f"the text is longer than {schema.MAX_FILE_BYTES // 1024} KiB; a campaign is a few "
+                       "lines of YAML")
+    try:
+        data = yaml.load(text, Loader=CampaignLoader)
+    except yaml.YAMLError as exc:
+        raise CampaignError(source, "", yaml_error(exc)) from exc
+    data = check.mapping(data, "", TOP_KEYS, required=("name", "simulator", "parameters", "design"))
+    schema.campaign_name(check, data["name"])
+    check.integer(data.get("seed", 0), "seed", 0)
+    return check, data, schema.simulator(check, data["simulator"])
+
+
+def build_campaign(check: Checker, data: dict, simulator: dict, parameters: list[Parameter], text: str) -> Campaign:
+    """The Campaign of a checked mapping (`read_settings`) and its parameters, its other sections checked
+    (the design is not built: `runs` stays None)."""
+    name = data["name"]
     design_kind = data["design"].get("kind") if isinstance(data["design"], dict) else None
     default_method = "monte_carlo" if design_kind in SAMPLED_DESIGNS else "integration"
     method = schema.method(check, data.get("method", {"kind": default_method}))
@@ -106,34 +136,5 @@ def parse_campaign(text: str, source: str = "<campaign>", probe: PropertyProbe |
     storage = schema.storage(check, data.get("storage", {}), name)
     analysis = schema.analysis(check, data.get("analysis", {}))
     limits = schema.limits(check, data.get("limits", {}))
-    if isinstance(data["design"], dict):  # sizes from the campaign alone, before building anything
-        schema.check_size(check, data, simulator, parameters, method, execution, storage, limits)
-    campaign = Campaign(source, text, name, seed, simulator, parameters, data["design"], method,
-                        execution, storage, analysis, limits)
-    try:
-        design = campaign.design()
-    except ValueError as exc:
-        message = str(exc)
-        field_path, sep, rest = message.partition(": ")
-        if sep and (field_path.startswith("design") or field_path == "seed"):
-            raise CampaignError(source, field_path, rest) from exc
-        raise CampaignError(source, "design", message) from exc
-    schema.check_method_fits_design(check, method, design, campaign.germs)
-    campaign.runs = len(design.weights)
-    return campaign
-
-
-def stored_parameters(campaign_text: str) -> list[dict] | None:
-    """The parameters of a campaign text stored in a results file, as dicts (name, property, distribution,
-    lower, upper, nominal), read through the campaign parser (nominal values from the aircraft when the
-    campaign leaves them to it); None when the text cannot be parsed."""
-    from ..simulators.jsbsim_probe import jsbsim_probe
-
-    for probe in (None, jsbsim_probe):
-        try:
-            campaign = parse_campaign(campaign_text, "<results file>", probe)
-        except Exception:  # noqa: BLE001 - e.g. an aircraft not on this machine: try the next way, else None
-            continue
-        return [{"name": p.name, "property": p.property, "distribution": p.distribution, "lower": p.lower,
-                 "upper": p.upper, "nominal": p.nominal} for p in campaign.parameters]
-    return None
+    return Campaign(check.source, text, name, data.get("seed", 0), simulator, parameters, data["design"], method,
+                    execution, storage, analysis, limits)

@@ -18,7 +18,7 @@ from ..parameters import DISTRIBUTIONS, Parameter, make_parameter
 from ..parameters.distributions import SEED_REFUSAL
 from ..simulators.jsbsim import Excitation, FlightSetup
 from ..simulators.patch import patch_kind
-from ..simulators.python import PluginError, load_function
+from ..simulators.python import PluginError, load_function, split_spec
 
 SIMULATOR_KINDS = ("jsbsim", "python")
 EXECUTORS = ("local", "dask")
@@ -185,7 +185,8 @@ def check_method_fits_design(check: Checker, method: dict, design: Design, germs
         check.fail("method.order" if method["kind"] != "monte_carlo" else "method.kind", problem)
 
 
-def simulator(check: Checker, value, source: str) -> dict:
+def simulator(check: Checker, value) -> dict:
+    """The `simulator:` mapping checked as written: nothing is imported or located (`resolve_simulator`)."""
     if not isinstance(value, dict):
         check.fail("simulator", f"expected a mapping with a kind key, got {shown(value)}")
     if "kind" not in value:
@@ -194,7 +195,7 @@ def simulator(check: Checker, value, source: str) -> dict:
     if kind == "python":
         sim = check.mapping(value, "simulator", PYTHON_KEYS, required=("function",))
         try:
-            load_function(sim["function"], Path(source).parent)
+            split_spec(sim["function"])
         except PluginError as exc:
             check.fail("simulator.function", str(exc))
         if "outputs" in sim:
@@ -203,12 +204,6 @@ def simulator(check: Checker, value, source: str) -> dict:
     sim = dict(check.mapping(value, "simulator", JSBSIM_KEYS))
     sim.setdefault("aircraft", "bacm")
     check.string(sim["aircraft"], "simulator.aircraft")
-    from ..simulators.aircraft import AircraftNotFound, locate
-
-    try:  # a path is relative to the campaign file; the resolved folder travels with the simulator
-        sim["aircraft_path"] = str(locate(sim["aircraft"], Path(source).resolve().parent).folder)
-    except AircraftNotFound as exc:
-        check.fail("simulator.aircraft", str(exc))
     if "trim" in sim:
         check.string(sim["trim"], "simulator.trim", FlightSetup.TRIMS)
     flight = check.mapping(sim.get("flight", {}), "simulator.flight", ("altitude_ft", "airspeed_ktas"))
@@ -245,6 +240,31 @@ def outputs(check: Checker, value) -> list[str]:
     if len(set(value)) != len(value):
         check.fail("simulator.outputs", "names must be unique")
     return value
+
+
+def resolve_simulator(check: Checker, sim: dict, source: str) -> None:
+    """Find what the simulator `sim` (checked by `simulator`) runs, relative to the campaign file
+    `source`: a python simulator's function is imported (its module's code runs); a JSBSim aircraft
+    is located (`sim["aircraft_path"]`, the folder that travels with the simulator). Only for
+    campaigns about to be planned or run: reading results never calls this."""
+    if sim["kind"] == "python":
+        try:
+            load_function(sim["function"], Path(source).parent)
+        except PluginError as exc:
+            check.fail("simulator.function", str(exc))
+        return
+    locate_aircraft(check, sim, source)
+
+
+def locate_aircraft(check: Checker, sim: dict, source: str) -> None:
+    """sim["aircraft_path"]: the folder of a JSBSim simulator's aircraft, relative to the campaign file
+    `source` (or the project's, JSBSim's; see `aircraft.locate`). Reads folders only."""
+    from ..simulators.aircraft import AircraftNotFound, locate
+
+    try:
+        sim["aircraft_path"] = str(locate(sim["aircraft"], Path(source).resolve().parent).folder)
+    except AircraftNotFound as exc:
+        check.fail("simulator.aircraft", str(exc))
 
 
 def parameters(check: Checker, value, kind: str, aircraft) -> list[Parameter]:

@@ -8,7 +8,7 @@ from pathlib import Path
 import numpy as np
 
 from . import plots
-from ..campaign import stored_parameters
+from ..campaign.reading import stored_parameters
 from .loading import Entry, _same_file, campaign_settings, design_info, file_name, method_label
 
 BELOW_FLOOR = "below reference resolution"
@@ -116,7 +116,7 @@ def run_section(entries: list[Entry], out_dir: Path) -> Section:
                       ("method", methods), ("seed", settings.get("seed", 0)), ("runs", counts),
                       ("created", e.attrs.get("created", "?")), ("aircraft sha256", e.attrs.get("aircraft_hash", "-")),
                       ("campaign sha256", e.campaign_hash), ("versions", versions)])
-        parameters = stored_parameters(text)
+        parameters = stored_parameters(e.attrs)
         if parameters is None:
             parameter_rows.append([e.stem, "(the campaign text could not be read)", "", "", "", "", ""])
         else:

@@ -22,12 +22,19 @@ class PluginError(ValueError):
     """A `simulator.function` that cannot be loaded; the message says what was expected."""
 
 
-def load_function(spec: str, base: Path) -> Callable:
-    """The callable named `module:attribute` or `path/to/file.py:attribute` (relative to base)."""
+def split_spec(spec) -> tuple[str, str]:
+    """(module or file, attribute) of `module:attribute` or `path/to/file.py:attribute`, nothing imported."""
     if not isinstance(spec, str) or spec.count(":") != 1:
         shown = repr(spec) if isinstance(spec, str) and len(repr(spec)) <= 60 else type(spec).__name__
         raise PluginError(f"expected 'package.module:callable' or 'file.py:callable', got {shown}")
     module_name, attribute = spec.split(":")
+    return module_name, attribute
+
+
+def load_function(spec: str, base: Path) -> Callable:
+    """The callable named `module:attribute` or `path/to/file.py:attribute` (relative to base): the
+    module is imported, which runs its code."""
+    module_name, attribute = split_spec(spec)
     try:
         if module_name.endswith(".py"):
             file = (base / module_name) if not Path(module_name).is_absolute() else Path(module_name)

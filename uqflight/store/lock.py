@@ -1,21 +1,32 @@
-"""One writer per results file: `FILE.lock`, created with O_EXCL, holding the writer's pid, host
-and process start time.
+"""One writer per results file: `FILE.lock`, holding the writer's pid, host and process start time
+as JSON (`{"pid", "host", "started", "since", "command"}`, nothing else).
 
-A second run on the same file is refused with the holder named. A lock whose process is gone (same
-host, pid dead or reused by another process) is stale and taken over; a lock from another host is
-never taken over automatically: the message says how to remove it.
+The lock appears whole: it is written to a temporary file beside it and hard-linked into place
+(`link` fails when FILE.lock exists), so a lock of ours is never empty or half written.
+
+A second run on the same file is refused with the holder named. Only a lock in this format whose
+holder is provably gone (written on this host, and its pid dead or now another process, told by its
+start time) is taken over. Anything else at FILE.lock (a lock from another host, text, JSON of
+another shape, a folder, a symbolic link) is never removed: the run is refused, naming the file
+and what to do.
 """
 from __future__ import annotations
 
+import errno
 import json
 import os
 import socket
+import stat
 import time
 from pathlib import Path
 
 
 class LockHeld(FileExistsError):
-    """Another run holds the results file."""
+    """Another run holds the results file, or something that is not a lock of ours sits at FILE.lock."""
+
+
+LOCK_KEYS = {"pid", "host", "started", "since", "command"}  # exactly what `acquire` writes
+LOCK_BYTES = 4096  # a lock we write is ~150 bytes: more is not ours
 
 
 def lock_path(path) -> Path:
@@ -23,16 +34,17 @@ def lock_path(path) -> Path:
     return path.with_name(path.name + ".lock")
 
 
-def _start_time(pid: int) -> str | None:
+def start_time(pid: int) -> str | None:
     """The process's start time in clock ticks since boot (/proc/PID/stat field 22), or None."""
     try:
-        stat = Path(f"/proc/{pid}/stat").read_text()
+        stat_line = Path(f"/proc/{pid}/stat").read_text()
     except OSError:
         return None
-    return stat.rsplit(")", 1)[1].split()[19]
+    return stat_line.rsplit(")", 1)[1].split()[19]
 
 
-def _alive(pid: int, started: str | None) -> bool:
+def alive(pid: int, started: str | None) -> bool:
+    """False only when no process `pid` runs, or the one that does started at another time."""
     if pid <= 0:
         return False
     try:
@@ -41,31 +53,60 @@ def _alive(pid: int, started: str | None) -> bool:
         return False
     except PermissionError:
         return True
-    now = _start_time(pid)
+    now = start_time(pid)
     return started is None or now is None or now == started
 
 
-LOCK_BYTES = 4096  # a lock we write is ~150 bytes: more is not ours
+def _is_ours(holder) -> bool:
+    """A lock exactly as `ResultsLock.acquire` writes it."""
+    return (isinstance(holder, dict) and set(holder) == LOCK_KEYS
+            and type(holder["pid"]) is int and 0 < holder["pid"] < 2**31
+            and isinstance(holder["host"], str) and isinstance(holder["since"], str)
+            and isinstance(holder["command"], str)
+            and (holder["started"] is None or isinstance(holder["started"], str) and holder["started"].isdigit()))
+
+
+def _read_lock(file: Path) -> tuple[dict | None, str, os.stat_result | None]:
+    """(holder, what the file is, its stat): holder is None unless `file` is a regular file (not a
+    link) holding a lock of ours; the description says what it is instead."""
+    try:
+        fd = os.open(file, os.O_RDONLY | os.O_NOFOLLOW | os.O_NONBLOCK)
+    except FileNotFoundError:
+        return None, "gone", None
+    except OSError:
+        kind = "a symbolic link" if file.is_symlink() else "a folder" if file.is_dir() else "unreadable"
+        return None, kind, None
+    try:
+        info = os.fstat(fd)
+        if not stat.S_ISREG(info.st_mode):
+            return None, "a folder" if stat.S_ISDIR(info.st_mode) else "not a regular file", info
+        data = os.read(fd, LOCK_BYTES + 1)
+    finally:
+        os.close(fd)
+    try:
+        holder = json.loads(data) if len(data) <= LOCK_BYTES else None
+    except (ValueError, RecursionError):
+        holder = None
+    if not _is_ours(holder):
+        return None, "empty" if not data else "a file uqflight did not write", info
+    return holder, "ours", info
 
 
 def read_holder(path) -> dict | None:
-    """The lock's holder {pid, host, started, since, command}, or None when the lock is unreadable or
-    not one a run of ours wrote (empty, being written, foreign, damaged)."""
-    try:
-        with open(lock_path(path), "rb") as fh:
-            holder = json.loads(fh.read(LOCK_BYTES + 1))
-    except (OSError, ValueError, RecursionError):
-        return None
-    pid = holder.get("pid") if isinstance(holder, dict) else None
-    if type(pid) is not int or not 0 < pid < 2**31:
-        return None
-    return holder
+    """The holder {pid, host, started, since, command} of FILE's lock, or None when there is no lock of
+    ours there."""
+    return _read_lock(lock_path(path))[0]
+
+
+def _gone(holder: dict) -> bool:
+    """The holder is provably not running: on this host, and its pid dead or another process now."""
+    return holder["host"] == socket.gethostname() and not alive(holder["pid"], holder["started"])
 
 
 def live_holder(path) -> dict | None:
     """The holder of FILE's lock when it is a live run on this host (a run writing the file now), else None."""
     holder = read_holder(path)
-    if holder and holder.get("host") == socket.gethostname() and _alive(int(holder.get("pid", 0)), holder.get("started")):
+    if holder and holder["host"] == socket.gethostname() and alive(holder["pid"], holder["started"]):
         return holder
     return None
 
@@ -86,47 +127,81 @@ class ResultsLock:
         self.held = False
 
     def acquire(self) -> None:
-        me = {"pid": os.getpid(), "host": socket.gethostname(), "started": _start_time(os.getpid()),
+        me = {"pid": os.getpid(), "host": socket.gethostname(), "started": start_time(os.getpid()),
               "since": time.strftime("%Y-%m-%d %H:%M:%S"), "command": "uqflight run"}
         for _ in range(3):
-            try:
-                fd = os.open(self.file, os.O_CREAT | os.O_EXCL | os.O_WRONLY, 0o644)
-            except FileExistsError:
-                holder = read_holder(self.path)
-                if self._stale(holder):
-                    try:
-                        self.file.unlink()
-                    except FileNotFoundError:
-                        pass
-                    continue
+            if self._place(me):
+                self.held = True
+                return
+            holder, kind, info = _read_lock(self.file)
+            if kind == "gone":
+                continue
+            if holder is None:
+                raise LockHeld(f"{self.file} exists and is not a uqflight lock ({kind}); uqflight removes only "
+                               f"locks it wrote. If no run of uqflight writes {self.path}, move {self.file} away "
+                               "or delete it, then run again") from None
+            if holder["host"] != socket.gethostname():
+                raise LockHeld(f"{self.path} is locked by a run on another host ({describe_holder(holder)}), which "
+                               f"cannot be checked from here; wait for it, or if you are sure it no longer runs, "
+                               f"remove {self.file}") from None
+            if not _gone(holder):
                 raise LockHeld(f"{self.path} is being written by another run ({describe_holder(holder)}); "
                                f"wait for it or stop it. If no such run exists, remove {self.file}") from None
-            try:
-                with os.fdopen(fd, "w") as fh:
-                    json.dump(me, fh)
-                    fh.flush()
-                    os.fsync(fh.fileno())
-            except OSError:  # e.g. a full disk: leave no empty lock behind
-                self.file.unlink(missing_ok=True)
-                raise
-            self.held = True
-            return
+            self._remove_if_same(info)
         raise LockHeld(f"{self.path}: cannot take the lock {self.file} (other runs keep taking it)")
 
-    def _stale(self, holder: dict | None) -> bool:
-        if holder is None:  # being written right now, or left empty by a crash: stale once old
+    def _place(self, me: dict) -> bool:
+        """Create FILE.lock holding `me`, whole (written beside it, then linked); False when it exists."""
+        temporary = self.file.with_name(f".{self.file.name}.{os.getpid()}.{time.monotonic_ns()}.tmp")
+        try:
+            with open(temporary, "x", encoding="utf-8") as fh:
+                json.dump(me, fh)
+                fh.flush()
+                os.fsync(fh.fileno())
             try:
-                return time.time() - self.file.stat().st_mtime > 10
-            except FileNotFoundError:
-                return True
-        if holder.get("host") != socket.gethostname():
+                os.link(temporary, self.file)
+            except OSError as exc:
+                if exc.errno not in (errno.EPERM, errno.EOPNOTSUPP):  # FileExistsError: someone's lock
+                    raise
+                self._create_in_place(me)  # a filesystem without hard links
+            return True
+        except FileExistsError:
             return False
-        return not _alive(int(holder.get("pid", -1)), holder.get("started"))
+        finally:
+            temporary.unlink(missing_ok=True)
+
+    def _create_in_place(self, me: dict) -> None:
+        """FILE.lock created with O_EXCL and written (empty for an instant; FileExistsError when it exists)."""
+        fd = os.open(self.file, os.O_CREAT | os.O_EXCL | os.O_WRONLY, 0o644)
+        try:
+            with os.fdopen(fd, "w", encoding="utf-8") as fh:
+                json.dump(me, fh)
+                fh.flush()
+                os.fsync(fh.fileno())
+        except OSError:  # e.g. a full disk: leave no empty lock behind
+            self.file.unlink(missing_ok=True)
+            raise
+
+    def _remove_if_same(self, seen: os.stat_result) -> None:
+        """Remove the stale lock `seen`, unless another run replaced it meanwhile: it is first moved
+        aside under a name of this process, and put back when it turns out to be another file."""
+        aside = self.file.with_name(f".{self.file.name}.{os.getpid()}.stale")
+        try:
+            os.rename(self.file, aside)
+        except FileNotFoundError:
+            return
+        moved = os.lstat(aside)
+        if (moved.st_dev, moved.st_ino) != (seen.st_dev, seen.st_ino):
+            try:
+                os.link(aside, self.file)  # a fresh lock taken meanwhile: back in place
+            except FileExistsError:
+                pass
+        os.unlink(aside)
 
     def release(self) -> None:
         if self.held:
             holder = read_holder(self.path)
-            if holder and holder.get("pid") == os.getpid():
+            if holder and holder["pid"] == os.getpid() and holder["host"] == socket.gethostname():
                 try:
                     self.file.unlink()
                 except FileNotFoundError:
