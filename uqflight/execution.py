@@ -125,8 +125,8 @@ def prepare_store(campaign: Campaign, design: Design, out: Path, force: bool, pr
              "analysis": json.dumps(campaign.analysis),
              "design_kind": design.kind, "design_info": json.dumps(design.info, default=str)}
     if campaign.simulator["kind"] == "jsbsim":
-        from .simulators.jsbsim import aircraft_hash, flight_setup_from
-        attrs["aircraft_hash"] = aircraft_hash(flight_setup_from(campaign.simulator))
+        from .simulators import simulator_provenance
+        attrs.update(simulator_provenance(campaign.simulator, Path(campaign.source).resolve().parent))
     out.parent.mkdir(parents=True, exist_ok=True)
     return open_for_campaign(
         out, campaign_text=campaign.text, force=force, restart=restart, xi=design.xi, kappa=kappa, weights=design.weights,
