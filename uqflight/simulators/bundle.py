@@ -2,7 +2,8 @@
 
 `make_bundle` packs, on the client, the files a simulator needs: the aircraft's XML files (the
 patched copy when parameters scale or offset its functions; engines and systems included) or a
-`file.py` python simulator, as bytes, with their sha256. `localized` unpacks them on the worker
+`file.py` python simulator, as bytes, with their sha256; and the files of a script scenario (the
+script, its initialisation file: `scenarios.ScenarioKind.files`). `localized` unpacks them on the worker
 into its own cache (`$UQFLIGHT_CACHE`, else `$XDG_CACHE_HOME/uqflight`, else ~/.cache/uqflight),
 keyed by the hash, and returns the spec's simulator mapping pointing there. Before a worker
 flies, it hashes the aircraft files it is about to load; files that differ from the client's
@@ -12,11 +13,14 @@ from __future__ import annotations
 
 import hashlib
 import io
+import os
+import shutil
 import zipfile
 from dataclasses import replace
 from pathlib import Path
 
 from .aircraft import AircraftFiles, cache_dir
+from .scenarios import scenario_entry
 
 
 class AircraftMismatch(RuntimeError):
@@ -45,7 +49,11 @@ def make_bundle(simulator: dict, properties, base: str | Path) -> dict | None:
             return None
         prepared = PreparedAircraft(simulator.get("aircraft_path", simulator.get("aircraft", "bacm")), Path(base),
                                     properties)
-        return {"kind": "aircraft", "name": prepared.name, "hash": prepared.hash, "zip": _zip(prepared.files.files)}
+        bundle = {"kind": "aircraft", "name": prepared.name, "hash": prepared.hash, "zip": _zip(prepared.files.files)}
+        files = scenario_entry(simulator).files(simulator)  # a script scenario's script and initialisation
+        if files:
+            bundle["scenario"] = {"hash": AircraftFiles("", files).hash(), "zip": _zip(files)}
+        return bundle
     module, _, attribute = str(simulator.get("function", "")).partition(":")
     if module.endswith(".py"):
         file = Path(module) if Path(module).is_absolute() else Path(base) / module
@@ -68,6 +76,9 @@ def localized(spec):
         check_aircraft(root, bundle["name"], bundle["hash"])
         simulator.update(root=str(root), aircraft=bundle["name"])
         simulator.pop("aircraft_path", None)
+        if bundle.get("scenario"):
+            folder = _unpacked(bundle["scenario"], cache_dir("scenario", bundle["scenario"]["hash"][:24]))
+            simulator = scenario_entry(simulator).localize(simulator, folder)
     else:
         folder = cache_dir("python", bundle["hash"][:24])
         file = folder / bundle["name"]
@@ -79,6 +90,28 @@ def localized(spec):
                                    f"(sha256 {bundle['hash'][:12]}): refusing to run it; delete {folder}")
         simulator["function"] = f"{file}:{bundle['attribute']}"
     return replace(spec, simulator=simulator, bundle=None)
+
+
+def _unpacked(files: dict, folder: Path) -> Path:
+    """A scenario's files written once into `folder` (all or nothing); AircraftMismatch when the files
+    found there do not hash to the client's."""
+    if not folder.is_dir():
+        tmp = folder.parent / f".{folder.name}.{os.getpid()}.tmp"
+        for name, data in _unzip(files["zip"]).items():
+            path = (tmp / name).resolve()
+            if not path.is_relative_to(tmp.resolve()):
+                raise AircraftMismatch(f"worker: the bundle's file {name!r} leads outside its folder")
+            path.parent.mkdir(parents=True, exist_ok=True)
+            path.write_bytes(data)
+        try:
+            tmp.rename(folder)
+        except OSError:  # another process wrote it first
+            shutil.rmtree(tmp, ignore_errors=True)
+    found = {p.relative_to(folder).as_posix(): p.read_bytes() for p in sorted(folder.rglob("*")) if p.is_file()}
+    if AircraftFiles("", found).hash() != files["hash"]:
+        raise AircraftMismatch(f"worker: the scenario files in {folder} differ from the client's (sha256 "
+                               f"{files['hash'][:12]}): refusing to fly them; delete {folder}")
+    return folder
 
 
 def check_aircraft(root: Path, name: str, expected: str) -> None:

@@ -203,6 +203,16 @@ def quiet_jsbsim() -> None:
     jsbsim.set_logger(jsbsim.DefaultLogger(jsbsim.LogLevel.FATAL))
 
 
+def ready_to_load(setup, preflight: bool = True) -> None:
+    """Before a flight loads `setup`'s aircraft: FileNotFoundError when its file is missing; with
+    `preflight`, the check that JSBSim loads it without aborting the process (preflight.py); JSBSim quiet."""
+    if not setup.aircraft_file.is_file():
+        raise FileNotFoundError(f"aircraft {setup.aircraft!r}: no file {setup.aircraft_file}")
+    if preflight:  # JSBSim may abort the process that loads a broken aircraft
+        check_loads(setup.root, setup.aircraft)
+    quiet_jsbsim()
+
+
 class PropertyAccess:
     """Cached property nodes of a loaded `self.fdm`, with errors naming the aircraft's closest properties."""
 
@@ -247,11 +257,7 @@ class JSBSimFlight(PropertyAccess):
     def __init__(self, setup: FlightSetup = FlightSetup(), preflight: bool = True):
         """`preflight` false: the caller reloads an aircraft this process has already loaded (and so
         checked, see preflight.py); the check would only hash its files again."""
-        if not setup.aircraft_file.is_file():
-            raise FileNotFoundError(f"aircraft {setup.aircraft!r}: no file {setup.aircraft_file}")
-        if preflight:  # JSBSim may abort the process that loads a broken aircraft
-            check_loads(setup.root, setup.aircraft)
-        quiet_jsbsim()
+        ready_to_load(setup, preflight)
         self.setup = setup
         self._bind(jsbsim.FGFDMExec(str(setup.root)), setup.aircraft)
         self.fdm.set_debug_level(0)

@@ -2,6 +2,7 @@
 
 - level_flight (the default): trim in unaccelerated level flight, elevator excitation, record
   (keys flight, excitation, duration_s, output_rate_hz, trim).
+- script: a JSBSim run script (`scenario: {kind: script, script, end_s}`, key output_rate_hz).
 
 An entry owns its keys and their checks (the campaign schema asks it), builds the setup and the
 flight of a campaign's `simulator:` mapping, counts its recorded times from the campaign alone, names
@@ -12,7 +13,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Callable
 
-from . import level_flight
+from . import level_flight, script
 
 
 @dataclass(frozen=True)
@@ -47,6 +48,11 @@ REGISTRY: dict[str, ScenarioKind] = {
         level_flight.KEYS, (), level_flight.check, level_flight.setup, level_flight.flight, level_flight.times,
         level_flight.files, level_flight.localize, level_flight.provenance, level_flight.resolution,
         {"kind": "jsbsim", "duration_s": 2.0, "output_rate_hz": 10.0}),
+    "script": ScenarioKind(
+        script.KEYS, script.SCENARIO_KEYS, script.check, script.setup, script.flight, script.times,
+        script.files, script.localize, script.provenance, script.resolution,
+        {"kind": "jsbsim", "scenario": {"kind": "script", "script": "c172_cruise_8K", "end_s": 2.0},
+         "output_rate_hz": 10.0}),
 }
 SCENARIO_KINDS = tuple(REGISTRY)
 DEFAULT = "level_flight"
