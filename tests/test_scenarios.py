@@ -1,6 +1,7 @@
 """Scenario kinds (simulator.scenario): a JSBSim run script flown as a campaign records what plain JSBSim
 records, writes and prints nothing, travels to workers in the bundle, and is refused at plan when it
 cannot be flown; both kinds' flight loops feed per-step observers the values plain JSBSim steps give."""
+import itertools
 import os
 import shutil
 from pathlib import Path
@@ -237,3 +238,32 @@ def test_a_script_campaign_is_bit_identical_with_one_or_two_workers(tmp_path):
     one = run_campaign(campaign, out=tmp_path / "one.h5", workers=1)
     two = run_campaign(campaign, out=tmp_path / "two.h5", workers=2)
     assert_same_results(one.path, two.path)
+
+
+class FirstContact:
+    """An observer: the first time each gear unit carries weight."""
+
+    properties = ("gear/unit[0]/WOW", "gear/unit[1]/WOW", "gear/unit[2]/WOW")
+
+    def __init__(self):
+        self.first = {}
+
+    def step(self, t, values):
+        for name, value in zip(self.properties, values):
+            if value > 0.5:
+                self.first.setdefault(name, t)
+
+
+@pytest.mark.slow
+def test_the_landing_campaign_touches_down_at_every_corner_of_its_box():
+    campaign = load_campaign(ROOT / "campaigns" / "c172p-landing.yaml", jsbsim_probe)
+    properties = [p.property for p in campaign.parameters]
+    simulator = make_simulator(campaign.simulator, [p.name for p in campaign.parameters], properties,
+                               ROOT / "campaigns")
+    end = simulator.setup.time[-1]
+    for corner in itertools.product(*[(p.lower, p.upper) for p in campaign.parameters]):
+        observer = FirstContact()
+        simulator.flight.fly(dict(zip(properties, corner)), observers=(observer,))
+        assert set(observer.first) == set(FirstContact.properties), corner  # both mains and the nose wheel
+        mains = min(observer.first["gear/unit[1]/WOW"], observer.first["gear/unit[2]/WOW"])
+        assert 20 < mains < observer.first["gear/unit[0]/WOW"] < end - 2, corner  # mains first, 2 s to spare
