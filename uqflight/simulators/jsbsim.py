@@ -131,10 +131,14 @@ class FlightSetup:
         return int(round(self.rate_hz / self.output_rate_hz))
 
     @property
+    def n_times(self) -> int:
+        """The number of recorded times (without building them: a size estimate reads it)."""
+        return int(round(self.duration_s * self.output_rate_hz)) + 1
+
+    @property
     def time(self) -> np.ndarray:
         """Recorded times [s]: 0 (the trimmed state) to duration_s at the output rate."""
-        n = int(round(self.duration_s * self.output_rate_hz))
-        return np.arange(n + 1) / self.output_rate_hz
+        return np.arange(self.n_times) / self.output_rate_hz
 
     @property
     def aircraft_file(self) -> Path:

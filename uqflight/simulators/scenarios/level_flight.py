@@ -51,7 +51,7 @@ def _timing(config: dict) -> FlightSetup:
 
 def times(config: dict) -> int:
     """The number of recorded times (the trimmed state, then duration_s at output_rate_hz)."""
-    return len(_timing(config).time)
+    return _timing(config).n_times
 
 
 def setup(config: dict, root: Path | None = None, base: Path | None = None, properties=()) -> FlightSetup:

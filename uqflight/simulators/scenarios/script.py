@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import difflib
 import json
+import math
 import shutil
 import tempfile
 import weakref
@@ -35,6 +36,7 @@ KEYS = ("output_rate_hz",)
 SCENARIO_KEYS = ("script", "end_s")
 DEFAULT_OUTPUT_RATE_HZ = 20.0
 MAX_SCRIPT_BYTES = 1 << 20
+MAX_SUMMED = 10**8  # steps (800 MB of times): beyond, a script's step count is the closed form's
 TIME = "simulation/sim-time-sec"
 
 
@@ -146,17 +148,33 @@ class ScriptFile:
         raise ScriptError(f"{self.path}: initialize={self.initialize!r} names no file beside the script nor in the "
                           f"aircraft folder {aircraft_folder}")
 
+    def _end(self, end_s: float | None) -> float:
+        """The last time a step may reach: the script's end (or `end_s` when earlier) plus 0.99 dt,
+        JSBSim's own margin (FGScript)."""
+        return (self.end_s if end_s is None else min(self.end_s, end_s)) + 0.99 * self.dt_s
+
+    def steps(self, end_s: float | None = None) -> int:
+        """The steps JSBSim runs before the end: the largest n whose summed time start + dt + ... + dt
+        is at most the end. The closed form decides unless the sum's rounding (n additions) could
+        cross the end, then the sum itself does (beyond MAX_SUMMED steps the closed form stands: a
+        size estimate off by one step of a flight that long)."""
+        end, dt = self._end(end_s), self.dt_s
+        n = max(0, math.floor((end - self.start_s) / dt))
+        slack = (n + 2) * max(abs(end), abs(self.start_s)) * 2.3e-16
+        near = min(abs(self.start_s + k * dt - end) for k in (n, n + 1)) <= slack
+        if near and n <= MAX_SUMMED:
+            summed = self._summed(n + 1)
+            n = int(np.searchsorted(summed, end, side="right")) - 1
+        return n
+
+    def _summed(self, n: int) -> np.ndarray:
+        """start, then the time after each of n steps, summed as JSBSim sums it (sim_time += dt; NumPy's
+        cumulative sum adds in order, bit for bit the same)."""
+        return np.cumsum(np.r_[self.start_s, np.full(n, self.dt_s)])
+
     def times(self, end_s: float | None = None) -> np.ndarray:
-        """The simulator's time after each step, from start: dt summed as JSBSim sums it, while at most
-        the end time (the script's, or `end_s` when earlier) plus 0.99 dt, JSBSim's own margin."""
-        dt = self.dt_s
-        end = (self.end_s if end_s is None else min(self.end_s, end_s)) + 0.99 * dt
-        t, times = self.start_s, [self.start_s]
-        while True:
-            t += dt
-            if t > end:
-                return np.array(times)
-            times.append(t)
+        """The simulator's time at the start and after every step until the end (see `steps`)."""
+        return self._summed(self.steps(end_s))
 
 
 def _script_file(config: dict, base: Path | None) -> ScriptFile:
@@ -212,7 +230,7 @@ def times(config: dict) -> int:
     """The number of recorded times, from the script's timing and the output rate alone."""
     script = _script_file(config, None)
     end_s = config.get("scenario", {}).get("end_s")
-    steps = len(script.times(None if end_s is None else float(end_s))) - 1
+    steps = script.steps(None if end_s is None else float(end_s))
     return steps // script.steps_per_output(float(config.get("output_rate_hz", DEFAULT_OUTPUT_RATE_HZ))) + 1
 
 
