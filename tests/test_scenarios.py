@@ -13,6 +13,7 @@ import pytest
 import yaml
 
 from conftest import ROOT, assert_same_results, cli
+from test_distributed_aircraft import cluster  # noqa: F401 - the separately started Dask workers
 from uqflight.campaign import CampaignError, load_campaign, parse_campaign
 from uqflight.execution import run_campaign, worker_spec
 from uqflight.simulators import make_simulator
@@ -267,3 +268,19 @@ def test_the_landing_campaign_touches_down_at_every_corner_of_its_box():
         assert set(observer.first) == set(FirstContact.properties), corner  # both mains and the nose wheel
         mains = min(observer.first["gear/unit[1]/WOW"], observer.first["gear/unit[2]/WOW"])
         assert 20 < mains < observer.first["gear/unit[0]/WOW"] < end - 2, corner  # mains first, 2 s to spare
+
+
+@pytest.mark.slow
+def test_separate_dask_workers_fly_a_script_campaign_bit_identical_to_the_local_pool(cluster, tmp_path, monkeypatch):
+    """Workers started apart, in another folder with their own cache, fly the landing script from the
+    bundle (the script and its initialisation unpacked in their cache) and give the local pool's results."""
+    monkeypatch.setenv("UQFLIGHT_CACHE", str(tmp_path / "client-cache"))
+    address, worker_cache = cluster
+    shutil.copytree(ROOT / "campaigns" / "scripts", tmp_path / "scripts")
+    path = script_campaign(tmp_path, scenario={"kind": "script", "script": "scripts/c172p-landing.xml", "end_s": 3})
+    campaign = load_campaign(path, jsbsim_probe)
+    local = run_campaign(campaign, out=tmp_path / "local.h5", workers=2, executor="local")
+    remote = run_campaign(campaign, out=tmp_path / "dask.h5", workers=1, executor="dask", scheduler=address)
+    assert_same_results(local.path, remote.path)
+    unpacked = worker_cache / "scenario" / worker_spec(campaign).bundle["scenario"]["hash"][:24]
+    assert sorted(os.listdir(unpacked)) == ["c172p-landing-init.xml", "c172p-landing.xml"]
