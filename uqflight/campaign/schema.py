@@ -17,6 +17,7 @@ from ..methods.exactness import exact_total_degree, max_projection_order
 from ..methods.validity import MAX_TERMS, method_problem
 from ..parameters import DISTRIBUTIONS, Parameter, make_parameter
 from ..simulators.python import PluginError, load_function
+from ..simulators.scenarios import DEFAULT as DEFAULT_SCENARIO
 from ..simulators.scenarios import REGISTRY as SCENARIOS
 from ..simulators.scenarios import SCENARIO_KINDS
 
@@ -201,7 +202,7 @@ def simulator(check: Checker, value, source: str) -> dict:
         if "outputs" in sim:
             outputs(check, sim["outputs"])
         return dict(sim)
-    kind = "level_flight"
+    kind = DEFAULT_SCENARIO
     if "scenario" in value:  # how the run is flown: the scenario kind owns its keys and their checks
         scenario = value["scenario"]
         if not isinstance(scenario, dict):
