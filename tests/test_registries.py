@@ -4,6 +4,7 @@ import math
 
 import numpy as np
 import pytest
+import yaml
 
 from uqflight.designs import REGISTRY as DESIGNS
 from uqflight.designs import build_design, design_size
@@ -11,6 +12,7 @@ from uqflight.designs.rules import RULE_TABLE, nodes_weights
 from uqflight.methods import METHODS, fit
 from uqflight.methods.basis import orthonormal_basis, orthonormal_polynomials, total_degree_indices
 from uqflight.parameters import DISTRIBUTIONS, GERMS, make_parameter
+from uqflight.simulators.scenarios import REGISTRY as SCENARIOS
 
 GERM_NAMES = list(GERMS)
 
@@ -171,3 +173,52 @@ def test_every_sampling_method_gives_the_sample_moments(kind):
     result = fit(kind, design.xi, design.weights, Y, germs)
     np.testing.assert_allclose(result.mean, Y.mean(axis=0), rtol=1e-14)
     np.testing.assert_allclose(result.variance, Y.var(axis=0, ddof=1), rtol=1e-12)
+
+
+def _scenario_campaign(simulator: dict) -> str:
+    return yaml.safe_dump({"name": "x", "simulator": simulator, "design": {"kind": "monte_carlo", "samples": 2},
+                           "parameters": {"wind": {"property": "atmosphere/wind-north-fps", "distribution": "uniform",
+                                                   "lower": -1, "upper": 1}}})
+
+
+class _Altitude:
+    properties = ("position/h-sl-ft",)
+
+    def __init__(self):
+        self.t, self.h = [], []
+
+    def step(self, t, values):
+        self.t.append(t)
+        self.h.append(values[0])
+
+
+@pytest.mark.parametrize("kind", list(SCENARIOS))
+def test_a_scenario_counts_its_times_from_the_campaign_and_its_observers_see_what_it_records(kind, tmp_path):
+    from uqflight.campaign import parse_campaign
+    from uqflight.simulators import make_simulator
+    from uqflight.simulators.jsbsim_probe import jsbsim_probe
+
+    entry = SCENARIOS[kind]
+    campaign = parse_campaign(_scenario_campaign({**entry.example, "outputs": ["h_ft"]}), str(tmp_path / "x.yaml"),
+                              jsbsim_probe)
+    simulator = make_simulator(campaign.simulator, ["wind"], ["atmosphere/wind-north-fps"], tmp_path)
+    time = simulator.setup.time
+    assert entry.times(campaign.simulator) == len(time)  # the size estimate is the flight's own grid
+    observer = _Altitude()
+    result = simulator.flight.fly({"atmosphere/wind-north-fps": 0.5}, observers=(observer,))
+    assert observer.t[0] == time[0] and len(observer.t) > len(time)  # t = 0, then every integration step
+    at = np.searchsorted(observer.t, time)
+    np.testing.assert_array_equal(np.asarray(observer.t)[at], time)  # the recorded times are steps' times
+    np.testing.assert_array_equal(np.asarray(observer.h)[at], result.outputs["h_ft"])  # and their values
+    assert all(isinstance(k, str) and not k.startswith(("/", "..")) for k in entry.files(campaign.simulator))
+
+
+@pytest.mark.parametrize("kind", list(SCENARIOS))
+def test_a_scenario_refuses_the_keys_of_the_others(kind, tmp_path):
+    from uqflight.campaign import CampaignError, parse_campaign
+
+    foreign = {key for other in SCENARIOS.values() for key in other.keys} - set(SCENARIOS[kind].keys)
+    for key in sorted(foreign):
+        text = _scenario_campaign({**SCENARIOS[kind].example, key: 1})
+        with pytest.raises(CampaignError, match=f"simulator.{key}: unknown key"):
+            parse_campaign(text, str(tmp_path / "x.yaml"))

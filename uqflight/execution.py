@@ -129,9 +129,9 @@ def prepare_store(campaign: Campaign, design: Design, out: Path, force: bool, pr
     if seeds:  # written only when there are any: files of other campaigns keep their attributes
         attrs["seeds"] = json.dumps(seeds)
     if campaign.simulator["kind"] == "jsbsim":
-        from .simulators.jsbsim import aircraft_hash, flight_setup_from
-        flown = flight_setup_from(campaign.simulator, properties=[p.property for p in campaign.parameters])
-        attrs["aircraft_hash"] = aircraft_hash(flown)  # the patched copy's, when parameters patch functions
+        from .simulators import simulator_provenance
+        attrs.update(simulator_provenance(campaign.simulator, Path(campaign.source).resolve().parent,
+                                          properties=[p.property for p in campaign.parameters]))
     out.parent.mkdir(parents=True, exist_ok=True)
     return open_for_campaign(
         out, campaign_text=campaign.text, force=force, restart=restart, xi=design.xi, kappa=kappa, weights=design.weights,

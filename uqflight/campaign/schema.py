@@ -16,15 +16,17 @@ from ..methods.exactness import exact_total_degree, max_projection_order
 from ..methods.validity import MAX_TERMS, method_problem
 from ..parameters import DISTRIBUTIONS, Parameter, make_parameter
 from ..parameters.distributions import SEED_REFUSAL
-from ..simulators.jsbsim import Excitation, FlightSetup
 from ..simulators.patch import patch_kind
 from ..simulators.python import PluginError, load_function, split_spec
+from ..simulators.scenarios import DEFAULT as DEFAULT_SCENARIO
+from ..simulators.scenarios import REGISTRY as SCENARIOS
+from ..simulators.scenarios import SCENARIO_KINDS, scenario_kind
 
 SIMULATOR_KINDS = ("jsbsim", "python")
 EXECUTORS = ("local", "dask")
 TOP_KEYS = ("name", "description", "seed", "simulator", "parameters", "design", "method",
             "execution", "storage", "analysis", "limits")
-JSBSIM_KEYS = ("kind", "aircraft", "flight", "excitation", "duration_s", "output_rate_hz", "outputs", "trim")
+JSBSIM_KEYS = ("kind", "aircraft", "scenario", "outputs")  # and the scenario kind's own (simulators/scenarios)
 PYTHON_KEYS = ("kind", "function", "outputs")
 PARAMETER_KEYS = ("property", "function", "perturbation", "distribution", "nominal", "interval_pct", "lower", "upper")
 PERTURBATIONS = ("scale", "offset", "offset_value")
@@ -201,32 +203,20 @@ def simulator(check: Checker, value) -> dict:
         if "outputs" in sim:
             outputs(check, sim["outputs"])
         return dict(sim)
-    sim = dict(check.mapping(value, "simulator", JSBSIM_KEYS))
-    sim.setdefault("aircraft", "bacm")
-    check.string(sim["aircraft"], "simulator.aircraft")
-    if "trim" in sim:
-        check.string(sim["trim"], "simulator.trim", FlightSetup.TRIMS)
-    flight = check.mapping(sim.get("flight", {}), "simulator.flight", ("altitude_ft", "airspeed_ktas"))
-    if "altitude_ft" in flight:
-        check.number(flight["altitude_ft"], "simulator.flight.altitude_ft", 0.0)
-    if "airspeed_ktas" in flight:
-        check.number(flight["airspeed_ktas"], "simulator.flight.airspeed_ktas", 0.0, strict=True)
-    excitation = check.mapping(sim.get("excitation", {}), "simulator.excitation",
-                               ("kind", "amplitude_deg", "start_s", "duration_s"))
-    if "kind" in excitation:
-        check.string(excitation["kind"], "simulator.excitation.kind", Excitation.KINDS)
-    if "amplitude_deg" in excitation:
-        check.number(excitation["amplitude_deg"], "simulator.excitation.amplitude_deg")
-    for key in ("start_s", "duration_s"):
-        if key in excitation:
-            check.number(excitation[key], f"simulator.excitation.{key}", 0.0)
-    if "duration_s" in sim:
-        check.number(sim["duration_s"], "simulator.duration_s", 0.0, strict=True)
-    if "output_rate_hz" in sim:
-        rate = check.number(sim["output_rate_hz"], "simulator.output_rate_hz", 0.0, strict=True)
-        if abs(120.0 / rate - round(120.0 / rate)) > 1e-9:
-            check.fail("simulator.output_rate_hz",
-                       f"expected a divisor of the 120 Hz integration rate (120, 60, 40, 30, 24, 20, ...), got {rate:g}")
+    kind = DEFAULT_SCENARIO
+    if "scenario" in value:  # how the run is flown: the scenario kind owns its keys and their checks
+        scenario = value["scenario"]
+        if not isinstance(scenario, dict):
+            check.fail("simulator.scenario", f"expected a mapping with a kind key, got {shown(scenario)}")
+        if "kind" not in scenario:
+            check.fail("simulator.scenario.kind", f"is required; expected one of {', '.join(SCENARIO_KINDS)}")
+        kind = check.string(scenario["kind"], "simulator.scenario.kind", SCENARIO_KINDS)
+        check.mapping(scenario, "simulator.scenario", ("kind", *SCENARIOS[kind].scenario_keys))
+    sim = dict(check.mapping(value, "simulator", (*JSBSIM_KEYS, *SCENARIOS[kind].keys)))
+    if kind == DEFAULT_SCENARIO:  # a script names its aircraft itself (resolved with the script)
+        sim.setdefault("aircraft", "bacm")
+    if "aircraft" in sim:
+        check.string(sim["aircraft"], "simulator.aircraft")
     if "outputs" in sim:
         outputs(check, sim["outputs"])
     return sim
@@ -253,6 +243,9 @@ def resolve_simulator(check: Checker, sim: dict, source: str) -> None:
         except PluginError as exc:
             check.fail("simulator.function", str(exc))
         return
+    folder = Path(source).resolve().parent
+    sim.update(SCENARIOS[scenario_kind(sim)].check(check, sim, folder))  # the scenario's keys, its files
+    check.string(sim.setdefault("aircraft", "bacm"), "simulator.aircraft")
     locate_aircraft(check, sim, source)
 
 
@@ -511,8 +504,11 @@ def check_size(check: Checker, data: dict, simulator: dict, parameters: list, me
         check.fail("method.order", f"a PCE of order {order} in {d} dimensions has {float(terms):.4g} "
                                    f"terms, more than limits.max_pce_terms = {limits['max_pce_terms']}")
     if simulator["kind"] == "jsbsim":
-        times = math.floor(float(simulator.get("duration_s", 50.0)) * float(simulator.get("output_rate_hz", 20.0))) + 1
-        n_outputs = len(simulator.get("outputs", ())) or 5
+        from ..simulators.jsbsim import DEFAULT_OUTPUTS
+        from ..simulators.scenarios import scenario_entry
+
+        times = scenario_entry(simulator).times(simulator)
+        n_outputs = len(simulator.get("outputs", DEFAULT_OUTPUTS))
     else:
         times, n_outputs = 1, len(simulator.get("outputs", ())) or 1  # known only once a sample has run
     n = points or 0

@@ -5,25 +5,27 @@ Both kinds offer `probe(kappa) -> (time, output names)`, `evaluate(kappa) -> {na
 """
 from __future__ import annotations
 
-from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
 
 from .base import FlightError
-from .jsbsim import UNITS, FlightSetup, JSBSimFlight, flight_setup_from
+from .jsbsim import UNITS, aircraft_hash
 from .python import PythonSimulator
+from .scenarios import scenario_entry
 
 
 class JSBSimSimulator:
-    """The campaign's aircraft and flight; parameters map to JSBSim properties."""
+    """The campaign's aircraft and flight, flown as its scenario kind says (scenarios/); parameters
+    map to JSBSim properties."""
 
     def __init__(self, config: dict, properties: list[str], base: Path | None = None):
         # the aircraft is located (a path relative to the campaign's folder) and, when parameters
         # set aero/uq/scale/... or aero/uq/offset/... properties, patched (see patch.py)
-        self.setup: FlightSetup = flight_setup_from(config, base=base, properties=properties)
+        self.scenario = scenario_entry(config)
+        self.setup = self.scenario.setup(config, base=base, properties=properties)
         self.properties = list(properties)
-        self.flight = JSBSimFlight(self.setup)
+        self.flight = self.scenario.flight(self.setup)
         self._flown = False
         self.units = {name: UNITS.get(name, "") for name in self.setup.outputs}
 
@@ -36,19 +38,9 @@ class JSBSimSimulator:
 
     def trim_repeatability(self, kappa: np.ndarray, ours: dict[str, np.ndarray] | None = None
                            ) -> dict[str, np.ndarray] | None:
-        """{output: (T,)}: how far the flight of `kappa` with the campaign's trim (`ours`, the outputs
-        `evaluate(kappa)` gave, flown here when None) and with the other trim (Newton's, JSBSim's) have
-        drifted apart so far, max over t' ≤ t of |y₁(t') − y₂(t')|. Both trims pass the same acceptance
-        checks, so a spread of the outputs below this is the trims' residual dynamics, not the inputs':
-        the simulator does not resolve it. None when either trim fails."""
-        other = replace(self.setup, trim="jsbsim" if self.setup.trim == "newton" else "newton")
-        settings = dict(zip(self.properties, map(float, kappa)))
-        try:
-            ours = ours if ours is not None else JSBSimFlight(self.setup, preflight=False).fly(settings).outputs
-            theirs = JSBSimFlight(other, preflight=False).fly(settings).outputs  # same files as __init__ checked
-        except FlightError:
-            return None
-        return {name: np.maximum.accumulate(np.abs(ours[name] - theirs[name])) for name in ours}
+        """{output: (T,)}: the simulator's own resolution at `kappa` as its scenario states it (level
+        flight: the drift between its two valid trims; see `level_flight.resolution`), or None."""
+        return self.scenario.resolution(self.setup, dict(zip(self.properties, map(float, kappa))), ours)
 
     def restart(self) -> None:
         """Reload the aircraft (about 2 ms), so that a chunk's results do not depend on what
@@ -56,8 +48,17 @@ class JSBSimSimulator:
         moves trims in the 13th digit. Chunks are fixed by design order, so results are
         bit-identical whatever the number of workers or the executor."""
         if self._flown:
-            self.flight = JSBSimFlight(self.setup, preflight=False)  # checked by __init__
+            self.flight = self.scenario.flight(self.setup, preflight=False)  # checked by __init__
             self._flown = False
+
+
+def simulator_provenance(config: dict, base: Path | None = None, properties=()) -> dict:
+    """Results-file attributes naming what a JSBSim campaign flew: the aircraft's hash (the patched copy's
+    when `properties` scale or offset its functions), and what its scenario kind adds (nothing for level
+    flight)."""
+    entry = scenario_entry(config)
+    return {"aircraft_hash": aircraft_hash(entry.setup(config, base=base, properties=properties)),
+            **entry.provenance(config)}
 
 
 def make_simulator(config: dict, parameter_names: list[str], properties: list[str], base: Path):
@@ -67,4 +68,4 @@ def make_simulator(config: dict, parameter_names: list[str], properties: list[st
     return JSBSimSimulator(config, properties, base)
 
 
-__all__ = ["FlightError", "JSBSimSimulator", "PythonSimulator", "make_simulator"]
+__all__ = ["FlightError", "JSBSimSimulator", "PythonSimulator", "make_simulator", "simulator_provenance"]

@@ -2,7 +2,8 @@
 
 `make_bundle` packs, on the client, the files a simulator needs: the aircraft's XML files (the
 patched copy when parameters scale or offset its functions; engines and systems included) or a
-`file.py` python simulator, as bytes, with their sha256. `localized` unpacks them on the worker
+`file.py` python simulator, as bytes, with their sha256; and the files of a script scenario (the
+script, its initialisation file: `scenarios.ScenarioKind.files`). `localized` unpacks them on the worker
 into its own cache (`$UQFLIGHT_CACHE`, else `$XDG_CACHE_HOME/uqflight`, else ~/.cache/uqflight),
 keyed by the hash, and returns the spec's simulator mapping pointing there. Before a worker
 flies, it hashes the aircraft files it is about to load; files that differ from the client's
@@ -17,14 +18,17 @@ from __future__ import annotations
 
 import hashlib
 import io
+import os
 import re
+import shutil
 import zipfile
 import zlib
 from dataclasses import replace
 from pathlib import Path
 
 from .aircraft import MAX_BYTES, MAX_FILES, AircraftFiles, AircraftUnsafe, cache_dir, unsafe_key
-from .safe_paths import single_name
+from .safe_paths import relative_name, single_name
+from .scenarios import scenario_entry
 
 SHA256 = re.compile(r"[0-9a-f]{64}")
 
@@ -109,7 +113,11 @@ def make_bundle(simulator: dict, properties, base: str | Path) -> dict | None:
             return None
         prepared = PreparedAircraft(simulator.get("aircraft_path", simulator.get("aircraft", "bacm")), Path(base),
                                     properties)
-        return {"kind": "aircraft", "name": prepared.name, "hash": prepared.hash, "zip": _zip(prepared.files.files)}
+        bundle = {"kind": "aircraft", "name": prepared.name, "hash": prepared.hash, "zip": _zip(prepared.files.files)}
+        files = scenario_entry(simulator).files(simulator)  # a script scenario's script and initialisation
+        if files:
+            bundle["scenario"] = {"hash": AircraftFiles("", files).hash(), "zip": _zip(files)}
+        return bundle
     module, _, attribute = str(simulator.get("function", "")).partition(":")
     if module.endswith(".py"):
         file = Path(module) if Path(module).is_absolute() else Path(base) / module
@@ -141,6 +149,13 @@ def localized(spec):
         check_aircraft(root, name, digest)
         simulator.update(root=str(root), aircraft=name)
         simulator.pop("aircraft_path", None)
+        if bundle.get("scenario"):
+            scenario = bundle["scenario"]
+            if not (isinstance(scenario, dict) and isinstance(scenario.get("hash"), str)
+                    and SHA256.fullmatch(scenario["hash"]) and isinstance(scenario.get("zip"), bytes)):
+                raise _refuse("scenario: expected a sha256 and the files as zip bytes")
+            folder = _unpacked(scenario, cache_dir("scenario", scenario["hash"][:24]))
+            simulator = scenario_entry(simulator).localize(simulator, folder)
     else:
         data = _unzip(bundle["zip"], lambda key: None if key == name else f"expected only {name!r}")
         if name not in data or hashlib.sha256(data[name]).hexdigest() != digest:
@@ -155,6 +170,36 @@ def localized(spec):
                                    f"(sha256 {digest[:12]}): refusing to run it; delete {folder}")
         simulator["function"] = f"{file}:{bundle['attribute']}"
     return replace(spec, simulator=simulator, bundle=None)
+
+
+def _unsafe_scenario_key(key: str) -> str | None:
+    """Why `key` cannot name a scenario file (None when it can): a normalized path inside its folder."""
+    return None if isinstance(key, str) and relative_name(key) == key else (
+        "expected a relative path inside the scenario's folder (no leading /, no .., backslash, drive or NUL)")
+
+
+def _unpacked(files: dict, folder: Path) -> Path:
+    """A scenario's files written once into `folder` (all or nothing), once their names, count, size and
+    hash are checked (BundleRefused, nothing written); AircraftMismatch when the files found there do not
+    hash to the client's."""
+    if not folder.is_dir():
+        data = _unzip(files["zip"], _unsafe_scenario_key)
+        if AircraftFiles("", data).hash() != files["hash"]:
+            raise _refuse(f"the scenario's files do not hash to the bundle's sha256 {files['hash'][:12]}")
+        tmp = folder.parent / f".{folder.name}.{os.getpid()}.tmp"
+        for name, content in data.items():
+            path = tmp / name
+            path.parent.mkdir(parents=True, exist_ok=True)
+            path.write_bytes(content)
+        try:
+            tmp.rename(folder)
+        except OSError:  # another process wrote it first
+            shutil.rmtree(tmp, ignore_errors=True)
+    found = {p.relative_to(folder).as_posix(): p.read_bytes() for p in sorted(folder.rglob("*")) if p.is_file()}
+    if AircraftFiles("", found).hash() != files["hash"]:
+        raise AircraftMismatch(f"worker: the scenario files in {folder} differ from the client's (sha256 "
+                               f"{files['hash'][:12]}): refusing to fly them; delete {folder}")
+    return folder
 
 
 def check_aircraft(root: Path, name: str, expected: str) -> None:

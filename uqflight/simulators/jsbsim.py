@@ -1,16 +1,22 @@
-"""One trimmed, excited JSBSim flight per sample, on an aircraft loaded once and reused.
+"""One trimmed, excited JSBSim flight per sample, on an aircraft loaded once and reused: the
+`level_flight` scenario (see scenarios/), and what every JSBSim scenario shares.
 
 `JSBSimFlight` is the worker-side object: it loads the aircraft once, then for every sample
 resets the model, sets the sample's properties, trims in unaccelerated level flight, applies
 the elevator excitation and records the outputs. A reused instance gives the same
 trajectories as a freshly loaded one (the reset restores every property the previous sample
 touched and the controls' values at load time).
+
+Every scenario's flight loop accepts observers (`Observer`): the quantities of interest are
+computed by one, at every integration step.
 """
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Protocol
 
 import jsbsim
 import numpy as np
@@ -112,11 +118,11 @@ class FlightSetup:
     def __post_init__(self):
         if self.trim not in self.TRIMS:
             raise ValueError(f"trim: expected one of {', '.join(self.TRIMS)}, got {self.trim!r}")
-        ratio = self.rate_hz / self.output_rate_hz
-        if self.output_rate_hz <= 0 or abs(ratio - round(ratio)) > 1e-9 or round(ratio) < 1:
-            raise ValueError(
-                f"output_rate_hz: expected a divisor of the integration rate {self.rate_hz:g} Hz, "
-                f"got {self.output_rate_hz:g}")
+        ratio = self.rate_hz / self.output_rate_hz if self.output_rate_hz > 0 else 0.0
+        if abs(ratio - round(ratio)) > 1e-9 or round(ratio) < 1:
+            divisors = ", ".join(f"{self.rate_hz / k:g}" for k in range(1, 7))
+            raise ValueError(f"output_rate_hz: expected a divisor of the {self.rate_hz:g} Hz integration rate "
+                             f"({divisors}, ...), got {self.output_rate_hz:g}")
         if self.duration_s <= 0:
             raise ValueError(f"duration_s: expected a positive number, got {self.duration_s:g}")
 
@@ -125,10 +131,14 @@ class FlightSetup:
         return int(round(self.rate_hz / self.output_rate_hz))
 
     @property
+    def n_times(self) -> int:
+        """The number of recorded times (without building them: a size estimate reads it)."""
+        return int(round(self.duration_s * self.output_rate_hz)) + 1
+
+    @property
     def time(self) -> np.ndarray:
         """Recorded times [s]: 0 (the trimmed state) to duration_s at the output rate."""
-        n = int(round(self.duration_s * self.output_rate_hz))
-        return np.arange(n + 1) / self.output_rate_hz
+        return np.arange(self.n_times) / self.output_rate_hz
 
     @property
     def aircraft_file(self) -> Path:
@@ -157,7 +167,31 @@ class TrimResult:
 class FlightResult:
     time: np.ndarray
     outputs: dict[str, np.ndarray]
-    trim: TrimResult
+    trim: TrimResult | None  # None: the scenario has no trim of its own (a script trims itself, if at all)
+
+
+class Observer(Protocol):
+    """Watches one flight: `step(t, values)` is called once at t = 0 (after the trim, or after a script's
+    run_ic) and after every integration step, with the current values of `properties` in order. A
+    level flight also calls `at_trim(fdm)`, when the observer has it, right after a successful trim and
+    before the excitation."""
+
+    properties: tuple[str, ...]
+
+    def step(self, t: float, values: Sequence[float]) -> None:
+        """One integration step's values of `properties` at the simulator's time t [s]."""
+
+
+class Watch:
+    """A flight's observers bound to their property nodes: `watch(t)` calls every observer's step."""
+
+    def __init__(self, flight, observers: Sequence[Observer]):
+        self._bound = [(observer.step, [flight.node(name) for name in observer.properties])
+                       for observer in observers]
+
+    def __call__(self, t: float) -> None:
+        for step, nodes in self._bound:
+            step(t, [node.get_double_value() for node in nodes])
 
 
 def aircraft_hash(setup: FlightSetup) -> str:
@@ -173,31 +207,27 @@ def quiet_jsbsim() -> None:
     jsbsim.set_logger(jsbsim.DefaultLogger(jsbsim.LogLevel.FATAL))
 
 
-class JSBSimFlight:
-    """A loaded aircraft that flies any number of samples: reset, set, trim, excite, record."""
+def ready_to_load(setup, preflight: bool = True) -> None:
+    """Before a flight loads `setup`'s aircraft: FileNotFoundError when its file is missing; with
+    `preflight`, the check that JSBSim loads it without aborting the process (preflight.py); JSBSim quiet."""
+    if not setup.aircraft_file.is_file():
+        raise FileNotFoundError(f"aircraft {setup.aircraft!r}: no file {setup.aircraft_file}")
+    if preflight:  # JSBSim may abort the process that loads a broken aircraft
+        check_loads(setup.root, setup.aircraft)
+    quiet_jsbsim()
 
-    def __init__(self, setup: FlightSetup = FlightSetup(), preflight: bool = True):
-        """`preflight` false: the caller reloads an aircraft this process has already loaded (and so
-        checked, see preflight.py); the check would only hash its files again."""
-        if not setup.aircraft_file.is_file():
-            raise FileNotFoundError(f"aircraft {setup.aircraft!r}: no file {setup.aircraft_file}")
-        if preflight:  # JSBSim may abort the process that loads a broken aircraft
-            check_loads(setup.root, setup.aircraft)
-        quiet_jsbsim()
-        self.setup = setup
-        self.fdm = jsbsim.FGFDMExec(str(setup.root))
-        self.fdm.set_debug_level(0)
-        if not self.fdm.load_model(setup.aircraft):
-            raise RuntimeError(f"JSBSim could not load aircraft {setup.aircraft!r} from {setup.root}")
-        self.fdm.set_dt(1.0 / setup.rate_hz)
-        self._pm = self.fdm.get_property_manager()
+
+class PropertyAccess:
+    """Cached property nodes of a loaded `self.fdm`, with errors naming the aircraft's closest properties."""
+
+    fdm: jsbsim.FGFDMExec
+    aircraft: str
+
+    def _bind(self, fdm: jsbsim.FGFDMExec, aircraft: str) -> None:
+        self.fdm, self.aircraft = fdm, aircraft
+        self._pm = fdm.get_property_manager()
         self._nodes: dict[str, object] = {}
-        self._engines = self.fdm.get_propulsion().get_num_engines()
-        self._load_values = {p: self.node(p).get_double_value() for p in TRIM_CONTROLS if self.has_property(p)}
-        self._touched: dict[str, float] = {}
-        self._recorded = [self._output_source(name) for name in setup.outputs]
 
-    # -- properties -------------------------------------------------------------------------
     def has_property(self, name: str) -> bool:
         return bool(self._pm.hasNode(name))
 
@@ -206,7 +236,7 @@ class JSBSimFlight:
         node = self._nodes.get(name)
         if node is None:
             if not self.has_property(name):
-                raise KeyError(f"property {name!r} does not exist in aircraft {self.setup.aircraft!r}"
+                raise KeyError(f"property {name!r} does not exist in aircraft {self.aircraft!r}"
                                f"{self.property_hint(name)}")
             node = self._nodes[name] = self._pm.get_node(name)
         return node
@@ -220,21 +250,50 @@ class JSBSimFlight:
         close = difflib.get_close_matches(name.lower(), by_lower, n=3, cutoff=0.8)
         return f"; did you mean {' or '.join(by_lower[c] for c in close)}?" if close else ""
 
+    def _output_source(self, name: str):
+        prop, scale = NAMED_OUTPUTS.get(name, (name, 1.0))
+        return self.node(prop), scale
+
+
+class JSBSimFlight(PropertyAccess):
+    """A loaded aircraft that flies any number of samples: reset, set, trim, excite, record."""
+
+    def __init__(self, setup: FlightSetup = FlightSetup(), preflight: bool = True):
+        """`preflight` false: the caller reloads an aircraft this process has already loaded (and so
+        checked, see preflight.py); the check would only hash its files again."""
+        ready_to_load(setup, preflight)
+        self.setup = setup
+        self._bind(jsbsim.FGFDMExec(str(setup.root)), setup.aircraft)
+        self.fdm.set_debug_level(0)
+        if not self.fdm.load_model(setup.aircraft):
+            raise RuntimeError(f"JSBSim could not load aircraft {setup.aircraft!r} from {setup.root}")
+        self.fdm.set_dt(1.0 / setup.rate_hz)
+        self._engines = self.fdm.get_propulsion().get_num_engines()
+        self._load_values = {p: self.node(p).get_double_value() for p in TRIM_CONTROLS if self.has_property(p)}
+        self._touched: dict[str, float] = {}
+        self._recorded = [self._output_source(name) for name in setup.outputs]
+
+    # -- properties -------------------------------------------------------------------------
     def property_value(self, name: str) -> float | None:
         """The value of `name` as loaded (None when the aircraft has no such property)."""
         if name in self._touched:
             return self._touched[name]
         return self.node(name).get_double_value() if self.has_property(name) else None
 
-    def _output_source(self, name: str):
-        prop, scale = NAMED_OUTPUTS.get(name, (name, 1.0))
-        return self.node(prop), scale
+    def prepare_probe(self) -> None:
+        """The state campaign validation reads nominal values in: the flight condition's initial
+        conditions set, as `trim` sets them (so `ic/vc-kts` reads the matching calibrated airspeed)."""
+        self.fdm["ic/h-sl-ft"] = self.setup.altitude_ft
+        self.fdm["ic/vt-kts"] = self.setup.airspeed_ktas
 
     # -- one sample -------------------------------------------------------------------------
-    def fly(self, settings: dict[str, float] | None = None) -> FlightResult:
-        """Fly one sample with the given property values; raises a FlightError subclass."""
+    def fly(self, settings: dict[str, float] | None = None, observers: Sequence[Observer] = ()) -> FlightResult:
+        """Fly one sample with the given property values, watched by `observers`; raises a FlightError subclass."""
         trim = self.trim(settings or {})
-        return self.run_trimmed(trim)
+        for observer in observers:
+            if hasattr(observer, "at_trim"):
+                observer.at_trim(self.fdm)
+        return self.run_trimmed(trim, observers)
 
     def trim(self, settings: dict[str, float]) -> TrimResult:
         """Reset, apply `settings`, trim in unaccelerated level flight and settle the engines.
@@ -336,8 +395,9 @@ class JSBSimFlight:
             raise TrimError(f"trim angle of attack {result.alpha_deg:.2f} deg is past the stall")
         return result
 
-    def run_trimmed(self, trim: TrimResult) -> FlightResult:
-        """Excite and integrate from the trimmed state, recording at the output rate."""
+    def run_trimmed(self, trim: TrimResult, observers: Sequence[Observer] = ()) -> FlightResult:
+        """Excite and integrate from the trimmed state, recording at the output rate; `observers` see
+        t = 0 and every step (t = steps / rate_hz)."""
         s = self.setup
         time = s.time
         k = s.steps_per_output
@@ -350,10 +410,15 @@ class JSBSimFlight:
         run = self.fdm.run
         data = np.empty((len(time), len(self._recorded)))
         data[0] = [node.get_double_value() for node, _ in self._recorded]
+        watch = Watch(self, observers) if observers else None
+        if watch:
+            watch(0.0)
         for i in range(n_steps):
             if i in change_at:
                 exc_node.set_double_value(exc_base + exc_per_deg * change_at[i])
             run()
+            if watch:
+                watch((i + 1) / s.rate_hz)
             if (i + 1) % k == 0:
                 data[(i + 1) // k] = [node.get_double_value() for node, _ in self._recorded]
         exc_node.set_double_value(exc_base)
@@ -384,37 +449,24 @@ class JSBSimFlight:
         return self._travel
 
     def _check_envelope(self, data: np.ndarray) -> None:
-        if not np.all(np.isfinite(data)):
-            raise DivergenceError("NaN or infinite value in the recorded outputs")
+        check_finite(data)
         for name, limit in DIVERGENCE_LIMITS.items():
             value = self.fdm[name]
             if not abs(value) <= limit:
                 raise DivergenceError(f"{name} = {value:.1f} at the end of the flight (limit {limit:g})")
 
 
-def flight_setup_from(config: dict, root: Path | None = None, base: Path | None = None,
-                      properties=()) -> FlightSetup:
-    """A FlightSetup from a campaign's `simulator:` mapping (keys already validated). The aircraft
-    is located (a path relative to `base`, the project's, JSBSim's; see `aircraft.locate`) and
-    patched when `properties` scale or offset its functions, unless `root` or config["root"] is given."""
-    from .aircraft import default_condition
-    from .patch import PreparedAircraft
+def check_finite(data: np.ndarray) -> None:
+    """DivergenceError when the recorded outputs hold a NaN or an infinity."""
+    if not np.all(np.isfinite(data)):
+        raise DivergenceError("NaN or infinite value in the recorded outputs")
 
-    name = config.get("aircraft", "bacm")
-    root = config.get("root", root)
-    if root is None:
-        prepared = PreparedAircraft(config.get("aircraft_path", name), base, properties)
-        name, root = prepared.name, prepared.root
-    flight = {**default_condition(name), **config.get("flight", {})}
-    return FlightSetup(
-        aircraft=name,
-        root=Path(root),
-        altitude_ft=float(flight["altitude_ft"]),
-        airspeed_ktas=float(flight["airspeed_ktas"]),
-        excitation=Excitation(**config.get("excitation", {})),
-        duration_s=float(config.get("duration_s", 50.0)),
-        rate_hz=float(config.get("rate_hz", 120.0)),
-        output_rate_hz=float(config.get("output_rate_hz", 20.0)),
-        outputs=tuple(config.get("outputs", DEFAULT_OUTPUTS)),
-        trim=config.get("trim", "newton"),
-    )
+
+def flight_setup_from(config: dict, root: Path | None = None, base: Path | None = None, properties=()):
+    """The setup of a campaign's `simulator:` mapping (keys already validated), built by its scenario
+    kind (scenarios/): the aircraft located (a path relative to `base`, the project's, JSBSim's; see
+    `aircraft.locate`) and patched when `properties` scale or offset its functions, unless `root` or
+    config["root"] is given."""
+    from .scenarios import scenario_entry
+
+    return scenario_entry(config).setup(config, root, base, properties)

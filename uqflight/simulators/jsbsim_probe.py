@@ -4,27 +4,27 @@ from __future__ import annotations
 
 import jsbsim
 
-from .jsbsim import JSBSimFlight, flight_setup_from
+from .jsbsim import flight_setup_from
 
 
 class AircraftProperties:
-    """The campaign's aircraft as a sample finds it before the trim: loaded, with the flight
-    condition's initial conditions set (so `ic/vt-kts` reads the campaign's airspeed and
-    `ic/vc-kts` the matching calibrated airspeed). Validation reads nominal values here."""
+    """The campaign's aircraft as a sample finds it before the flight, as its scenario prepares it
+    (level flight: loaded, with the flight condition's initial conditions set, so `ic/vt-kts` reads the
+    campaign's airspeed and `ic/vc-kts` the matching calibrated airspeed; a script: loaded with it).
+    Validation reads nominal values here."""
 
     def __init__(self, simulator: dict):
         from .aircraft import aero_functions
         from .reference import references
+        from .scenarios import scenario_entry
 
         setup = flight_setup_from({**simulator, "outputs": []})  # raises AircraftNotFound (a FileNotFoundError)
         self.aircraft = setup.aircraft
         xml = setup.aircraft_file.read_bytes()
         self.functions = [f.name for f in aero_functions(xml)]
         self.references = references(xml)  # each function's unit and reference factor
-        self._flight = JSBSimFlight(setup)
-        fdm = self._flight.fdm
-        fdm["ic/h-sl-ft"] = setup.altitude_ft  # as JSBSimFlight.trim sets them
-        fdm["ic/vt-kts"] = setup.airspeed_ktas
+        self._flight = scenario_entry(simulator).flight(setup)
+        self._flight.prepare_probe()
 
     def value(self, name: str) -> float | None:
         """The property's value (None when the aircraft has no such property)."""

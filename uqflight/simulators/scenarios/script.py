@@ -1,0 +1,417 @@
+"""The `script` scenario: a JSBSim run script flown as JSBSim flies it (`load_script`, `run_ic`, `run`).
+
+`simulator.scenario: {kind: script, script: PATH_OR_NAME, end_s: T}`: PATH_OR_NAME is a file relative
+to the campaign's folder, or the name of a script shipped with JSBSim (`c172_cruise_8K`). The aircraft
+and its initial conditions are the script's `<use aircraft= initialize=>`: the initialisation file
+beside the script when there is one, else the aircraft folder's (JSBSim's rule). `end_s` cuts the
+script's end time. A sample sets its `ic/...` properties before `run_ic`, the others after it.
+
+Every sample loads the script afresh (its events and local properties start over) with the script's
+`<output>` and state files sent to a scratch folder and disabled, so nothing is written beside the
+script, the aircraft or the working directory. The recorded times are the simulator's own
+(`simulation/sim-time-sec`): the script's dt summed as JSBSim sums it, the same for every sample.
+"""
+from __future__ import annotations
+
+import difflib
+import json
+import math
+import shutil
+import tempfile
+import weakref
+import xml.etree.ElementTree as ET
+from dataclasses import dataclass
+from functools import cached_property
+from decimal import Decimal, InvalidOperation
+from pathlib import Path
+
+import jsbsim
+import numpy as np
+
+from ..aircraft import AircraftFiles
+from ..base import FlightError, TrimError
+from ..jsbsim import DEFAULT_OUTPUTS, FlightResult, PropertyAccess, Watch, check_finite, ready_to_load
+
+KEYS = ("output_rate_hz",)
+SCENARIO_KEYS = ("script", "end_s")
+DEFAULT_OUTPUT_RATE_HZ = 20.0
+MAX_SCRIPT_BYTES = 1 << 20
+MAX_SUMMED = 10**8  # steps (800 MB of times): beyond, a script's step count is the closed form's
+TIME = "simulation/sim-time-sec"
+
+
+class ScriptError(ValueError):
+    """A script that cannot be flown: not found, not a JSBSim run script, or naming files it lacks."""
+
+
+def jsbsim_scripts() -> Path:
+    """The scripts shipped with JSBSim's Python package."""
+    return Path(jsbsim.__file__).resolve().parent / "scripts"
+
+
+def resolve(text: str, folder: Path) -> Path:
+    """The script `text` names: a file relative to `folder`, else one of JSBSim's scripts (without .xml)."""
+    candidate = Path(text).expanduser()
+    candidate = candidate if candidate.is_absolute() else Path(folder) / candidate
+    if candidate.is_file():
+        return candidate.resolve()
+    shipped = jsbsim_scripts()
+    if "/" not in text and (shipped / f"{text}.xml").is_file():
+        return (shipped / f"{text}.xml").resolve()
+    names = sorted(p.stem for p in shipped.glob("*.xml"))
+    close = difflib.get_close_matches(text, names, n=3, cutoff=0.6)
+    hint = f"; did you mean {' or '.join(close)}?" if close else ""
+    raise ScriptError(f"no script {text!r}: expected a file relative to {folder} or the name of one of the "
+                      f"{len(names)} scripts shipped with JSBSim, without .xml (e.g. c172_cruise_8K){hint}")
+
+
+def _inside(folder: Path, name: str) -> Path:
+    """folder/name, refused when the name leads outside the folder."""
+    path = (folder / name).resolve()
+    if not path.is_relative_to(folder.resolve()):
+        raise ScriptError(f"{name!r} leads outside the script's folder {folder}")
+    return path
+
+
+@dataclass(frozen=True)
+class ScriptFile:
+    """What uqflight reads of a run script: its aircraft and initialisation, its timing, the files it names."""
+
+    path: Path
+    aircraft: str
+    initialize: str
+    start_s: float
+    end_s: float
+    dt_s: float
+    dt_text: str
+    outputs_files: tuple[str, ...]  # `<output file=...>`, relative to the script's folder
+
+    @classmethod
+    def read(cls, path: Path) -> "ScriptFile":
+        path = Path(path)
+        data = path.read_bytes()
+        if len(data) > MAX_SCRIPT_BYTES:
+            raise ScriptError(f"{path} is larger than {MAX_SCRIPT_BYTES >> 10} KiB; a run script is a few pages of XML")
+        try:
+            root = ET.fromstring(data)
+        except ET.ParseError as exc:
+            raise ScriptError(f"{path} is not well-formed XML ({exc})") from None
+        if root.tag != "runscript":
+            raise ScriptError(f"{path} is not a JSBSim run script (its root element is <{root.tag}>, not <runscript>)")
+        use, run = root.find("use"), root.find("run")
+        if use is None or not use.get("aircraft") or not use.get("initialize"):
+            raise ScriptError(f"{path}: expected <use aircraft=... initialize=...>")
+        if run is None or run.get("end") is None or run.get("dt") is None:
+            raise ScriptError(f"{path}: expected <run start=... end=... dt=...>")
+        try:
+            start, end, dt = (float(run.get(key, "0").strip()) for key in ("start", "end", "dt"))
+        except ValueError:
+            raise ScriptError(f"{path}: <run> start, end and dt must be numbers") from None
+        if not dt > 0 or not end > start:
+            raise ScriptError(f"{path}: <run> needs dt > 0 and end > start, got start={start:g}, end={end:g}, dt={dt:g}")
+        files = tuple(e.get("file").strip() for e in root.iter("output") if e.get("file"))
+        for name in files:
+            _inside(path.parent, name)
+        return cls(path, use.get("aircraft").strip(), use.get("initialize").strip(), start, end, dt,
+                   run.get("dt").strip(), files)
+
+    @property
+    def rate_hz(self) -> float:
+        return 1.0 / self.dt_s
+
+    @property
+    def dt_rounding(self) -> float:
+        """Half a unit of the last digit of dt as the script writes it (0.0083333: 5e-8)."""
+        try:
+            exponent = Decimal(self.dt_text).as_tuple().exponent
+        except InvalidOperation:
+            return 0.0
+        return 0.5 * 10.0 ** exponent if isinstance(exponent, int) else 0.0
+
+    def steps_per_output(self, output_rate_hz: float) -> int | None:
+        """Integration steps per recorded time; None when `output_rate_hz` does not divide the script's
+        rate within the rounding of its dt (k steps of dt must last 1 / output_rate_hz)."""
+        k = round(1.0 / (self.dt_s * output_rate_hz))
+        if k < 1:
+            return None
+        tolerance = k * self.dt_rounding + 1e-9 * k * self.dt_s
+        return k if abs(k * self.dt_s - 1.0 / output_rate_hz) <= tolerance else None
+
+    def initfile(self, aircraft_folder: Path) -> Path | None:
+        """The initialisation file beside the script (passed to JSBSim), else None: then JSBSim reads
+        the aircraft folder's; ScriptError when neither exists."""
+        for folder in (self.path.parent, Path(aircraft_folder)):
+            for name in (self.initialize, f"{self.initialize}.xml"):
+                candidate = _inside(folder, name)
+                if candidate.is_file():
+                    return candidate if folder == self.path.parent else None
+        raise ScriptError(f"{self.path}: initialize={self.initialize!r} names no file beside the script nor in the "
+                          f"aircraft folder {aircraft_folder}")
+
+    def _end(self, end_s: float | None) -> float:
+        """The last time a step may reach: the script's end (or `end_s` when earlier) plus 0.99 dt,
+        JSBSim's own margin (FGScript)."""
+        return (self.end_s if end_s is None else min(self.end_s, end_s)) + 0.99 * self.dt_s
+
+    def steps(self, end_s: float | None = None) -> int:
+        """The steps JSBSim runs before the end: the largest n whose summed time start + dt + ... + dt
+        is at most the end. The closed form decides unless the sum's rounding (n additions) could
+        cross the end, then the sum itself does (beyond MAX_SUMMED steps the closed form stands: a
+        size estimate off by one step of a flight that long)."""
+        end, dt = self._end(end_s), self.dt_s
+        n = max(0, math.floor((end - self.start_s) / dt))
+        slack = (n + 2) * max(abs(end), abs(self.start_s)) * 2.3e-16
+        near = min(abs(self.start_s + k * dt - end) for k in (n, n + 1)) <= slack
+        if near and n <= MAX_SUMMED:
+            summed = self._summed(n + 1)
+            n = int(np.searchsorted(summed, end, side="right")) - 1
+        return n
+
+    def _summed(self, n: int) -> np.ndarray:
+        """start, then the time after each of n steps, summed as JSBSim sums it (sim_time += dt; NumPy's
+        cumulative sum adds in order, bit for bit the same)."""
+        return np.cumsum(np.r_[self.start_s, np.full(n, self.dt_s)])
+
+    def times(self, end_s: float | None = None) -> np.ndarray:
+        """The simulator's time at the start and after every step until the end (see `steps`)."""
+        return self._summed(self.steps(end_s))
+
+
+def _script_file(config: dict, base: Path | None) -> ScriptFile:
+    path = config.get("script_path") or resolve(config["scenario"]["script"], Path(base or Path.cwd()))
+    return ScriptFile.read(Path(path))
+
+
+def check(check, sim: dict, folder: Path) -> dict:
+    """Resolve and read the script, check end_s, the output rate against the script's dt and the
+    campaign's aircraft against the script's (`check` is the campaign's Checker)."""
+    from ..aircraft import AircraftNotFound, locate
+
+    scenario = sim["scenario"]
+    if "script" not in scenario:
+        check.fail("simulator.scenario.script", "is required: a run script relative to the campaign file, or the "
+                                                "name of one shipped with JSBSim (e.g. c172_cruise_8K)")
+    text = check.string(scenario["script"], "simulator.scenario.script")
+    try:
+        script = ScriptFile.read(resolve(text, folder))
+    except (ScriptError, OSError) as exc:
+        check.fail("simulator.scenario.script", str(exc))
+    sim["script_path"] = str(script.path)
+    if "end_s" in scenario:
+        end = check.number(scenario["end_s"], "simulator.scenario.end_s")
+        if not script.start_s < end <= script.end_s:
+            check.fail("simulator.scenario.end_s", f"expected a time after the script's start {script.start_s:g} s and "
+                                                   f"at most its end {script.end_s:g} s, got {end:g}")
+    rate = DEFAULT_OUTPUT_RATE_HZ
+    if "output_rate_hz" in sim:
+        rate = check.number(sim["output_rate_hz"], "simulator.output_rate_hz", 0.0, strict=True)
+    if script.steps_per_output(rate) is None:
+        divisors = ", ".join(f"{script.rate_hz / k:.4g}" for k in range(1, 7))
+        check.fail("simulator.output_rate_hz", f"expected a divisor of the script's {script.rate_hz:.7g} Hz rate "
+                                               f"(dt = {script.dt_text} s: {divisors}, ...), got {rate:g}")
+    named = sim.get("aircraft", script.aircraft)
+    check.string(named, "simulator.aircraft")
+    try:
+        location = locate(named, folder)
+    except AircraftNotFound as exc:
+        check.fail("simulator.aircraft", str(exc))
+    if location.name != script.aircraft:
+        check.fail("simulator.aircraft", f"{named!r} is not the script's aircraft {script.aircraft!r} (<use aircraft=> "
+                                         f"in {script.path.name}); leave simulator.aircraft out, or name that aircraft")
+    try:
+        script.initfile(location.folder)
+    except ScriptError as exc:
+        check.fail("simulator.scenario.script", str(exc))
+    sim["aircraft"] = named
+    return sim
+
+
+def times(config: dict) -> int:
+    """The number of recorded times, from the script's timing and the output rate alone."""
+    script = _script_file(config, None)
+    end_s = config.get("scenario", {}).get("end_s")
+    steps = script.steps(None if end_s is None else float(end_s))
+    return steps // script.steps_per_output(float(config.get("output_rate_hz", DEFAULT_OUTPUT_RATE_HZ))) + 1
+
+
+@dataclass(frozen=True)
+class ScriptSetup:
+    """Everything that is the same for every sample of a script campaign."""
+
+    aircraft: str
+    root: Path
+    script: ScriptFile
+    initfile: Path | None  # beside the script, else None (the aircraft folder's, as JSBSim finds it)
+    end_s: float | None
+    output_rate_hz: float
+    outputs: tuple[str, ...]
+
+    @property
+    def steps_per_output(self) -> int:
+        return self.script.steps_per_output(self.output_rate_hz)
+
+    @cached_property
+    def step_times(self) -> np.ndarray:
+        """The simulator's time at the start and after every step flown (each seen by the observers)."""
+        return self.script.times(self.end_s)
+
+    @property
+    def steps(self) -> int:
+        return len(self.step_times) - 1
+
+    @property
+    def time(self) -> np.ndarray:
+        """Recorded times [s]: the simulator's, every steps_per_output steps from the start."""
+        return self.step_times[:: self.steps_per_output]
+
+    @property
+    def aircraft_file(self) -> Path:
+        return Path(self.root) / "aircraft" / self.aircraft / f"{self.aircraft}.xml"
+
+
+def setup(config: dict, root: Path | None = None, base: Path | None = None, properties=()) -> ScriptSetup:
+    """A ScriptSetup from a campaign's `simulator:` mapping (keys already validated): the script's
+    aircraft located and patched as for level flight (see `level_flight.setup`)."""
+    from ..patch import PreparedAircraft
+
+    script = _script_file(config, base)
+    name = config.get("aircraft", script.aircraft)
+    root = config.get("root", root)
+    if root is None:
+        prepared = PreparedAircraft(config.get("aircraft_path", name), base, properties)
+        name, root = prepared.name, prepared.root
+    root = Path(root)
+    scenario = config.get("scenario", {})
+    return ScriptSetup(
+        aircraft=name, root=root, script=script,
+        initfile=script.initfile(root / "aircraft" / name) if (root / "aircraft" / name).is_dir() else None,
+        end_s=float(scenario["end_s"]) if "end_s" in scenario else None,
+        output_rate_hz=float(config.get("output_rate_hz", DEFAULT_OUTPUT_RATE_HZ)),
+        outputs=tuple(config.get("outputs", DEFAULT_OUTPUTS)),
+    )
+
+
+class ScriptFlight(PropertyAccess):
+    """Flies the script once per sample, from a fresh load: set ic/..., run_ic, set the rest, run."""
+
+    def __init__(self, setup: ScriptSetup, preflight: bool = True):
+        ready_to_load(setup, preflight)
+        self.setup = setup
+        self._scratch = Path(tempfile.mkdtemp(prefix="uqflight-script-"))  # JSBSim's output and state files
+        weakref.finalize(self, shutil.rmtree, self._scratch, True)
+        self._load()
+
+    def _load(self) -> None:
+        s = self.setup
+        fdm = jsbsim.FGFDMExec(str(s.root))
+        fdm.set_debug_level(0)
+        fdm.set_output_path(str(self._scratch))
+        if not fdm.load_script(str(s.script.path), 0.0, str(s.initfile) if s.initfile else ""):
+            raise FlightError(f"JSBSim could not load the script {s.script.path} with aircraft {s.aircraft!r} "
+                              f"from {s.root}")
+        fdm.disable_output()
+        if fdm.get_delta_t() != s.script.dt_s:
+            raise FlightError(f"JSBSim reads the script's dt as {fdm.get_delta_t()!r}, uqflight as {s.script.dt_s!r}")
+        self._bind(fdm, s.aircraft)
+        self._recorded = [self._output_source(name) for name in s.outputs]
+
+    def prepare_probe(self) -> None:
+        """The state campaign validation reads nominal values in: the script loaded, before run_ic."""
+
+    def property_value(self, name: str) -> float | None:
+        """The value of `name` once the script is loaded (None when there is no such property)."""
+        return self.node(name).get_double_value() if self.has_property(name) else None
+
+    def fly(self, settings: dict[str, float] | None = None, observers=()) -> FlightResult:
+        """Fly one sample with the given property values, watched by `observers` (t = the simulator's
+        time); raises a FlightError subclass."""
+        settings = settings or {}
+        s = self.setup
+        if getattr(self, "_flown", False):
+            self._load()
+        self._flown = True
+        try:
+            for name, value in settings.items():
+                if name.startswith("ic/"):
+                    self.node(name).set_double_value(float(value))
+            self.fdm.run_ic()
+            for name, value in settings.items():
+                if not name.startswith("ic/"):
+                    self.node(name).set_double_value(float(value))
+            data, times = self._run(observers)
+        except jsbsim.TrimFailureError as exc:
+            raise TrimError(f"a trim in the script failed at t = {self.fdm.get_sim_time():.4g} s: "
+                            f"{str(exc).strip() or 'no convergence'}") from exc
+        except jsbsim.BaseError as exc:
+            raise FlightError(f"JSBSim stopped the script at t = {self.fdm.get_sim_time():.4g} s: {exc}") from exc
+        finally:
+            for child in self._scratch.iterdir():  # the header of a disabled output, a state file
+                if child.is_dir():
+                    shutil.rmtree(child)
+                else:
+                    child.unlink()
+        grid = s.time
+        if not np.array_equal(times, grid):
+            at = int(np.argmax(times != grid))
+            raise FlightError(f"the simulator's time {times[at]:.6g} s is not the script's {grid[at]:.6g} s (recorded "
+                              f"time {at}): does the script reset the simulation? cut it before with "
+                              "simulator.scenario.end_s")
+        check_finite(data)
+        return FlightResult(time=grid, outputs=dict(zip(s.outputs, data.T.copy())), trim=None)
+
+    def _run(self, observers) -> tuple[np.ndarray, np.ndarray]:
+        """Integrate the setup's steps, recording every steps_per_output steps: (outputs (T, n), times (T,))."""
+        s = self.setup
+        k, steps = s.steps_per_output, s.steps
+        clock = self.node(TIME)
+        run = self.fdm.run
+        data = np.empty((steps // k + 1, len(self._recorded)))
+        times = np.empty(steps // k + 1)
+        data[0], times[0] = [node.get_double_value() for node, _ in self._recorded], clock.get_double_value()
+        watch = Watch(self, observers) if observers else None
+        if watch:
+            watch(times[0])
+        for i in range(1, steps + 1):
+            if not run():
+                raise FlightError(f"the script ended at t = {clock.get_double_value():.6g} s, before its end "
+                                  f"{s.time[-1]:.6g} s: cut it with simulator.scenario.end_s")
+            if watch:
+                watch(clock.get_double_value())
+            if i % k == 0:
+                data[i // k] = [node.get_double_value() for node, _ in self._recorded]
+                times[i // k] = clock.get_double_value()
+        data *= np.array([scale for _, scale in self._recorded])
+        return data, times
+
+
+def flight(setup: ScriptSetup, preflight: bool = True) -> ScriptFlight:
+    return ScriptFlight(setup, preflight=preflight)
+
+
+def files(config: dict) -> dict[str, bytes]:
+    """The script, its initialisation file when beside it, and the output files it names (keys relative
+    to the script's folder): what a worker needs beyond the aircraft's files."""
+    script = ScriptFile.read(Path(config["script_path"]))
+    folder = script.path.parent
+    names = [script.path.name, *script.outputs_files]
+    for name in (script.initialize, f"{script.initialize}.xml"):
+        if _inside(folder, name).is_file():
+            names.append(name)
+            break
+    return {name: _inside(folder, name).read_bytes() for name in dict.fromkeys(names)}
+
+
+def localize(config: dict, folder: Path) -> dict:
+    """The mapping reading the script (and the files beside it) from `folder`, where `files` were written."""
+    return {**config, "script_path": str(Path(folder) / Path(config["script_path"]).name)}
+
+
+def provenance(config: dict) -> dict:
+    """The scenario and the sha256 of the script's files, for the results file."""
+    return {"scenario": json.dumps({"kind": "script", "script": Path(config["script_path"]).name,
+                                    "sha256": AircraftFiles("", files(config)).hash()})}
+
+
+def resolution(setup: ScriptSetup, settings, ours=None) -> None:
+    """A script has no second way of flying it: no resolution of its own."""
+    return None
