@@ -87,6 +87,7 @@ def parse_campaign(text: str, source: str = "<campaign>", probe: PropertyProbe |
                 check.fail(f"simulator.outputs[{i}]", f"expected one of {', '.join(NAMED_OUTPUTS)} or a JSBSim "
                            f"property of aircraft {aircraft.aircraft!r}, got {output!r}{aircraft.hint(output)}")
     parameters = schema.parameters(check, data["parameters"], simulator["kind"], aircraft)
+    schema.check_fixed_properties(check, simulator, parameters, aircraft)
     campaign = build_campaign(check, data, simulator, parameters, text)
     if isinstance(data["design"], dict):  # sizes from the campaign alone, before building anything
         schema.check_size(check, data, simulator, parameters, campaign.method, campaign.execution,

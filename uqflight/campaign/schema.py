@@ -26,7 +26,7 @@ SIMULATOR_KINDS = ("jsbsim", "python")
 EXECUTORS = ("local", "dask")
 TOP_KEYS = ("name", "description", "seed", "simulator", "parameters", "design", "method",
             "execution", "storage", "analysis", "limits")
-JSBSIM_KEYS = ("kind", "aircraft", "scenario", "outputs")  # and the scenario kind's own (simulators/scenarios)
+JSBSIM_KEYS = ("kind", "aircraft", "scenario", "outputs", "properties")  # and the scenario kind's own (simulators/scenarios)
 PYTHON_KEYS = ("kind", "function", "outputs")
 PARAMETER_KEYS = ("property", "function", "perturbation", "distribution", "nominal", "interval_pct", "lower", "upper")
 PERTURBATIONS = ("scale", "offset", "offset_value")
@@ -217,9 +217,33 @@ def simulator(check: Checker, value) -> dict:
         sim.setdefault("aircraft", "bacm")
     if "aircraft" in sim:
         check.string(sim["aircraft"], "simulator.aircraft")
+    if "properties" in sim:
+        fixed_properties(check, sim["properties"])
     if "outputs" in sim:
         outputs(check, sim["outputs"])
     return sim
+
+
+def fixed_properties(check: Checker, value) -> dict:
+    """`simulator.properties`: {PROPERTY: VALUE} set for every run (a turbulence model, a steady wind)."""
+    if not isinstance(value, dict) or not value:
+        check.fail("simulator.properties", f"expected a mapping of JSBSim properties to numbers, got {shown(value)}")
+    for name, number in value.items():
+        check.string(name, "simulator.properties")
+        check.number(number, f"simulator.properties.{name}")
+    return value
+
+
+def check_fixed_properties(check: Checker, sim: dict, parameters: list[Parameter], aircraft) -> None:
+    """Each fixed property is one the aircraft can set (when it is known), and no parameter sets it too."""
+    by_parameter = {p.property: p.name for p in parameters}
+    for name in sim.get("properties", {}):
+        path = f"simulator.properties.{name}"
+        if name in by_parameter:
+            check.fail(path, f"is also set by parameters.{by_parameter[name]}: give it in one place")
+        if aircraft is not None and (aircraft.value(name) is None or not aircraft.writable(name)):
+            check.fail(path, f"expected a property the simulator can set in aircraft {aircraft.aircraft!r}, "
+                             f"got {name!r}{aircraft.hint(name)}")
 
 
 def outputs(check: Checker, value) -> list[str]:

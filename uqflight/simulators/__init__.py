@@ -25,6 +25,7 @@ class JSBSimSimulator:
         self.scenario = scenario_entry(config)
         self.setup = self.scenario.setup(config, base=base, properties=properties)
         self.properties = list(properties)
+        self.fixed = {str(k): float(v) for k, v in config.get("properties", {}).items()}  # every run's settings
         self.flight = self.scenario.flight(self.setup)
         self._flown = False
         self.units = {name: UNITS.get(name, "") for name in self.setup.outputs}
@@ -34,13 +35,18 @@ class JSBSimSimulator:
 
     def evaluate(self, kappa: np.ndarray) -> dict[str, np.ndarray]:
         self._flown = True
-        return self.flight.fly(dict(zip(self.properties, map(float, kappa)))).outputs
+        return self.flight.fly(self.settings(kappa)).outputs
+
+    def settings(self, kappa: np.ndarray) -> dict[str, float]:
+        """The property values of the run at `kappa`: the campaign's fixed `simulator.properties`, then
+        the parameters' values."""
+        return {**self.fixed, **dict(zip(self.properties, map(float, kappa)))}
 
     def trim_repeatability(self, kappa: np.ndarray, ours: dict[str, np.ndarray] | None = None
                            ) -> dict[str, np.ndarray] | None:
         """{output: (T,)}: the simulator's own resolution at `kappa` as its scenario states it (level
         flight: the drift between its two valid trims; see `level_flight.resolution`), or None."""
-        return self.scenario.resolution(self.setup, dict(zip(self.properties, map(float, kappa))), ours)
+        return self.scenario.resolution(self.setup, self.settings(kappa), ours)
 
     def restart(self) -> None:
         """Reload the aircraft (about 2 ms), so that a chunk's results do not depend on what

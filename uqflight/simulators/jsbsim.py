@@ -58,6 +58,8 @@ TRIM_TOLERANCES = {
     "accelerations/wdot-ft_sec2": 1e-2,
     "accelerations/qdot-rad_sec2": 1e-3,
 }
+ATMOSPHERE = "atmosphere/"  # settings applied after the trim (still air), at t = 0 of the recorded flight
+RANDOM_SEED = "atmosphere/randomseed"  # the wind and turbulence generator's seed (jsbsim >= 1.3)
 STALL_PROPERTY = "aero/coefficient/CL-stall"  # non-zero past the stall (bacm)
 DIVERGENCE_LIMITS = {"aero/alpha-deg": 30.0, "attitude/phi-deg": 60.0}
 
@@ -271,6 +273,7 @@ class JSBSimFlight(PropertyAccess):
         self._engines = self.fdm.get_propulsion().get_num_engines()
         self._load_values = {p: self.node(p).get_double_value() for p in TRIM_CONTROLS if self.has_property(p)}
         self._touched: dict[str, float] = {}
+        self._random_seed = self.node(RANDOM_SEED).get_double_value() if self.has_property(RANDOM_SEED) else 0.0
         self._recorded = [self._output_source(name) for name in setup.outputs]
 
     # -- properties -------------------------------------------------------------------------
@@ -288,11 +291,15 @@ class JSBSimFlight(PropertyAccess):
 
     # -- one sample -------------------------------------------------------------------------
     def fly(self, settings: dict[str, float] | None = None, observers: Sequence[Observer] = ()) -> FlightResult:
-        """Fly one sample with the given property values, watched by `observers`; raises a FlightError subclass."""
-        trim = self.trim(settings or {})
+        """Fly one sample with the given property values, watched by `observers`; raises a FlightError subclass.
+        The trim is flown in still air: `atmosphere/...` settings (turbulence, gusts, winds, the random
+        seed) are applied after it, so that they start at t = 0 of the recorded flight."""
+        settings = settings or {}
+        trim = self.trim({k: v for k, v in settings.items() if not k.startswith(ATMOSPHERE)})
         for observer in observers:
             if hasattr(observer, "at_trim"):
                 observer.at_trim(self.fdm)
+        self._apply({k: v for k, v in settings.items() if k.startswith(ATMOSPHERE)})
         return self.run_trimmed(trim, observers)
 
     def trim(self, settings: dict[str, float]) -> TrimResult:
@@ -341,6 +348,10 @@ class JSBSimFlight(PropertyAccess):
             self.node(name).set_double_value(value)
         for name, value in self._touched.items():
             self.node(name).set_double_value(value)
+        if self.has_property(RANDOM_SEED) and RANDOM_SEED not in settings:
+            # the wind generator restarts its stream at every run: without a seed parameter every run flies
+            # the same turbulence, whatever it flew before on this model
+            self.node(RANDOM_SEED).set_double_value(self._random_seed)
         fdm["ic/h-sl-ft"] = s.altitude_ft
         fdm["ic/vt-kts"] = s.airspeed_ktas
         # ic/alpha-deg first: the Newton trim leaves its alpha there, the reset must not see it.
