@@ -16,6 +16,7 @@ from .likelihood import DataError, LogPosterior, interpolate_in_time, parse_nois
 from .outputs import (OUTPUT_FILES, calibrated_campaign, corner_plot, marginal, marginals_plot, predictive_plot,
                       write_json, write_posterior)
 from .sampler import sample
+from .size import check_size
 from .surrogate import (SurrogateError, campaign_folder, campaign_mapping, check_campaign_text, fit_surrogate,
                         parameter_specs, prior_summaries, simulate, to_physical)
 
@@ -49,9 +50,11 @@ def calibrate(results, data, out, outputs: list[str] | None = None, noise: list[
               progress: bool = False) -> Calibration:
     """Calibrate the campaign of `results` on flight `data`; see docs/calibration.md.
 
-    Raises DataError / SurrogateError (bad input), ValueError (bad settings), NotConverged.
+    Raises DataError / SurrogateError (bad input, data too large for memory: calibration.size),
+    ValueError (bad settings), NotConverged.
     One BLAS thread: the matrices are small (a few hundred rows), where several threads on a shared
     machine make the SVDs 10-100x slower."""
+    check_size(data, outputs, walkers, steps, predictive_draws, PREDICTIVE_NOISE_DRAWS)  # before any work
     with threadpool_limits(limits=1):
         return _calibrate(results, data, out, outputs, noise, seed, walkers, steps, method, order, campaign,
                           predictive_draws, truth, progress)
