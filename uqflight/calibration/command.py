@@ -45,7 +45,8 @@ def calibrate_command(
 
     Exit 0: done; 2: bad input (data, options, results file, data times outside the surrogate's); 3: the chain did not converge (nothing written; the message says what to change); 130: interrupted (Ctrl-C).
     """  # noqa: E501
-    from .run import DataError, NotConverged, SurrogateError, calibrate
+    from .likelihood import DataError
+    from .size import check_size
 
     check_results_file(results)
     check_output(out, "--out", folder=True, create=True)
@@ -55,6 +56,13 @@ def calibrate_command(
     if predictive_draws < 1:
         echo(f"error: --predictive-draws: expected an integer >= 1, got {predictive_draws}", err=True)
         raise typer.Exit(EXIT_BAD_INPUT)
+    try:  # before the sampler's and the surrogate's modules are even imported: a refusal is immediate
+        check_size(data, list(output) or None, walkers, steps, predictive_draws)
+    except DataError as exc:
+        echo(f"error: {exc}", err=True)
+        raise typer.Exit(EXIT_BAD_INPUT)
+    from .run import NotConverged, SurrogateError, calibrate
+
     streams, previous = (sys.stdout, sys.stderr), signal.signal(signal.SIGINT, _interrupted)
     try:
         result = calibrate(results, data, out, outputs=list(output) or None, noise=list(noise), seed=seed,

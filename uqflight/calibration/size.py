@@ -15,16 +15,17 @@ from ..campaign.schema import DEFAULT_LIMITS
 from .likelihood import DataError
 
 DEFAULT_WALKERS = 32  # the fewest `calibrate` uses when --walkers is not given
+PREDICTIVE_NOISE_DRAWS = 40  # noise draws per simulator run for the 95 % predictive band
 
 
-def row_bytes(predictive_draws: int, noise_draws: int, walkers: int) -> float:
+def row_bytes(predictive_draws: int, walkers: int, noise_draws: int = PREDICTIVE_NOISE_DRAWS) -> float:
     """Bytes per data row and output: the predictive band (twice: its quantiles sort a copy), the runs,
     the surrogate and its error at the draws, and the walkers' residuals (float64)."""
     return 8.0 * (predictive_draws * (2 * noise_draws + 3) + 4 * walkers)
 
 
 def check_size(data, outputs: list[str] | None, walkers: int | None, steps: int, predictive_draws: int,
-               noise_draws: int, max_memory_gb: float = DEFAULT_LIMITS["max_memory_gb"]) -> None:
+               max_memory_gb: float = DEFAULT_LIMITS["max_memory_gb"]) -> None:
     """DataError when the calibration of `data` would need more than `max_memory_gb`; reads the
     header and counts lines, nothing more."""
     path = Path(data)
@@ -39,7 +40,7 @@ def check_size(data, outputs: list[str] | None, walkers: int | None, steps: int,
             header = fh.readline(1 << 20).decode("utf-8-sig", "replace")
             columns = max(len(header.split(",")) - 1, 1)  # every column but time_s may be calibrated
             count = len(outputs) if outputs else columns
-            per_row = count * row_bytes(predictive_draws, noise_draws, walkers)
+            per_row = count * row_bytes(predictive_draws, walkers)
             most = int((budget - chain) // per_row)
             rows = 0
             while rows <= most:
