@@ -626,8 +626,8 @@ def _execute_dask(tasks, spec, n_times, outputs, workers: int, scheduler: str | 
                 if not told and not client.scheduler_info().get("workers"):
                     address = scheduler or cluster.scheduler_address
                     note(f"waiting for a Dask worker: the scheduler {address} has had none for "
-                         f"{NO_WORKERS_NOTICE_S:g} s, {len(running) + len(queue)} chunks are left (start one: "
-                         f"dask worker {address}; Ctrl-C stops, a rerun resumes)")
+                         f"{NO_WORKERS_NOTICE_S:g} s ({len(running) + len(queue)} of {len(tasks)} chunks left; "
+                         f"start one: dask worker {address}; Ctrl-C stops, a rerun resumes)")
                     told = True
                 continue
             told = False
