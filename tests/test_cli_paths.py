@@ -72,11 +72,14 @@ def test_files_of_the_wrong_kind_are_named_for_what_they_are(results, tmp_path):
         assert result.returncode == 2
         assert result.stderr == (f"error: {yaml} is a campaign file, not a results file: `uqflight run {yaml}` "
                                  "makes its results file\n"), args
-    for command in ("run", "plan", "design"):
-        result = cli_in_process(command, results, *(["--csv", tmp_path / "d.csv"] if command == "design" else []))
+    data = tmp_path / "flight.csv"
+    data.write_text("time_s,y\n0,15000\n")
+    for args in (["run", results], ["plan", results], ["design", results, "--csv", tmp_path / "d.csv"],
+                 ["calibrate", results, "--data", data, "--out", tmp_path / "cal", "--campaign", results]):
+        result = cli_in_process(*args)
         assert result.returncode == 2
         assert result.stderr == (f"error: {results} is a results file (HDF5), not a campaign file: "
-                                 f"`uqflight info {results}` describes it\n"), command
+                                 f"`uqflight info {results}` describes it\n"), args
 
 
 def test_a_closed_pipe_ends_info_quietly(results):

@@ -13,7 +13,7 @@ import typer
 
 from .arguments import check_campaign_file, check_output, check_results_file
 from .calibration.command import register as register_calibrate
-from .console import echo
+from .console import clean, echo
 
 from .methods import METHOD_KINDS
 from .simulators.base import FlightError
@@ -429,8 +429,10 @@ class _status:
         return self.tell
 
     def tell(self, text: str) -> None:
-        if self._status is not None:
-            self._status.update(f"{self.what}: {text}")
+        if self._status is not None:  # plain text: a label holding [brackets] is no rich markup
+            from rich.text import Text
+
+            self._status.update(Text(clean(f"{self.what}: {text}")))
 
     def __exit__(self, *exc):
         if self._status is not None:

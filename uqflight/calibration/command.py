@@ -9,7 +9,7 @@ from typing import List, Optional
 
 import typer
 
-from ..arguments import check_output, check_results_file
+from ..arguments import check_campaign_file, check_output, check_results_file
 from ..console import echo
 
 EXIT_BAD_INPUT = 2
@@ -49,6 +49,8 @@ def calibrate_command(
     from .size import check_size
 
     check_results_file(results)
+    if campaign is not None:
+        check_campaign_file(campaign)
     check_output(out, "--out", folder=True, create=True)
     if order is not None and order < 0:
         echo(f"error: --order: expected an integer >= 0, got {order}", err=True)
