@@ -78,3 +78,15 @@ def test_report_escapes_markdown_and_quotes_formulas(hostile):
     with open(out / "tables" / "statistics_at_times.csv", newline="") as fh:
         statistics = list(csv.DictReader(fh))
     assert float(statistics[0]["band99 lower"]) < 0  # a negative number stays a number
+
+
+def test_the_command_line_prints_only_through_echo():
+    """One place strips control characters: a typer.echo or print in a command would bypass it."""
+    from pathlib import Path
+
+    import uqflight
+
+    package = Path(uqflight.__file__).parent
+    for module in (package / "cli.py", package / "calibration" / "command.py"):
+        text = module.read_text()
+        assert "typer.echo(" not in text and "print(" not in text, module

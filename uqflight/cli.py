@@ -167,17 +167,17 @@ def plan(campaign: Path = typer.Argument(..., metavar="CAMPAIGN", help="Campaign
     echo("parameters:")
     for p in spec.parameters:
         echo(f"  {p.name:<10} {p.property:<18} {p.distribution:<16} nominal {p.nominal:<10.6g} "
-                   f"interval [{p.lower:.6g}, {p.upper:.6g}]")
+             f"interval [{p.lower:.6g}, {p.upper:.6g}]")
     echo(describe(design))
     echo(f"method: {spec.method['kind']} (order {spec.method['order']})")
     runs = len(design.xi)
     echo(f"runs: {runs}")
     echo(f"results: {Path(spec.storage['path']).resolve()} (storage.path, from the working directory; "
-               "--out to choose)")
+         "--out to choose)")
     seconds = _seconds_per_run(spec)
     workers = min(spec.execution["workers"], CORES)
     echo(f"estimated time: {runs * seconds / workers:.0f} s with {workers} worker(s) "
-               f"({seconds * 1e3:.0f} ms per run, one nominal run timed now on this machine)")
+         f"({seconds * 1e3:.0f} ms per run, one nominal run timed now on this machine)")
 
 
 CORES = os.cpu_count() or 1
@@ -250,7 +250,7 @@ def run(
     except KeyboardInterrupt as exc:
         code = 143 if isinstance(exc, Terminated) else 130
         echo(f"\n{'terminated' if code == 143 else 'interrupted'}: the finished runs are stored; "
-                   f"rerun `{resume}` to resume", err=True)
+             f"rerun `{resume}` to resume", err=True)
         raise typer.Exit(code)
     finally:
         signal.signal(signal.SIGTERM, previous)
@@ -319,7 +319,7 @@ def _describe_results(results, store, Status) -> None:
     echo(f"design: {attrs.get('design_kind', '?')} {attrs.get('design_info', '')}")
     echo(f"parameters: {', '.join(store.parameter_names)}")
     echo(f"outputs: {', '.join(store.output_names)} ({store.time.size} times, "
-               f"{store.time[0]:g} to {store.time[-1]:g} s)")
+         f"{store.time[0]:g} to {store.time[-1]:g} s)")
     counts = {s.name.lower(): int(np.sum(status == s)) for s in Status}
     echo("runs: " + ", ".join(f"{v} {k}" for k, v in counts.items()) + f" (of {status.size})")
     done = status.size - counts["pending"]
@@ -465,7 +465,7 @@ def design(
         echo(f"error: cannot write {csv_path}: {exc.strerror}", err=True)
         raise typer.Exit(2)
     echo(f"wrote {csv_path}: {len(points.xi)} points of a {points.kind} design in {len(names)} parameters "
-               f"({', '.join(names)})")
+         f"({', '.join(names)})")
 
 
 @surrogate_app.command("export")
@@ -535,12 +535,12 @@ def check(
         raise typer.Exit(2)
     if expected.get("campaign_hash") and expected["campaign_hash"] != attrs.get("campaign_hash"):
         echo(f"error: {results} comes from another campaign (sha256 {str(attrs.get('campaign_hash'))[:12]}) "
-                   f"than the baseline {baseline} ({str(expected['campaign_hash'])[:12]}): compare a results file "
-                   "with the baseline of its own campaign", err=True)
+             f"than the baseline {baseline} ({str(expected['campaign_hash'])[:12]}): compare a results file "
+             "with the baseline of its own campaign", err=True)
         raise typer.Exit(2)
     if comparison.drifts:
         echo(f"drift: {len(comparison.drifts)} of {comparison.compared} values outside "
-                   f"rtol={rtol:g}, atol={atol:g}")
+             f"rtol={rtol:g}, atol={atol:g}")
         echo(drift_table(comparison))
         raise typer.Exit(1)
     echo(f"no drift: {comparison.compared} values within rtol={rtol:g}/atol={atol:g}")
@@ -586,7 +586,7 @@ def aircraft_command(
     for i, (name, kind, thruster) in enumerate(engine_kinds(flight.fdm)):
         echo(f"  {i}: {name:<24} {kind:<10} thruster: {thruster}")
     echo(f"elevator travel: {flight.elevator_travel_deg[0]:.1f} deg down, {flight.elevator_travel_deg[1]:.1f} deg up"
-               + ("" if not flight.has_property("fcs/elevator-excitation-deg") else " (fcs/elevator-excitation-deg used)"))
+         + ("" if not flight.has_property("fcs/elevator-excitation-deg") else " (fcs/elevator-excitation-deg used)"))
     echo(f"nominal trim at {setup.altitude_ft:g} ft, {setup.airspeed_ktas:g} KTAS:")
     try:
         echo(flight.trim({}).describe())

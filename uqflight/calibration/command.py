@@ -89,23 +89,23 @@ def calibrate_command(
     summary = result.summary
     diag = summary["diagnostics"]
     echo(f"surrogate: {summary['surrogate']['kind']} order {summary['surrogate']['order']} from "
-               f"{summary['surrogate']['runs']} runs; {diag['walkers']} walkers x {diag['steps']} steps, "
-               f"acceptance {diag['acceptance_fraction']['mean']:.2f}, {diag['steps_per_tau']:.0f} tau kept, "
-               f"max split-R-hat {max(diag['split_rhat'].values()):.3f}")
+         f"{summary['surrogate']['runs']} runs; {diag['walkers']} walkers x {diag['steps']} steps, "
+         f"acceptance {diag['acceptance_fraction']['mean']:.2f}, {diag['steps_per_tau']:.0f} tau kept, "
+         f"max split-R-hat {max(diag['split_rhat'].values()):.3f}")
     echo(f"{'parameter':<10} {'prior mean':>12} {'prior std':>11} {'post mean':>12} {'post std':>11} "
-               f"{'narrowing':>9}  95 % interval")
+         f"{'narrowing':>9}  95 % interval")
     for name, p in summary["parameters"].items():
         narrowing = p["narrowing"]
         echo(f"{name:<10} {p['prior']['mean']:12.6g} {p['prior']['std']:11.4g} {p['posterior']['mean']:12.6g} "
-                   f"{p['posterior']['std']:11.4g} {narrowing if narrowing is not None else float('nan'):9.2f}  "
-                   f"[{p['posterior']['ci95'][0]:.6g}, {p['posterior']['ci95'][1]:.6g}]")
+             f"{p['posterior']['std']:11.4g} {narrowing if narrowing is not None else float('nan'):9.2f}  "
+             f"[{p['posterior']['ci95'][0]:.6g}, {p['posterior']['ci95'][1]:.6g}]")
     for name, n in summary["noise"].items():
         if n["inferred"]:
             echo(f"noise {name}: sigma {n['inferred']['mean']:.4g} (inferred)")
     pred = summary["predictive"]
     cover = ", ".join(f"{k} {v:.0%}" if v is not None else f"{k} -" for k, v in pred["coverage95"].items())
     echo(f"posterior predictive ({pred['draws']} simulator runs, {pred['failed']} failed): data inside the "
-               f"95 % band: {cover}")
+         f"95 % band: {cover}")
     echo(f"wrote {', '.join(result.written)} to {out} ({summary['seconds']['total']:.1f} s)")
 
 
