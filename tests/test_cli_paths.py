@@ -62,6 +62,10 @@ def test_an_unwritable_output_is_refused_before_any_work_with_one_message(result
         assert result.stderr == (f"error: {option} {missing}: the folder {tmp_path / 'missing'} does not exist; "
                                  "choose another path\n")
         assert not (tmp_path / "missing").exists()
+    if command == "calibrate --out":  # a file where the folder goes: refused before the sampling, not after
+        result = cli_in_process(*args, option, tmp_path / "a-file")
+        assert result.returncode == 2
+        assert result.stderr == f"error: --out {tmp_path / 'a-file'}: is a file, not a folder; choose another path\n"
 
 
 def test_files_of_the_wrong_kind_are_named_for_what_they_are(results, tmp_path):

@@ -14,9 +14,8 @@ CAMPAIGN_KEYS = ("simulator:", "parameters:", "design:")  # lines a campaign fil
 
 
 def check_output(path: Path, option: str, folder: bool = False, create: bool = False) -> None:
-    """Exit 2 naming `option` when `path` cannot be written: a file (with `folder`, a folder the command
-    makes or replaces: what may be replaced is the command's to say) whose folder exists and is
-    writable; with `create`, missing folders are made later, under a writable one."""
+    """Exit 2 naming `option` when `path` cannot be written: a file (a folder with `folder`) whose
+    folder exists and is writable; with `create`, missing folders are made later, under a writable one."""
     problem = output_problem(Path(path), folder, create)
     if problem:
         echo(f"error: {option} {path}: {problem}; choose another path", err=True)
@@ -27,6 +26,8 @@ def output_problem(path: Path, folder: bool = False, create: bool = False) -> st
     """Why `path` cannot be written, or None."""
     if path.is_dir() and not folder:
         return "is a folder, not a file"
+    if folder and (path.is_file() or path.is_symlink() and not path.is_dir()):
+        return "is a file, not a folder"
     parent = Path(os.path.abspath(path)).parent
     while create and not parent.exists() and parent != parent.parent:
         parent = parent.parent

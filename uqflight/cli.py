@@ -389,7 +389,8 @@ def report(
     for path in [*results, *([reference] if reference else [])]:
         check_results_file(path)
     out = out if out is not None else default_out_dir(results[0])
-    check_output(out, "--out", folder=True, create=True)
+    if not out.exists() and not out.is_symlink():  # an existing DIR is the report's to judge (check_replaceable)
+        check_output(out, "--out", folder=True, create=True)
     if write_baseline:
         check_output(write_baseline, "--write-baseline")
     try:
