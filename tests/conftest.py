@@ -2,6 +2,7 @@
 the numbers against. Test modules import these names (`from conftest import ...`)."""
 from __future__ import annotations
 
+import contextlib
 import json
 import os
 import subprocess
@@ -37,6 +38,24 @@ def cli_in_process(*args, cwd=None) -> subprocess.CompletedProcess:
     finally:
         os.chdir(here)
     return subprocess.CompletedProcess(list(args), result.exit_code, result.stdout, result.stderr)
+
+
+@contextlib.contextmanager
+def mounted_tmpfs(folder, size: str):
+    """A tmpfs of `size` (e.g. "8m") mounted at FOLDER/disk for the block: a disk that fills on demand.
+    The test is skipped where it cannot be mounted (it needs root)."""
+    import pytest
+
+    mount = Path(folder) / "disk"
+    mount.mkdir()
+    done = subprocess.run(["mount", "-t", "tmpfs", "-o", f"size={size}", "tmpfs", str(mount)],
+                          capture_output=True, text=True)
+    if done.returncode != 0:
+        pytest.skip(f"cannot mount a small tmpfs here ({done.stderr.strip()}); needs root")
+    try:
+        yield mount
+    finally:
+        subprocess.run(["umount", "-l", str(mount)], check=False)
 
 
 def read_results(path) -> dict[str, np.ndarray]:

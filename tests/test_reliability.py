@@ -11,7 +11,7 @@ from pathlib import Path
 import h5py
 import numpy as np
 import pytest
-from conftest import DATA, UQFLIGHT, assert_same_results, cli_in_process
+from conftest import DATA, UQFLIGHT, assert_same_results, cli_in_process, mounted_tmpfs
 
 from uqflight.campaign import parse_campaign
 from uqflight.execution import run_campaign
@@ -219,14 +219,8 @@ def test_no_orphan_workers_after_the_runner_is_killed(tmp_path):
 
 @pytest.fixture
 def small_disk(tmp_path):
-    mount = tmp_path / "disk"
-    mount.mkdir()
-    done = subprocess.run(["mount", "-t", "tmpfs", "-o", "size=8m", "tmpfs", str(mount)],
-                          capture_output=True, text=True)
-    if done.returncode != 0:
-        pytest.skip(f"cannot mount a small tmpfs here ({done.stderr.strip()}); needs root")
-    yield mount
-    subprocess.run(["umount", "-l", str(mount)], check=False)
+    with mounted_tmpfs(tmp_path, "8m") as mount:
+        yield mount
 
 
 def test_a_full_disk_stops_cleanly_and_the_resume_equals_an_uninterrupted_run(tmp_path, small_disk):

@@ -243,7 +243,7 @@ def test_check_refuses_bad_input_with_exit_2_and_one_line(files, baseline, tmp_p
         assert "Traceback" not in result.stderr and len(result.stderr.strip().splitlines()) == 1, (name, result.stderr)
     for args, message in (((files["pg"], "--baseline", tmp_path / "missing.json"), "cannot read the baseline"),
                           ((tmp_path / "missing.h5", "--baseline", baseline), "no such results file"),
-                          ((baseline, "--baseline", baseline), "cannot analyse the results file")):
+                          ((baseline, "--baseline", baseline), "baseline.json is not a results file (a results file is HDF5")):
         result = cli_in_process("check", *args)
         assert result.returncode == 2 and message in result.stderr and "Traceback" not in result.stderr, result.stderr
 

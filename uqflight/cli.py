@@ -11,7 +11,9 @@ from typing import List, Optional
 import numpy as np
 import typer
 
+from .arguments import check_campaign_file, check_output, check_results_file
 from .calibration.command import register as register_calibrate
+from .console import clean, echo
 
 from .methods import METHOD_KINDS
 from .simulators.base import FlightError
@@ -33,7 +35,7 @@ def _version(value: bool):
     if value:
         from . import __version__
 
-        typer.echo(f"uqflight {__version__}")
+        echo(f"uqflight {__version__}")
         raise typer.Exit(0)
 
 
@@ -82,6 +84,9 @@ def simulate(
 ):
     """Trim one flight in level flight, excite the elevator and record the outputs."""
     settings = parse_settings(set_)
+    for path, option in ((out, "--out"), (plot, "--plot")):
+        if path:
+            check_output(path, option)
     try:
         located = _prepared(aircraft, scale, offset, offset_value)
         settings.update(located.settings)
@@ -97,29 +102,29 @@ def simulate(
         flight = JSBSimFlight(setup)
         result = flight.fly(settings)
     except FlightError as exc:
-        typer.echo(f"flight failed: {exc}", err=True)
+        echo(f"flight failed: {exc}", err=True)
         raise typer.Exit(1)
     except (ValueError, KeyError, FileNotFoundError, RuntimeError) as exc:  # bad input; an aircraft JSBSim refuses
-        typer.echo(f"error: {exc.args[0]}", err=True)
+        echo(f"error: {exc.args[0]}", err=True)
         raise typer.Exit(2)
-    typer.echo(result.trim.describe())
+    echo(result.trim.describe())
     for line in _offset_lines(located, flight):
-        typer.echo(line)
+        echo(line)
     for name, values in result.outputs.items():
-        typer.echo(f"{name:>12}: start {values[0]:12.4f}  min {values.min():12.4f}  max {values.max():12.4f}")
+        echo(f"{name:>12}: start {values[0]:12.4f}  min {values.min():12.4f}  max {values.max():12.4f}")
     if out:
         with open(out, "w", newline="") as fh:
             writer = csv.writer(fh)
             writer.writerow(["time_s", *result.outputs])
             for i, t in enumerate(result.time):
                 writer.writerow([f"{t:g}", *(repr(float(v[i])) for v in result.outputs.values())])
-        typer.echo(f"wrote {out}")
+        echo(f"wrote {out}")
     if plot:
         from .report.plots import plot_flight
 
         plot_flight(result.time, result.outputs, plot,
                     title=f"{setup.aircraft}: {excitation} {amplitude_deg:g} deg at {altitude_ft:g} ft, {airspeed_ktas:g} KTAS")
-        typer.echo(f"wrote {plot}")
+        echo(f"wrote {plot}")
 
 
 def _offset_lines(located, flight) -> list[str]:
@@ -164,10 +169,11 @@ def _load(path: Path):
     from .campaign import CampaignError, load_campaign
     from .simulators.jsbsim_probe import jsbsim_probe
 
+    check_campaign_file(path)
     try:
         return load_campaign(path, probe=jsbsim_probe)
     except CampaignError as exc:
-        typer.echo(f"error: {exc}", err=True)
+        echo(f"error: {exc}", err=True)
         raise typer.Exit(2)
 
 
@@ -178,21 +184,21 @@ def plan(campaign: Path = typer.Argument(..., metavar="CAMPAIGN", help="Campaign
 
     spec = _load(campaign)
     design = spec.design()
-    typer.echo(f"campaign: {spec.name} ({campaign})")
-    typer.echo("parameters:")
+    echo(f"campaign: {spec.name} ({campaign})")
+    echo("parameters:")
     for p in spec.parameters:
-        typer.echo(f"  {p.name:<10} {p.property:<18} {p.distribution:<16} nominal {p.nominal:<10.6g} "
-                   f"interval [{p.lower:.6g}, {p.upper:.6g}]")
-    typer.echo(describe(design))
-    typer.echo(f"method: {spec.method['kind']} (order {spec.method['order']})")
+        echo(f"  {p.name:<10} {p.property:<18} {p.distribution:<16} nominal {p.nominal:<10.6g} "
+             f"interval [{p.lower:.6g}, {p.upper:.6g}]")
+    echo(describe(design))
+    echo(f"method: {spec.method['kind']} (order {spec.method['order']})")
     runs = len(design.xi)
-    typer.echo(f"runs: {runs}")
-    typer.echo(f"results: {Path(spec.storage['path']).resolve()} (storage.path, from the working directory; "
-               "--out to choose)")
+    echo(f"runs: {runs}")
+    echo(f"results: {Path(spec.storage['path']).resolve()} (storage.path, from the working directory; "
+         "--out to choose)")
     seconds = _seconds_per_run(spec)
     workers = min(spec.execution["workers"], CORES)
-    typer.echo(f"estimated time: {runs * seconds / workers:.0f} s with {workers} worker(s) "
-               f"({seconds * 1e3:.0f} ms per run, one nominal run timed now on this machine)")
+    echo(f"estimated time: {runs * seconds / workers:.0f} s with {workers} worker(s) "
+         f"({seconds * 1e3:.0f} ms per run, one nominal run timed now on this machine)")
 
 
 CORES = os.cpu_count() or 1
@@ -238,11 +244,12 @@ def run(
     from .store import CorruptFile
 
     spec = _load(campaign)
+    check_output(out or Path(spec.storage["path"]), "--out" if out else "storage.path", create=True)
     if executor not in (None, "local", "dask"):
-        typer.echo(f"error: --executor: expected local or dask, got {executor!r}", err=True)
+        echo(f"error: --executor: expected local or dask, got {executor!r}", err=True)
         raise typer.Exit(2)
     if workers is not None and workers < 1:
-        typer.echo(f"error: --workers: expected an integer >= 1, got {workers}", err=True)
+        echo(f"error: --workers: expected an integer >= 1, got {workers}", err=True)
         raise typer.Exit(2)
     resume = f"uqflight run {campaign}" + (f" --out {out}" if out else "")
     previous = _stop_on_sigterm()
@@ -250,25 +257,25 @@ def run(
         summary = run_campaign(spec, out=out, workers=workers, executor=executor, scheduler=scheduler,
                                force=force, progress=True, restart=restart)
     except DiskFull as exc:
-        typer.echo(f"\nerror: {exc.strerror}", err=True)
+        echo(f"\nerror: {exc.strerror}", err=True)
         _exit_now(2)
     except CorruptFile as exc:
-        typer.echo(f"error: {exc}; `{resume} --restart` starts it over", err=True)
+        echo(f"error: {exc}; `{resume} --restart` starts it over", err=True)
         raise typer.Exit(2)
     except IncompleteFile as exc:
-        typer.echo(f"error: {exc}", err=True)
+        echo(f"error: {exc}", err=True)
         _exit_now(1)
     except (FileExistsError, ValueError, WorkerError) as exc:
-        typer.echo(f"error: {campaign}: {exc}", err=True)
+        echo(f"error: {campaign}: {exc}", err=True)
         raise typer.Exit(2)
     except KeyboardInterrupt as exc:
         code = 143 if isinstance(exc, Terminated) else 130
-        typer.echo(f"\n{'terminated' if code == 143 else 'interrupted'}: the finished runs are stored; "
-                   f"rerun `{resume}` to resume", err=True)
+        echo(f"\n{'terminated' if code == 143 else 'interrupted'}: the finished runs are stored; "
+             f"rerun `{resume}` to resume", err=True)
         raise typer.Exit(code)
     finally:
         signal.signal(signal.SIGTERM, previous)
-    typer.echo(summary.describe())
+    echo(summary.describe())
 
 
 def _exit_now(code: int):
@@ -299,57 +306,55 @@ def info(results: Path = typer.Argument(..., metavar="RESULTS", help="Results fi
     from .store import CorruptFile, ResultStore, Status, read_error
     from .store.lock import describe_holder, live_holder
 
-    if not results.is_file():
-        typer.echo(f"error: {results}: no such results file", err=True)
-        raise typer.Exit(2)
+    check_results_file(results)
     writer = live_holder(results)
     if writer:
-        typer.echo(f"being written by {describe_holder(writer)}")
+        echo(f"being written by {describe_holder(writer)}")
     try:
         try:
             store = ResultStore.open(results, while_written=writer is not None)
         except BlockingIOError:  # HDF5's lock held by a writer without a lock file of ours
-            typer.echo("locked by another process (a run writing it?): read as it is now")
+            echo("locked by another process (a run writing it?): read as it is now")
             writer = {"locked": True}
             store = ResultStore.open(results, while_written=True)
     except CorruptFile as exc:
-        typer.echo(f"error: {exc}", err=True)
+        echo(f"error: {exc}", err=True)
         raise typer.Exit(2)
     except (OSError, ValueError) as exc:
         retry = "; it is being written: try again in a moment" if writer else ""
-        typer.echo(f"error: {results}: {read_error(exc)}{retry}", err=True)
+        echo(f"error: {results}: {read_error(exc)}{retry}", err=True)
         raise typer.Exit(2)
     with store:
         try:
             _describe_results(results, store, Status)
         except OSError as exc:
-            typer.echo(f"error: {results}: {read_error(exc)}", err=True)
+            echo(f"error: {results}: {read_error(exc)}", err=True)
             raise typer.Exit(2)
 
 
 def _describe_results(results, store, Status) -> None:
     status = store.status
     attrs = store.attrs
-    typer.echo(f"file: {results}")
-    typer.echo(f"campaign: {attrs.get('campaign_name', '?')} (sha256 {store.campaign_hash[:12]})")
-    typer.echo(f"design: {attrs.get('design_kind', '?')} {attrs.get('design_info', '')}")
-    typer.echo(f"parameters: {', '.join(store.parameter_names)}")
-    typer.echo(f"outputs: {', '.join(store.output_names)} ({store.time.size} times, "
-               f"{store.time[0]:g} to {store.time[-1]:g} s)")
+    echo(f"file: {results}")
+    echo(f"campaign: {attrs.get('campaign_name', '?')} (sha256 {store.campaign_hash[:12]})")
+    echo(f"design: {attrs.get('design_kind', '?')} {attrs.get('design_info', '')}")
+    echo(f"parameters: {', '.join(store.parameter_names)}")
+    echo(f"outputs: {', '.join(store.output_names)} ({store.time.size} times, "
+         f"{store.time[0]:g} to {store.time[-1]:g} s)")
     counts = {s.name.lower(): int(np.sum(status == s)) for s in Status}
-    typer.echo("runs: " + ", ".join(f"{v} {k}" for k, v in counts.items()) + f" (of {status.size})")
+    echo("runs: " + ", ".join(f"{v} {k}" for k, v in counts.items()) + f" (of {status.size})")
     done = status.size - counts["pending"]
-    typer.echo(f"progress: {done} of {status.size} runs done ({100 * done / max(status.size, 1):.1f} %)")
+    echo(f"progress: {done} of {status.size} runs done ({100 * done / max(status.size, 1):.1f} %)")
     reasons = Counter(r for r, s in zip(store.reasons, status) if s > 0)
     for reason, n in reasons.most_common(5):
-        typer.echo(f"  failed ({n}): {reason}")
+        echo(f"  failed ({n}): {reason}")
     problems = store.verify()  # reads every checksummed chunk: a flipped byte is reported
     for problem in problems:
-        typer.echo(f"  problem: {problem}")
-    typer.echo(f"storage: {store.storage_description}")
-    typer.echo(f"versions: {attrs.get('versions', '?')}")
+        echo(f"  problem: {problem}")
+    echo(f"storage: {store.storage_description}")
+    echo(f"versions: {attrs.get('versions', '?')}")
     if "aircraft_hash" in attrs:
-        typer.echo(f"aircraft sha256: {attrs['aircraft_hash']}")
+        echo(f"aircraft sha256: {attrs['aircraft_hash']}")
     if problems:
         raise typer.Exit(2)
 
@@ -402,25 +407,31 @@ def report(
         overrides = parse_methods(method, order)
     except ValueError as exc:
         raise typer.BadParameter(str(exc), param_hint="--method")
+    for path in [*results, *([reference] if reference else [])]:
+        check_results_file(path)
     out = out if out is not None else default_out_dir(results[0])
+    if not out.exists() and not out.is_symlink():  # an existing DIR is the report's to judge (check_replaceable)
+        check_output(out, "--out", folder=True, create=True)
+    if write_baseline:
+        check_output(write_baseline, "--write-baseline")
     try:
         with _status("report") as tell:
             written = write_report(results, out, reference=reference, times=selected, baseline=write_baseline,
                                    method=overrides or None, progress=tell, partial=partial,
                                    allow_aliasing=allow_aliasing)
     except BadInput as exc:
-        typer.echo(f"error: {exc}", err=True)
+        echo(f"error: {exc}", err=True)
         raise typer.Exit(2)
     except OSError as exc:
-        typer.echo(f"error: cannot write the report: {exc}", err=True)
+        echo(f"error: cannot write the report: {exc}", err=True)
         raise typer.Exit(2)
     except KeyboardInterrupt:
-        typer.echo(f"\ninterrupted: no report written ({out} unchanged)", err=True)
+        echo(f"\ninterrupted: no report written ({out} unchanged)", err=True)
         raise typer.Exit(130)
     in_report = [p for p in written if Path(os.path.abspath(out)) in p.parents]  # written paths are absolute
-    typer.echo(f"wrote {len(in_report)} files to {out}: open {out / 'report.html'}")
+    echo(f"wrote {len(in_report)} files to {out}: open {out / 'report.html'}")
     if write_baseline:
-        typer.echo(f"wrote baseline {write_baseline}")
+        echo(f"wrote baseline {write_baseline}")
 
 
 class _status:
@@ -440,8 +451,10 @@ class _status:
         return self.tell
 
     def tell(self, text: str) -> None:
-        if self._status is not None:
-            self._status.update(f"{self.what}: {text}")
+        if self._status is not None:  # plain text: a label holding [brackets] is no rich markup
+            from rich.text import Text
+
+            self._status.update(Text(clean(f"{self.what}: {text}")))
 
     def __exit__(self, *exc):
         if self._status is not None:
@@ -459,6 +472,7 @@ def design(
     """Write a campaign's design (the points and weights the runs would use) as CSV, without running it."""
     from .parameters import to_physical
 
+    check_output(csv_path, "--csv")
     spec = _load(campaign)
     points = spec.design()
     kappa = to_physical(spec.parameters, points.xi)
@@ -470,10 +484,10 @@ def design(
             for j, (x, k, w) in enumerate(zip(points.xi, kappa, points.weights)):
                 writer.writerow([j, *map(repr, map(float, x)), *map(repr, map(float, k)), repr(float(w))])
     except OSError as exc:
-        typer.echo(f"error: cannot write {csv_path}: {exc.strerror}", err=True)
+        echo(f"error: cannot write {csv_path}: {exc.strerror}", err=True)
         raise typer.Exit(2)
-    typer.echo(f"wrote {csv_path}: {len(points.xi)} points of a {points.kind} design in {len(names)} parameters "
-               f"({', '.join(names)})")
+    echo(f"wrote {csv_path}: {len(points.xi)} points of a {points.kind} design in {len(names)} parameters "
+         f"({', '.join(names)})")
 
 
 @surrogate_app.command("export")
@@ -492,18 +506,17 @@ def surrogate_export(
         override = parse_method_option(method)
     except ValueError as exc:
         raise typer.BadParameter(str(exc), param_hint="--method")
-    if not results.is_file():
-        typer.echo(f"error: {results}: no such results file", err=True)
-        raise typer.Exit(2)
+    check_results_file(results)
+    check_output(out, "--out")
     try:
         export(results, out, override)
     except SurrogateError as exc:
-        typer.echo(f"error: {exc}", err=True)
+        echo(f"error: {exc}", err=True)
         raise typer.Exit(2)
     except (OSError, KeyError, ValueError) as exc:
-        typer.echo(f"error: {results}: cannot export the surrogate ({' '.join(str(exc).split())})", err=True)
+        echo(f"error: {results}: cannot export the surrogate ({' '.join(str(exc).split())})", err=True)
         raise typer.Exit(2)
-    typer.echo(f"wrote {out}")
+    echo(f"wrote {out}")
 
 
 def parse_method_option(method: str | None) -> dict | None:
@@ -532,26 +545,27 @@ def check(
     from .statistics import BadInput, read_statistics
 
     if rtol < 0 or atol < 0:
-        typer.echo("error: --rtol and --atol must be >= 0", err=True)
+        echo("error: --rtol and --atol must be >= 0", err=True)
         raise typer.Exit(2)
+    check_results_file(results)
     try:
         expected = load_baseline(baseline)
         stats, attrs = read_statistics(results, partial=partial)
         comparison = compare(stats, expected, rtol, atol)
     except BadInput as exc:
-        typer.echo(f"error: {exc}", err=True)
+        echo(f"error: {exc}", err=True)
         raise typer.Exit(2)
     if expected.get("campaign_hash") and expected["campaign_hash"] != attrs.get("campaign_hash"):
-        typer.echo(f"error: {results} comes from another campaign (sha256 {str(attrs.get('campaign_hash'))[:12]}) "
-                   f"than the baseline {baseline} ({str(expected['campaign_hash'])[:12]}): compare a results file "
-                   "with the baseline of its own campaign", err=True)
+        echo(f"error: {results} comes from another campaign (sha256 {str(attrs.get('campaign_hash'))[:12]}) "
+             f"than the baseline {baseline} ({str(expected['campaign_hash'])[:12]}): compare a results file "
+             "with the baseline of its own campaign", err=True)
         raise typer.Exit(2)
     if comparison.drifts:
-        typer.echo(f"drift: {len(comparison.drifts)} of {comparison.compared} values outside "
-                   f"rtol={rtol:g}, atol={atol:g}")
-        typer.echo(drift_table(comparison))
+        echo(f"drift: {len(comparison.drifts)} of {comparison.compared} values outside "
+             f"rtol={rtol:g}, atol={atol:g}")
+        echo(drift_table(comparison))
         raise typer.Exit(1)
-    typer.echo(f"no drift: {comparison.compared} values within rtol={rtol:g}/atol={atol:g}")
+    echo(f"no drift: {comparison.compared} values within rtol={rtol:g}/atol={atol:g}")
 
 
 @app.command("aircraft")
@@ -569,42 +583,42 @@ def aircraft_command(
 
     if list_ or aircraft is None:
         for origin, names in known_aircraft().items():
-            typer.echo(f"{origin}: {' '.join(names)}")
+            echo(f"{origin}: {' '.join(names)}")
         return
     try:
         located = _prepared(aircraft, [], [])
     except (ValueError, FileNotFoundError) as exc:
-        typer.echo(f"error: {exc}", err=True)
+        echo(f"error: {exc}", err=True)
         raise typer.Exit(2)
     files = AircraftFiles.read(located.location)
-    typer.echo(f"aircraft: {located.name} ({located.location.origin}: {located.location.folder})")
-    typer.echo(f"files: {len(files.files)} XML, sha256 {files.hash()}")
+    echo(f"aircraft: {located.name} ({located.location.origin}: {located.location.folder})")
+    echo(f"files: {len(files.files)} XML, sha256 {files.hash()}")
     functions = aero_functions(files.main)
     refs = references(files.main)
-    typer.echo(f"aerodynamic functions ({len(functions)}; perturb with function: NAME, perturbation: "
-               "scale|offset|offset_value; unit, and the factor an offset ΔC is multiplied by):")
+    echo(f"aerodynamic functions ({len(functions)}; perturb with function: NAME, perturbation: "
+         "scale|offset|offset_value; unit, and the factor an offset ΔC is multiplied by):")
     for f in functions:
         ref = refs[f.name]
         factor = f"ΔC x {ref.symbol}" if not ref.refusal else "offset_value only"
-        typer.echo(f"  {f.axis or '-':<6} {f.name:<40} {ref.unit or 'own':<6} {factor:<17} {f.description[:60]}")
+        echo(f"  {f.axis or '-':<6} {f.name:<40} {ref.unit or 'own':<6} {factor:<17} {f.description[:60]}")
     condition = default_condition(located.name)
     condition.update({k: v for k, v in (("altitude_ft", altitude_ft), ("airspeed_ktas", airspeed_ktas)) if v is not None})
     setup = FlightSetup(aircraft=located.name, root=located.root, excitation=Excitation(kind="none"), **condition)
     try:
         flight = JSBSimFlight(setup)
     except (RuntimeError, FileNotFoundError) as exc:
-        typer.echo(f"error: {exc}", err=True)
+        echo(f"error: {exc}", err=True)
         raise typer.Exit(2)
-    typer.echo("engines:")
+    echo("engines:")
     for i, (name, kind, thruster) in enumerate(engine_kinds(flight.fdm)):
-        typer.echo(f"  {i}: {name:<24} {kind:<10} thruster: {thruster}")
-    typer.echo(f"elevator travel: {flight.elevator_travel_deg[0]:.1f} deg down, {flight.elevator_travel_deg[1]:.1f} deg up"
-               + ("" if not flight.has_property("fcs/elevator-excitation-deg") else " (fcs/elevator-excitation-deg used)"))
-    typer.echo(f"nominal trim at {setup.altitude_ft:g} ft, {setup.airspeed_ktas:g} KTAS:")
+        echo(f"  {i}: {name:<24} {kind:<10} thruster: {thruster}")
+    echo(f"elevator travel: {flight.elevator_travel_deg[0]:.1f} deg down, {flight.elevator_travel_deg[1]:.1f} deg up"
+         + ("" if not flight.has_property("fcs/elevator-excitation-deg") else " (fcs/elevator-excitation-deg used)"))
+    echo(f"nominal trim at {setup.altitude_ft:g} ft, {setup.airspeed_ktas:g} KTAS:")
     try:
-        typer.echo(flight.trim({}).describe())
+        echo(flight.trim({}).describe())
     except FlightError as exc:
-        typer.echo(f"trim failed: {exc}")
+        echo(f"trim failed: {exc}")
         raise typer.Exit(1)
-    typer.echo("reference factors at the trim (an offset ΔC adds ΔC times its function's): " + ", ".join(
+    echo("reference factors at the trim (an offset ΔC adds ΔC times its function's): " + ", ".join(
         f"{symbol} = {number:.6g} {unit}" for symbol, number, unit in factor_values(flight.property_value)))

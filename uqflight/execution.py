@@ -46,6 +46,7 @@ from threadpoolctl import threadpool_limits
 from .campaign import Campaign
 from .campaign.reading import parameters_attribute
 from .campaign.schema import WORKER_BYTES
+from .console import clean
 from .designs import Design
 from .parameters import to_physical
 from .store import ResultStore, Status, compact, open_for_campaign
@@ -301,7 +302,7 @@ def _run_pending(store, campaign, pool, spec, chunk, workers, executor, schedule
     # written elsewhere may have one) is rerun whole; only its pending rows are written.
     tasks = [Task(c, kappa[c]) for c in chunks]
     if executor == "dask":
-        results = _execute_dask(tasks, spec, n_times, outputs, workers, scheduler, timeout)
+        results = _execute_dask(tasks, spec, n_times, outputs, workers, scheduler, timeout, bar.note)
     else:
         results = pool.run(tasks, n_times, outputs)
     try:
@@ -596,11 +597,16 @@ def supervised_chunk(spec: WorkerSpec, indices, kappa, n_times: int, outputs: li
     return next(iter(pool.run([Task(np.asarray(indices), np.asarray(kappa))], n_times, outputs)))
 
 
-def _execute_dask(tasks, spec, n_times, outputs, workers: int, scheduler: str | None, timeout: float):
-    """Yield chunk results as they finish, keeping about four chunks per worker in flight."""
+NO_WORKERS_NOTICE_S = 5.0  # no chunk finished for this long and the scheduler has no worker: say so
+
+
+def _execute_dask(tasks, spec, n_times, outputs, workers: int, scheduler: str | None, timeout: float,
+                  note=lambda text: None):
+    """Yield chunk results as they finish, keeping about four chunks per worker in flight; `note(text)`
+    is told when the scheduler has had no worker for NO_WORKERS_NOTICE_S (none started, or all gone)."""
     if not tasks:
         return
-    from dask.distributed import Client, LocalCluster, as_completed
+    from dask.distributed import Client, LocalCluster, wait
 
     cluster = None
     if scheduler:
@@ -618,11 +624,24 @@ def _execute_dask(tasks, spec, n_times, outputs, workers: int, scheduler: str | 
 
         # a deeper queue than the local pool's: it hides the scheduler round trip of a remote cluster
         in_flight = 4 * max(workers, len(client.scheduler_info().get("workers", {})) or 1)
-        futures = as_completed([submit(queue.pop()) for _ in range(min(in_flight, len(queue)))])
-        for future in futures:
-            yield future.result()
-            if queue:
-                futures.add(submit(queue.pop()))
+        running = {submit(queue.pop()) for _ in range(min(in_flight, len(queue)))}
+        told = False
+        while running:
+            try:
+                done, running = wait(running, timeout=NO_WORKERS_NOTICE_S, return_when="FIRST_COMPLETED")
+            except TimeoutError:
+                if not told and not client.scheduler_info().get("workers"):
+                    address = scheduler or cluster.scheduler_address
+                    note(f"waiting for a Dask worker: the scheduler {address} has had none for "
+                         f"{NO_WORKERS_NOTICE_S:g} s ({len(running) + len(queue)} of {len(tasks)} chunks left; "
+                         f"start one: dask worker {address}; Ctrl-C stops, a rerun resumes)")
+                    told = True
+                continue
+            told = False
+            for future in done:
+                yield future.result()
+                if queue:
+                    running.add(submit(queue.pop()))
     finally:
         client.close()
         if cluster is not None:
@@ -665,6 +684,17 @@ class Progress:
             self.stream.write(f"{self.done}/{self.total} runs ({100 * fraction:.0f} %), {rate:.1f} runs/s, "
                               f"ETA {eta:.0f} s\n")
             self._next_log = fraction + 0.1
+
+    def note(self, text: str) -> None:
+        """A line for the reader (above the bar on a terminal); nothing when quiet."""
+        if self.quiet:
+            return
+        text = clean(text)
+        if self._bar is not None:
+            self._bar.console.print(text, markup=False, highlight=False)
+        else:
+            self.stream.write(text + "\n")
+            self.stream.flush()
 
     def close(self) -> None:
         if self._bar is not None:

@@ -22,7 +22,7 @@ import numpy as np
 
 FORMAT = "uqflight-pce"
 VERSION = 1
-MAX_FILE_BYTES = 1 << 30  # a surrogate of 10^4 terms x 10^4 times is ~2 GB of JSON: beyond that, not ours
+MAX_FILE_BYTES = 64 << 20  # 64 MiB of JSON (about 3 million coefficients); parsing takes about 10 times that
 
 
 class SurrogateError(ValueError):
@@ -130,24 +130,38 @@ def surrogate_json(surrogate: Surrogate, results: str = "") -> dict:
 
 
 def export(results, out, method: dict | None = None) -> Path:
-    """Fit the PCE of `results` and write it to `out` as strict JSON; returns `out`."""
+    """Fit the PCE of `results` and write it to `out` as strict JSON; returns `out`. The folder of
+    `out` must exist; nothing is left behind when the write fails (a full disk)."""
     data = surrogate_json(fit_surrogate(results, method), str(results))
+    text = json.dumps(data, allow_nan=False) + "\n"
+    if len(text) > MAX_FILE_BYTES:
+        raise SurrogateError(f"{results}: the surrogate takes {len(text) / 2**20:.0f} MiB of JSON, more than the "
+                             f"{MAX_FILE_BYTES >> 20} MiB that load() reads; export a lower order (--method KIND:ORDER)")
     out = Path(out)
-    out.parent.mkdir(parents=True, exist_ok=True)
     tmp = out.with_name(out.name + ".part")
-    tmp.write_text(json.dumps(data, allow_nan=False) + "\n", encoding="utf-8")
-    tmp.replace(out)
+    try:
+        tmp.write_text(text, encoding="utf-8")
+        tmp.replace(out)
+    except BaseException:
+        tmp.unlink(missing_ok=True)
+        raise
     return out
 
 
 def load(path) -> Surrogate:
     """The surrogate written by `export` (or `uqflight surrogate export`); SurrogateError, naming the
-    file and what is wrong, for anything else (a damaged or hand-edited file is never evaluated)."""
+    file and the key, for anything else (a damaged or hand-edited file is never evaluated): a file
+    above MAX_FILE_BYTES (refused before it is read), numbers that are strings, booleans or out of
+    range, multi-indices that are not integers in [0, MAX_DEGREE] or repeat a row, laws whose germ is
+    not the one given, times that do not increase."""
     try:
+        size = Path(path).stat().st_size
+        if size > MAX_FILE_BYTES:
+            raise ValueError(f"{size / 2**20:.0f} MiB, more than the {MAX_FILE_BYTES >> 20} MiB a surrogate takes")
         with open(path, "rb") as fh:
             text = fh.read(MAX_FILE_BYTES + 1)
         if len(text) > MAX_FILE_BYTES:
-            raise ValueError(f"larger than {MAX_FILE_BYTES >> 30} GiB")
+            raise ValueError(f"more than the {MAX_FILE_BYTES >> 20} MiB a surrogate takes")
         data = json.loads(text)
     except (OSError, ValueError, RecursionError) as exc:
         raise SurrogateError(f"{path}: cannot read the surrogate ({exc})") from exc
@@ -160,11 +174,16 @@ def load(path) -> Surrogate:
 
 
 def _checked(data: dict) -> Surrogate:
-    """The Surrogate a parsed file describes, every shape and value checked (ValueError naming the key)."""
+    """The Surrogate a parsed file describes, every type, shape and value checked before any array is
+    built (ValueError naming the key)."""
     from .parameters import Parameter
     from .parameters.germs import GERMS
 
-    germs = [str(g) for g in data["germs"]]
+    if data.get("version") != VERSION:
+        raise ValueError(f"version: expected {VERSION}, got {_shown(data.get('version'))}")
+    germs = data["germs"]
+    if not isinstance(germs, list) or not germs or not all(isinstance(g, str) for g in germs):
+        raise ValueError(f"germs: expected a list of names ({', '.join(GERMS)}), got {_shown(germs)}")
     unknown = [g for g in germs if g not in GERMS]
     if unknown:
         raise ValueError(f"germs: unknown {unknown} (known: {', '.join(GERMS)})")
@@ -173,25 +192,82 @@ def _checked(data: dict) -> Surrogate:
     if not isinstance(parameters, list) or len(parameters) != d or not all(
             isinstance(p, dict) and {"name", "distribution", "lower", "upper", "nominal"} <= set(p) for p in parameters):
         raise ValueError(f"parameters: expected {d} entries with name, distribution, lower, upper, nominal")
-    for p in parameters:  # their laws map κ to ξ: built once here so that a bad one is refused now
-        Parameter(p["name"], p.get("property", p["name"]), p["distribution"], p["nominal"], p["lower"], p["upper"])
-    indices = np.array(data["multi_indices"], dtype=np.int64)
-    if indices.ndim != 2 or indices.shape[1] != d or not len(indices) or (indices < 0).any() or indices.max() > 1000:
-        raise ValueError(f"multi_indices: expected rows of {d} integers in [0, 1000], got shape {indices.shape}")
-    time = np.array(data["time"], dtype=float)
-    if time.ndim != 1 or not np.isfinite(time).all():
-        raise ValueError("time: expected a list of finite numbers")
+    for j, p in enumerate(parameters):  # their laws map κ to ξ: built once here so that a bad one is refused now
+        for key in ("name", "distribution", "property"):
+            if not isinstance(p.get(key, ""), str):
+                raise ValueError(f"parameters[{j}].{key}: expected a string, got {_shown(p[key])}")
+        for key in ("lower", "upper", "nominal"):
+            _number(p[key], f"parameters[{j}].{key}")
+        law = Parameter(p["name"], p.get("property", p["name"]), p["distribution"], p["nominal"], p["lower"],
+                        p["upper"])
+        if law.germ != germs[j]:
+            raise ValueError(f"parameters[{j}] ({p['name']}): a {p['distribution']} law is driven by a {law.germ} "
+                             f"germ, but germs[{j}] is {germs[j]}")
+    order = data["order"]
+    if isinstance(order, bool) or not isinstance(order, int) or not 0 <= order <= MAX_DEGREE:
+        raise ValueError(f"order: expected an integer in [0, {MAX_DEGREE}], got {_shown(order)}")
+    indices = _array(data["multi_indices"], "multi_indices", (None, d), integers=True)
+    if not len(indices) or indices.sum(axis=1).max() > order:
+        raise ValueError(f"multi_indices: expected rows of {d} integers of total degree <= order {order}, "
+                         f"got {len(indices)} rows of total degree up to {indices.sum(axis=1).max(initial=0)}")
+    rows = {}
+    for i, row in enumerate(map(tuple, indices.tolist())):
+        if row in rows:
+            raise ValueError(f"multi_indices: row {i} repeats row {rows[row]} ({list(row)})")
+        rows[row] = i
+    time = _array(data["time"], "time", (None,))
+    if not time.size or np.any(np.diff(time) <= 0):
+        raise ValueError("time: expected a list of strictly increasing numbers")
     outputs = data["outputs"]
     if not isinstance(outputs, dict) or not outputs:
         raise ValueError("outputs: expected a mapping of at least one output")
     coefficients = {}
     for name, output in outputs.items():
-        values = np.array(output["coefficients"], dtype=float)  # null → NaN, refused below
-        if values.shape != (len(indices), time.size) or not np.isfinite(values).all():
-            raise ValueError(f"outputs.{name}.coefficients: expected {len(indices)} x {time.size} finite numbers, "
-                             f"got shape {values.shape}{'' if np.isfinite(values).all() else ' with nulls'}")
-        coefficients[name] = values
+        coefficients[name] = _array(output["coefficients"], f"outputs.{name}.coefficients", (len(indices), time.size))
+        if not isinstance(output.get("units", ""), str):
+            raise ValueError(f"outputs.{name}.units: expected a string, got {_shown(output['units'])}")
+    for key, kind in (("method", str), ("split", bool), ("campaign", str)):
+        if key in data and not isinstance(data[key], kind):
+            raise ValueError(f"{key}: expected a {kind.__name__}, got {_shown(data[key])}")
     return Surrogate(parameters, germs, indices, time, coefficients,
-                     {name: str(o.get("units", "")) for name, o in outputs.items()},
-                     {"kind": str(data["method"]), "order": int(data["order"]), "split": bool(data.get("split", False))},
-                     str(data.get("campaign", "")))
+                     {name: o.get("units", "") for name, o in outputs.items()},
+                     {"kind": data["method"], "order": order, "split": data.get("split", False)},
+                     data.get("campaign", ""))
+
+
+MAX_DEGREE = 1000  # a multi-index entry or order beyond this is refused (a PCE of useful size stays far below)
+_LARGEST = 1.7976931348623157e308
+
+
+def _number(value, key: str) -> float:
+    """A finite JSON number (never a string, a boolean, a null or an integer beyond float range)."""
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or not -_LARGEST <= value <= _LARGEST:
+        raise ValueError(f"{key}: expected a finite number, got {_shown(value)}")
+    return float(value)
+
+
+def _array(value, key: str, shape: tuple, integers: bool = False) -> np.ndarray:
+    """The JSON list (of lists) `value` as an array of `shape` (None: any length), its entries checked
+    first: finite numbers, or with `integers` integers in [0, MAX_DEGREE] (a fraction is never truncated)."""
+    what = f"integers in [0, {MAX_DEGREE}]" if integers else "finite numbers"
+    expected = {(None,): "a list of", (None, shape[-1]): f"rows of {shape[-1]}"}.get(shape, " x ".join(map(str, shape)))
+    try:
+        cells = np.array(value if isinstance(value, list) else None, dtype=object)
+    except ValueError:  # rows of unequal lengths
+        raise ValueError(f"{key}: expected {expected} {what}, got rows of unequal lengths") from None
+    if cells.ndim != len(shape) or any(n is not None and n != m for n, m in zip(shape, cells.shape)):
+        raise ValueError(f"{key}: expected {expected} {what}, got shape {cells.shape}")
+    for cell in cells.flat:
+        if integers:
+            good = type(cell) is int and 0 <= cell <= MAX_DEGREE
+        else:
+            good = type(cell) in (int, float) and -_LARGEST <= cell <= _LARGEST
+        if not good:
+            found = "nulls" if cell is None else _shown(cell)
+            raise ValueError(f"{key}: expected {expected} {what}, got shape {cells.shape} with {found}")
+    return cells.astype(np.int64 if integers else float)
+
+
+def _shown(value) -> str:
+    text = repr(value) if not isinstance(value, int) or abs(value) < 10**50 else "an integer of 50+ digits"
+    return text if len(text) <= 60 else text[:57] + "..."

@@ -1,13 +1,20 @@
 """The `uqflight calibrate` command; `register(app)` adds it to a typer app (the lead wires it into cli.py)."""
 from __future__ import annotations
 
+import os
+import signal
+import sys
 from pathlib import Path
 from typing import List, Optional
 
 import typer
 
+from ..arguments import check_campaign_file, check_output, check_results_file
+from ..console import echo
+
 EXIT_BAD_INPUT = 2
 EXIT_NOT_CONVERGED = 3
+EXIT_INTERRUPTED = 130
 
 
 def calibrate_command(
@@ -36,51 +43,78 @@ def calibrate_command(
 
     Writes OUT/posterior.h5 (draws in standard and physical variables), OUT/summary.json (prior and posterior mean, std, 95 % interval per parameter, correlations, diagnostics; strict JSON), OUT/calibrated.yaml (the campaign with the posterior marginals) and OUT/plots/ (corner, marginals, posterior predictive from real simulator runs).
 
-    Exit 0: done; 2: bad input (data, options, results file, data times outside the surrogate's); 3: the chain did not converge (nothing written; the message says what to change).
+    Exit 0: done; 2: bad input (data, options, results file, data times outside the surrogate's); 3: the chain did not converge (nothing written; the message says what to change); 130: interrupted (Ctrl-C).
     """  # noqa: E501
-    from .run import DataError, NotConverged, SurrogateError, calibrate
+    from .likelihood import DataError
+    from .size import check_size
 
+    check_results_file(results)
+    if campaign is not None:
+        check_campaign_file(campaign)
+    check_output(out, "--out", folder=True, create=True)
     if order is not None and order < 0:
-        typer.echo(f"error: --order: expected an integer >= 0, got {order}", err=True)
+        echo(f"error: --order: expected an integer >= 0, got {order}", err=True)
         raise typer.Exit(EXIT_BAD_INPUT)
     if predictive_draws < 1:
-        typer.echo(f"error: --predictive-draws: expected an integer >= 1, got {predictive_draws}", err=True)
+        echo(f"error: --predictive-draws: expected an integer >= 1, got {predictive_draws}", err=True)
         raise typer.Exit(EXIT_BAD_INPUT)
+    try:  # before the sampler's and the surrogate's modules are even imported: a refusal is immediate
+        check_size(data, list(output) or None, walkers, steps, predictive_draws)
+    except DataError as exc:
+        echo(f"error: {exc}", err=True)
+        raise typer.Exit(EXIT_BAD_INPUT)
+    from .run import NotConverged, SurrogateError, calibrate
+
+    streams, previous = (sys.stdout, sys.stderr), signal.signal(signal.SIGINT, _interrupted)
     try:
         result = calibrate(results, data, out, outputs=list(output) or None, noise=list(noise), seed=seed,
                            walkers=walkers, steps=steps, method=method, order=order, campaign=campaign,
                            predictive_draws=predictive_draws, progress=False)
+    except KeyboardInterrupt:
+        sys.stdout, sys.stderr = streams
+        echo(f"\ninterrupted: no calibration written to {out}", err=True)
+        raise typer.Exit(EXIT_INTERRUPTED)
     except (DataError, SurrogateError, ValueError) as exc:
-        typer.echo(f"error: {exc}", err=True)
+        echo(f"error: {exc}", err=True)
         raise typer.Exit(EXIT_BAD_INPUT)
     except NotConverged as exc:
-        typer.echo("not converged: no posterior is reported.", err=True)
+        echo("not converged: no posterior is reported.", err=True)
         for problem in exc.diagnostics["problems"]:
-            typer.echo(f"  - {problem}", err=True)
+            echo(f"  - {problem}", err=True)
         if exc.removed:
-            typer.echo(f"  (removed the outputs of an earlier run from {out}: {', '.join(exc.removed)})", err=True)
+            echo(f"  (removed the outputs of an earlier run from {out}: {', '.join(exc.removed)})", err=True)
         raise typer.Exit(EXIT_NOT_CONVERGED)
+    finally:
+        signal.signal(signal.SIGINT, previous)
     summary = result.summary
     diag = summary["diagnostics"]
-    typer.echo(f"surrogate: {summary['surrogate']['kind']} order {summary['surrogate']['order']} from "
-               f"{summary['surrogate']['runs']} runs; {diag['walkers']} walkers x {diag['steps']} steps, "
-               f"acceptance {diag['acceptance_fraction']['mean']:.2f}, {diag['steps_per_tau']:.0f} tau kept, "
-               f"max split-R-hat {max(diag['split_rhat'].values()):.3f}")
-    typer.echo(f"{'parameter':<10} {'prior mean':>12} {'prior std':>11} {'post mean':>12} {'post std':>11} "
-               f"{'narrowing':>9}  95 % interval")
+    echo(f"surrogate: {summary['surrogate']['kind']} order {summary['surrogate']['order']} from "
+         f"{summary['surrogate']['runs']} runs; {diag['walkers']} walkers x {diag['steps']} steps, "
+         f"acceptance {diag['acceptance_fraction']['mean']:.2f}, {diag['steps_per_tau']:.0f} tau kept, "
+         f"max split-R-hat {max(diag['split_rhat'].values()):.3f}")
+    echo(f"{'parameter':<10} {'prior mean':>12} {'prior std':>11} {'post mean':>12} {'post std':>11} "
+         f"{'narrowing':>9}  95 % interval")
     for name, p in summary["parameters"].items():
         narrowing = p["narrowing"]
-        typer.echo(f"{name:<10} {p['prior']['mean']:12.6g} {p['prior']['std']:11.4g} {p['posterior']['mean']:12.6g} "
-                   f"{p['posterior']['std']:11.4g} {narrowing if narrowing is not None else float('nan'):9.2f}  "
-                   f"[{p['posterior']['ci95'][0]:.6g}, {p['posterior']['ci95'][1]:.6g}]")
+        echo(f"{name:<10} {p['prior']['mean']:12.6g} {p['prior']['std']:11.4g} {p['posterior']['mean']:12.6g} "
+             f"{p['posterior']['std']:11.4g} {narrowing if narrowing is not None else float('nan'):9.2f}  "
+             f"[{p['posterior']['ci95'][0]:.6g}, {p['posterior']['ci95'][1]:.6g}]")
     for name, n in summary["noise"].items():
         if n["inferred"]:
-            typer.echo(f"noise {name}: sigma {n['inferred']['mean']:.4g} (inferred)")
+            echo(f"noise {name}: sigma {n['inferred']['mean']:.4g} (inferred)")
     pred = summary["predictive"]
     cover = ", ".join(f"{k} {v:.0%}" if v is not None else f"{k} -" for k, v in pred["coverage95"].items())
-    typer.echo(f"posterior predictive ({pred['draws']} simulator runs, {pred['failed']} failed): data inside the "
-               f"95 % band: {cover}")
-    typer.echo(f"wrote {', '.join(result.written)} to {out} ({summary['seconds']['total']:.1f} s)")
+    echo(f"posterior predictive ({pred['draws']} simulator runs, {pred['failed']} failed): data inside the "
+         f"95 % band: {cover}")
+    echo(f"wrote {', '.join(result.written)} to {out} ({summary['seconds']['total']:.1f} s)")
+
+
+def _interrupted(signum, frame):
+    """Ctrl-C: stop with one line. emcee prints every exception raised in the log-probability (a
+    KeyboardInterrupt too) with its arguments and a traceback before re-raising it: what is printed
+    from here on goes to /dev/null, until the command restores the streams to say it stopped."""
+    sys.stdout = sys.stderr = open(os.devnull, "w")
+    raise KeyboardInterrupt
 
 
 def register(app: typer.Typer) -> None:

@@ -46,7 +46,7 @@ def read_flight_csv(path, outputs: list[str] | None, available: list[str]) -> Fl
     """
     path = Path(path)
     try:
-        with open(path, newline="", encoding="utf-8") as fh:
+        with open(path, newline="", encoding="utf-8-sig") as fh:  # a byte-order mark is no part of the header
             rows = list(csv.reader(fh))
     except (OSError, UnicodeDecodeError) as exc:
         raise DataError(f"{path}: cannot read the file ({exc})") from exc
@@ -103,6 +103,8 @@ def parse_noise(pairs: list[str], outputs: list[str]) -> dict[str, float]:
             raise DataError(f"--noise: expected OUTPUT=SIGMA with SIGMA > 0, got {pair!r}")
         if name not in outputs:
             raise DataError(f"--noise {name}: not one of the calibrated outputs ({', '.join(outputs)})")
+        if name in noise:
+            raise DataError(f"--noise {name}: given twice ({noise[name]:g} and {sigma:g}); give it once")
         noise[name] = sigma
     return noise
 

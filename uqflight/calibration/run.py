@@ -18,6 +18,7 @@ from .likelihood import DataError, LogPosterior, interpolate_in_time, parse_nois
 from .outputs import (OUTPUT_FILES, calibrated_campaign, corner_plot, marginal, marginals_plot, predictive_plot,
                       write_json, write_posterior)
 from .sampler import sample
+from .size import PREDICTIVE_NOISE_DRAWS, check_size
 from .surrogate import (SurrogateError, campaign_folder, campaign_mapping, check_campaign_text, fit_surrogate,
                         parameter_specs, prior_summaries, simulate, to_physical)
 
@@ -27,7 +28,6 @@ NOISE_PRIOR = ("inferred noise: half-Cauchy(0, S) prior on sigma, sampled as log
                "data of (data - prior-mean prediction)^2 + prior variance + surrogate error variance; cut to "
                "S e^-30 < sigma < S e^10")
 NOISE_FREE = 1e-6  # an inferred noise below this share of the data's scale: hint that the data look noise-free
-PREDICTIVE_NOISE_DRAWS = 40  # noise draws per simulator run for the 95 % predictive band
 
 
 class NotConverged(RuntimeError):
@@ -51,9 +51,11 @@ def calibrate(results, data, out, outputs: list[str] | None = None, noise: list[
               progress: bool = False) -> Calibration:
     """Calibrate the campaign of `results` on flight `data`; see docs/calibration.md.
 
-    Raises DataError / SurrogateError (bad input), ValueError (bad settings), NotConverged.
+    Raises DataError / SurrogateError (bad input, data too large for memory: calibration.size),
+    ValueError (bad settings), NotConverged.
     One BLAS thread: the matrices are small (a few hundred rows), where several threads on a shared
     machine make the SVDs 10-100x slower."""
+    check_size(data, outputs, walkers, steps, predictive_draws)  # before any work
     with threadpool_limits(limits=1):
         return _calibrate(results, data, out, outputs, noise, seed, walkers, steps, method, order, campaign,
                           predictive_draws, truth, progress)

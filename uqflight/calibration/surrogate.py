@@ -2,8 +2,9 @@
 its leave-one-out error, and the simulator for posterior-predictive runs.
 
 This is the ONLY module of uqflight.calibration that imports other uqflight modules (results
-store, campaign loading, parameters, methods, statistics, simulators): after a restructure of
-the package, retarget the imports here.
+store, campaign loading, parameters, methods, statistics, simulators), but for the command line's
+helpers in command.py and the memory limit in size.py: after a restructure of the package,
+retarget the imports here.
 """
 from __future__ import annotations
 

@@ -117,22 +117,62 @@ class Checker:
         return value
 
 
+MAX_DEPTH = 64           # YAML nesting deeper than this is refused (a campaign nests 4 levels)
+MAX_INTEGER_CHARS = 100  # an integer written longer is refused (Python reads at most 4300 decimal digits)
+
+
 class CampaignLoader(yaml.SafeLoader):
     """YAML's safe loader, except that a key given twice in one mapping is an error (plain YAML
-    keeps the last one silently, so a parameter pasted twice would vanish), and that aliases
-    (`*name`) are refused: nested aliases expand exponentially (a "billion laughs" bomb)."""
+    keeps the last one silently, so a parameter pasted twice would vanish), that aliases
+    (`*name`) are refused: nested aliases expand exponentially (a "billion laughs" bomb), and that
+    every other way a value can fail to be read is a YAML error at its line: nesting beyond
+    MAX_DEPTH (Python's recursion limit otherwise), integers longer than MAX_INTEGER_CHARS, and
+    values that YAML's own constructors reject with a Python error (`2001-13-45`, `!!float abc`)."""
+
+    def __init__(self, stream):
+        super().__init__(stream)
+        self.depth = 0
 
     def compose_node(self, parent, index):
-        if self.check_event(yaml.events.AliasEvent):
-            event = self.peek_event()
+        event = self.peek_event()
+        if isinstance(event, yaml.events.AliasEvent):
             raise yaml.composer.ComposerError(
                 None, None, "YAML aliases (*name) are not accepted in campaign files; write the value out",
                 event.start_mark)
-        return super().compose_node(parent, index)
+        if self.depth >= MAX_DEPTH:
+            raise yaml.composer.ComposerError(
+                None, None, f"nested deeper than {MAX_DEPTH} levels; a campaign nests a few", event.start_mark)
+        self.depth += 1
+        try:
+            return super().compose_node(parent, index)
+        finally:
+            self.depth -= 1
+
+    def construct_document(self, node):
+        return self._readable(super().construct_document, node)
+
+    def construct_object(self, node, deep=False):
+        return self._readable(super().construct_object, node, deep)
+
+    @staticmethod
+    def _readable(construct, node, *args):
+        try:
+            return construct(node, *args)
+        except (ValueError, TypeError, ArithmeticError) as exc:
+            raise yaml.constructor.ConstructorError(None, None, f"cannot read this value ({exc})",
+                                                    node.start_mark) from None
+
+    def construct_yaml_int(self, node):
+        text = self.construct_scalar(node)
+        if len(text) > MAX_INTEGER_CHARS:
+            raise yaml.constructor.ConstructorError(
+                None, None, f"an integer of {len(text)} characters; no field takes more than {MAX_INTEGER_CHARS}",
+                node.start_mark)
+        return super().construct_yaml_int(node)
 
     def construct_mapping(self, node, deep=False):
         seen = set()
-        for key_node, _ in node.value:
+        for key_node, _ in node.value if isinstance(node, yaml.MappingNode) else ():
             if key_node.tag == "tag:yaml.org,2002:merge":
                 continue
             key = self.construct_object(key_node, deep=deep)
@@ -145,6 +185,7 @@ class CampaignLoader(yaml.SafeLoader):
         return super().construct_mapping(node, deep)
 
 
+CampaignLoader.add_constructor("tag:yaml.org,2002:int", CampaignLoader.construct_yaml_int)
 # YAML 1.1 (PyYAML) reads 1e-8 as a string: accept exponents without a dot, as YAML 1.2 does.
 CampaignLoader.yaml_implicit_resolvers = {
     key: list(value) for key, value in yaml.SafeLoader.yaml_implicit_resolvers.items()}
@@ -159,12 +200,14 @@ CampaignLoader.add_implicit_resolver(
 
 
 def yaml_error(exc: yaml.YAMLError) -> str:
-    """'YAML syntax error at line L, column C: problem (context at line L', column C')'."""
+    """'YAML syntax error at line L, column C: problem (context at line L', column C')' ('YAML error'
+    for a value that cannot be read)."""
     def at(mark) -> str:
         return f"line {mark.line + 1}, column {mark.column + 1}"
 
     mark = getattr(exc, "problem_mark", None)
-    message = f"YAML syntax error at {at(mark)}: " if mark else "YAML syntax error: "
+    kind = "YAML syntax error" if isinstance(exc, (yaml.scanner.ScannerError, yaml.parser.ParserError)) else "YAML error"
+    message = f"{kind} at {at(mark)}: " if mark else f"{kind}: "
     message += getattr(exc, "problem", None) or str(exc)
     context, context_mark = getattr(exc, "context", None), getattr(exc, "context_mark", None)
     if context and context_mark:

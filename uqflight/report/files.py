@@ -3,6 +3,7 @@ from __future__ import annotations
 
 import csv
 import json
+import re
 from pathlib import Path
 
 import numpy as np
@@ -41,9 +42,22 @@ def write_statistics_tables(entries: list[Entry], out_dir: Path) -> list[Path]:
 def write_csv(path: Path, header: list[str], rows: list[list]) -> Path:
     with open(path, "w", newline="", encoding="utf-8") as fh:
         writer = csv.writer(fh)
-        writer.writerow(header)
-        writer.writerows([[float(v) if isinstance(v, np.floating) else v for v in row] for row in rows])
+        writer.writerow([inert(h) for h in header])
+        writer.writerows([[float(v) if isinstance(v, np.floating) else inert(v) for v in row] for row in rows])
     return path
+
+
+FORMULA_START = ("=", "+", "-", "@", "\t", "\r")
+NUMBER = re.compile(r"[-+]?(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?")
+
+
+def inert(value):
+    """A text cell a spreadsheet would evaluate as a formula (starting with = + - @, a tab or a carriage
+    return) behind a single quote, which spreadsheets show as text; numbers, and text that is a
+    plain number such as "-0.5", stay as they are."""
+    if isinstance(value, str) and value.startswith(FORMULA_START) and not NUMBER.fullmatch(value):
+        return "'" + value
+    return value
 
 
 def _write_json(path: Path, data: dict) -> Path:

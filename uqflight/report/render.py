@@ -3,6 +3,7 @@ from __future__ import annotations
 
 import base64
 import html
+import re
 from datetime import datetime, timezone
 from pathlib import Path
 
@@ -63,22 +64,36 @@ def _html_block(anchor: str, n: int, block, out_dir: Path) -> str:
 
 
 def render_markdown(title: str, sections: list[Section]) -> str:
-    """The same page in Markdown, linking the PNGs in plots/."""
-    lines = [f"# {title}", "", "## Contents", ""]
-    lines += [f"- [{s.title}](#{s.anchor})" for s in sections]
+    """The same page in Markdown, linking the PNGs in plots/. Every name, reason and caption is
+    escaped (`md`); the campaign text sits in a fence longer than any run of backticks in it."""
+    lines = [f"# {md(title)}", "", "## Contents", ""]
+    lines += [f"- [{md(s.title)}](#{s.anchor})" for s in sections]
     for s in sections:
-        text = f"```yaml\n{s.text}\n```" if s.preformatted else s.text
+        text = "\n".join(md(line) for line in s.text.splitlines())
+        if s.preformatted:
+            fence = "`" * max(3, 1 + max((len(run) for run in re.findall("`+", s.text)), default=0))
+            text = f"{fence}yaml\n{s.text}\n{fence}"
         if s.notes:
-            text = "\n".join(f"> **{line}**" for line in s.text.splitlines())
-        lines += ["", f'<a id="{s.anchor}"></a>', f"## {s.title}", "", text]
+            text = "\n".join(f"> **{md(line)}**" for line in s.text.splitlines())
+        lines += ["", f'<a id="{s.anchor}"></a>', f"## {md(s.title)}", "", text]
         for block in s.blocks:
             if isinstance(block, Figure):
-                lines += ["", f"![{block.caption}]({block.file})", "", f"*{block.caption}* ({block.file})"]
+                lines += ["", f"![{md(block.caption)}]({block.file})", "", f"*{md(block.caption)}* ({md(block.file)})"]
             else:
-                lines += ["", f"### {block.caption}", "", f"({block.file})", "",
-                          "| " + " | ".join(block.header) + " |", "|" + "---|" * len(block.header)]
-                lines += ["| " + " | ".join(_cell(v).replace("|", "\\|") for v in row) + " |" for row in block.rows]
+                lines += ["", f"### {md(block.caption)}", "", f"({md(block.file)})", "",
+                          "| " + " | ".join(md(h) for h in block.header) + " |", "|" + "---|" * len(block.header)]
+                lines += ["| " + " | ".join(md(_cell(v)) for v in row) + " |" for row in block.rows]
     return "\n".join(lines) + "\n"
+
+
+MARKDOWN_SPECIAL = re.compile(r"([\\`*_{}\[\]<>|#!~])")
+
+
+def md(text: str) -> str:
+    """`text` as literal Markdown on one line: its punctuation backslash-escaped, so that a name or a
+    failure reason holding | * _ ` [ ] < > # cannot end a table cell, make a link, emphasis, a
+    heading or HTML."""
+    return MARKDOWN_SPECIAL.sub(r"\\\1", " ".join(str(text).splitlines()))
 
 
 def _cell(value) -> str:

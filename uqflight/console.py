@@ -1,0 +1,40 @@
+"""What the command line prints goes through `echo`: terminal control characters are stripped (a
+failure reason or a name holding an escape sequence, a carriage return or a bell cannot retitle,
+clear or overwrite the terminal), and a closed pipe (`uqflight info r.h5 | head -1`) ends the
+command quietly with exit 141, as a shell's SIGPIPE would."""
+from __future__ import annotations
+
+import os
+import re
+import sys
+
+import typer
+
+CONTROL = re.compile("[\x00-\x08\x0b-\x1f\x7f-\x9f]")  # C0 but tab and newline, DEL, C1
+EXIT_CLOSED_PIPE = 141  # 128 + SIGPIPE
+
+
+def clean(text: str) -> str:
+    """`text` without terminal control characters (tab and newline kept)."""
+    return CONTROL.sub("", text)
+
+
+def echo(message: object = "", err: bool = False, nl: bool = True) -> None:
+    """typer.echo of `message` cleaned; a reader gone (closed pipe) exits quietly with 141."""
+    try:
+        typer.echo(clean(str(message)), err=err, nl=nl)
+    except BrokenPipeError:
+        _discard(sys.stderr if err else sys.stdout)
+        raise typer.Exit(EXIT_CLOSED_PIPE) from None
+
+
+def _discard(stream) -> None:
+    """Point the stream's file descriptor at /dev/null: what it still buffers is flushed there at exit,
+    not reported as another broken pipe."""
+    try:
+        fd = stream.fileno()
+    except (AttributeError, OSError, ValueError):  # a stream without a descriptor (tests capture output)
+        return
+    devnull = os.open(os.devnull, os.O_WRONLY)
+    os.dup2(devnull, fd)
+    os.close(devnull)
