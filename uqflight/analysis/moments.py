@@ -129,10 +129,15 @@ def standardised_moments(Y, weights=None) -> tuple[np.ndarray, np.ndarray]:
     n = len(Y)
     w = probability_weights(weights, n)
     deviation = Y - w @ Y
-    variance = w @ deviation**2
+    power = deviation * deviation  # powers by multiplication, in place: ** 3 and ** 4 call pow per element
+    variance = w @ power
+    power *= deviation
+    third = w @ power
+    power *= deviation
+    fourth = w @ power
     with np.errstate(invalid="ignore", divide="ignore"):
-        g1 = np.where(variance > 0, (w @ deviation**3) / variance**1.5, np.nan)
-        g2 = np.where(variance > 0, (w @ deviation**4) / variance**2, np.nan) - 3.0
+        g1 = np.where(variance > 0, third / variance**1.5, np.nan)
+        g2 = np.where(variance > 0, fourth / variance**2, np.nan) - 3.0
     if weights is not None:
         return g1, g2 + 3.0
     skewness = g1 * np.sqrt(n * (n - 1.0)) / (n - 2.0) if n >= 3 else np.full_like(g1, np.nan)
