@@ -14,6 +14,7 @@ import yaml
 
 from ..designs import SAMPLED_DESIGNS, Design, build_design
 from ..parameters import Parameter
+from ..quantities.spec import check_quantities
 from ..simulators.jsbsim import NAMED_OUTPUTS
 from . import schema
 from .schema import TOP_KEYS, CampaignError, CampaignLoader, Checker, yaml_error
@@ -37,6 +38,7 @@ class Campaign:
     analysis: dict = field(default_factory=dict)
     limits: dict = field(default_factory=lambda: dict(schema.DEFAULT_LIMITS))
     runs: int | None = None  # the design's size, known once validated
+    quantities: dict = field(default_factory=dict)  # name -> checked spec (uqflight.quantities)
 
     @property
     def germs(self) -> list[str]:
@@ -95,17 +97,18 @@ def parse_campaign(text: str, source: str = "<campaign>", probe: PropertyProbe |
                 check.fail(f"simulator.outputs[{i}]", f"expected one of {', '.join(NAMED_OUTPUTS)} or a JSBSim "
                            f"property of aircraft {aircraft.aircraft!r}, got {output!r}{aircraft.hint(output)}")
     parameters = schema.parameters(check, data["parameters"], simulator["kind"], aircraft)
+    quantities = check_quantities(check, data.get("quantities"), simulator, aircraft)
     design_kind = data["design"].get("kind") if isinstance(data["design"], dict) else None
     default_method = "monte_carlo" if design_kind in SAMPLED_DESIGNS else "integration"
     method = schema.method(check, data.get("method", {"kind": default_method}))
     execution = schema.execution(check, data.get("execution", {}))
     storage = schema.storage(check, data.get("storage", {}), name)
-    analysis = schema.analysis(check, data.get("analysis", {}))
+    analysis = schema.analysis(check, data.get("analysis", {}), quantities)
     limits = schema.limits(check, data.get("limits", {}))
     if isinstance(data["design"], dict):  # sizes from the campaign alone, before building anything
         schema.check_size(check, data, simulator, parameters, method, execution, storage, limits)
     campaign = Campaign(source, text, name, seed, simulator, parameters, data["design"], method,
-                        execution, storage, analysis, limits)
+                        execution, storage, analysis, limits, quantities=quantities)
     try:
         design = campaign.design()
     except ValueError as exc:

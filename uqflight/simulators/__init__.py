@@ -11,7 +11,7 @@ from pathlib import Path
 import numpy as np
 
 from .base import FlightError
-from .jsbsim import UNITS, FlightSetup, JSBSimFlight, flight_setup_from
+from .jsbsim import NAMED_OUTPUTS, UNITS, FlightSetup, JSBSimFlight, flight_setup_from
 from .python import PythonSimulator
 
 
@@ -30,9 +30,15 @@ class JSBSimSimulator:
     def probe(self, kappa: np.ndarray) -> tuple[np.ndarray, list[str]]:
         return self.setup.time, list(self.setup.outputs)
 
-    def evaluate(self, kappa: np.ndarray) -> dict[str, np.ndarray]:
+    def evaluate(self, kappa: np.ndarray, observers=()) -> dict[str, np.ndarray]:
+        """`observers` see every integration step (JSBSimFlight.run_trimmed)."""
         self._flown = True
-        return self.flight.fly(dict(zip(self.properties, map(float, kappa)))).outputs
+        return self.flight.fly(dict(zip(self.properties, map(float, kappa))), observers).outputs
+
+    @staticmethod
+    def source(name: str) -> tuple[str, float]:
+        """The property a quantity's `of:` reads and its scale: a named output's, else the property."""
+        return NAMED_OUTPUTS.get(name, (name, 1.0))
 
     def trim_repeatability(self, kappa: np.ndarray, ours: dict[str, np.ndarray] | None = None
                            ) -> dict[str, np.ndarray] | None:

@@ -231,10 +231,11 @@ class JSBSimFlight:
         return self.node(prop), scale
 
     # -- one sample -------------------------------------------------------------------------
-    def fly(self, settings: dict[str, float] | None = None) -> FlightResult:
-        """Fly one sample with the given property values; raises a FlightError subclass."""
+    def fly(self, settings: dict[str, float] | None = None, observers=()) -> FlightResult:
+        """Fly one sample with the given property values; raises a FlightError subclass.
+        `observers`: see run_trimmed."""
         trim = self.trim(settings or {})
-        return self.run_trimmed(trim)
+        return self.run_trimmed(trim, observers)
 
     def trim(self, settings: dict[str, float]) -> TrimResult:
         """Reset, apply `settings`, trim in unaccelerated level flight and settle the engines.
@@ -336,8 +337,12 @@ class JSBSimFlight:
             raise TrimError(f"trim angle of attack {result.alpha_deg:.2f} deg is past the stall")
         return result
 
-    def run_trimmed(self, trim: TrimResult) -> FlightResult:
-        """Excite and integrate from the trimmed state, recording at the output rate."""
+    def run_trimmed(self, trim: TrimResult, observers=()) -> FlightResult:
+        """Excite and integrate from the trimmed state, recording at the output rate.
+
+        Each observer (uqflight.quantities.recorder) gets `at_trim(fdm)`, if it has one, before the
+        excitation, then `step(t, values)` at t = 0 and after every integration step, `values` being
+        those of its `properties`, in order."""
         s = self.setup
         time = s.time
         k = s.steps_per_output
@@ -350,10 +355,17 @@ class JSBSimFlight:
         run = self.fdm.run
         data = np.empty((len(time), len(self._recorded)))
         data[0] = [node.get_double_value() for node, _ in self._recorded]
+        for observer in observers:
+            getattr(observer, "at_trim", lambda fdm: None)(self.fdm)
+        watched = [(observer.step, [self.node(p) for p in observer.properties]) for observer in observers]
+        for step, nodes in watched:
+            step(0.0, [node.get_double_value() for node in nodes])
         for i in range(n_steps):
             if i in change_at:
                 exc_node.set_double_value(exc_base + exc_per_deg * change_at[i])
             run()
+            for step, nodes in watched:
+                step((i + 1) / s.rate_hz, [node.get_double_value() for node in nodes])
             if (i + 1) % k == 0:
                 data[(i + 1) // k] = [node.get_double_value() for node, _ in self._recorded]
         exc_node.set_double_value(exc_base)
