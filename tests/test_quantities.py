@@ -191,3 +191,57 @@ def test_a_jsbsim_quantity_is_taken_at_every_integration_step():
     assert found["h"] == max(heights)
     assert found["q"] == min(rates) * (180.0 / math.pi)  # the named output q_degps, scaled as recorded
     assert found["q"] <= recorded["q_degps"].min() and found["h"] >= recorded["h_ft"].max()
+
+
+def test_the_report_shows_the_quantities_table_pdfs_and_sobol_bars(tmp_path):
+    from uqflight.report import write_report
+
+    text = python_campaign(tmp_path, "{final_y: {of: y, take: final}, t_up: {take: time_of_first, when: "
+                                     "{of: y, above: 4}}}", "{kind: sparse_grid, rule: gauss_legendre, level: 2}",
+                           "{kind: pseudo_galerkin, order: 2}", analysis="{exceedance: {final_y: [{above: 5}]}}")
+    out = tmp_path / "grid.h5"
+    run_campaign(parse_campaign(text, str(tmp_path / "q.yaml")), out=out)
+    report = tmp_path / "report"
+    write_report([out], report)
+    page = (report / "report.html").read_text()
+    assert 'id="quantities"' in page and "Exceedance probabilities" in page
+    assert (report / "plots" / "quantity_pdfs_grid.png").stat().st_size > 0
+    assert (report / "plots" / "quantity_sobol_grid.png").stat().st_size > 0
+    import csv
+
+    rows = list(csv.reader((report / "tables" / "quantities.csv").open()))
+    assert [row[1:3] for row in rows[1:]] == [["final_y", "0"], ["t_up", "7"]] and rows[2][3] == ""
+
+
+def test_quantities_written_in_two_sessions_equal_one_and_a_damaged_layout_is_refused(tmp_path):
+    import h5py
+
+    from uqflight.quantities import quantity_key
+    from uqflight.store import CorruptFile
+
+    def create(path):
+        return ResultStore.create(path, campaign_text="x", xi=np.zeros((4, 1)), kappa=np.zeros((4, 1)),
+                                  weights=np.full(4, 0.25), parameter_names=["a"], outputs=["y"],
+                                  time=np.arange(3.0), quantities=["q"])
+
+    def batch(rows):
+        return (rows, np.zeros(len(rows), np.int8), [""] * len(rows),
+                {"y": np.ones((len(rows), 3)), quantity_key("q"): np.array([1.5, np.nan, 2.5, 3.5])[rows]})
+
+    with create(tmp_path / "one.h5") as store:
+        store.write_batch(*batch(np.arange(4)))
+    with create(tmp_path / "two.h5") as store:
+        store.write_batch(*batch(np.array([2, 0])))
+    with ResultStore.open(tmp_path / "two.h5", "a") as store:  # a resume
+        assert store.pending().tolist() == [1, 3]
+        store.write_batch(*batch(np.array([3, 1])))
+    assert_same_results(tmp_path / "one.h5", tmp_path / "two.h5")
+    with ResultStore.open(tmp_path / "one.h5") as store:
+        np.testing.assert_array_equal(store.quantity("q"), [1.5, np.nan, 2.5, 3.5])
+        with pytest.raises(ValueError, match="quantities"):  # an ok run without its quantities
+            store._split_quantities(np.arange(1), np.zeros(1), {"y": np.ones((1, 3))})
+    with h5py.File(tmp_path / "one.h5", "a") as f:
+        del f["quantities/q"]
+        f["quantities/q"] = np.zeros(3)
+    with pytest.raises(CorruptFile, match="/quantities/q has shape"):
+        ResultStore.open(tmp_path / "one.h5")
