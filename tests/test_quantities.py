@@ -198,7 +198,8 @@ def test_the_report_shows_the_quantities_table_pdfs_and_sobol_bars(tmp_path):
 
     text = python_campaign(tmp_path, "{final_y: {of: y, take: final}, t_up: {take: time_of_first, when: "
                                      "{of: y, above: 4}}}", "{kind: sparse_grid, rule: gauss_legendre, level: 2}",
-                           "{kind: pseudo_galerkin, order: 2}", analysis="{exceedance: {final_y: [{above: 5}]}}")
+                           "{kind: pseudo_galerkin, order: 2}",
+                           analysis="{band_samples: 2000, exceedance: {final_y: [{above: 5}]}}")
     out = tmp_path / "grid.h5"
     run_campaign(parse_campaign(text, str(tmp_path / "q.yaml")), out=out)
     report = tmp_path / "report"
