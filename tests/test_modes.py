@@ -44,7 +44,7 @@ def test_an_overdamped_short_period_is_undefined():
     assert modes["phugoid_period_s"] == pytest.approx(2 * math.pi / 0.1359, rel=1e-12)
 
 
-@pytest.mark.slow  # one linearisation of bacm: ~20 s (JSBSim settles both turboprops at every perturbation)
+@pytest.mark.slow  # one linearisation of bacm: 5-20 s (JSBSim settles both turboprops at every perturbation)
 def test_bacm_nominal_modes_match_the_flight_and_leave_the_flight_as_it_was():
     from uqflight.simulators import make_simulator
 

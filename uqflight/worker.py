@@ -113,7 +113,7 @@ def probe(spec: WorkerSpec, kappa: np.ndarray, resolution: bool = True):
     time_grid, outputs = simulator.probe(kappa)
     observers = (QuantityRecorder(spec.quantities, simulator.source),) if spec.quantities else ()
     started = time.perf_counter()
-    try:  # with the quantities: a linearisation costs more than the flight (20 s for bacm's two turboprops)
+    try:  # with the quantities: a linearisation costs more than the flight (5 s for bacm's two turboprops)
         flown = simulator.evaluate(kappa, observers)
     except Exception:  # a failed nominal flight still measures the cost of a flight
         flown = None
