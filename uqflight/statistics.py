@@ -458,7 +458,7 @@ class _QuantityView:
     `_output_statistics` reads, so a quantity gets the outputs' methods, refusals and flags."""
 
     def __init__(self, store: ResultStore, name: str, values: np.ndarray):
-        self._store, self._name, self._values = store, name, values
+        self._store, self._values = store, values
         self.time, self.units = np.zeros(1), {name: ""}
 
     def __getattr__(self, attribute):  # the design, its weights, names and attributes: the file's

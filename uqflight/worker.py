@@ -88,6 +88,8 @@ def run_chunk(spec: WorkerSpec, indices: np.ndarray, kappa: np.ndarray, n_times:
         try:
             if recorder:
                 recorder.reset()
+                if recorder.modes:  # JSBSim linearises a reused bacm in minutes (240 s), a fresh one in 4 s
+                    simulator.restart()
             result = simulator.evaluate(k, observers)
             for name in outputs:
                 if name not in result:
