@@ -69,3 +69,20 @@ def test_bacm_nominal_modes_match_the_flight_and_leave_the_flight_as_it_was():
     without = simulator.evaluate(nominal)
     for name, history in without.items():
         assert np.abs(with_modes[name] - history).max() <= 1e-8 * np.abs(history).max(), name
+
+
+@pytest.mark.slow  # three linearisations of bacm: 15-60 s
+def test_a_runs_modes_do_not_depend_on_the_run_flown_before_it_in_its_chunk():
+    # JSBSim's linearisation of a reused aircraft differs (0.1 % on the phugoid period of one Table 1
+    # point) and can take minutes: each run with modes is flown on a freshly loaded one
+    from uqflight.execution import worker_spec
+    from uqflight.parameters import to_physical
+    from uqflight.worker import run_chunk
+
+    campaign = load_campaign(ROOT / "campaigns" / "bacm-modes.yaml", probe=jsbsim_probe)
+    kappa = to_physical(campaign.parameters, campaign.design().xi)[16:18]
+    spec, outputs = worker_spec(campaign), list(campaign.simulator["outputs"])
+    pair = run_chunk(spec, np.arange(16, 18), kappa, 1001, outputs)[3]
+    alone = run_chunk(spec, np.arange(17, 18), kappa[1:], 1001, outputs)[3]
+    for key, values in alone.items():
+        np.testing.assert_array_equal(pair[key][1:], values, err_msg=str(key))

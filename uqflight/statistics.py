@@ -530,6 +530,9 @@ def _quantity_json(quantity: QuantityStatistics) -> dict:
         entry["sobol_total_ci"] = {k: {"lower": v[0][0], "upper": v[1][0]} for k, v in out.sobol_total_ci.items()}
     if out.loo_error is not None:
         entry["loo_error"] = out.loo_error[0]
+    if out.convergence is not None:
+        entry["convergence"] = {**out.convergence, "eps_m": out.convergence["eps_m"][0],
+                                "eps_v": out.convergence["eps_v"][0]}
     return entry
 
 
