@@ -13,7 +13,7 @@ PACKAGE = Path(__file__).resolve().parents[1] / "uqflight"
 LAYERS = [
     ("uqflight.paper", "uqflight.tsvd", "uqflight.simulators.base", "uqflight.parameters.germs", "uqflight.console",
      "uqflight.arguments"),
-    ("uqflight.parameters", "uqflight.analysis", "uqflight.simulators"),
+    ("uqflight.parameters", "uqflight.analysis", "uqflight.simulators", "uqflight.quantities"),
     ("uqflight.designs",),
     ("uqflight.methods",),
     ("uqflight.store", "uqflight.worker"),
@@ -71,4 +71,6 @@ def test_a_worker_imports_only_what_flying_needs():
     code = ("import sys, uqflight.worker; print(' '.join(sorted(m for m in sys.modules "
             "if m.startswith(('uqflight', 'scipy', 'h5py', 'yaml', 'matplotlib', 'dask')))))")
     loaded = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout.split()
-    assert all(m.startswith(("uqflight.simulators", "uqflight.worker")) or m == "uqflight" for m in loaded), loaded
+    # the quantities' recorder is part of flying: it sees every integration step
+    assert all(m.startswith(("uqflight.simulators", "uqflight.worker", "uqflight.quantities")) or m == "uqflight"
+               for m in loaded), loaded

@@ -210,13 +210,17 @@ def _seconds_per_run(spec) -> float:
 
     from .execution import worker_spec
 
+    from .quantities.recorder import QuantityRecorder
+
     simulator = worker_spec(spec).build()
     nominal = np.array([p.nominal for p in spec.parameters])
-    for _ in range(2):  # the first run loads what every later one reuses (the Newton trim's nominal)
+    # the timed run computes the quantities too: a linearisation costs more than the flight
+    observers = (QuantityRecorder(spec.quantities, simulator.source),) if spec.quantities else ()
+    for timed in (False, True):  # the first run loads what every later one reuses (the Newton trim's nominal)
         simulator.restart()
         started = time.perf_counter()
         try:
-            simulator.evaluate(nominal)
+            simulator.evaluate(nominal, observers if timed else ())
         except FlightError:
             pass
     return time.perf_counter() - started

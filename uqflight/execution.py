@@ -138,7 +138,7 @@ def prepare_store(campaign: Campaign, design: Design, out: Path, force: bool, pr
         out, campaign_text=campaign.text, force=force, restart=restart, xi=design.xi, kappa=kappa, weights=design.weights,
         parameter_names=[p.name for p in campaign.parameters], outputs=outputs, time=time_grid,
         raw=campaign.storage["raw"], tsvd=campaign.storage.get("tsvd"), attrs=attrs, units=units,
-        batch_rows=campaign.execution["chunk"], repeatability=repeatability)
+        batch_rows=campaign.execution["chunk"], repeatability=repeatability, quantities=list(campaign.quantities))
 
 
 def nominal_kappa(campaign: Campaign) -> np.ndarray:
@@ -153,7 +153,8 @@ def worker_spec(campaign: Campaign) -> WorkerSpec:
     return WorkerSpec(simulator=campaign.simulator,
                       parameter_names=tuple(p.name for p in campaign.parameters),
                       properties=properties, base=base,
-                      bundle=make_bundle(campaign.simulator, properties, base))  # files travel with the task
+                      bundle=make_bundle(campaign.simulator, properties, base),  # files travel with the task
+                      quantities=campaign.quantities or None)
 
 
 def local_workers(campaign: Campaign, workers: int, chunk: int) -> int:

@@ -32,6 +32,7 @@ import numpy as np
 from .analysis.density import pdf_over_time
 from .analysis.divergence import kl_divergence
 from .analysis.errors import error_summary, relative_errors
+from .analysis.exceedance import exceedance_from_pce, exceedance_from_runs
 from .analysis.failures import failure_probability, grid_failure_probability
 from .analysis.floors import central_moments, floors_from_moments, kld_floor
 from .analysis.moments import modified_cov, standardised_moments, weighted_moments, weighted_quantiles
@@ -125,6 +126,18 @@ class Statistics:
     from_runs: bool = False  # statistics of the runs themselves (a sampled design), not of a PCE
     replicates: int = 1  # independent randomised-QMC replicates of the design
     seeds: list[str] = field(default_factory=list)  # parameters that are random streams' seeds
+    quantities: dict[str, QuantityStatistics] = field(default_factory=dict)
+
+
+@dataclass
+class QuantityStatistics:
+    """A quantity of interest (one number per run) analysed as an output with one time point; `output`
+    None when its statistics are undefined (see `quantity_statistics`)."""
+
+    name: str
+    missing: int  # successful runs where the quantity is undefined
+    output: OutputStatistics | None
+    exceedance: list[dict] = field(default_factory=list)
 
 
 def campaign_facts(store: ResultStore) -> tuple[dict, list[str], dict]:
@@ -197,6 +210,9 @@ def analyse(path, reference: str | None = None, options: Options | None = None, 
             out = stats.outputs[name] = _output_statistics(store, name, method, germs, design_kind, ok, options)
             if stats.replicates > 1:
                 out.replicate_moments = _replicate_moments(store, name, stats.replicates)
+        for name in store.quantity_names:
+            stats.quantities[name] = quantity_statistics(store, stats, name, germs, ok, options,
+                                                         analysis.get("exceedance", {}).get(name, []))
     if reference:
         add_reference_errors(stats, analyse(reference, options=Options(
             band_samples=options.band_samples, bootstrap=0, seed=options.seed, quantiles=options.quantiles)))
@@ -451,6 +467,89 @@ def _reference_floor(reference: Statistics, ref: OutputStatistics, out: OutputSt
     return {"eps_m_floor": None, "eps_v_floor": None, "kld_floor": None, "floor_note": note}
 
 
+class _QuantityView:
+    """A results file seen with one quantity as its only output, of one time point: what
+    `_output_statistics` reads, so a quantity gets the outputs' methods, refusals and flags."""
+
+    def __init__(self, store: ResultStore, name: str, values: np.ndarray):
+        self._store, self._values = store, values
+        self.time, self.units = np.zeros(1), {name: ""}
+
+    def __getattr__(self, attribute):  # the design, its weights, names and attributes: the file's
+        return getattr(self._store, attribute)
+
+    def output_factors(self, name: str):
+        return None
+
+    def output_matrix(self, name: str, rows) -> np.ndarray:
+        return self._values[np.asarray(rows, dtype=np.int64)][:, None]
+
+    def resolution(self, name: str):
+        return None
+
+
+def quantity_statistics(store: ResultStore, stats: Statistics, name: str, germs: list[str], ok: np.ndarray,
+                        options: Options, thresholds: list[dict]) -> QuantityStatistics:
+    """Statistics of quantity `name` over the successful runs where it is defined. Undefined in some:
+    a sampled design's statistics are conditional on the others (noted); a grid's are None (noted:
+    a projection needs every run). Exceedance probabilities from the runs or from the PCE."""
+    values = store.quantity(name)
+    defined = ok & np.isfinite(values)
+    missing = int(ok.sum() - defined.sum())
+    sampled = is_sampled(stats.design_kind)
+    why = None
+    if not defined.any():
+        why = f"quantity {name} is undefined in every successful run: its statistics are null"
+    elif missing and not sampled:
+        why = (f"quantity {name} is undefined in {missing} of {int(ok.sum())} successful runs: a projection on "
+               f"a {stats.design_kind} needs every run, so its statistics are null")
+    elif missing:
+        problem = method_problem(stats.method["kind"], stats.method["order"], store.xi[defined],
+                                 store.weights[defined], germs, sampled, missing=int((~defined).sum()))
+        why = problem and f"quantity {name}: method {stats.method['kind']} on the runs where it is defined: {problem}"
+        if not why:
+            stats.notes.append(f"quantity {name} is undefined in {missing} of {int(ok.sum())} successful runs: "
+                               "its statistics are conditional on the runs where it is defined")
+    if why:
+        stats.notes.append(why)
+        nulls = [{**item, "probability": None, "lower": None, "upper": None, "method": None, "note": why}
+                 for item in thresholds]
+        return QuantityStatistics(name, missing, None, nulls)
+    view = _QuantityView(store, name, values)
+    out = _output_statistics(view, name, stats.method, germs, stats.design_kind, defined, options)
+    if out.pce is None:
+        exceedance = exceedance_from_runs(values[defined], thresholds)
+    else:
+        exceedance = exceedance_from_pce(out.pce.sample(options.band_samples, options.seed)[:, 0],
+                                         int(defined.sum()), thresholds)
+    return QuantityStatistics(name, missing, out, exceedance)
+
+
+def _quantity_json(quantity: QuantityStatistics) -> dict:
+    """summary.json's quantities.NAME: numbers, not lists (null where undefined)."""
+    out = quantity.output
+    entry = {"missing": quantity.missing, "exceedance": quantity.exceedance}
+    if out is None:
+        return {"mean": None, "variance": None, "std": None, "band99": {"lower": None, "upper": None},
+                "quantiles": {}, "skewness": None, "kurtosis": None, "sobol_first": {}, "sobol_total": {}, **entry}
+    entry.update({
+        "mean": out.mean[0], "variance": out.variance[0], "std": out.std[0],
+        "band99": {"lower": out.band99[0][0], "upper": out.band99[1][0]},
+        "quantiles": {f"{p:g}": values[0] for p, values in out.quantiles.items()},
+        "skewness": out.skewness[0], "kurtosis": out.kurtosis[0], "resolved": out.resolved[0],
+        "sobol_first": {k: v[0] for k, v in out.sobol_first.items()},
+        "sobol_total": {k: v[0] for k, v in out.sobol_total.items()}})
+    if out.sobol_first_ci:
+        entry["sobol_first_ci"] = {k: {"lower": v[0][0], "upper": v[1][0]} for k, v in out.sobol_first_ci.items()}
+        entry["sobol_total_ci"] = {k: {"lower": v[0][0], "upper": v[1][0]} for k, v in out.sobol_total_ci.items()}
+    if out.loo_error is not None:
+        entry["loo_error"] = out.loo_error[0]
+    if out.convergence is not None:
+        entry["convergence"] = {**out.convergence, "eps_m": out.convergence["eps_m"][0],
+                                "eps_v": out.convergence["eps_v"][0]}
+    return entry
+
+
 def json_ready(value):
     """`value` with numpy arrays as lists and NaN or infinite floats as None: strict JSON."""
     if isinstance(value, dict):
@@ -518,4 +617,5 @@ def summary_json(stats: Statistics) -> dict:
         "runs": stats.runs, "completed": stats.completed, "failed": stats.failed, "pending": stats.pending,
         "failure_probability": stats.failure_probability, "partial": stats.partial, "notes": stats.notes,
         "failures": stats.failures, "parameters": stats.parameter_names, "reference": stats.reference,
-        "outputs": outputs})
+        "outputs": outputs,
+        "quantities": {name: _quantity_json(quantity) for name, quantity in stats.quantities.items()}})

@@ -23,6 +23,8 @@ from pathlib import Path
 
 import numpy as np
 
+from .quantities import quantity_key
+from .quantities.recorder import QuantityRecorder
 from .simulators import FlightError, make_simulator
 from .simulators.base import NominalFailed
 from .simulators.bundle import localized
@@ -37,6 +39,7 @@ class WorkerSpec:
     properties: tuple[str, ...]
     base: str
     bundle: dict | None = None  # the aircraft's (or file.py's) files as bytes + hash (simulators/bundle.py)
+    quantities: dict | None = None  # the campaign's quantities of interest, {name: spec} (uqflight.quantities)
 
     @property
     def key(self) -> str:
@@ -64,13 +67,19 @@ def run_chunk(spec: WorkerSpec, indices: np.ndarray, kappa: np.ndarray, n_times:
 
     `skip`: rows (positions in the chunk) not to fly (they killed or hung a worker before; the
     runner records them); they are left NaN with status ok, for the runner to overwrite.
-    `on_start(row)` is called before each sample is flown."""
+    `on_start(row)` is called before each sample is flown. The values hold every output's (n, T) rows and,
+    under `quantity_key(name)`, every quantity's (n,) values, computed at every step of the flight
+    (NaN where undefined or failed)."""
     simulator = worker_simulator(spec)
     simulator.restart()
     n = len(indices)
     status = np.zeros(n, dtype=np.int8)
     reasons = [""] * n
     values = {name: np.full((n, n_times), np.nan) for name in outputs}
+    recorder = QuantityRecorder(spec.quantities, simulator.source) if spec.quantities else None
+    observers = (recorder,) if recorder else ()
+    for name in spec.quantities or ():
+        values[quantity_key(name)] = np.full(n, np.nan)
     skip = set(skip)
     for row, k in enumerate(kappa):
         if row in skip:
@@ -78,13 +87,19 @@ def run_chunk(spec: WorkerSpec, indices: np.ndarray, kappa: np.ndarray, n_times:
         if on_start is not None:
             on_start(row)
         try:
-            result = simulator.evaluate(k)
+            if recorder:
+                recorder.reset()
+                if recorder.modes:  # JSBSim linearises a reused bacm in minutes (240 s), a fresh one in 4 s
+                    simulator.restart()
+            result = simulator.evaluate(k, observers)
             for name in outputs:
                 if name not in result:
                     raise FlightError(f"the simulator returned no output {name!r}")
                 if result[name].shape != (n_times,):
                     raise FlightError(f"output {name} has {result[name].size} values, expected {n_times}")
                 values[name][row] = result[name]
+            for name, value in (recorder.result() if recorder else {}).items():
+                values[quantity_key(name)][row] = value
         except FlightError as exc:
             status[row], reasons[row] = exc.status, str(exc)
         except Exception as exc:  # a simulator bug must not stop the campaign: record it
@@ -99,9 +114,10 @@ def probe(spec: WorkerSpec, kappa: np.ndarray, resolution: bool = True):
     worker that only warms up."""
     simulator = spec.build()
     time_grid, outputs = simulator.probe(kappa)
+    observers = (QuantityRecorder(spec.quantities, simulator.source),) if spec.quantities else ()
     started = time.perf_counter()
-    try:
-        flown = simulator.evaluate(kappa)
+    try:  # with the quantities: a linearisation costs more than the flight (5 s for bacm's two turboprops)
+        flown = simulator.evaluate(kappa, observers)
     except Exception:  # a failed nominal flight still measures the cost of a flight
         flown = None
     seconds = time.perf_counter() - started

@@ -14,6 +14,7 @@ import yaml
 
 from ..designs import SAMPLED_DESIGNS, Design, build_design
 from ..parameters import Parameter
+from ..quantities.spec import check_quantities
 from ..simulators.jsbsim import NAMED_OUTPUTS
 from . import schema
 from .schema import TOP_KEYS, CampaignError, CampaignLoader, Checker, yaml_error
@@ -37,6 +38,7 @@ class Campaign:
     analysis: dict = field(default_factory=dict)
     limits: dict = field(default_factory=lambda: dict(schema.DEFAULT_LIMITS))
     runs: int | None = None  # the design's size, known once validated
+    quantities: dict = field(default_factory=dict)  # name -> checked spec (uqflight.quantities)
 
     @property
     def germs(self) -> list[str]:
@@ -88,7 +90,8 @@ def parse_campaign(text: str, source: str = "<campaign>", probe: PropertyProbe |
                            f"property of aircraft {aircraft.aircraft!r}, got {output!r}{aircraft.hint(output)}")
     parameters = schema.parameters(check, data["parameters"], simulator["kind"], aircraft)
     schema.check_fixed_properties(check, simulator, parameters, aircraft)
-    campaign = build_campaign(check, data, simulator, parameters, text)
+    quantities = check_quantities(check, data.get("quantities"), simulator, aircraft)
+    campaign = build_campaign(check, data, simulator, parameters, text, quantities)
     if isinstance(data["design"], dict):  # sizes from the campaign alone, before building anything
         schema.check_size(check, data, simulator, parameters, campaign.method, campaign.execution,
                           campaign.storage, campaign.limits)
@@ -122,7 +125,8 @@ def read_settings(text: str, source: str) -> tuple[Checker, dict, dict]:
     return check, data, schema.simulator(check, data["simulator"])
 
 
-def build_campaign(check: Checker, data: dict, simulator: dict, parameters: list[Parameter], text: str) -> Campaign:
+def build_campaign(check: Checker, data: dict, simulator: dict, parameters: list[Parameter], text: str,
+                   quantities: dict | None = None) -> Campaign:
     """The Campaign of a checked mapping (`read_settings`) and its parameters, its other sections checked
     (the design is not built: `runs` stays None)."""
     name = data["name"]
@@ -135,7 +139,9 @@ def build_campaign(check: Checker, data: dict, simulator: dict, parameters: list
         simulator["seed_parameters"] = seeds
     execution = schema.execution(check, data.get("execution", {}))
     storage = schema.storage(check, data.get("storage", {}), name)
-    analysis = schema.analysis(check, data.get("analysis", {}))
+    if quantities is None:  # read from a results file: checked as written, no aircraft to name properties
+        quantities = check_quantities(check, data.get("quantities"), simulator)
+    analysis = schema.analysis(check, data.get("analysis", {}), quantities)
     limits = schema.limits(check, data.get("limits", {}))
     return Campaign(check.source, text, name, data.get("seed", 0), simulator, parameters, data["design"], method,
-                    execution, storage, analysis, limits)
+                    execution, storage, analysis, limits, quantities=quantities)

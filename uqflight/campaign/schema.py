@@ -25,7 +25,7 @@ from ..simulators.scenarios import SCENARIO_KINDS, scenario_kind
 SIMULATOR_KINDS = ("jsbsim", "python")
 EXECUTORS = ("local", "dask")
 TOP_KEYS = ("name", "description", "seed", "simulator", "parameters", "design", "method",
-            "execution", "storage", "analysis", "limits")
+            "execution", "storage", "analysis", "limits", "quantities")
 JSBSIM_KEYS = ("kind", "aircraft", "scenario", "outputs", "properties")  # and the scenario kind's own (simulators/scenarios)
 PYTHON_KEYS = ("kind", "function", "outputs")
 PARAMETER_KEYS = ("property", "function", "perturbation", "distribution", "nominal", "interval_pct", "lower", "upper")
@@ -35,7 +35,7 @@ EXECUTION_KEYS = ("workers", "executor", "scheduler", "chunk", "timeout_s")
 STORAGE_KEYS = ("path", "raw", "tsvd")
 TSVD_KEYS = ("tol", "batch")
 DEFAULT_ORDER = 2
-ANALYSIS_KEYS = ("band_samples", "bootstrap", "quantiles")
+ANALYSIS_KEYS = ("band_samples", "bootstrap", "quantiles", "exceedance")
 # Refused before anything is built (see `check_size`); a campaign raises them under `limits:`.
 WORKER_BYTES = 60e6  # memory of one local worker process: Python, numpy, JSBSim, the aircraft (52 MB measured)
 DEFAULT_LIMITS = {"max_runs": 1_000_000, "max_memory_gb": 8.0, "max_disk_gb": 100.0, "max_pce_terms": MAX_TERMS}
@@ -512,8 +512,13 @@ def storage(check: Checker, value, name: str) -> dict:
     return storage
 
 
-def analysis(check: Checker, value) -> dict:
+def analysis(check: Checker, value, quantities: dict | None = None) -> dict:
+    """`quantities`: the campaign's checked quantities, which `exceedance:` must name."""
     analysis = dict(check.mapping(value, "analysis", ANALYSIS_KEYS))
+    if "exceedance" in analysis:
+        from ..quantities.spec import check_exceedance
+
+        analysis["exceedance"] = check_exceedance(check, analysis["exceedance"], quantities or {})
     analysis["band_samples"] = check.integer(analysis.get("band_samples", 20000), "analysis.band_samples", 100)
     analysis["bootstrap"] = check.integer(analysis.get("bootstrap", 200), "analysis.bootstrap", 0)
     if "quantiles" in analysis:  # kept only when given (default: statistics.DEFAULT_QUANTILES)

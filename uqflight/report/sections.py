@@ -55,6 +55,11 @@ def build_sections(entries: list[Entry], ref: Entry | None, times: list[float], 
     if any(e.has_errors for e in entries):
         tell("drawing the errors against the reference")
         sections.append(accuracy_section(entries, out_dir))
+    if any(e.stats.quantities for e in entries):
+        from .quantities import quantities_section
+
+        tell("drawing the quantities of interest")
+        sections.append(quantities_section(entries, out_dir))
     if any(e.has_sobol for e in entries):
         tell("drawing the Sobol' indices")
         sections.append(sensitivity_section(entries, times, out_dir))

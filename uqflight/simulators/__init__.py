@@ -10,7 +10,7 @@ from pathlib import Path
 import numpy as np
 
 from .base import FlightError
-from .jsbsim import UNITS, aircraft_hash
+from .jsbsim import NAMED_OUTPUTS, UNITS, aircraft_hash
 from .python import PythonSimulator
 from .scenarios import scenario_entry
 
@@ -33,14 +33,20 @@ class JSBSimSimulator:
     def probe(self, kappa: np.ndarray) -> tuple[np.ndarray, list[str]]:
         return self.setup.time, list(self.setup.outputs)
 
-    def evaluate(self, kappa: np.ndarray) -> dict[str, np.ndarray]:
+    def evaluate(self, kappa: np.ndarray, observers=()) -> dict[str, np.ndarray]:
+        """`observers` see every integration step (JSBSimFlight.run_trimmed)."""
         self._flown = True
-        return self.flight.fly(self.settings(kappa)).outputs
+        return self.flight.fly(self.settings(kappa), observers).outputs
 
     def settings(self, kappa: np.ndarray) -> dict[str, float]:
         """The property values of the run at `kappa`: the campaign's fixed `simulator.properties`, then
         the parameters' values."""
         return {**self.fixed, **dict(zip(self.properties, map(float, kappa)))}
+
+    @staticmethod
+    def source(name: str) -> tuple[str, float]:
+        """The property a quantity's `of:` reads and its scale: a named output's, else the property."""
+        return NAMED_OUTPUTS.get(name, (name, 1.0))
 
     def trim_repeatability(self, kappa: np.ndarray, ours: dict[str, np.ndarray] | None = None
                            ) -> dict[str, np.ndarray] | None:

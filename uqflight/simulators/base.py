@@ -64,8 +64,12 @@ class Simulator(Protocol):
     def probe(self, kappa: np.ndarray) -> tuple[np.ndarray, list[str]]:
         """The recorded times and the output names (one call at the nominal point, if needed)."""
 
-    def evaluate(self, kappa: np.ndarray) -> dict[str, np.ndarray]:
-        """{output name: (T,)} for one sample; raises a FlightError subclass for a failed one."""
+    def evaluate(self, kappa: np.ndarray, observers=()) -> dict[str, np.ndarray]:
+        """{output name: (T,)} for one sample; raises a FlightError subclass for a failed one. Each
+        observer's `step(t, values)` sees every step (uqflight.quantities.recorder)."""
+
+    def source(self, name: str) -> tuple[str, float]:
+        """The property (or output) a quantity's `of:` reads, and the scale to its unit."""
 
     def restart(self) -> None:
         """Forget what earlier samples left behind (called at the start of every chunk)."""

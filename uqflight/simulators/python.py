@@ -94,7 +94,9 @@ class PythonSimulator:
         self.outputs = list(names)
         return time, self.outputs
 
-    def evaluate(self, kappa: np.ndarray) -> dict[str, np.ndarray]:
+    def evaluate(self, kappa: np.ndarray, observers=()) -> dict[str, np.ndarray]:
+        """The outputs at `kappa`; each observer gets `step(t, values)` at every time point of the
+        model's own grid, `values` being those of the outputs it names in `properties`."""
         raw = self._call(kappa)
         result = {}
         for name in self.outputs or [k for k in raw if k != "time"]:
@@ -103,7 +105,26 @@ class PythonSimulator:
             result[name] = np.atleast_1d(np.asarray(raw[name], dtype=float))
             if not np.all(np.isfinite(result[name])):
                 raise DivergenceError(f"NaN or infinite value in output {name!r}")
+        for observer in observers:
+            self._feed(observer, raw, result)
         return result
+
+    @staticmethod
+    def _feed(observer, raw: dict, result: dict) -> None:
+        missing = [name for name in observer.properties if name not in result]
+        if missing:
+            raise FlightError(f"a quantity reads {', '.join(map(repr, missing))}, which is not among the "
+                              f"model's outputs ({', '.join(result)})")
+        columns = [result[name] for name in observer.properties]
+        length = len(columns[0]) if columns else 0
+        time = np.asarray(raw["time"], dtype=float) if "time" in raw else np.arange(length, dtype=float)
+        for j in range(length):
+            observer.step(float(time[j]), [float(column[j]) for column in columns])
+
+    @staticmethod
+    def source(name: str) -> tuple[str, float]:
+        """A quantity's `of:` names one of the model's outputs, read as it is."""
+        return name, 1.0
 
     def restart(self) -> None:
         """Nothing to reload: a Python function keeps no state between samples."""

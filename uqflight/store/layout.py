@@ -99,6 +99,12 @@ def layout_problems(f: h5py.File) -> list[str]:
     if isinstance(raw, h5py.Group):
         for key in raw:
             _dataset(f, f"outputs/{key}", "float", (n, n_times), problems)
+    quantities = f.get("quantities")
+    if quantities is not None and not isinstance(quantities, h5py.Group):
+        problems.append("/quantities must be a group of per-run quantities")
+    elif quantities is not None:
+        for key in quantities:
+            _dataset(f, f"quantities/{key}", "float", (n,), problems)
     resolution = f.get("resolution")
     if resolution is not None and not isinstance(resolution, h5py.Group):
         problems.append("/resolution must be a group of per-output resolutions")

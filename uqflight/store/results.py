@@ -8,6 +8,8 @@ Layout (fixed by DESIGN.md; N runs, d parameters, T recorded times):
     /outputs/<name> (N, T)  raw histories, NaN rows where not run or failed
     /tsvd/<name>/U (T, r), s (r), V (n, r), columns (n)   A_:c ≈ U diag(s) V_c: is sample columns[c]
     /tsvd/<name>/buffer (m, T), buffer_index (m)          ok runs not folded into the factors yet
+    /quantities/<name> (N)  optional: one number per run (uqflight.quantities), NaN where undefined in
+                            the run, not run or failed
     /resolution/<name> (T)  optional: the simulator's own resolution of the output (its trim
                             repeatability, see JSBSimSimulator.trim_repeatability); a spread below it
                             is not the inputs'
@@ -46,6 +48,7 @@ import numpy as np
 
 from threadpoolctl import threadpool_limits
 
+from ..quantities import is_quantity_key
 from ..simulators.base import Status
 from ..tsvd import IncrementalSVD, iter_column_blocks
 from .compressed import append_rows, apply_staged, buffer_rows, chunk_rows, commit, ingest, write_state
@@ -69,6 +72,7 @@ def text_hash(text: str) -> str:
 MIN_CHUNK_BYTES = 64 * 1024  # raw chunks hold whole batches, but no fewer bytes than this (tiny runs)
 REASON_BYTES = 256  # a failure's reason is stored in at most this many UTF-8 bytes, longer ones cut with "…"
 REASON_ROWS = 256  # reasons per HDF5 chunk (64 KiB); only chunks holding a failed run are ever written
+QUANTITY_ROWS = 8192  # quantity values per HDF5 chunk (64 KiB)
 CHECKED = {"chunks": True, "fletcher32": True}  # every fixed-size dataset: chunked and checksummed
 
 
@@ -124,7 +128,7 @@ class ResultStore:
     def create(cls, path, *, campaign_text: str, xi, kappa, weights, parameter_names, outputs, time,
                raw: bool = True, tsvd: dict | None = None, attrs: dict | None = None,
                units: dict | None = None, batch_rows: int | None = None,
-               repeatability: dict | None = None) -> ResultStore:
+               repeatability: dict | None = None, quantities=()) -> ResultStore:
         """A new file (refused if `path` exists) holding the design, with every run pending.
 
         `tsvd` = {"tol": ..., "batch": ...} turns on compression (batch defaults to the paper's 1000
@@ -132,6 +136,7 @@ class ResultStore:
         `batch_rows`: the runs the writer stores at a time (the runner's chunk): raw chunks of that many
         rows (at least 64 KiB, at most ~1 MiB), so that a batch fills whole HDF5 chunks instead of
         rewriting part-filled ones. `repeatability` maps output name → (T,) the simulator's own resolution.
+        `quantities`: the names of the campaign's quantities of interest, one value per run each.
         """
         xi, kappa = np.atleast_2d(xi).astype(float), np.atleast_2d(kappa).astype(float)
         weights, time = np.asarray(weights, dtype=float), np.asarray(time, dtype=float)
@@ -179,6 +184,12 @@ class ResultStore:
                 ds = group.create_dataset(_key(name), shape=(n, time.size), dtype="f8", fillvalue=np.nan,
                                           chunks=(rows, time.size), fletcher32=True)
                 ds.attrs.update({"units": units.get(name, ""), "dimensions": ["sample", "time"]})
+        if quantities:
+            group = f.create_group("quantities", track_order=True)
+            group.attrs["description"] = "one number per run (the campaign's quantities:), NaN where undefined"
+            for name in quantities:
+                group.create_dataset(_key(name), shape=(n,), dtype="f8", fillvalue=np.nan,
+                                     chunks=(min(n, QUANTITY_ROWS),), fletcher32=True)
         if tsvd is not None:
             group = f.create_group("tsvd", track_order=True)
             group.attrs.update({"tol": empty.tol, "batch": batch,
@@ -284,6 +295,16 @@ class ResultStore:
         group = self._file["outputs" if self._raw else "tsvd"]
         return {_name(key): str(group[key].attrs.get("units", "")) for key in group}
 
+    @property
+    def quantity_names(self) -> list[str]:
+        """The campaign's quantities of interest ([] for a file without them)."""
+        group = self._file.get("quantities")
+        return [] if group is None else [_name(key) for key in group]
+
+    def quantity(self, name: str) -> np.ndarray:
+        """(N,) the values of quantity `name`, NaN where undefined, not run or failed."""
+        return self._file["quantities"][_key(name)][()]
+
     def resolution(self, name: str) -> np.ndarray | None:
         """(T,) the simulator's own resolution of output `name` (its trim repeatability), None when the
         file holds none (a Python simulator, a file from before it was recorded)."""
@@ -331,13 +352,18 @@ class ResultStore:
         """Store finished runs, in any order: outputs[name] is (n, T) for the n `indices`.
 
         Rows of failed runs are stored as NaN (their values are ignored); ok rows must be finite.
+        The quantities come under `quantity_key(name)`, (n,) each, NaN where undefined; a batch
+        without them must hold no ok run.
         Data and reasons first, status last, each followed by a flush; then the completed
         design-order prefix is folded into the tSVD factors.
         """
+        outputs, quantities = self._split_quantities(indices, status, outputs)
         idx, status, reasons, values = self._checked_batch(indices, status, reasons, outputs)
         ok = status == Status.OK
         if not ok.all():  # ok runs keep the fill value "": a campaign without failures writes no reason
             self._write_reasons(idx[~ok], reasons[~ok])
+        for name, column in quantities.items():
+            self._file["quantities"][_key(name)][idx] = np.where(ok, column, np.nan)
         for name, rows in values.items():
             if self._raw:
                 self._file["outputs"][_key(name)][idx] = np.where(ok[:, None], rows, np.nan)
@@ -352,6 +378,22 @@ class ResultStore:
             all_status = self.status
             for name in values:
                 self._fold_ready(name, all_status)
+
+    def _split_quantities(self, indices, status, outputs: dict) -> tuple[dict, dict]:
+        """(outputs, quantities sorted as _checked_batch sorts the runs), the quantities checked
+        against the file's."""
+        quantities = {key[1]: value for key, value in outputs.items() if is_quantity_key(key)}
+        outputs = {key: value for key, value in outputs.items() if not is_quantity_key(key)}
+        names, order = self.quantity_names, np.argsort(np.asarray(indices, dtype=np.int64).ravel())
+        any_ok = bool(np.any(np.asarray(status).ravel() == Status.OK))
+        if (quantities or any_ok) and set(quantities) != set(names):
+            raise ValueError(f"batch quantities {sorted(quantities)} differ from the file's {names}")
+        for name, column in quantities.items():
+            column = np.asarray(column, dtype=float).ravel()
+            if column.shape != order.shape:
+                raise ValueError(f"quantity {name}: expected {order.size} values, got {column.size}")
+            quantities[name] = column[order]
+        return outputs, quantities
 
     def _flush(self, sync: bool) -> None:
         """HDF5's caches to the OS, then (sync) the OS's to the disk."""
@@ -383,6 +425,10 @@ class ResultStore:
                 held = np.zeros(status.size, dtype=bool)
                 held[np.union1d(group["columns"][()], index).astype(np.int64)] = True
                 lost |= (status == Status.OK) & ~held
+        for key in self._file.get("quantities", {}):  # NaN is a valid value here: only torn chunks are lost
+            for start, stop, values in _chunk_blocks(self._file["quantities"][key], block, np.nan):
+                if values is None:
+                    lost[start:stop] |= status[start:stop] == Status.OK
         reasons = self._file["samples/reason"]
         stale = np.zeros(status.size, dtype=bool)
         for start, stop, values in _chunk_blocks(reasons, block, _no_reasons(reasons, 1)[0]):

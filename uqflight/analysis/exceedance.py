@@ -1,0 +1,55 @@
+"""Probabilities that a quantity of interest exceeds a threshold (`analysis.exceedance`).
+
+* From runs (sampled designs): p̂ = k/n over the n runs where the quantity is defined, with the 95 %
+  Wilson score interval (analysis.failures.wilson_interval), `method: "wilson"`.
+* From a PCE: the fraction of the expansion's draws beyond the threshold, `method: "pce"`. Its bounds
+  are null: a PCE's error is known in the mean square (leave-one-out, lower-order difference), not on
+  the individual values a threshold sorts, so no interval would hold.
+Fewer than RARE_COUNT runs beyond the threshold (p < RARE_COUNT/n for a PCE) is flagged: the estimate
+then rests on the tail of a few runs, a rare-event extrapolation.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from .failures import wilson_interval
+
+RARE_COUNT = 10
+CONFIDENCE = 0.95
+
+
+def _beyond(values: np.ndarray, bound: str, threshold: float) -> np.ndarray:
+    return values > threshold if bound == "above" else values < threshold
+
+
+def exceedance_from_runs(values: np.ndarray, thresholds: list[dict]) -> list[dict]:
+    """[{above|below, probability, lower, upper, method, note}] over the runs `values` (defined ones)."""
+    n, found = values.size, []
+    for item in thresholds:
+        (bound, threshold), = item.items()
+        k = int(_beyond(values, bound, threshold).sum())
+        lower, upper = wilson_interval(k / n, n, CONFIDENCE)
+        note = f"{k} of {n} runs {bound} {threshold:g}; {100 * CONFIDENCE:g} % Wilson score interval"
+        if k < RARE_COUNT:
+            note += (f"; fewer than {RARE_COUNT} runs exceed: a rare-event extrapolation from the runs, "
+                     "run more to resolve it")
+        found.append({bound: threshold, "probability": k / n, "lower": lower, "upper": upper,
+                      "method": "wilson", "note": note})
+    return found
+
+
+def exceedance_from_pce(draws: np.ndarray, runs: int, thresholds: list[dict]) -> list[dict]:
+    """[{above|below, probability, lower: None, upper: None, method: "pce", note}] from the PCE's draws;
+    `runs`: the runs the expansion was made from (the rare-event flag compares p with 10/runs)."""
+    found = []
+    for item in thresholds:
+        (bound, threshold), = item.items()
+        p = float(_beyond(draws, bound, threshold).mean())
+        note = (f"fraction of {draws.size} draws of the PCE {bound} {threshold:g}; no interval: the expansion's "
+                "error is known in the mean square, not on the individual values a threshold sorts")
+        if p < RARE_COUNT / runs:
+            note += (f"; p < {RARE_COUNT}/{runs} (fewer than {RARE_COUNT} of the runs' worth): a rare-event "
+                     "extrapolation of the expansion's tail")
+        found.append({bound: threshold, "probability": p, "lower": None, "upper": None, "method": "pce",
+                      "note": note})
+    return found

@@ -1,0 +1,63 @@
+"""The observer that computes a run's quantities while it flies.
+
+A flight loop calls `step(t, values)` once at t = 0 and after every integration step, `values` being
+the current values of `properties` in that order, and, on a level-flight trim, `at_trim(fdm)` before
+the excitation. `reset()` starts a run, `result()` gives {name: value} (NaN where undefined).
+"""
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+
+from . import take_entry
+from .modes import eigen_modes
+
+Resolve = Callable[[str], tuple[str, float]]  # a name in `of:` -> (the property recorded, its scale)
+
+
+class QuantityRecorder:
+    """`specs`: the campaign's checked quantities; `resolve`: the simulator's `source` (a named output's
+    property and scale for JSBSim, the output itself for a Python model)."""
+
+    def __init__(self, specs: dict[str, dict], resolve: Resolve):
+        self.specs = dict(specs)
+        self.reductions, self.modes = {}, []
+        sources: dict[str, int] = {}
+        self._wiring = []  # (reduction, index of `of`, scale, index of `when.of`, its scale)
+
+        def index(name):
+            prop, scale = resolve(name)
+            return sources.setdefault(prop, len(sources)), scale
+
+        for name, spec in self.specs.items():
+            entry = take_entry(spec["take"])
+            if entry.mode:
+                self.modes.append(name)
+                continue
+            reduction = self.reductions[name] = entry.reduction(spec)
+            of, of_scale = index(spec["of"]) if "of" in spec else (None, 1.0)
+            when, when_scale = index(spec["when"]["of"]) if "when" in spec else (None, 1.0)
+            self._wiring.append((reduction, of, of_scale, when, when_scale))
+        self.properties: tuple[str, ...] = tuple(sources)
+        self._modes: dict[str, float] = {}
+
+    def reset(self) -> None:
+        for reduction in self.reductions.values():
+            reduction.reset()
+        self._modes = {}
+
+    def at_trim(self, fdm) -> None:
+        if self.modes:
+            self._modes = eigen_modes(fdm)
+
+    def step(self, t: float, values: Sequence[float]) -> None:
+        nan = float("nan")
+        for reduction, of, of_scale, when, when_scale in self._wiring:
+            x = values[of] * of_scale if of is not None else nan
+            y = values[when] * when_scale if when is not None else nan
+            reduction.step(t, x, y)
+
+    def result(self) -> dict[str, float]:
+        found = {name: reduction.result() for name, reduction in self.reductions.items()}
+        for name in self.modes:
+            found[name] = self._modes.get(self.specs[name]["take"], float("nan"))
+        return {name: float(found[name]) for name in self.specs}

@@ -1,0 +1,98 @@
+"""The report's section on the quantities of interest: a table of their statistics, their PDFs, their
+Sobol' indices as bars, and the exceedance probabilities asked for (`analysis.exceedance`)."""
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from . import plots
+from .loading import Entry
+from .sections import Figure, Section, Table, _rel
+
+
+def _top_index(out) -> tuple[str, float] | tuple[None, None]:
+    """The parameter with the largest total Sobol' index and that index (None where there are none)."""
+    finite = {p: float(v[0]) for p, v in (out.sobol_total or {}).items() if np.isfinite(v[0])}
+    if not finite:
+        return None, None
+    top = max(finite, key=finite.get)
+    return top, finite[top]
+
+
+def plot_quantity_pdfs(quantities: dict, path: Path, title: str) -> Path:
+    """One panel per quantity: its PDF, the mean and the 99 % band marked."""
+    fig, axes = plots._panels(len(quantities), title, row_height=2.7)
+    for ax, (name, out) in zip(axes, quantities.items()):
+        ax.plot(out.pdf_support[0], out.pdf_density[0], color=plots.COLORS[0], lw=1.3)
+        ax.axvline(out.mean[0], color="k", lw=1.0, label="mean")
+        for bound in out.band99:
+            ax.axvline(bound[0], color="k", lw=0.9, ls="--")
+        ax.set_title(name, fontsize=10)
+        ax.set_xlabel(name, fontsize=8)
+        ax.set_ylabel("probability density", fontsize=8)
+        ax.tick_params(labelsize=8)
+        ax.grid(alpha=0.3)
+    return plots._save(fig, path)
+
+
+def plot_quantity_sobol(quantities: dict, path: Path, title: str) -> Path:
+    """One panel per quantity: first-order and total Sobol' indices per parameter, as bars (unresolved: none)."""
+    fig, axes = plots._panels(len(quantities), title, row_height=2.7)
+    for ax, (name, out) in zip(axes, quantities.items()):
+        parameters = list(out.sobol_first)
+        x = np.arange(len(parameters))
+        first = [float(out.sobol_first[p][0]) for p in parameters]
+        total = [float(out.sobol_total[p][0]) for p in parameters]
+        ax.bar(x - 0.2, np.nan_to_num(first), width=0.4, color=plots.COLORS[0], label="first order S_i")
+        ax.bar(x + 0.2, np.nan_to_num(total), width=0.4, color=plots.COLORS[1], label="total S_Ti")
+        ax.set_xticks(x, parameters, fontsize=8, rotation=30 if max(map(len, parameters)) > 4 else 0)
+        ax.set_ylim(0, 1.05)
+        ax.set_title(name, fontsize=10)
+        ax.set_ylabel("Sobol' index [-]", fontsize=8)
+        ax.tick_params(labelsize=8)
+        ax.grid(alpha=0.3, axis="y")
+    handles = [plots.Line2D([], [], color=plots.COLORS[k], lw=6) for k in (0, 1)]
+    return plots._save(fig, path, (handles, ["first order S_i", "total S_Ti"]), legend_columns=2)
+
+
+def quantities_section(entries: list[Entry], out_dir: Path) -> Section:
+    """The quantities of every file: statistics table, PDFs, Sobol' bars, exceedance table."""
+    blocks, statistics, exceedance = [], [], []
+    for entry in entries:
+        quantities = entry.stats.quantities
+        for name, quantity in quantities.items():
+            out = quantity.output
+            if out is None:
+                statistics.append([entry.label, name, quantity.missing, *[None] * 6])
+            else:
+                top, index = _top_index(out)
+                statistics.append([entry.label, name, quantity.missing, out.mean[0], out.std[0], out.band99[0][0],
+                                   out.band99[1][0], top, index])
+            for item in quantity.exceedance:
+                bound = "above" if "above" in item else "below"
+                exceedance.append([entry.label, name, f"{bound} {item[bound]:g}", item["probability"], item["lower"],
+                                   item["upper"], item["method"], item["note"]])
+        defined = {name: q.output for name, q in quantities.items() if q.output is not None}
+        if defined:
+            path = plot_quantity_pdfs(defined, out_dir / "plots" / f"quantity_pdfs_{entry.stem}.png",
+                                      f"Quantities of interest: {entry.label}")
+            blocks.append(Figure(_rel(path, out_dir), f"PDFs of the quantities of {entry.label} (kernel density "
+                                                      "estimate), the mean solid, the 99 % band dashed."))
+        with_sobol = {name: out for name, out in defined.items() if out.sobol_first}
+        if with_sobol:
+            path = plot_quantity_sobol(with_sobol, out_dir / "plots" / f"quantity_sobol_{entry.stem}.png",
+                                       f"Sobol' indices of the quantities: {entry.label}")
+            blocks.append(Figure(_rel(path, out_dir), f"First-order and total Sobol' indices of the quantities of "
+                                                      f"{entry.label}; an unresolved index is drawn as none."))
+    blocks.insert(0, Table("Quantities of interest: one number per run", [
+        "file", "quantity", "missing runs", "mean", "std", "band99 lower", "band99 upper",
+        "top total Sobol' index", "its value"], statistics, "tables/quantities.csv"))
+    if exceedance:
+        blocks.insert(1, Table("Exceedance probabilities (analysis.exceedance)", [
+            "file", "quantity", "event", "probability", "lower", "upper", "method", "note"],
+            exceedance, "tables/exceedance.csv"))
+    return Section("Quantities of interest", "quantities",
+                   "Computed in the worker at every integration step (or time point of a Python model); "
+                   "their statistics are those of an output with one time point. Missing runs: successful runs "
+                   "where the quantity is undefined (its condition never held).", blocks)
