@@ -17,7 +17,7 @@ from uqflight.statistics import analyse, summary_json
 from uqflight.store import ResultStore
 from uqflight.worker import WorkerSpec, run_chunk
 
-MODEL = f"{DATA / 'quantity_model.py'}:ramp"  # y = a + b t, z = a t², t = 0, 0.25, ..., 4
+MODEL = f"{DATA / 'quantity_model.py'}:ramp"  # y = a + b t, z = a t², w = a − b t, t = 0, 0.25, ..., 4
 
 # a = 0.5, b = 1: y = 0.5 + t, z = 0.5 t². Each value by hand, at the model's 17 time points.
 TRAPEZOID_Z = 0.5 * (0.25 * 1496 / 16 - 0.25 * 16 / 2) / 4  # trapezoid of 0.5 t² over the grid, / 4 s
@@ -25,6 +25,8 @@ CASES = {
     "max": ({"of": "z", "take": "max", "before_s": 2}, 2.0),
     "min": ({"of": "y", "take": "min", "after_s": 1}, 1.5),
     "final": ({"of": "y", "take": "final", "before_s": 3}, 3.5),
+    "drop": ({"of": "w", "take": "drop", "after_s": 1, "before_s": 3}, 2.0),  # w(1) = -0.5, min w(3) = -2.5
+    "drop_rising": ({"of": "y", "take": "drop"}, 0.0),
     "mean": ({"of": "z", "take": "mean"}, TRAPEZOID_Z),
     "mean_window": ({"of": "y", "take": "mean", "after_s": 1, "before_s": 3}, 2.5),
     "at": ({"of": "z", "take": "at", "at_s": 1.25}, 0.78125),
