@@ -83,3 +83,11 @@ def test_undefined_and_invalid_inputs():
     assert np.isnan(empty["estimate"]) and (empty["lower"], empty["upper"]) == (0.0, 1.0)
     with pytest.raises(ValueError, match="method"):
         failure_probability(failures(1, 5), method="wald")
+
+
+def test_the_wilson_interval_of_no_or_every_success_ends_exactly_at_0_or_1():
+    from uqflight.analysis.failures import wilson_interval
+
+    assert wilson_interval(0.0, 384)[0] == 0.0 and wilson_interval(1.0, 384)[1] == 1.0
+    low, high = wilson_interval(0.0, 384)
+    assert high == pytest.approx(3.8415 / (384 + 3.8415), rel=1e-4)  # z²/(n + z²), z = 1.95996

@@ -525,7 +525,7 @@ def quantity_statistics(store: ResultStore, stats: Statistics, name: str, germs:
     return QuantityStatistics(name, missing, out, exceedance)
 
 
-def _quantity_json(quantity: QuantityStatistics) -> dict:
+def _quantity_json(quantity: QuantityStatistics, seeds: list[str]) -> dict:
     """summary.json's quantities.NAME: numbers, not lists (null where undefined)."""
     out = quantity.output
     entry = {"missing": quantity.missing, "exceedance": quantity.exceedance}
@@ -542,12 +542,21 @@ def _quantity_json(quantity: QuantityStatistics) -> dict:
     if out.sobol_first_ci:
         entry["sobol_first_ci"] = {k: {"lower": v[0][0], "upper": v[1][0]} for k, v in out.sobol_first_ci.items()}
         entry["sobol_total_ci"] = {k: {"lower": v[0][0], "upper": v[1][0]} for k, v in out.sobol_total_ci.items()}
+        if seeds:
+            entry["variance_split"] = _at_first_time(variance_split(out, seeds[0]))
     if out.loo_error is not None:
         entry["loo_error"] = out.loo_error[0]
     if out.convergence is not None:
         entry["convergence"] = {**out.convergence, "eps_m": out.convergence["eps_m"][0],
                                 "eps_v": out.convergence["eps_v"][0]}
     return entry
+
+
+def _at_first_time(value):
+    """A mapping of per-time arrays with each array's first value (a quantity's one time point)."""
+    if isinstance(value, dict):
+        return {k: _at_first_time(v) for k, v in value.items()}
+    return value[0] if isinstance(value, np.ndarray) else value
 
 
 def json_ready(value):
@@ -618,4 +627,4 @@ def summary_json(stats: Statistics) -> dict:
         "failure_probability": stats.failure_probability, "partial": stats.partial, "notes": stats.notes,
         "failures": stats.failures, "parameters": stats.parameter_names, "reference": stats.reference,
         "outputs": outputs,
-        "quantities": {name: _quantity_json(quantity) for name, quantity in stats.quantities.items()}})
+        "quantities": {name: _quantity_json(quantity, stats.seeds) for name, quantity in stats.quantities.items()}})

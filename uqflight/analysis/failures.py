@@ -37,7 +37,10 @@ def wilson_interval(p_hat: float, n: float, confidence: float = 0.95) -> tuple[f
     z2n = z * z / n
     centre = (p_hat + 0.5 * z2n) / (1.0 + z2n)
     half = z * np.sqrt(max(p_hat * (1.0 - p_hat), 0.0) / n + 0.25 * z2n / n) / (1.0 + z2n)
-    return float(max(centre - half, 0.0)), float(min(centre + half, 1.0))
+    # at p̂ = 0 (or 1) the bound is 0 (1) exactly; the formula leaves rounding (1e-19) there
+    lower = 0.0 if p_hat <= 0.0 else max(centre - half, 0.0)
+    upper = 1.0 if p_hat >= 1.0 else min(centre + half, 1.0)
+    return float(lower), float(upper)
 
 
 def clopper_pearson_interval(k: float, n: float, confidence: float = 0.95) -> tuple[float, float]:
