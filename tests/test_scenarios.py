@@ -284,3 +284,16 @@ def test_separate_dask_workers_fly_a_script_campaign_bit_identical_to_the_local_
     assert_same_results(local.path, remote.path)
     unpacked = worker_cache / "scenario" / worker_spec(campaign).bundle["scenario"]["hash"][:24]
     assert sorted(os.listdir(unpacked)) == ["c172p-landing-init.xml", "c172p-landing.xml"]
+
+
+def test_a_quantity_at_a_time_past_the_scripts_end_is_refused_at_plan(tmp_path):
+    """c172_cruise_8K ends at 40 s: at_s 1200 lies outside the flight."""
+    from uqflight.campaign import CampaignError, load_campaign
+
+    path = tmp_path / "late.yaml"
+    path.write_text("name: late\nsimulator: {kind: jsbsim, scenario: {kind: script, script: c172_cruise_8K}}\n"
+                    "parameters:\n  h: {property: ic/h-sl-ft, distribution: uniform, lower: 7900, upper: 8100}\n"
+                    "design: {kind: monte_carlo, samples: 4}\n"
+                    "quantities:\n  late: {of: h_ft, take: at, at_s: 1200}\n")
+    with pytest.raises(CampaignError, match=r"quantities\.late\.at_s: 1200 s is outside the flight"):
+        load_campaign(path)

@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import math
 import re
+from pathlib import Path
 
 from . import REGISTRY, TAKES, WINDOW
 
@@ -18,15 +19,22 @@ DEFAULT_DURATION_S = 50.0  # simulator.duration_s's default (level flight)
 
 
 def flight_span(simulator: dict) -> float | None:
-    """The flight's last time [s] when the campaign fixes it (a level flight's duration, a script's
-    end_s), else None (a script's own end, a Python model's time grid: known once a run is made)."""
+    """The flight's last time [s] when the campaign fixes it (a level flight's duration, a script's end_s or,
+    once the script is resolved at plan, its own end), else None (a Python model's time grid: known once a
+    run is made)."""
     if simulator["kind"] != "jsbsim":
         return None
     scenario = simulator.get("scenario") or {}
     if scenario.get("kind", "level_flight") == "level_flight":
         return float(simulator.get("duration_s", DEFAULT_DURATION_S))
     end = scenario.get("end_s")
-    return float(end) if isinstance(end, (int, float)) and not isinstance(end, bool) else None
+    if isinstance(end, (int, float)) and not isinstance(end, bool):
+        return float(end)
+    if simulator.get("script_path"):  # resolved at plan: the script's own end (no file is read otherwise)
+        from ..simulators.scenarios.script import ScriptFile
+
+        return ScriptFile.read(Path(simulator["script_path"])).end_s
+    return None
 
 
 def is_level_flight(simulator: dict) -> bool:
