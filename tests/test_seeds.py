@@ -123,3 +123,18 @@ def test_a_jsbsim_seed_must_be_a_property_of_the_aircraft(tmp_path):
     done = cli_in_process("plan", tmp_path / "s.yaml")
     assert done.returncode == 2, done.stderr
     assert "parameters.turbulence.property" in done.stderr and "did you mean atmosphere/randomseed" in done.stderr
+
+
+@pytest.mark.slow
+def test_the_report_shows_the_variance_split_with_its_intervals(tmp_path):
+    import csv
+
+    results = run(tmp_path, campaign(design="{kind: pick_freeze, samples: 128}", bootstrap=100))
+    done = cli_in_process("report", results, "--out", tmp_path / "r", "--times", "1,2")
+    assert done.returncode == 0, done.stderr
+    with open(tmp_path / "r" / "tables" / "variance_split.csv", newline="") as fh:
+        rows = {row["quantity or output"]: row for row in csv.DictReader(fh)}
+    at_1 = rows["y at 1 s"]  # closed form: the seed's share 0.2, the others' 0.8
+    assert float(at_1["seed total lower"]) <= 0.2 <= float(at_1["seed total upper"])
+    assert float(at_1["others first lower"]) <= 0.8 <= float(at_1["others first upper"])
+    assert "Variance split" in (tmp_path / "r" / "report.md").read_text()

@@ -581,7 +581,9 @@ def variance_split(out: OutputStatistics, seed: str) -> dict:
     (epistemic), first-order and total, with the pick-freeze intervals: the others' first-order share is the
     closed index of the complement, 1 − S_T(seed), and their total share 1 − S(seed)."""
     first, total = out.sobol_first[seed], out.sobol_total[seed]
-    (first_low, first_high), (total_low, total_high) = out.sobol_first_ci[seed], out.sobol_total_ci[seed]
+    (first_low, first_high), (total_low, total_high) = (
+        np.where(np.isnan(index), np.nan, ci) for index, ci in ((first, out.sobol_first_ci[seed]),
+                                                                (total, out.sobol_total_ci[seed])))  # unresolved
     return {"seed": seed,
             "seeds": {"first": first, "total": total, "first_ci": {"lower": first_low, "upper": first_high},
                       "total_ci": {"lower": total_low, "upper": total_high}},

@@ -60,6 +60,12 @@ def build_sections(entries: list[Entry], ref: Entry | None, times: list[float], 
 
         tell("drawing the quantities of interest")
         sections.append(quantities_section(entries, out_dir))
+    if any(e.stats.seeds for e in entries):
+        from .variance_split import variance_split_section
+
+        split = variance_split_section(entries, times)
+        if split is not None:
+            sections.append(split)
     if any(e.has_sobol for e in entries):
         tell("drawing the Sobol' indices")
         sections.append(sensitivity_section(entries, times, out_dir))

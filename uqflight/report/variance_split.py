@@ -1,0 +1,50 @@
+"""The report's section on a random stream's share: for files whose design is pick-freeze over a seed
+parameter, each quantity's and each output's variance split between the seed (the turbulence realisation,
+aleatory) and the other inputs (epistemic), first-order and total, with the pick-freeze intervals
+(`statistics.variance_split`)."""
+from __future__ import annotations
+
+import numpy as np
+
+from ..statistics import variance_split
+from .loading import Entry
+from .sections import Section, Table
+
+
+def _row(label: str, name: str, out, seed: str, at: int) -> list:
+    split = variance_split(out, seed)
+    row = [label, name]
+    for group in ("seeds", "other_parameters"):
+        shares = split[group]
+        for order in ("first", "total"):
+            row += [shares[order][at], shares[f"{order}_ci"]["lower"][at], shares[f"{order}_ci"]["upper"][at]]
+    return [value if not (isinstance(value, float) and np.isnan(value)) else "unresolved" for value in row]
+
+
+def variance_split_section(entries: list[Entry], times: list[float]) -> Section | None:
+    """None when no file has a seed parameter with pick-freeze indices."""
+    rows = []
+    for entry in entries:
+        seeds = entry.stats.seeds
+        if not seeds:
+            continue
+        for name, quantity in entry.stats.quantities.items():
+            if quantity.output is not None and quantity.output.sobol_first_ci:
+                rows.append(_row(entry.label, name, quantity.output, seeds[0], 0))
+        for name, out in entry.outputs.items():
+            if not out.sobol_first_ci:
+                continue
+            for t in times:
+                at = int(np.argmin(np.abs(out.time - t)))
+                rows.append(_row(entry.label, f"{name} at {out.time[at]:g} s", out, seeds[0], at))
+    if not rows:
+        return None
+    header = ["file", "quantity or output"] + [f"{group} {order}{part}" for group in ("seed", "others")
+                                               for order in ("first", "total") for part in ("", " lower", " upper")]
+    return Section("Variance split: the random stream against the other inputs", "variance-split",
+                   "The share of each variance due to the seed parameter's random stream (e.g. the turbulence "
+                   "realisation: aleatory) and to the other inputs (epistemic), from the pick-freeze Sobol' "
+                   "indices with their bootstrap intervals: the seed's first-order and total indices, and the "
+                   "others' as the complement's closed indices (first 1 − S_T(seed), total 1 − S(seed)). "
+                   "Estimates outside [0, 1] are sampling noise: read the intervals.",
+                   [Table("Shares of the variance", header, rows, "tables/variance_split.csv")])
