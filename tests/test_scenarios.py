@@ -297,3 +297,23 @@ def test_a_quantity_at_a_time_past_the_scripts_end_is_refused_at_plan(tmp_path):
                     "quantities:\n  late: {of: h_ft, take: at, at_s: 1200}\n")
     with pytest.raises(CampaignError, match=r"quantities\.late\.at_s: 1200 s is outside the flight"):
         load_campaign(path)
+
+
+def test_a_results_file_of_an_edited_script_is_not_resumed(tmp_path):
+    """The script's files are part of what a file's runs flew: an edited script refuses the resume."""
+    from uqflight.campaign import load_campaign
+    from uqflight.execution import run_campaign
+
+    scripts = Path(__file__).resolve().parents[1] / "campaigns" / "scripts"
+    shutil.copytree(scripts, tmp_path / "scripts")
+    path = tmp_path / "s.yaml"
+    path.write_text("name: s\nsimulator: {kind: jsbsim, scenario: {kind: script, script: scripts/c172p-landing.xml, "
+                    "end_s: 2}, output_rate_hz: 10, outputs: [h_ft]}\nparameters:\n"
+                    "  wind: {property: landing/head-wind-fps, distribution: uniform, lower: 0, upper: 5}\n"
+                    "design: {kind: monte_carlo, samples: 2}\n")
+    run_campaign(load_campaign(path), out=tmp_path / "s.h5", workers=1)
+    script = tmp_path / "scripts" / "c172p-landing.xml"
+    script.write_text(script.read_text().replace("landing/turbulence-severity </property>",
+                                                 "landing/turbulence-severity </property>\n    <!-- edited -->"))
+    with pytest.raises(FileExistsError, match="other script files"):
+        run_campaign(load_campaign(path), out=tmp_path / "s.h5", workers=1)

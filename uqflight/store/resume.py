@@ -9,18 +9,22 @@ import h5py
 from .results import ResultStore, text_hash
 
 
+FLOWN = ("aircraft_hash", "scenario")  # what a results file's runs flew beside the campaign text (the
+# aircraft's files; a script scenario's script and initialisation files, simulators.simulator_provenance)
+
+
 def open_for_campaign(path, *, campaign_text: str, force: bool = False, restart: bool = False,
                       **create_args) -> ResultStore:
     """Resume `path` when it holds this campaign, else create it (see ResultStore.create).
 
-    A file holding another campaign (a different campaign_hash), or made with other aircraft files
-    (attrs["aircraft_hash"]), is refused unless `force`, which deletes and recreates it. `force`
+    A file holding another campaign (a different campaign_hash), or made with other aircraft or script
+    files (attrs["aircraft_hash"], attrs["scenario"]), is refused unless `force`, which deletes and recreates it. `force`
     never deletes what is not a uqflight results file (a directory, a text file, another HDF5 file):
     those are refused, with how to remove them. (The caller holds the file's lock: `force` never
     touches a file another run writes.) `restart` starts a results file of this same campaign over.
     """
     path = Path(path)
-    aircraft = (create_args.get("attrs") or {}).get("aircraft_hash")
+    flown = {key: (create_args.get("attrs") or {}).get(key) for key in FLOWN}
     if path.is_dir():
         raise FileExistsError(f"{path} is a directory, not a results file; choose a file path such as "
                               f"{path / 'results.h5'}")
@@ -34,26 +38,28 @@ def open_for_campaign(path, *, campaign_text: str, force: bool = False, restart:
                                   "choose another results file")
         try:
             with h5py.File(path, "r") as f:
-                stored, stored_aircraft = f.attrs.get("campaign_hash"), f.attrs.get("aircraft_hash")
+                stored, stored_flown = f.attrs.get("campaign_hash"), {key: f.attrs.get(key) for key in FLOWN}
                 ours = stored is not None and "samples/status" in f
         except OSError as exc:  # e.g. killed while the file was being created: nothing to resume
             if not force:
                 reason = " ".join(str(exc).split())[:200]
                 raise FileExistsError(f"{path} is a damaged HDF5 file ({reason}); choose another results "
                                       "file, or force to overwrite it") from exc
-            stored = stored_aircraft = None
+            stored, stored_flown = None, {}
             ours = True
         if not ours:
             raise FileExistsError(f"{path} is an HDF5 file but not a uqflight results file (no campaign_hash "
                                   "or /samples/status); uqflight never overwrites it, even with --force: "
                                   f"remove it yourself (rm {path}) or choose another results file")
-        if stored == text_hash(campaign_text) and stored_aircraft == aircraft and not restart:
+        if stored == text_hash(campaign_text) and stored_flown == flown and not restart:
             return ResultStore.open(path, "a")
         if restart and stored == text_hash(campaign_text):
             force = True
         if not force:
             if stored == text_hash(campaign_text):
-                raise FileExistsError(f"{path} was made with other aircraft files (sha256 {stored_aircraft}); "
+                key = next(key for key in FLOWN if stored_flown.get(key) != flown[key])
+                what = {"aircraft_hash": "aircraft files (sha256", "scenario": "script files ("}[key]
+                raise FileExistsError(f"{path} was made with other {what} {str(stored_flown.get(key))[:80]}); "
                                       "resuming would mix two models: choose another results file, or force "
                                       "to start over")
             raise FileExistsError(f"{path} holds the results of another campaign (campaign_hash {stored}); "
