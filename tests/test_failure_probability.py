@@ -74,6 +74,7 @@ def test_a_monte_carlo_design_keeps_its_wilson_interval(runs):
     assert p["lower"] <= P_FAIL <= p["upper"] and "Wilson" in p["method"]
 
 
+@pytest.mark.slow
 def test_the_report_says_a_sparse_grid_estimates_no_failure_probability(runs, tmp_path):
     done = cli_in_process("report", runs["sparse"], "--out", tmp_path / "r")
     assert done.returncode == 0, done.stderr

@@ -196,6 +196,7 @@ def test_aircraft_command_prints_each_function_unit_and_reference_factor(tmp_pat
     assert qsc == pytest.approx(qs * 4.9, rel=1e-5) and qsb == pytest.approx(qs * 35.8, rel=1e-5)  # c̄, b of c172p
 
 
+@pytest.mark.slow
 def test_a_campaign_with_an_offset_records_the_patched_copy_flown(tmp_path):
     # The results file keys a resume by aircraft_hash: it is the patched copy's (the patch text
     # included), so a file made when offsets were in lbf (it recorded the unpatched aircraft's

@@ -195,6 +195,7 @@ def test_a_jsbsim_quantity_is_taken_at_every_integration_step():
     assert found["q"] <= recorded["q_degps"].min() and found["h"] >= recorded["h_ft"].max()
 
 
+@pytest.mark.slow
 def test_the_report_shows_the_quantities_table_pdfs_and_sobol_bars(tmp_path):
     from uqflight.report import write_report
 

@@ -77,7 +77,8 @@ def ran_code(world) -> dict[str, str]:
     return {path.name: path.read_text() for path in world["sentinels"].iterdir()}
 
 
-@pytest.mark.parametrize("name", ["file", pytest.param("module", marks=pytest.mark.slow)])
+@pytest.mark.slow  # four commands, a report with plots among them: ~17 s
+@pytest.mark.parametrize("name", ["file", "module"])
 def test_info_report_check_and_surrogate_export_import_no_model(world, name, tmp_path):
     results = world["results"] / f"{name}.h5"
     info = read(world, "info", results)
