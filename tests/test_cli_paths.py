@@ -119,7 +119,8 @@ def test_a_dask_run_without_workers_says_what_it_waits_for(results, tmp_path):
         assert f"waiting for a Dask worker: the scheduler {address} has had none for 5 s (3 of 3 chunks left; " \
                f"start one: dask worker {address}; Ctrl-C stops, a rerun resumes)" in said, said
         run.send_signal(signal.SIGINT)
-        assert run.wait(timeout=180) == 130  # a bound against a hang (the Dask client's close), not a speed test
+        _, rest = run.communicate(timeout=60)  # drains both pipes: the client's close logs to stderr, and a full
+        assert run.returncode == 130, rest     # pipe nobody reads would block the runner (it did, twice)
     finally:
         for process in (run, scheduler):
             if process is not None and process.poll() is None:
