@@ -436,11 +436,15 @@ def test_check_refuses_non_finite_tolerances(rtol, atol):
         compare(None, {"outputs": {}}, rtol, atol)
 
 
-def test_sigint_to_the_runner_alone_stops_it_cleanly(tmp_path):
+@pytest.mark.parametrize("inherited", ["default", "ignored"])
+def test_sigint_to_the_runner_alone_stops_it_cleanly(tmp_path, inherited):
+    """Also when the runner starts with SIGINT ignored, as a script's `uqflight run ... &` does (a test
+    harness left it so once: the interrupted run then waited on its workers for ever)."""
     yaml = write_campaign(tmp_path, "hanging", samples=200, chunk=4, workers=2, extra=", timeout_s: 300")
     out = tmp_path / "r.h5"
+    ignore = (lambda: signal.signal(signal.SIGINT, signal.SIG_IGN)) if inherited == "ignored" else None
     runner = subprocess.Popen([UQFLIGHT, "run", str(yaml)] + ["--out", str(out)], stdout=subprocess.PIPE,
-                              stderr=subprocess.PIPE, text=True)
+                              stderr=subprocess.PIPE, text=True, preexec_fn=ignore)
     try:
         assert wait_for(lambda: len(children(runner.pid)) >= 2 and out.exists())
         time.sleep(1.0)  # a worker is now stuck in a hung sample

@@ -256,6 +256,10 @@ def run(
         echo(f"error: --workers: expected an integer >= 1, got {workers}", err=True)
         raise typer.Exit(2)
     resume = f"uqflight run {campaign}" + (f" --out {out}" if out else "")
+    if signal.getsignal(signal.SIGINT) is signal.SIG_IGN:
+        # started with SIGINT ignored (a script's `uqflight run ... &`, some test harnesses): Ctrl-C or
+        # kill -INT would be lost and a run waiting on workers would never stop; it stops cleanly instead
+        signal.signal(signal.SIGINT, signal.default_int_handler)
     previous = _stop_on_sigterm()
     try:
         summary = run_campaign(spec, out=out, workers=workers, executor=executor, scheduler=scheduler,
