@@ -48,7 +48,7 @@ from .campaign.reading import parameters_attribute
 from .campaign.schema import WORKER_BYTES
 from .console import clean
 from .designs import Design
-from .parameters import to_physical
+from .parameters import seed_names, to_physical
 from .store import ResultStore, Status, compact, open_for_campaign
 from .store.lock import LockHeld, ResultsLock
 from .worker import WorkerSpec
@@ -126,7 +126,7 @@ def prepare_store(campaign: Campaign, design: Design, out: Path, force: bool, pr
              "method": json.dumps(campaign.method), "germs": json.dumps(campaign.germs),
              "analysis": json.dumps(campaign.analysis),
              "design_kind": design.kind, "design_info": json.dumps(design.info, default=str)}
-    seeds = [p.name for p in campaign.parameters if not p.law.polynomial]
+    seeds = seed_names(campaign.parameters)
     if seeds:  # written only when there are any: files of other campaigns keep their attributes
         attrs["seeds"] = json.dumps(seeds)
     if campaign.simulator["kind"] == "jsbsim":

@@ -13,7 +13,7 @@ from typing import Callable
 import yaml
 
 from ..designs import SAMPLED_DESIGNS, Design, build_design
-from ..parameters import Parameter
+from ..parameters import Parameter, seed_names
 from ..quantities.spec import check_quantities
 from ..simulators.jsbsim import NAMED_OUTPUTS
 from . import schema
@@ -134,7 +134,7 @@ def build_campaign(check: Checker, data: dict, simulator: dict, parameters: list
     default_method = "monte_carlo" if design_kind in SAMPLED_DESIGNS else "integration"
     method = schema.method(check, data.get("method", {"kind": default_method}))
     schema.check_seeds(check, parameters, design_kind, method)
-    seeds = [p.name for p in parameters if not p.law.polynomial]
+    seeds = seed_names(parameters)
     if seeds and simulator["kind"] == "python":
         simulator["seed_parameters"] = seeds
     execution = schema.execution(check, data.get("execution", {}))

@@ -14,7 +14,7 @@ from ..designs import DESIGN_KINDS, SAMPLED_DESIGNS, Design, design_size, is_sam
 from ..methods import METHOD_KINDS, method_entry
 from ..methods.exactness import exact_total_degree, max_projection_order
 from ..methods.validity import MAX_TERMS, method_problem
-from ..parameters import DISTRIBUTIONS, Parameter, make_parameter
+from ..parameters import DISTRIBUTIONS, Parameter, make_parameter, seed_names
 from ..parameters.distributions import SEED_REFUSAL
 from ..simulators.patch import patch_kind
 from ..simulators.python import PluginError, load_function, split_spec
@@ -415,7 +415,7 @@ def seed_parameter(check: Checker, spec: dict, path: str, name: str, kind: str, 
 def check_seeds(check: Checker, parameters: list[Parameter], design_kind, method: dict) -> None:
     """A seed's random stream has no polynomial expansion: refuse grids and PCE methods over it, and more
     than one seed (the split of the variance between seeds and the other inputs needs them as one input)."""
-    seeds = [p.name for p in parameters if not p.law.polynomial]
+    seeds = seed_names(parameters)
     if not seeds:
         return
     if len(seeds) > 1:

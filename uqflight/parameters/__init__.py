@@ -113,6 +113,11 @@ def make_parameter(
     return Parameter(name, property, distribution, nominal, nominal - half_width, nominal + half_width)
 
 
+def seed_names(params) -> list[str]:
+    """The names of the parameters that are random streams' seeds (`distribution: seed`)."""
+    return [p.name for p in params if not p.law.polynomial]
+
+
 def germs_of(params) -> list[str]:
     """The germ of each parameter, in order."""
     return [p.germ for p in params]
@@ -139,4 +144,5 @@ def to_standard(params, kappa: np.ndarray) -> np.ndarray:
     return _map_columns(params, kappa, "kappa", Parameter.to_standard)
 
 
-__all__ = ["DISTRIBUTIONS", "GERMS", "Parameter", "germs_of", "make_parameter", "to_physical", "to_standard"]
+__all__ = ["DISTRIBUTIONS", "GERMS", "Parameter", "germs_of", "make_parameter", "seed_names", "to_physical",
+           "to_standard"]
