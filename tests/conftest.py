@@ -58,6 +58,17 @@ def mounted_tmpfs(folder, size: str):
         subprocess.run(["umount", "-l", str(mount)], check=False)
 
 
+def scheduler_address(file: Path, tries: int = 600) -> str:
+    """The address a `dask scheduler --scheduler-file FILE` writes, once it has written it (0.1 s apart)."""
+    import time
+
+    for _ in range(tries):
+        if file.exists() and file.stat().st_size:
+            break
+        time.sleep(0.1)
+    return json.loads(file.read_text())["address"]
+
+
 def read_results(path) -> dict[str, np.ndarray]:
     """Every dataset of a results file (design, status, raw outputs or tSVD factors), by path."""
     found = {}

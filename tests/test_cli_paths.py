@@ -2,7 +2,6 @@
 message for every command, a file of the wrong kind is named for what it is, a closed pipe ends
 quietly, a Dask run without workers says what it waits for, and a full disk leaves no partial file."""
 import errno
-import json
 import os
 import select
 import signal
@@ -12,7 +11,7 @@ import time
 from pathlib import Path
 
 import pytest
-from conftest import UQFLIGHT, cli_in_process, mounted_tmpfs, run_python_campaign
+from conftest import UQFLIGHT, cli_in_process, mounted_tmpfs, run_python_campaign, scheduler_address
 from test_trust import NORMAL_2D, campaign
 
 BIN = Path(sys.executable).parent
@@ -104,11 +103,7 @@ def test_a_dask_run_without_workers_says_what_it_waits_for(results, tmp_path):
                                  stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     run = None
     try:
-        for _ in range(600):
-            if file.exists() and file.stat().st_size:
-                break
-            time.sleep(0.1)
-        address = json.loads(file.read_text())["address"]
+        address = scheduler_address(file)
         run = subprocess.Popen([UQFLIGHT, "run", results.with_suffix(".yaml"), "--out", tmp_path / "r.h5",
                                 "--executor", "dask", "--scheduler", address],
                                stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)

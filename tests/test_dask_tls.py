@@ -3,16 +3,14 @@ and the client's certificates from dask's own configuration (`distributed.comm.t
 its environment variables), which dask's Client reads when given no security of its own. A
 separately started scheduler and worker that require TLS; a client without the certificates cannot
 connect. Real processes, real certificates (openssl)."""
-import json
 import os
 import shutil
 import subprocess
 import sys
-import time
 from pathlib import Path
 
 import pytest
-from conftest import UQFLIGHT, assert_same_results
+from conftest import UQFLIGHT, assert_same_results, scheduler_address
 
 BIN = Path(sys.executable).parent
 CAMPAIGN = """
@@ -40,11 +38,7 @@ def tls_cluster(tmp_path):
     procs = [subprocess.Popen([str(BIN / "dask"), "scheduler", "--protocol", "tls", "--host", "127.0.0.1", "--port", "0",
                                "--no-dashboard", "--scheduler-file", str(file), *tls], **quiet)]
     try:
-        for _ in range(600):
-            if file.exists() and file.stat().st_size:
-                break
-            time.sleep(0.1)
-        address = json.loads(file.read_text())["address"]
+        address = scheduler_address(file)
         assert address.startswith("tls://")
         procs.append(subprocess.Popen([str(BIN / "dask"), "worker", address, "--nworkers", "1", "--nthreads", "1",
                                        "--no-dashboard", *tls], **quiet))

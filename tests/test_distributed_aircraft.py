@@ -1,16 +1,15 @@
 """Workers that share no disk with the client: separately started Dask scheduler and workers
 (loopback, another working directory, their own cache) get the patched aircraft with the task,
 give bit-identical results to the local pool, and refuse other aircraft files."""
-import json
 import os
 import subprocess
 import sys
-import time
 from pathlib import Path
 
 import h5py
 import numpy as np
 import pytest
+from conftest import scheduler_address
 
 from uqflight.campaign import load_campaign
 from uqflight.execution import run_campaign, worker_spec
@@ -31,11 +30,7 @@ def cluster(tmp_path):
                                "--no-dashboard", "--scheduler-file", str(file)], cwd=where, env=env,
                               stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)]
     try:
-        for _ in range(300):
-            if file.exists() and file.stat().st_size:
-                break
-            time.sleep(0.1)
-        address = json.loads(file.read_text())["address"]
+        address = scheduler_address(file, 300)
         procs.append(subprocess.Popen([str(BIN / "dask"), "worker", address, "--nworkers", "1", "--nthreads", "1",
                                        "--no-dashboard"], cwd=where, env=env,
                                       stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL))
