@@ -12,6 +12,7 @@ from uqflight.designs.rules import RULE_TABLE, nodes_weights
 from uqflight.methods import METHODS, fit
 from uqflight.methods.basis import orthonormal_basis, orthonormal_polynomials, total_degree_indices
 from uqflight.parameters import DISTRIBUTIONS, GERMS, make_parameter
+from uqflight.simulators.kinds import REGISTRY as SIMULATORS
 from uqflight.simulators.scenarios import REGISTRY as SCENARIOS
 
 GERM_NAMES = list(GERMS)
@@ -204,6 +205,7 @@ def test_a_scenario_counts_its_times_from_the_campaign_and_its_observers_see_wha
     simulator = make_simulator(campaign.simulator, ["wind"], ["atmosphere/wind-north-fps"], tmp_path)
     time = simulator.setup.time
     assert entry.times(campaign.simulator) == len(time)  # the size estimate is the flight's own grid
+    assert entry.span(campaign.simulator) == pytest.approx(time[-1], abs=0.1)  # within one output step (10 Hz)
     observer = _Altitude()
     result = simulator.flight.fly({"atmosphere/wind-north-fps": 0.5}, observers=(observer,))
     assert observer.t[0] == time[0] and len(observer.t) > len(time)  # t = 0, then every integration step
@@ -222,3 +224,43 @@ def test_a_scenario_refuses_the_keys_of_the_others(kind, tmp_path):
         text = _scenario_campaign({**SCENARIOS[kind].example, key: 1})
         with pytest.raises(CampaignError, match=f"simulator.{key}: unknown key"):
             parse_campaign(text, str(tmp_path / "x.yaml"))
+
+
+def _simulator_campaign(simulator: dict, parameters: dict) -> str:
+    return yaml.safe_dump({"name": "kinds", "simulator": simulator, "parameters": parameters,
+                           "design": {"kind": "monte_carlo", "samples": 2}})
+
+
+@pytest.mark.parametrize("kind", list(SIMULATORS))
+def test_a_simulator_kind_builds_what_it_checks_and_counts_what_it_records(kind, tmp_path):
+    from uqflight.campaign import parse_campaign
+    from uqflight.simulators import make_simulator
+    from uqflight.simulators.bundle import make_bundle
+    from uqflight.simulators.jsbsim_probe import jsbsim_probe
+
+    entry = SIMULATORS[kind]
+    campaign = parse_campaign(_simulator_campaign(*entry.example), str(tmp_path / "x.yaml"), jsbsim_probe)
+    names, properties = [p.name for p in campaign.parameters], [p.property for p in campaign.parameters]
+    simulator = make_simulator(campaign.simulator, names, properties, tmp_path)
+    kappa = np.array([p.nominal for p in campaign.parameters])
+    time, outputs = simulator.probe(kappa)
+    assert set(simulator.evaluate(kappa)) == set(outputs)
+    times, n_outputs = entry.recorded(campaign.simulator)
+    span = entry.span(campaign.simulator)
+    if entry.aircraft:  # known from the campaign alone: the flight's own grid
+        assert (times, n_outputs) == (len(time), len(outputs)) and span == pytest.approx(time[-1])
+    else:  # known once a sample has run
+        assert (times, span) == (1, None)
+    bundle = make_bundle(campaign.simulator, properties, tmp_path)
+    assert bundle is None or bundle["kind"] in ("aircraft", "python")
+    assert set(entry.provenance(campaign.simulator, tmp_path, properties)) <= {"aircraft_hash", "scenario"}
+
+
+@pytest.mark.parametrize("kind", list(SIMULATORS))
+def test_a_simulator_kind_refuses_the_keys_of_the_others(kind, tmp_path):
+    from uqflight.campaign import CampaignError, parse_campaign
+
+    simulator, parameters = SIMULATORS[kind].example
+    for key in {k for other in SIMULATORS.values() for k in other.keys} - set(SIMULATORS[kind].keys):
+        with pytest.raises(CampaignError, match=f"simulator.{key}: unknown key"):
+            parse_campaign(_simulator_campaign({**simulator, key: "x"}, parameters), str(tmp_path / "x.yaml"))

@@ -129,10 +129,10 @@ def prepare_store(campaign: Campaign, design: Design, out: Path, force: bool, pr
     seeds = seed_names(campaign.parameters)
     if seeds:  # written only when there are any: files of other campaigns keep their attributes
         attrs["seeds"] = json.dumps(seeds)
-    if campaign.simulator["kind"] == "jsbsim":
-        from .simulators import simulator_provenance
-        attrs.update(simulator_provenance(campaign.simulator, Path(campaign.source).resolve().parent,
-                                          properties=[p.property for p in campaign.parameters]))
+    from .simulators import simulator_provenance
+
+    attrs.update(simulator_provenance(campaign.simulator, Path(campaign.source).resolve().parent,
+                                      properties=[p.property for p in campaign.parameters]))
     out.parent.mkdir(parents=True, exist_ok=True)
     return open_for_campaign(
         out, campaign_text=campaign.text, force=force, restart=restart, xi=design.xi, kappa=kappa, weights=design.weights,

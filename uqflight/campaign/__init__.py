@@ -16,6 +16,7 @@ from ..designs import SAMPLED_DESIGNS, Design, build_design
 from ..parameters import Parameter, seed_names
 from ..quantities.spec import check_quantities
 from ..simulators.jsbsim import NAMED_OUTPUTS
+from ..simulators.kinds import simulator_entry
 from . import schema
 from .schema import TOP_KEYS, CampaignError, CampaignLoader, Checker, yaml_error
 
@@ -79,7 +80,7 @@ def parse_campaign(text: str, source: str = "<campaign>", probe: PropertyProbe |
     check, data, simulator = read_settings(text, source)
     schema.resolve_simulator(check, simulator, source)
     aircraft = None
-    if probe and simulator["kind"] == "jsbsim":
+    if probe and simulator_entry(simulator).aircraft:
         try:
             aircraft = probe(simulator)
         except (FileNotFoundError, RuntimeError) as exc:  # no such aircraft, or JSBSim cannot load it
@@ -135,7 +136,7 @@ def build_campaign(check: Checker, data: dict, simulator: dict, parameters: list
     method = schema.method(check, data.get("method", {"kind": default_method}))
     schema.check_seeds(check, parameters, design_kind, method)
     seeds = seed_names(parameters)
-    if seeds and simulator["kind"] == "python":
+    if seeds and simulator_entry(simulator).integer_seeds:
         simulator["seed_parameters"] = seeds
     execution = schema.execution(check, data.get("execution", {}))
     storage = schema.storage(check, data.get("storage", {}), name)

@@ -16,6 +16,8 @@ import math
 from pathlib import Path
 
 from ..parameters import Parameter
+from ..simulators.kinds import simulator_entry
+from ..simulators.kinds.jsbsim import locate_aircraft
 from . import Campaign, build_campaign, read_settings, schema
 from .schema import CampaignError, Checker
 
@@ -44,7 +46,7 @@ def results_campaign(attrs: dict, source: str) -> Campaign:
         try:
             parameters = schema.parameters(check, data["parameters"], simulator["kind"], None)
         except CampaignError:
-            if simulator["kind"] != "jsbsim":
+            if not simulator_entry(simulator).aircraft:
                 raise
             parameters = _from_aircraft(check, data, simulator, attrs)
     return build_campaign(check, data, simulator, parameters, str(attrs.get("campaign", "")))
@@ -92,7 +94,7 @@ def _from_aircraft(check: Checker, data: dict, simulator: dict, attrs: dict) -> 
 
     recorded = str(attrs.get("campaign_path", "")) or "<results file>"  # no path: the working directory
     simulator = dict(simulator)
-    schema.locate_aircraft(check, simulator, str(Path(recorded)))
+    locate_aircraft(check, simulator, str(Path(recorded)))
     try:
         aircraft = jsbsim_probe(simulator)
     except (FileNotFoundError, RuntimeError) as exc:

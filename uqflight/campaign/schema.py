@@ -6,7 +6,6 @@ import difflib
 import math
 import re
 from collections.abc import Hashable
-from pathlib import Path
 
 import yaml
 
@@ -17,17 +16,12 @@ from ..methods.validity import MAX_TERMS, method_problem
 from ..parameters import DISTRIBUTIONS, Parameter, make_parameter, seed_names
 from ..parameters.distributions import SEED_REFUSAL
 from ..simulators.patch import patch_kind
-from ..simulators.python import PluginError, load_function, split_spec
-from ..simulators.scenarios import DEFAULT as DEFAULT_SCENARIO
-from ..simulators.scenarios import REGISTRY as SCENARIOS
-from ..simulators.scenarios import SCENARIO_KINDS, scenario_kind
+from ..simulators.kinds import REGISTRY as SIMULATORS
+from ..simulators.kinds import SIMULATOR_KINDS, simulator_entry
 
-SIMULATOR_KINDS = ("jsbsim", "python")
 EXECUTORS = ("local", "dask")
 TOP_KEYS = ("name", "description", "seed", "simulator", "parameters", "design", "method",
             "execution", "storage", "analysis", "limits", "quantities")
-JSBSIM_KEYS = ("kind", "aircraft", "scenario", "outputs", "properties")  # and the scenario kind's own (simulators/scenarios)
-PYTHON_KEYS = ("kind", "function", "outputs")
 PARAMETER_KEYS = ("property", "function", "perturbation", "distribution", "nominal", "interval_pct", "lower", "upper")
 PERTURBATIONS = ("scale", "offset", "offset_value")
 METHOD_KEYS = ("kind", "order", "split", "allow_aliasing")
@@ -71,6 +65,8 @@ def shown(value) -> str:
 
 class Checker:
     """Typed access to a YAML mapping that raises CampaignError with the field's path."""
+
+    shown = staticmethod(shown)
 
     def __init__(self, source: str):
         self.source = source
@@ -231,50 +227,14 @@ def check_method_fits_design(check: Checker, method: dict, design: Design, germs
 
 
 def simulator(check: Checker, value) -> dict:
-    """The `simulator:` mapping checked as written: nothing is imported or located (`resolve_simulator`)."""
+    """The `simulator:` mapping checked as written by its kind's entry (simulators/kinds): nothing is
+    imported or located (`resolve_simulator`)."""
     if not isinstance(value, dict):
         check.fail("simulator", f"expected a mapping with a kind key, got {shown(value)}")
     if "kind" not in value:
         check.fail("simulator.kind", f"is required; expected one of {', '.join(SIMULATOR_KINDS)}")
     kind = check.string(value["kind"], "simulator.kind", SIMULATOR_KINDS)
-    if kind == "python":
-        sim = check.mapping(value, "simulator", PYTHON_KEYS, required=("function",))
-        try:
-            split_spec(sim["function"])
-        except PluginError as exc:
-            check.fail("simulator.function", str(exc))
-        if "outputs" in sim:
-            outputs(check, sim["outputs"])
-        return dict(sim)
-    kind = DEFAULT_SCENARIO
-    if "scenario" in value:  # how the run is flown: the scenario kind owns its keys and their checks
-        scenario = value["scenario"]
-        if not isinstance(scenario, dict):
-            check.fail("simulator.scenario", f"expected a mapping with a kind key, got {shown(scenario)}")
-        if "kind" not in scenario:
-            check.fail("simulator.scenario.kind", f"is required; expected one of {', '.join(SCENARIO_KINDS)}")
-        kind = check.string(scenario["kind"], "simulator.scenario.kind", SCENARIO_KINDS)
-        check.mapping(scenario, "simulator.scenario", ("kind", *SCENARIOS[kind].scenario_keys))
-    sim = dict(check.mapping(value, "simulator", (*JSBSIM_KEYS, *SCENARIOS[kind].keys)))
-    if kind == DEFAULT_SCENARIO:  # a script names its aircraft itself (resolved with the script)
-        sim.setdefault("aircraft", "bacm")
-    if "aircraft" in sim:
-        check.string(sim["aircraft"], "simulator.aircraft")
-    if "properties" in sim:
-        fixed_properties(check, sim["properties"])
-    if "outputs" in sim:
-        outputs(check, sim["outputs"])
-    return sim
-
-
-def fixed_properties(check: Checker, value) -> dict:
-    """`simulator.properties`: {PROPERTY: VALUE} set for every run (a turbulence model, a steady wind)."""
-    if not isinstance(value, dict) or not value:
-        check.fail("simulator.properties", f"expected a mapping of JSBSim properties to numbers, got {shown(value)}")
-    for name, number in value.items():
-        check.string(name, "simulator.properties")
-        check.number(number, f"simulator.properties.{name}")
-    return value
+    return SIMULATORS[kind].check(check, value)
 
 
 def check_fixed_properties(check: Checker, sim: dict, parameters: list[Parameter], aircraft) -> None:
@@ -289,42 +249,12 @@ def check_fixed_properties(check: Checker, sim: dict, parameters: list[Parameter
                              f"got {name!r}{aircraft.hint(name)}")
 
 
-def outputs(check: Checker, value) -> list[str]:
-    if not isinstance(value, list) or not value:
-        check.fail("simulator.outputs", f"expected a non-empty list of output names, got {shown(value)}")
-    for i, item in enumerate(value):
-        check.string(item, f"simulator.outputs[{i}]")
-    if len(set(value)) != len(value):
-        check.fail("simulator.outputs", "names must be unique")
-    return value
-
-
 def resolve_simulator(check: Checker, sim: dict, source: str) -> None:
     """Find what the simulator `sim` (checked by `simulator`) runs, relative to the campaign file
     `source`: a python simulator's function is imported (its module's code runs); a JSBSim aircraft
     is located (`sim["aircraft_path"]`, the folder that travels with the simulator). Only for
     campaigns about to be planned or run: reading results never calls this."""
-    if sim["kind"] == "python":
-        try:
-            load_function(sim["function"], Path(source).parent)
-        except PluginError as exc:
-            check.fail("simulator.function", str(exc))
-        return
-    folder = Path(source).resolve().parent
-    sim.update(SCENARIOS[scenario_kind(sim)].check(check, sim, folder))  # the scenario's keys, its files
-    check.string(sim.setdefault("aircraft", "bacm"), "simulator.aircraft")
-    locate_aircraft(check, sim, source)
-
-
-def locate_aircraft(check: Checker, sim: dict, source: str) -> None:
-    """sim["aircraft_path"]: the folder of a JSBSim simulator's aircraft, relative to the campaign file
-    `source` (or the project's, JSBSim's; see `aircraft.locate`). Reads folders only."""
-    from ..simulators.aircraft import AircraftNotFound, locate
-
-    try:
-        sim["aircraft_path"] = str(locate(sim["aircraft"], Path(source).resolve().parent).folder)
-    except AircraftNotFound as exc:
-        check.fail("simulator.aircraft", str(exc))
+    simulator_entry(sim).resolve(check, sim, source)
 
 
 def parameters(check: Checker, value, kind: str, aircraft) -> list[Parameter]:
@@ -342,7 +272,7 @@ def parameters(check: Checker, value, kind: str, aircraft) -> list[Parameter]:
         function = None
         if "function" in spec or "perturbation" in spec:
             function = function_property(check, spec, path, kind, aircraft)
-        if kind == "jsbsim" and "property" not in spec and function is None:
+        if SIMULATORS[kind].aircraft and "property" not in spec and function is None:
             check.fail(f"{path}.property", "is required: the JSBSim property the parameter sets, e.g. aero/uq/CL0 "
                                            "(or function: and perturbation: to scale or offset an aerodynamic function)")
         prop = function or check.string(spec.get("property", str(name)), f"{path}.property")
@@ -399,7 +329,7 @@ def seed_parameter(check: Checker, spec: dict, path: str, name: str, kind: str, 
         if key not in ("property", "distribution"):
             check.fail(f"{path}.{key}", f"has no meaning for a seed (its seeds are 0 to {SEED_COUNT - 1}, drawn "
                                         "from the campaign's seed and each run's design index): give only property")
-    if kind == "jsbsim" and "property" not in spec:
+    if SIMULATORS[kind].aircraft and "property" not in spec:
         check.fail(f"{path}.property", "is required: the JSBSim property the seed sets, e.g. atmosphere/randomseed")
     prop = check.string(spec.get("property", name), f"{path}.property")
     if prop in owners:
@@ -445,7 +375,7 @@ def function_property(check: Checker, spec: dict, path: str, kind: str, aircraft
     against the aircraft's aerodynamic functions when the aircraft is known."""
     from ..simulators.patch import PatchError, check_perturbation, patch_property, resolve_function
 
-    if kind != "jsbsim":
+    if not SIMULATORS[kind].aircraft:
         check.fail(f"{path}.function", "is for JSBSim aircraft; a python simulator's parameters have no functions")
     if "property" in spec:
         check.fail(path, "give either property or function (with perturbation), not both")
@@ -575,14 +505,7 @@ def check_size(check: Checker, data: dict, simulator: dict, parameters: list, me
     if terms > limits["max_pce_terms"]:
         check.fail("method.order", f"a PCE of order {order} in {d} dimensions has {float(terms):.4g} "
                                    f"terms, more than limits.max_pce_terms = {limits['max_pce_terms']}")
-    if simulator["kind"] == "jsbsim":
-        from ..simulators.jsbsim import DEFAULT_OUTPUTS
-        from ..simulators.scenarios import scenario_entry
-
-        times = scenario_entry(simulator).times(simulator)
-        n_outputs = len(simulator.get("outputs", DEFAULT_OUTPUTS))
-    else:
-        times, n_outputs = 1, len(simulator.get("outputs", ())) or 1  # known only once a sample has run
+    times, n_outputs = simulator_entry(simulator).recorded(simulator)  # 1 where known once a sample has run
     n = points or 0
     rank = min(times, n, 1000)
     memory = 8.0 * (n * (3 * d + 6)                                    # the design, status, merging

@@ -7,39 +7,28 @@ from __future__ import annotations
 
 import math
 import re
-from pathlib import Path
 
+from ..simulators.kinds import simulator_entry
+from ..simulators.scenarios import DEFAULT as LEVEL_FLIGHT
+from ..simulators.scenarios import scenario_kind
 from . import REGISTRY, TAKES, WINDOW
 
 KEYS = ("of", "take", "at_s", "when", "after_s", "before_s")
 WHEN_KEYS = ("of", "above", "below")
 BOUNDS = ("above", "below")
 NAME = re.compile(r"[A-Za-z0-9_][A-Za-z0-9_.-]{0,99}")
-DEFAULT_DURATION_S = 50.0  # simulator.duration_s's default (level flight)
 
 
 def flight_span(simulator: dict) -> float | None:
     """The flight's last time [s] when the campaign fixes it (a level flight's duration, a script's end_s or,
     once the script is resolved at plan, its own end), else None (a Python model's time grid: known once a
     run is made)."""
-    if simulator["kind"] != "jsbsim":
-        return None
-    scenario = simulator.get("scenario") or {}
-    if scenario.get("kind", "level_flight") == "level_flight":
-        return float(simulator.get("duration_s", DEFAULT_DURATION_S))
-    end = scenario.get("end_s")
-    if isinstance(end, (int, float)) and not isinstance(end, bool):
-        return float(end)
-    if simulator.get("script_path"):  # resolved at plan: the script's own end (no file is read otherwise)
-        from ..simulators.scenarios.script import ScriptFile
-
-        return ScriptFile.read(Path(simulator["script_path"])).end_s
-    return None
+    return simulator_entry(simulator).span(simulator)
 
 
 def is_level_flight(simulator: dict) -> bool:
-    return simulator["kind"] == "jsbsim" and (simulator.get("scenario") or {}).get("kind", "level_flight") \
-        == "level_flight"
+    """A JSBSim aircraft trimmed in level flight (its modes are those of that trim)."""
+    return simulator_entry(simulator).aircraft and scenario_kind(simulator) == LEVEL_FLIGHT
 
 
 def check_quantities(check, value, simulator: dict, aircraft=None) -> dict[str, dict]:
@@ -84,19 +73,8 @@ def check_quantities(check, value, simulator: dict, aircraft=None) -> dict[str, 
 
 
 def _source(check, name, path: str, simulator: dict, aircraft) -> None:
-    """An output or property a quantity reads: a named output or a property of the aircraft (JSBSim),
-    one of the model's outputs (Python, when the campaign lists them)."""
-    check.string(name, path)
-    if simulator["kind"] == "python":
-        outputs = simulator.get("outputs")
-        if outputs and name not in outputs:
-            check.fail(path, f"expected one of the model's outputs ({', '.join(outputs)}), got {name!r}")
-        return
-    from ..simulators.jsbsim import NAMED_OUTPUTS
-
-    if aircraft is not None and name not in NAMED_OUTPUTS and aircraft.value(name) is None:
-        check.fail(path, f"expected one of {', '.join(NAMED_OUTPUTS)} or a JSBSim property of aircraft "
-                         f"{aircraft.aircraft!r}, got {name!r}{aircraft.hint(name)}")
+    """An output or property a quantity reads, as the simulator kind knows its names."""
+    simulator_entry(simulator).check_source(check, name, path, simulator, aircraft)
 
 
 def _times(check, spec: dict, path: str, span: float | None) -> None:

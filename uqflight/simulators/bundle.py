@@ -106,25 +106,36 @@ def _checked(bundle) -> dict:
 
 def make_bundle(simulator: dict, properties, base: str | Path) -> dict | None:
     """{"kind", "name", "hash", "zip"} for the simulator's files, or None when there is nothing to send."""
-    if simulator["kind"] == "jsbsim":
-        from .patch import PreparedAircraft
+    from .kinds import simulator_entry
 
-        if "root" in simulator:
-            return None
-        prepared = PreparedAircraft(simulator.get("aircraft_path", simulator.get("aircraft", "bacm")), Path(base),
-                                    properties)
-        bundle = {"kind": "aircraft", "name": prepared.name, "hash": prepared.hash, "zip": _zip(prepared.files.files)}
-        files = scenario_entry(simulator).files(simulator)  # a script scenario's script and initialisation
-        if files:
-            bundle["scenario"] = {"hash": AircraftFiles("", files).hash(), "zip": _zip(files)}
-        return bundle
+    return simulator_entry(simulator).bundle(simulator, properties, base)
+
+
+def aircraft_bundle(simulator: dict, properties, base: str | Path) -> dict | None:
+    """A JSBSim simulator's aircraft (the patched copy when `properties` perturb its functions) and its
+    scenario's files; None when the simulator already reads a worker's local copy (`root`)."""
+    from .patch import PreparedAircraft
+
+    if "root" in simulator:
+        return None
+    prepared = PreparedAircraft(simulator.get("aircraft_path", simulator.get("aircraft", "bacm")), Path(base),
+                                properties)
+    bundle = {"kind": "aircraft", "name": prepared.name, "hash": prepared.hash, "zip": _zip(prepared.files.files)}
+    files = scenario_entry(simulator).files(simulator)  # a script scenario's script and initialisation
+    if files:
+        bundle["scenario"] = {"hash": AircraftFiles("", files).hash(), "zip": _zip(files)}
+    return bundle
+
+
+def python_bundle(simulator: dict, base: str | Path) -> dict | None:
+    """A python simulator's file (`file.py:callable`); None for an installed module."""
     module, _, attribute = str(simulator.get("function", "")).partition(":")
-    if module.endswith(".py"):
-        file = Path(module) if Path(module).is_absolute() else Path(base) / module
-        data = file.read_bytes()
-        return {"kind": "python", "name": file.name, "attribute": attribute,
-                "hash": hashlib.sha256(data).hexdigest(), "zip": _zip({file.name: data})}
-    return None
+    if not module.endswith(".py"):
+        return None
+    file = Path(module) if Path(module).is_absolute() else Path(base) / module
+    data = file.read_bytes()
+    return {"kind": "python", "name": file.name, "attribute": attribute,
+            "hash": hashlib.sha256(data).hexdigest(), "zip": _zip({file.name: data})}
 
 
 def localized(spec):

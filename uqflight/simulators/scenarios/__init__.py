@@ -26,7 +26,8 @@ class ScenarioKind:
     base, properties) -> setup (aircraft, root, aircraft_file, time, outputs). flight(setup, preflight)
     -> flight: fly(settings, observers=()) -> FlightResult. times(config): the number of recorded times.
     files(config) -> {name: bytes}: files beyond the aircraft's that a worker needs; localize(config,
-    folder) -> config reading them from `folder`. provenance(config) -> results-file attributes.
+    folder) -> config reading them from `folder`. provenance(config) -> results-file attributes. span(config)
+    -> the flight's last time [s] from the campaign alone (once a script is resolved, its own end), or None.
     resolution(setup, settings, outputs) -> {output: (T,)} or None: the simulator's own resolution.
     """
 
@@ -40,17 +41,18 @@ class ScenarioKind:
     localize: Callable
     provenance: Callable
     resolution: Callable
+    span: Callable
     example: dict  # a small `simulator:` mapping of this kind (tests)
 
 
 REGISTRY: dict[str, ScenarioKind] = {
     "level_flight": ScenarioKind(
         level_flight.KEYS, (), level_flight.check, level_flight.setup, level_flight.flight, level_flight.times,
-        level_flight.files, level_flight.localize, level_flight.provenance, level_flight.resolution,
+        level_flight.files, level_flight.localize, level_flight.provenance, level_flight.resolution, level_flight.span,
         {"kind": "jsbsim", "duration_s": 2.0, "output_rate_hz": 10.0}),
     "script": ScenarioKind(
         script.KEYS, script.SCENARIO_KEYS, script.check, script.setup, script.flight, script.times,
-        script.files, script.localize, script.provenance, script.resolution,
+        script.files, script.localize, script.provenance, script.resolution, script.span,
         {"kind": "jsbsim", "scenario": {"kind": "script", "script": "c172_cruise_8K", "end_s": 2.0},
          "output_rate_hz": 10.0}),
 }

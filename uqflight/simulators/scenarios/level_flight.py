@@ -45,8 +45,13 @@ def check(check, sim: dict, folder: Path) -> dict:
 
 
 def _timing(config: dict) -> FlightSetup:
-    return FlightSetup(duration_s=float(config.get("duration_s", 50.0)), rate_hz=float(config.get("rate_hz", 120.0)),
-                       output_rate_hz=float(config.get("output_rate_hz", 20.0)))
+    """The timing alone, FlightSetup's defaults where the campaign gives none (its own checks apply)."""
+    return FlightSetup(**{key: float(config[key]) for key in ("duration_s", "rate_hz", "output_rate_hz") if key in config})
+
+
+def span(config: dict) -> float:
+    """The flight's last time [s]: duration_s."""
+    return _timing(config).duration_s
 
 
 def times(config: dict) -> int:

@@ -226,6 +226,15 @@ def check(check, sim: dict, folder: Path) -> dict:
     return sim
 
 
+def span(config: dict) -> float | None:
+    """end_s when given, else the script's own end once it is resolved (`script_path`), else None: no
+    file is read before the campaign is resolved."""
+    end = config.get("scenario", {}).get("end_s")
+    if isinstance(end, (int, float)) and not isinstance(end, bool):
+        return float(end)
+    return ScriptFile.read(Path(config["script_path"])).end_s if config.get("script_path") else None
+
+
 def times(config: dict) -> int:
     """The number of recorded times, from the script's timing and the output rate alone."""
     script = _script_file(config, None)
