@@ -1,6 +1,7 @@
 """Every registered germ, distribution, rule, design and method, picked up from its registry and checked
 against closed forms: a new entry is tested without a new test."""
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -264,3 +265,30 @@ def test_a_simulator_kind_refuses_the_keys_of_the_others(kind, tmp_path):
     for key in {k for other in SIMULATORS.values() for k in other.keys} - set(SIMULATORS[kind].keys):
         with pytest.raises(CampaignError, match=f"simulator.{key}: unknown key"):
             parse_campaign(_simulator_campaign({**simulator, key: "x"}, parameters), str(tmp_path / "x.yaml"))
+
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+@pytest.mark.parametrize("simulator, parameters, folder", [
+    ({"kind": "jsbsim", "aircraft": "../aircraft/bacm", "duration_s": 1.0}, None, "campaigns"),
+    ({"kind": "jsbsim", "scenario": {"kind": "script", "script": "scripts/c172p-landing.xml", "end_s": 1.0}},
+     {"w": {"property": "atmosphere/wind-east-fps", "distribution": "uniform", "lower": -1, "upper": 1}}, "campaigns"),
+    ({"kind": "python", "function": "data/quantity_model.py:ramp"}, None, "tests"),
+], ids=["aircraft-folder", "script-file", "model-file"])
+def test_a_relocated_simulator_reads_the_same_files_from_another_folder(simulator, parameters, folder, tmp_path):
+    from uqflight.campaign import CampaignError, parse_campaign
+    from uqflight.simulators.jsbsim_probe import jsbsim_probe
+
+    entry = SIMULATORS[simulator["kind"]]
+    parameters = parameters or entry.example[1]
+    elsewhere = str(tmp_path / "x.yaml")
+    with pytest.raises(CampaignError):  # the relative names do not resolve from elsewhere
+        parse_campaign(_simulator_campaign(simulator, parameters), elsewhere, jsbsim_probe)
+    moved = entry.relocated(simulator, ROOT / folder)
+    here = parse_campaign(_simulator_campaign(simulator, parameters), str(ROOT / folder / "x.yaml"), jsbsim_probe)
+    there = parse_campaign(_simulator_campaign(moved, parameters), elsewhere, jsbsim_probe)
+    for key in ("aircraft_path", "script_path", "function"):
+        assert (key in here.simulator) == (key in there.simulator)
+        if key.endswith("_path") and key in here.simulator:
+            assert Path(here.simulator[key]).resolve() == Path(there.simulator[key]).resolve()

@@ -25,7 +25,9 @@ class SimulatorKind:
     find what it runs relative to the campaign file `source` (a python module is imported; an aircraft
     located); only for campaigns about to be planned or run. make(config, parameter_names, properties,
     base) -> simulator. bundle(config, properties, base) -> the files a worker needs, or None.
-    provenance(config, base, properties) -> results-file attributes. recorded(config) -> (times, outputs)
+    provenance(config, base, properties) -> results-file attributes. relocated(config, folder) -> the
+    mapping as written with the files it names relative to `folder` made absolute (a campaign written
+    elsewhere, e.g. calibrate's calibrated.yaml, reads the same files). recorded(config) -> (times, outputs)
     a run records, from the campaign alone (1 where known only once a sample has run). span(config) ->
     the flight's last time [s], or None. check_source(checker, name, path, config, aircraft): a name a
     quantity reads. aircraft: parameters set properties of an aircraft (`property` or `function`
@@ -40,6 +42,7 @@ class SimulatorKind:
     make: Callable
     bundle: Callable
     provenance: Callable
+    relocated: Callable
     recorded: Callable
     span: Callable
     check_source: Callable
@@ -50,13 +53,13 @@ class SimulatorKind:
 
 REGISTRY: dict[str, SimulatorKind] = {
     "jsbsim": SimulatorKind(jsbsim.KEYS, jsbsim.check, jsbsim.resolve, jsbsim.make, jsbsim.bundle,
-                            jsbsim.provenance, jsbsim.recorded, jsbsim.span, jsbsim.check_source,
+                            jsbsim.provenance, jsbsim.relocated, jsbsim.recorded, jsbsim.span, jsbsim.check_source,
                             aircraft=True, integer_seeds=False,
                             example=({"kind": "jsbsim", "duration_s": 1.0, "output_rate_hz": 10.0},
                                      {"CL0": {"property": "aero/uq/CL0", "distribution": "normal",
                                               "interval_pct": 20}})),
     "python": SimulatorKind(python.KEYS, python.check, python.resolve, python.make, python.bundle,
-                            python.provenance, python.recorded, python.span, python.check_source,
+                            python.provenance, python.relocated, python.recorded, python.span, python.check_source,
                             aircraft=False, integer_seeds=True,
                             example=({"kind": "python", "function": "uqflight.simulators.models:exp_decay"},
                                      {"a": {"distribution": "normal", "nominal": 1.0, "lower": 0.9, "upper": 1.1}})),

@@ -137,6 +137,19 @@ def provenance(config: dict, base: Path | None = None, properties=()) -> dict:
             **entry.provenance(config)}
 
 
+def relocated(config: dict, folder: Path) -> dict:
+    """An aircraft given as a folder relative to `folder` made absolute (a project or JSBSim aircraft
+    keeps its name), and the scenario's files as its kind says."""
+    from ..aircraft import locate
+
+    sim = dict(config)
+    if "aircraft" in sim:
+        location = locate(sim["aircraft"], Path(folder))
+        if location.origin == "path":
+            sim["aircraft"] = str(location.folder)
+    return SCENARIOS[scenario_kind(sim)].relocated(sim, Path(folder))
+
+
 def recorded(config: dict) -> tuple[int, int]:
     return scenario_entry(config).times(config), len(config.get("outputs", DEFAULT_OUTPUTS))
 

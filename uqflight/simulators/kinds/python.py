@@ -42,6 +42,14 @@ def provenance(config: dict, base: Path | None = None, properties=()) -> dict:
     return {}
 
 
+def relocated(config: dict, folder: Path) -> dict:
+    """A `file.py:callable` relative to `folder` made absolute; an installed module as it is."""
+    module, attribute = split_spec(config["function"])
+    if not module.endswith(".py") or Path(module).is_absolute():
+        return dict(config)
+    return {**config, "function": f"{(Path(folder) / module).resolve()}:{attribute}"}
+
+
 def recorded(config: dict) -> tuple[int, int]:
     """The time grid is the model's: known once a sample has run (1 until then)."""
     return 1, len(config.get("outputs", ())) or 1

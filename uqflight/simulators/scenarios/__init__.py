@@ -26,7 +26,8 @@ class ScenarioKind:
     base, properties) -> setup (aircraft, root, aircraft_file, time, outputs). flight(setup, preflight)
     -> flight: fly(settings, observers=()) -> FlightResult. times(config): the number of recorded times.
     files(config) -> {name: bytes}: files beyond the aircraft's that a worker needs; localize(config,
-    folder) -> config reading them from `folder`. provenance(config) -> results-file attributes. span(config)
+    folder) -> config reading them from `folder`; relocated(config, folder) -> config with the files it names
+    relative to the campaign's `folder` made absolute. provenance(config) -> results-file attributes. span(config)
     -> the flight's last time [s] from the campaign alone (once a script is resolved, its own end), or None.
     resolution(setup, settings, outputs) -> {output: (T,)} or None: the simulator's own resolution.
     """
@@ -39,6 +40,7 @@ class ScenarioKind:
     times: Callable
     files: Callable
     localize: Callable
+    relocated: Callable
     provenance: Callable
     resolution: Callable
     span: Callable
@@ -48,11 +50,13 @@ class ScenarioKind:
 REGISTRY: dict[str, ScenarioKind] = {
     "level_flight": ScenarioKind(
         level_flight.KEYS, (), level_flight.check, level_flight.setup, level_flight.flight, level_flight.times,
-        level_flight.files, level_flight.localize, level_flight.provenance, level_flight.resolution, level_flight.span,
+        level_flight.files, level_flight.localize, level_flight.relocated,
+        level_flight.provenance, level_flight.resolution, level_flight.span,
         {"kind": "jsbsim", "duration_s": 2.0, "output_rate_hz": 10.0}),
     "script": ScenarioKind(
         script.KEYS, script.SCENARIO_KEYS, script.check, script.setup, script.flight, script.times,
-        script.files, script.localize, script.provenance, script.resolution, script.span,
+        script.files, script.localize, script.relocated, script.provenance,
+        script.resolution, script.span,
         {"kind": "jsbsim", "scenario": {"kind": "script", "script": "c172_cruise_8K", "end_s": 2.0},
          "output_rate_hz": 10.0}),
 }

@@ -100,6 +100,11 @@ def localize(config: dict, folder: Path) -> dict:
     return config
 
 
+def relocated(config: dict, folder: Path) -> dict:
+    """Level flight names no files."""
+    return config
+
+
 def provenance(config: dict) -> dict:
     """Nothing beyond the aircraft's hash (results files stay as they were before scenarios)."""
     return {}

@@ -415,6 +415,15 @@ def localize(config: dict, folder: Path) -> dict:
     return {**config, "script_path": str(Path(folder) / Path(config["script_path"]).name)}
 
 
+def relocated(config: dict, folder: Path) -> dict:
+    """A script given as a file relative to `folder` made absolute (a JSBSim script keeps its name)."""
+    scenario = dict(config["scenario"])
+    candidate = Path(folder) / str(scenario["script"])
+    if not Path(str(scenario["script"])).is_absolute() and candidate.is_file():
+        scenario["script"] = str(candidate.resolve())
+    return {**config, "scenario": scenario}
+
+
 def provenance(config: dict) -> dict:
     """The scenario and the sha256 of the script's files, for the results file."""
     return {"scenario": json.dumps({"kind": "script", "script": Path(config["script_path"]).name,
