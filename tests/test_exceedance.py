@@ -52,7 +52,7 @@ def test_the_wilson_interval_covers_the_true_probability_about_95_percent_of_the
     covered = []
     for _ in range(400):
         final = rng.uniform(-1, 1, 200) + 4 * rng.uniform(0.5, 1.5, 200)
-        item, = exceedance_from_runs(final, [{"above": 5.0}])
+        item, = exceedance_from_runs(final, np.ones(final.size, bool), [{"above": 5.0}])
         covered.append(item["lower"] <= 0.25 <= item["upper"])
     assert 0.90 <= np.mean(covered) <= 0.99
 

@@ -33,7 +33,8 @@ from .analysis.density import pdf_over_time
 from .analysis.divergence import kl_divergence
 from .analysis.errors import error_summary, relative_errors
 from .analysis.exceedance import exceedance_from_pce, exceedance_from_runs
-from .analysis.failures import failure_probability, grid_failure_probability
+from .analysis.failures import grid_failure_probability
+from .analysis.proportions import sampled_proportion
 from .analysis.floors import central_moments, floors_from_moments, kld_floor
 from .analysis.moments import modified_cov, standardised_moments, weighted_moments, weighted_quantiles
 from .analysis.resolution import RESOLUTION_RTOL, resolved_variance
@@ -204,7 +205,7 @@ def analyse(path, reference: str | None = None, options: Options | None = None, 
             raise BadInput(f"{path}: method {method['kind']} order {method['order']}: {problem}")
         _note_runs(store, stats, sampled, allow_aliasing)
         stats.from_runs = method_entry(method["kind"]).runs_on_sampled and sampled
-        replicates = int(json.loads(store.attrs.get("design_info", "{}")).get("replicates", 1))
+        replicates = int(design_info(store).get("replicates", 1))
         stats.replicates = replicates if stats.from_runs and ok.all() else 1
         for name in store.output_names:
             out = stats.outputs[name] = _output_statistics(store, name, method, germs, design_kind, ok, options)
@@ -217,6 +218,11 @@ def analyse(path, reference: str | None = None, options: Options | None = None, 
         add_reference_errors(stats, analyse(reference, options=Options(
             band_samples=options.band_samples, bootstrap=0, seed=options.seed, quantiles=options.quantiles)))
     return stats
+
+
+def design_info(store: ResultStore) -> dict:
+    """The design's recorded facts (samples, replicates, scramble, n_base, ...)."""
+    return json.loads(store.attrs.get("design_info", "{}"))
 
 
 def _check_runs(store: ResultStore, stats: Statistics, sampled: bool, partial: bool) -> None:
@@ -240,8 +246,12 @@ def _note_runs(store: ResultStore, stats: Statistics, sampled: bool, allow_alias
     status = store.status
     done = status != Status.PENDING
     failed = status[done] > 0
-    stats.failure_probability = (failure_probability(failed) if sampled
-                                 else grid_failure_probability(failed, store.weights[done]))
+    if sampled:
+        found = sampled_proportion(status > 0, done, DESIGNS[stats.design_kind].draws, design_info(store))
+        stats.failure_probability = {**{k: found[k] for k in ("estimate", "lower", "upper", "n_effective")},
+                                     "method": found["sentence"].replace("runs", "runs failed", 1)}
+    else:
+        stats.failure_probability = grid_failure_probability(failed, store.weights[done])
     if stats.failed:
         kappa, reasons, names = store.kappa, store.reasons, store.parameter_names
         stats.failures = [{"run": int(i), "status": Status(int(status[i])).name.lower(), "reason": reasons[i],
@@ -518,7 +528,8 @@ def quantity_statistics(store: ResultStore, stats: Statistics, name: str, germs:
     view = _QuantityView(store, name, values)
     out = _output_statistics(view, name, stats.method, germs, stats.design_kind, defined, options)
     if out.pce is None:
-        exceedance = exceedance_from_runs(values[defined], thresholds)
+        exceedance = exceedance_from_runs(values, defined, thresholds, DESIGNS[stats.design_kind].draws,
+                                          design_info(store))
     else:
         exceedance = exceedance_from_pce(out.pce.sample(options.band_samples, options.seed)[:, 0],
                                          int(defined.sum()), thresholds)

@@ -1,7 +1,8 @@
 """Probabilities that a quantity of interest exceeds a threshold (`analysis.exceedance`).
 
-* From runs (sampled designs): p̂ = k/n over the n runs where the quantity is defined, with the 95 %
-  Wilson score interval (analysis.failures.wilson_interval), `method: "wilson"`.
+* From runs (sampled designs): the proportion of the runs where the quantity is defined, with the 95 %
+  interval that holds for how the design drew them (analysis.proportions): `method: "wilson"` (the
+  Wilson score interval), "replicates" (randomised QMC) or "points" (unscrambled QMC, no interval).
 * From a PCE: the fraction of the expansion's draws beyond the threshold, `method: "pce"`. Its bounds
   are null: a PCE's error is known in the mean square (leave-one-out, lower-order difference), not on
   the individual values a threshold sorts, so no interval would hold.
@@ -12,7 +13,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .failures import wilson_interval
+from .proportions import sampled_proportion
 
 RARE_COUNT = 10
 CONFIDENCE = 0.95
@@ -22,19 +23,21 @@ def _beyond(values: np.ndarray, bound: str, threshold: float) -> np.ndarray:
     return values > threshold if bound == "above" else values < threshold
 
 
-def exceedance_from_runs(values: np.ndarray, thresholds: list[dict]) -> list[dict]:
-    """[{above|below, probability, lower, upper, method, note}] over the runs `values` (defined ones)."""
-    n, found = values.size, []
+def exceedance_from_runs(values: np.ndarray, defined: np.ndarray, thresholds: list[dict], draws: str = "independent",
+                         info: dict | None = None) -> list[dict]:
+    """[{above|below, probability, lower, upper, method, note}] over the runs where `defined` (bool (N,),
+    design order) holds; `draws`, `info`: how the design drew its points (analysis.proportions)."""
+    found = []
     for item in thresholds:
         (bound, threshold), = item.items()
-        k = int(_beyond(values, bound, threshold).sum())
-        lower, upper = wilson_interval(k / n, n, CONFIDENCE)
-        note = f"{k} of {n} runs {bound} {threshold:g}; {100 * CONFIDENCE:g} % Wilson score interval"
-        if k < RARE_COUNT:
+        beyond = _beyond(np.where(defined, values, np.nan), bound, threshold)
+        p = sampled_proportion(beyond, defined, draws, info or {}, CONFIDENCE)
+        note = p["sentence"].replace("runs", f"runs {bound} {threshold:g}", 1)
+        if int((beyond & defined).sum()) < RARE_COUNT:
             note += (f"; fewer than {RARE_COUNT} runs exceed: a rare-event extrapolation from the runs, "
                      "run more to resolve it")
-        found.append({bound: threshold, "probability": k / n, "lower": lower, "upper": upper,
-                      "method": "wilson", "note": note})
+        found.append({bound: threshold, "probability": p["estimate"], "lower": p["lower"], "upper": p["upper"],
+                      "method": p["method"], "note": note})
     return found
 
 

@@ -1,8 +1,9 @@
 """Probability that a run fails: from random draws with a confidence interval that holds for small
 counts; from a quadrature grid only what its weights can say.
 
-Sampled designs (Monte Carlo, QMC, Latin hypercube, pick-freeze): k failures of n runs give p̂ = k/n
-and the Wilson score interval (default) or the exact Clopper–Pearson interval.
+Independent draws: k failures of n runs give p̂ = k/n and the Wilson score interval (default) or the
+exact Clopper–Pearson interval; how other sampled designs (QMC, Latin hypercube, pick-freeze) count
+their runs for it is analysis.proportions'.
 
 Grids (`grid_failure_probability`): the nodes are fixed, not drawn, so the failed count is no
 binomial sample and no interval has a coverage. With weights all ≥ 0 (tensor grids) Σ_failed w / Σw

@@ -28,24 +28,31 @@ class DesignKind:
     """A registered design: its builder (spec, germs, seed) -> (xi, weights, info); its size (spec,
     germs) -> the runs it builds, from the spec alone and without building anything (for the campaign's
     limits; a sparse grid's points before merging; None when the spec is malformed, so that the
-    builder's own checks speak); and whether its points are random draws (`sampled`: moments are sample
-    averages, valid on any subset of runs) or a quadrature grid (its weights are valid only all together)."""
+    builder's own checks speak); and `draws`: how its random points relate to independent draws
+    (analysis.proportions), or None for a quadrature grid (its weights are valid only all together)."""
 
     build: Callable
     size: Callable
-    sampled: bool
+    draws: str | None
     example: dict  # a small `design:` mapping of this kind (help text and tests)
+
+    @property
+    def sampled(self) -> bool:
+        """Random draws: moments are sample averages, valid on any subset of runs."""
+        return self.draws is not None
 
 
 REGISTRY: dict[str, DesignKind] = {
-    "monte_carlo": DesignKind(monte_carlo_design, samples_size, True, {"kind": "monte_carlo", "samples": 64}),
-    "sobol": DesignKind(sobol_design, sobol_size, True, {"kind": "sobol", "samples": 64}),
-    "halton": DesignKind(halton_design, samples_size, True, {"kind": "halton", "samples": 64}),
-    "latin_hypercube": DesignKind(latin_hypercube_design, samples_size, True,
+    "monte_carlo": DesignKind(monte_carlo_design, samples_size, "independent",
+                              {"kind": "monte_carlo", "samples": 64}),
+    "sobol": DesignKind(sobol_design, sobol_size, "net", {"kind": "sobol", "samples": 64}),
+    "halton": DesignKind(halton_design, samples_size, "net", {"kind": "halton", "samples": 64}),
+    "latin_hypercube": DesignKind(latin_hypercube_design, samples_size, "stratified",
                                   {"kind": "latin_hypercube", "samples": 64}),
-    "sparse_grid": DesignKind(sparse_grid_design, sparse_grid_size, False, {"kind": "sparse_grid", "level": 2}),
-    "tensor_grid": DesignKind(tensor_grid_design, tensor_grid_size, False, {"kind": "tensor_grid", "points": 4}),
-    "pick_freeze": DesignKind(pick_freeze_design, pick_freeze_size, True, {"kind": "pick_freeze", "samples": 16}),
+    "sparse_grid": DesignKind(sparse_grid_design, sparse_grid_size, None, {"kind": "sparse_grid", "level": 2}),
+    "tensor_grid": DesignKind(tensor_grid_design, tensor_grid_size, None, {"kind": "tensor_grid", "points": 4}),
+    "pick_freeze": DesignKind(pick_freeze_design, pick_freeze_size, "pick_freeze",
+                              {"kind": "pick_freeze", "samples": 16}),
 }
 DESIGN_KINDS = tuple(REGISTRY)
 SAMPLED_DESIGNS = tuple(kind for kind, entry in REGISTRY.items() if entry.sampled)

@@ -1,0 +1,75 @@
+"""Probabilities from a sampled design's runs (analysis.proportions): each interval covers the true
+probability as often as it says, for how the design drew its points, or there is none.
+
+The event: ξ1² + ξ2² < 1/2 for uniform germs on [-1, 1]^d, probability π/8 exactly (a disk of area π/2
+in a square of area 4; curved, so that no QMC net stratifies it exactly). Coverage over 300 independent designs is a binomial mean with s.d. 0.0126 at
+0.95: the bounds below are 3 s.d. either side."""
+import numpy as np
+import pytest
+
+from uqflight.analysis.proportions import sampled_proportion
+from uqflight.designs import REGISTRY, build_design
+
+TRUE = np.pi / 8
+SEEDS = range(300)
+
+
+def _found(spec: dict, d: int, seed: int) -> tuple[dict, np.ndarray]:
+    design = build_design(spec, ["uniform"] * d, seed)
+    hits = design.xi[:, 0] ** 2 + design.xi[:, 1] ** 2 < 0.5
+    return sampled_proportion(hits, np.ones(hits.size, bool), REGISTRY[spec["kind"]].draws, design.info), hits
+
+
+def _coverage(spec: dict, d: int) -> float:
+    covered = []
+    for seed in SEEDS:
+        found, _ = _found(spec, d, seed)
+        covered.append(found["lower"] <= TRUE <= found["upper"])
+    return float(np.mean(covered))
+
+
+def test_pick_freeze_counts_its_independent_rows_only_and_then_covers():
+    spec = {"kind": "pick_freeze", "samples": 64}
+    found, hits = _found(spec, 4, 0)
+    assert found["n_effective"] == 128 and "rows A and B" in found["sentence"]  # not the 384 rows
+    assert found["estimate"] == hits[:128].mean()
+    assert _coverage(spec, 4) >= 0.912  # A and B are scrambled Sobol' points: conservative
+
+
+def test_independent_draws_get_the_wilson_interval_that_covers():
+    assert 0.912 <= _coverage({"kind": "monte_carlo", "samples": 128}, 3) <= 0.988
+
+
+def test_randomised_qmc_replicates_give_a_student_t_interval_that_covers():
+    spec = {"kind": "sobol", "samples": 64, "replicates": 8}
+    found, hits = _found(spec, 3, 1)
+    assert found["method"] == "replicates"
+    assert found["estimate"] == pytest.approx(np.mean([hits[r * 64:(r + 1) * 64].mean() for r in range(8)]))
+    assert 0.912 <= _coverage(spec, 3) <= 0.988
+
+
+def test_a_latin_hypercube_gets_the_conservative_wilson_interval_of_n_minus_one_draws():
+    spec = {"kind": "latin_hypercube", "samples": 128}
+    found, _ = _found(spec, 3, 2)
+    assert found["n_effective"] == 127 and found["method"] == "wilson"
+    assert _coverage(spec, 3) >= 0.912
+
+
+def test_one_scrambled_net_is_flagged_and_fixed_points_get_no_interval():
+    found, _ = _found({"kind": "sobol", "samples": 128}, 3, 3)
+    assert found["method"] == "wilson" and "design.replicates" in found["sentence"]
+    found, hits = _found({"kind": "sobol", "samples": 128, "scramble": False}, 3, 3)
+    assert (found["lower"], found["upper"], found["method"]) == (None, None, "points")
+    assert found["estimate"] == hits.mean()
+
+
+def test_replicates_that_all_agree_give_no_interval():
+    hits, counted = np.zeros(32, bool), np.ones(32, bool)
+    found = sampled_proportion(hits, counted, "net", {"replicates": 4, "scramble": True})
+    assert found["estimate"] == 0.0 and found["lower"] is None and "more samples" in found["sentence"]
+
+
+def test_only_counted_runs_count():
+    hits = np.array([True, True, False, False])
+    found = sampled_proportion(hits, np.array([True, False, True, True]), "independent", {})
+    assert found["estimate"] == pytest.approx(1 / 3) and found["n_effective"] == 3

@@ -1,0 +1,86 @@
+"""The probability that a run does something (fails; a quantity exceeds a threshold), from a sampled
+design's runs, with an interval only where one holds for how the design drew its points.
+
+How the points were drawn (`DesignKind.draws`, with the design's recorded info):
+- independent (monte_carlo): k/n and the Wilson score interval.
+- pick_freeze: Saltelli's rows [A; B; AB_1 … AB_d] repeat each other's coordinates (AB_i is A with B's
+  i-th column), so the proportion and its Wilson interval are those of the 2n rows A and B alone; they
+  are a scrambled Sobol' sample, for which that interval is unverified (usually wider than its own).
+- stratified (latin_hypercube): k/n; Latin hypercube sampling's variance is at most n/(n−1) times that
+  of n independent draws (Owen 1997), so the Wilson interval of n − 1 draws is conservative.
+- net (sobol, halton): with R ≥ 2 scrambled replicates (randomised QMC), the mean of the R proportions
+  and the Student-t interval of their spread; a single scrambled net: k/n and the Wilson interval of
+  independent draws, flagged (a scrambled net's variance is usually lower but not bounded by theirs for
+  an indicator); unscrambled points are fixed, not random: k/n without an interval.
+"""
+from __future__ import annotations
+
+import numpy as np
+from scipy import stats
+
+from .failures import wilson_interval
+
+DRAWS = ("independent", "pick_freeze", "stratified", "net")
+
+
+def sampled_proportion(hits, counted, draws: str, info: dict, confidence: float = 0.95) -> dict:
+    """{"estimate", "lower", "upper", "n_effective", "method", "sentence"} of the runs `counted` (bool
+    (N,), in design order) where `hits` (bool (N,)) holds. lower/upper are None without an interval;
+    `method`: "wilson", "replicates" or "points"; `sentence` says how, for a note. `info`: the design's
+    recorded info (n_base, replicates, scramble)."""
+    hits, counted = np.asarray(hits, dtype=bool), np.asarray(counted, dtype=bool)
+    if draws not in DRAWS:
+        raise ValueError(f"draws must be one of {', '.join(DRAWS)}, got {draws!r}")
+    replicates = int(info.get("replicates", 1))
+    if draws == "net" and replicates > 1:
+        return _replicated(hits, counted, replicates, confidence)
+    if draws == "pick_freeze":
+        counted = counted & (np.arange(hits.size) < 2 * int(info["n_base"]))
+    k, n = int((hits & counted).sum()), int(counted.sum())
+    if n == 0:
+        return {"estimate": None, "lower": None, "upper": None, "n_effective": 0.0, "method": None,
+                "sentence": "no run counts: the probability is undefined"}
+    estimate = k / n
+    counts = f"{k} of {n} runs"
+    if draws == "net" and not info.get("scramble", True):
+        return {"estimate": estimate, "lower": None, "upper": None, "n_effective": float(n), "method": "points",
+                "sentence": f"{counts}; no interval: unscrambled QMC points are fixed, not random (scramble them, "
+                            "with replicates, for an interval)"}
+    n_interval = n - 1 if draws == "stratified" else n
+    lower, upper = wilson_interval(estimate, n_interval, confidence) if n_interval > 0 else (0.0, 1.0)
+    sentence = f"{counts}; {100 * confidence:g} % Wilson score interval"
+    if draws == "pick_freeze":
+        sentence = (f"{counts} (the rows A and B of the pick-freeze design, which the other rows repeat); "
+                    f"{100 * confidence:g} % Wilson score interval of independent draws, unverified for their "
+                    "scrambled Sobol' points (usually wider than their own)")
+    elif draws == "stratified":
+        sentence += f" of {n_interval} draws (conservative: a Latin hypercube's variance is at most n/(n-1) " \
+                    "times that of independent draws)"
+    elif draws == "net":
+        sentence += (" of independent draws, unverified for one scrambled QMC net (usually wider than its own); "
+                     "set design.replicates for an interval from the design itself")
+    return {"estimate": estimate, "lower": lower, "upper": upper, "n_effective": float(n_interval),
+            "method": "wilson", "sentence": sentence}
+
+
+def _replicated(hits, counted, replicates: int, confidence: float) -> dict:
+    """Randomised QMC: the mean of the replicates' proportions, Student-t over their spread."""
+    size = hits.size // replicates
+    shares = [hits[r * size:(r + 1) * size][counted[r * size:(r + 1) * size]].mean()
+              for r in range(replicates) if counted[r * size:(r + 1) * size].any()]
+    k, n = int((hits & counted).sum()), int(counted.sum())
+    if len(shares) < 2:
+        return {"estimate": k / n if n else None, "lower": None, "upper": None, "n_effective": float(n),
+                "method": None, "sentence": f"{k} of {n} runs; no interval: fewer than 2 replicates have runs"}
+    shares = np.asarray(shares)
+    r = shares.size
+    estimate = float(shares.mean())
+    half = float(stats.t.ppf(0.5 * (1 + confidence), r - 1) * shares.std(ddof=1) / np.sqrt(r))
+    if half == 0.0:
+        return {"estimate": estimate, "lower": None, "upper": None, "n_effective": float(n), "method": "replicates",
+                "sentence": f"{k} of {n} runs; no interval: every one of the {r} replicates gives {estimate:g}, "
+                            f"so their spread says nothing finer than 1/{size}; run more samples per replicate"}
+    return {"estimate": estimate, "lower": max(estimate - half, 0.0), "upper": min(estimate + half, 1.0),
+            "n_effective": float(n), "method": "replicates",
+            "sentence": f"{k} of {n} runs; mean of {r} replicates' proportions, {100 * confidence:g} % Student-t "
+                        "interval of their spread"}
