@@ -1,5 +1,6 @@
-"""A failing nominal sample (the one `run` flies first, in a real worker process) stops the run with one
-message that names it, gives its values and says what to do; exit 2, no results file."""
+"""A failing nominal sample (the one `run` flies first, in a real worker process; a python model or a JSBSim
+flight) stops the run with one message that names it, gives its values and says what to do; exit 2, no
+results file."""
 from conftest import DATA, cli_in_process
 
 MODEL = DATA / "failure_models.py"
@@ -32,3 +33,16 @@ def test_a_campaign_error_found_at_the_nominal_is_not_called_a_failing_sample(tm
     assert done.returncode == 2
     assert "simulator.outputs: the function returned no 'z'" in done.stderr
     assert "nominal sample failed" not in done.stderr
+
+
+def test_a_jsbsim_campaign_whose_nominal_does_not_trim_stops_before_flying_the_others(tmp_path):
+    # bacm cannot trim in level flight at 90 KTAS (below its stall speed): every run would fail the same way
+    (tmp_path / "c.yaml").write_text(
+        "name: nominal\nsimulator: {kind: jsbsim, aircraft: bacm, flight: {airspeed_ktas: 90}, duration_s: 1}\n"
+        "parameters:\n  CL0: {property: aero/uq/CL0, distribution: normal, interval_pct: 5}\n"
+        "design: {kind: monte_carlo, samples: 8}\n")
+    done = cli_in_process("run", tmp_path / "c.yaml", "--out", tmp_path / "c.h5")
+    assert done.returncode == 2 and "Traceback" not in done.stderr, done.stderr
+    assert "the nominal sample failed (CL0 = " in done.stderr and "trim failed" in done.stderr
+    assert "uqflight simulate" in done.stderr
+    assert not (tmp_path / "c.h5").exists()

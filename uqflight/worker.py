@@ -26,7 +26,7 @@ import numpy as np
 from .quantities import quantity_key
 from .quantities.recorder import QuantityRecorder
 from .simulators import FlightError, make_simulator
-from .simulators.base import NominalFailed
+from .simulators.base import NominalFailed, nominal_failed
 from .simulators.bundle import localized
 
 
@@ -118,12 +118,13 @@ def probe(spec: WorkerSpec, kappa: np.ndarray, resolution: bool = True):
     started = time.perf_counter()
     try:  # with the quantities: a linearisation costs more than the flight (5 s for bacm's two turboprops)
         flown = simulator.evaluate(kappa, observers)
-    except Exception:  # a failed nominal flight still measures the cost of a flight
-        flown = None
+    except FlightError as exc:  # every run would start from a campaign whose centre does not fly
+        raise nominal_failed(spec.parameter_names, kappa, exc, "fly them with `uqflight simulate`, its --set and "
+                                                              "the campaign's flight") from exc
     seconds = time.perf_counter() - started
     repeatability = getattr(simulator, "trim_repeatability", None)
     return (np.asarray(time_grid, dtype=float), list(outputs), dict(getattr(simulator, "units", {}) or {}), seconds,
-            repeatability(kappa, flown) if resolution and repeatability and flown is not None else None)
+            repeatability(kappa, flown) if resolution and repeatability else None)
 
 
 def _die_with_parent(parent: int) -> None:
