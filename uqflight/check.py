@@ -1,7 +1,9 @@
 """Baselines of a results file's statistics, and the drift of a recomputation against one.
 
-A baseline (written by `uqflight report --write-baseline`) holds, per output and time, the mean,
-variance, 99 % band and Sobol' indices of one results file, with that file's campaign hash.
+A baseline (written by `uqflight report --write-baseline`) holds, per output and time and per quantity of
+interest, the mean, variance, 99 % band and Sobol' indices of one results file, with that file's campaign
+hash (a quantity undefined in every run is null). A baseline without `quantities` (written before they
+existed) is compared on its outputs.
 `compare` recomputes nothing itself: it takes fresh `Statistics` and lists every value outside
 |value − baseline| <= atol + rtol·|baseline| (NaN matches only NaN).
 """
@@ -55,18 +57,22 @@ def _series(entry) -> dict[str, list]:
     return series
 
 
+def _entry(out) -> dict | None:
+    """An output's (or quantity's) time grid and compared statistics; None for an undefined quantity."""
+    if out is None:
+        return None
+    return json_ready({"time": out.time, "mean": out.mean, "variance": out.variance,
+                       "band99": {"lower": out.band99[0], "upper": out.band99[1]},
+                       "sobol_first": out.sobol_first, "sobol_total": out.sobol_total})
+
+
 def baseline_json(stats: Statistics, campaign_hash: str) -> dict:
-    """The baseline of `stats`: per output its time grid and compared statistics, and the campaign hash."""
-    outputs = {}
-    for name, out in stats.outputs.items():
-        outputs[name] = json_ready({
-            "time": out.time, "mean": out.mean, "variance": out.variance,
-            "band99": {"lower": out.band99[0], "upper": out.band99[1]},
-            "sobol_first": out.sobol_first, "sobol_total": out.sobol_total,
-        })
+    """The baseline of `stats`: per output and quantity its time grid and compared statistics, and the
+    campaign hash."""
     return {"kind": BASELINE_KIND, "version": BASELINE_VERSION, "results": stats.path,
             "campaign": stats.campaign_name, "campaign_hash": campaign_hash, "method": stats.method,
-            "outputs": outputs}
+            "outputs": {name: _entry(out) for name, out in stats.outputs.items()},
+            "quantities": {name: _entry(quantity.output) for name, quantity in stats.quantities.items()}}
 
 
 def write_baseline(stats: Statistics, campaign_hash: str, path: Path) -> Path:
@@ -100,12 +106,17 @@ def load_baseline(path: Path) -> dict:
     if not isinstance(outputs, dict) or not outputs:
         raise BadInput(f"{path}: outputs: expected a non-empty mapping of output names to statistics")
     for name, entry in outputs.items():
-        _check_entry(path, name, entry)
+        _check_entry(f"{path}: outputs.{name}", entry)
+    quantities = data.get("quantities", {})
+    if not isinstance(quantities, dict):
+        raise BadInput(f"{path}: quantities: expected a mapping of quantity names to statistics")
+    for name, entry in quantities.items():
+        if entry is not None:  # undefined in every run
+            _check_entry(f"{path}: quantities.{name}", entry)
     return data
 
 
-def _check_entry(path: Path, name: str, entry) -> None:
-    where = f"{path}: outputs.{name}"
+def _check_entry(where: str, entry) -> None:
     if not isinstance(entry, dict):
         raise BadInput(f"{where}: expected a mapping of statistics")
     for key in ("time", "mean", "variance", "band99", "sobol_first", "sobol_total"):
@@ -141,19 +152,37 @@ def compare(stats: Statistics, baseline: dict, rtol: float, atol: float) -> Comp
     for label, tol in (("rtol", rtol), ("atol", atol)):
         if not isinstance(tol, (int, float)) or not math.isfinite(tol) or tol < 0:
             raise BadInput(f"{label}: expected a finite number >= 0, got {tol!r}")
-    fresh = baseline_json(stats, "")["outputs"]
-    expected = baseline["outputs"]
+    fresh = baseline_json(stats, "")
+    compared, drifts = _compare_section("output", fresh["outputs"], baseline["outputs"], rtol, atol)
+    if "quantities" in baseline:
+        counted, more = _compare_section("quantity", fresh["quantities"], baseline["quantities"], rtol, atol)
+        compared, drifts = compared + counted, drifts + more
+    return Comparison(compared, drifts)
+
+
+def _compare_section(what: str, fresh: dict, expected: dict, rtol: float, atol: float) -> tuple[int, list[Drift]]:
+    """(values compared, drifts) of the outputs or the quantities; a quantity defined on one side only
+    drifts in its mean."""
     if set(fresh) != set(expected):
-        raise BadInput(f"the baseline is for outputs {', '.join(expected)}; the results have {', '.join(fresh)}")
+        plural = {"output": "outputs", "quantity": "quantities"}[what]
+        raise BadInput(f"the baseline is for {plural} {', '.join(expected) or '-'}; the results have "
+                       f"{', '.join(fresh) or '-'}")
+    label = (lambda name: name) if what == "output" else (lambda name: f"quantity {name}")
     compared, drifts = 0, []
     for name, entry in expected.items():
+        if entry is None or fresh[name] is None:
+            if (entry is None) != (fresh[name] is None):
+                value, base = (math.nan, 0.0) if entry is not None else (0.0, math.nan)
+                drifts.append(Drift(label(name), "mean", 0.0, value, base, 0.0))
+            compared += 1
+            continue
         time = np.asarray(fresh[name]["time"])
-        _check_time_grid(name, time, np.asarray(entry["time"], dtype=float))
+        _check_time_grid(f"{what} {name}", time, np.asarray(entry["time"], dtype=float))
         values, reference = _series(fresh[name]), _series(entry)
         if set(values) != set(reference):
             only_baseline = ", ".join(sorted(set(reference) - set(values))) or "-"
             only_results = ", ".join(sorted(set(values) - set(reference))) or "-"
-            raise BadInput(f"output {name}: the baseline has statistics {only_baseline} that the results lack, the "
+            raise BadInput(f"{what} {name}: the baseline has statistics {only_baseline} that the results lack, the "
                            f"results {only_results} that the baseline lacks (another method or parameters?)")
         for statistic, baseline_values in reference.items():
             value = np.asarray(values[statistic], dtype=float)
@@ -161,14 +190,14 @@ def compare(stats: Statistics, baseline: dict, rtol: float, atol: float) -> Comp
             tolerance = atol + rtol * np.abs(base)
             ok = (np.abs(value - base) <= tolerance) | (np.isnan(value) & np.isnan(base))
             compared += value.size
-            drifts += [Drift(name, statistic, float(time[i]), float(value[i]), float(base[i]), float(tolerance[i]))
+            drifts += [Drift(label(name), statistic, float(time[i]), float(value[i]), float(base[i]), float(tolerance[i]))
                        for i in np.flatnonzero(~ok)]
-    return Comparison(compared, drifts)
+    return compared, drifts
 
 
 def _check_time_grid(name: str, time: np.ndarray, expected: np.ndarray) -> None:
     if time.shape != expected.shape or not np.allclose(time, expected, rtol=0.0, atol=TIME_ATOL):
-        raise BadInput(f"output {name}: the baseline's time grid ({expected.size} times, {expected[0]:g} to "
+        raise BadInput(f"{name}: the baseline's time grid ({expected.size} times, {expected[0]:g} to "
                        f"{expected[-1]:g} s) differs from the results' ({time.size} times, {time[0]:g} to "
                        f"{time[-1]:g} s)")
 
