@@ -126,7 +126,8 @@ def wait_for(predicate, seconds=60.0):
 
 
 def test_one_writer_per_file_and_sigterm_stops_cleanly(tmp_path):
-    yaml = write_campaign(tmp_path, "slow", samples=400, chunk=4, workers=2)
+    # 100 s of work: the SIGTERM ends it after a few, however slowly the other commands start on a loaded machine
+    yaml = write_campaign(tmp_path, "slow", samples=2000, chunk=4, workers=2)
     out = tmp_path / "r.h5"
     first = subprocess.Popen([UQFLIGHT, "run", str(yaml), "--out", str(out)], stdout=subprocess.PIPE,
                              stderr=subprocess.PIPE, text=True)
@@ -150,7 +151,7 @@ def test_one_writer_per_file_and_sigterm_stops_cleanly(tmp_path):
     assert wait_for(lambda: not any(alive(pid) for pid in workers), 10)
     assert not Path(str(out) + ".lock").exists()
     with ResultStore.open(out) as store:
-        assert 0 < store.pending().size < 400
+        assert 0 < store.pending().size < 2000
 
 
 def test_a_stale_lock_is_taken_over(tmp_path):
@@ -187,7 +188,8 @@ def test_a_results_path_that_cannot_be_written_is_refused(tmp_path, where):
 
 
 def test_no_orphan_workers_after_the_runner_is_killed(tmp_path):
-    yaml = write_campaign(tmp_path, "slow", samples=400, chunk=4, workers=2)
+    # 100 s of work: the SIGTERM ends it after a few, however slowly the other commands start on a loaded machine
+    yaml = write_campaign(tmp_path, "slow", samples=2000, chunk=4, workers=2)
     out = tmp_path / "r.h5"
     runner = subprocess.Popen([UQFLIGHT, "run", str(yaml), "--out", str(out)], stdout=subprocess.DEVNULL,
                               stderr=subprocess.DEVNULL)
