@@ -216,3 +216,98 @@ design: {kind: sparse_grid, level: 2, rule: gauss_legendre}
     assert caught.value.field == "design.rule" and "standard-normal germs" in str(caught.value)
     campaign = parse_campaign(grid.replace("rule: gauss_legendre", "rule: gauss_hermite"))  # the germs are normal
     assert campaign.runs == 13 and campaign.germs == ["normal", "normal"]
+
+
+# -- calibrate → calibrated.yaml with its dependence → plan → run -------------------------------------------
+@pytest.fixture(scope="module")
+def calibrated(tmp_path_factory):
+    """`calibrate` on the conjugate line y = a + b·t (test_calibration_conjugate): a strong posterior a–b
+    correlation; its output folder."""
+    from test_calibration_conjugate import SIGMA, TIME, flight, make_results
+
+    from uqflight.calibration.run import calibrate
+
+    folder = tmp_path_factory.mktemp("dependence-calibration")
+    results = make_results(folder)
+    data = folder / "flight.csv"
+    data.write_text("time_s,y\n" + "".join(f"{t!r},{v!r}\n" for t, v in zip(TIME.tolist(), flight(0).tolist())))
+    calibrate(results, data, folder / "out", noise=[f"y={SIGMA}"], seed=0, steps=800, predictive_draws=5)
+    return folder / "out"
+
+
+@pytest.mark.slow  # a real calibrate (800 steps) and four campaign runs: ~20 s under load
+def test_calibrated_dependence_plans_runs_and_narrows_the_band(calibrated, tmp_path):
+    import h5py
+    import yaml
+
+    from uqflight.calibration.surrogate import load_campaign_file
+
+    path = calibrated / "calibrated.yaml"
+    text = path.read_text()
+    assert "LOST" not in text
+    campaign = load_campaign_file(path)  # as `uqflight plan` loads it
+    with h5py.File(calibrated / "posterior.h5") as f:
+        draws = f["draws/kappa"][()]
+    r = np.corrcoef(draws, rowvar=False)[0, 1]
+    assert campaign.dependence.names == ("a", "b") and r < -0.5  # intercept and slope of a line: strongly negative
+    assert campaign.dependence.correlation[0, 1] == pytest.approx(r, rel=1e-9)  # normal marginals: ρ0 = r
+    plan = cli_in_process("plan", path, cwd=tmp_path)
+    assert plan.returncode == 0 and "dependence: gaussian_copula over a, b" in plan.stdout, plan.stderr
+    independent = yaml.safe_load(text)
+    del independent["dependence"]
+    (tmp_path / "independent.yaml").write_text(yaml.safe_dump(independent, sort_keys=False))
+    bands = {}
+    for name, source in (("dependent", path), ("independent", tmp_path / "independent.yaml")):
+        out = tmp_path / f"{name}.h5"
+        ran = cli_in_process("run", source, "--out", out, cwd=tmp_path)
+        assert ran.returncode == 0, ran.stderr
+        y = analyse(out).outputs["y"]
+        bands[name] = y.band99[1] - y.band99[0]
+        if name == "dependent":  # the order-1 PCE is the line: the variance is the draws' own, to rounding
+            t = y.time
+            line = draws[:, :1] + draws[:, 1:] * t[None, :]
+            np.testing.assert_allclose(y.variance, line.var(axis=0, ddof=1), rtol=1e-9)
+    # y(0) = a: the same band (a is first in the Cholesky order: the same draws); later the correlation narrows it
+    assert bands["dependent"][0] == pytest.approx(bands["independent"][0], rel=1e-12)
+    assert np.all(bands["dependent"][5:] < 0.8 * bands["independent"][5:])
+
+
+def test_calibrated_yaml_writes_the_copula_of_the_normal_scores():
+    # Draws of three parameters: a, b informed (normal marginals, so ρ0 is the draws' own correlation),
+    # c kept at its uniform prior (its score is Φ⁻¹ of its prior CDF), d independent of all (|r| < 0.1:
+    # left out of the group). The text must load as a campaign with exactly that block.
+    from uqflight.calibration.outputs import calibrated_campaign
+    from uqflight.calibration.run import normal_scores
+    from uqflight.calibration.surrogate import prior_summaries
+
+    text = """
+name: four
+simulator: {kind: python, function: "uqflight.simulators.models:linear"}
+parameters:
+  a: {distribution: normal, lower: -3, upper: 3}
+  b: {distribution: normal, lower: -3, upper: 3}
+  c: {distribution: uniform, lower: -1, upper: 1}
+  d: {distribution: normal, lower: -3, upper: 3}
+design: {kind: monte_carlo, samples: 8}
+dependence: {kind: gaussian_copula, parameters: [a, d], correlation: [[1, 0.3], [0.3, 1]]}
+"""
+    campaign = parse_campaign(text)
+    rng = np.random.default_rng(4)
+    z = rng.standard_normal((20000, 4)) @ np.linalg.cholesky([[1, -0.9, 0.5, 0], [-0.9, 1, -0.4, 0],
+                                                               [0.5, -0.4, 1, 0], [0, 0, 0, 1]]).T
+    kappa = np.column_stack([0.1 * z[:, 0] + 0.2, 0.3 * z[:, 1], 2 * special.ndtr(z[:, 2]) - 1, z[:, 3]])
+    names = ["a", "b", "c", "d"]
+    post = {n: {"mean": float(kappa[:, k].mean()), "std": float(kappa[:, k].std(ddof=1))} for k, n in enumerate(names)}
+    prior = prior_summaries(campaign.parameters)
+    scores = normal_scores(campaign.parameters, kappa, post, prior)
+    np.testing.assert_allclose(scores[:, 2], z[:, 2], atol=1e-9)  # kept at its prior: Φ⁻¹(F(κ))
+    import yaml
+
+    from uqflight.campaign.schema import CampaignLoader
+
+    written = calibrated_campaign(yaml.load(text, Loader=CampaignLoader), {}, post, prior, scores, names, None, "test")
+    again = parse_campaign(written)
+    assert again.dependence.names == ("a", "b", "c")  # the old block replaced; d is independent of all
+    np.testing.assert_allclose(again.dependence.correlation, np.corrcoef(scores[:, :3], rowvar=False), atol=1e-12)
+    assert again.dependence.correlation[0, 1] == pytest.approx(np.corrcoef(kappa[:, :2], rowvar=False)[0, 1], rel=1e-12)
+    assert [p.distribution for p in again.parameters] == ["normal", "normal", "uniform", "normal"]
