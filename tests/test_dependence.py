@@ -6,6 +6,7 @@ independent standard variables (Cholesky: x1 = ξ1, x2 = σ2(ρ ξ1 + √(1 − 
 ρ = 0.6, so an order-1 PCE on a Gauss–Hermite grid is exact and the Sobol' indices of ξ are 3.4²/21.8
 and 3.2²/21.8.
 """
+import json
 import math
 
 import numpy as np
@@ -108,12 +109,23 @@ def test_correlated_normals_on_a_gauss_hermite_grid_are_exact(tmp_path):
     assert "Cholesky order x1, x2" in summary["dependence"]["sobol_of"]
     assert any("Gaussian copula" in note for note in summary["notes"])
     # the exported surrogate evaluates at physical values through the inverse Nataf transform
-    from uqflight.surrogate import export, load
+    from uqflight.campaign.reading import results_campaign
+    from uqflight.store import ResultStore
+    from uqflight.surrogate import SurrogateError, export, load
 
     pce = load(export(path, tmp_path / "pce.json"))
     kappa = to_physical(parse_campaign(LINEAR.format(design="{kind: sobol, samples: 8}", method="{kind: monte_carlo}",
                                                      band=100)).parameters, xi, GaussianCopula(("x1", "x2"), [[1, RHO], [RHO, 1]]))
     np.testing.assert_allclose(pce.evaluate(kappa)["y"][:, 0], kappa[:, 0] + 2 * kappa[:, 1], atol=1e-10)
+    data = json.loads((tmp_path / "pce.json").read_text())
+    data["dependence"]["correlation"] = [[1.0, 0.6], [0.5, 1.0]]  # hand-edited: refused, naming the key
+    (tmp_path / "bad.json").write_text(json.dumps(data))
+    with pytest.raises(SurrogateError, match=r"dependence\.correlation\[0\]\[1\]: expected a symmetric matrix"):
+        load(tmp_path / "bad.json")
+    # reading the results rebuilds the transform from the stored campaign text, running no campaign code
+    with ResultStore.open(path) as store:
+        again = results_campaign(store.attrs, str(path))
+        np.testing.assert_array_equal(again.to_physical(store.xi), store.kappa)
 
 
 def test_correlated_normals_by_quasi_monte_carlo(tmp_path):
