@@ -45,6 +45,16 @@ def run_linear(tmp_path, name, design, method, band=20000):
     return path, analyse(path)
 
 
+def result_parameters(path):
+    """The parameters (laws) a results file records."""
+    from uqflight.campaign.reading import stored_parameters
+    from uqflight.parameters import Parameter
+    from uqflight.store import ResultStore
+
+    with ResultStore.open(path) as store:
+        return [Parameter(**row) for row in stored_parameters(store.attrs)]
+
+
 def test_nataf_transform_inverts_and_leaves_the_unlisted_and_the_first_listed_alone():
     params = [make_parameter("u", "u", "uniform", 1, lower=-1, upper=3),
               make_parameter("n", "n", "normal", 0, lower=-3, upper=3),
@@ -109,8 +119,7 @@ def test_correlated_normals_on_a_gauss_hermite_grid_are_exact(tmp_path):
     from uqflight.surrogate import SurrogateError, export, load
 
     pce = load(export(path, tmp_path / "pce.json"))
-    kappa = to_physical(parse_campaign(LINEAR.format(design="{kind: sobol, samples: 8}", method="{kind: monte_carlo}",
-                                                     band=100)).parameters, xi, GaussianCopula(("x1", "x2"), [[1, RHO], [RHO, 1]]))
+    kappa = to_physical(result_parameters(path), xi, GaussianCopula(("x1", "x2"), [[1, RHO], [RHO, 1]]))
     np.testing.assert_allclose(pce.evaluate(kappa)["y"][:, 0], kappa[:, 0] + 2 * kappa[:, 1], atol=1e-10)
     data = json.loads((tmp_path / "pce.json").read_text())
     data["dependence"]["correlation"] = [[1.0, 0.6], [0.5, 1.0]]  # hand-edited: refused, naming the key
@@ -144,8 +153,8 @@ BAD = {
     "not symmetric": ("[[1, 0.5], [0.4, 1]]", None, "dependence.correlation[0][1]", "expected a symmetric matrix"),
     "diagonal": ("[[1, 0.5], [0.5, 0.9]]", None, "dependence.correlation[1][1]", "expected 1 on the diagonal"),
     "above one": ("[[1, 1.5], [1.5, 1]]", None, "dependence.correlation[0][1]", "expected a correlation in [-1, 1]"),
-    "not positive definite": ("[[1, 0.9, 0.9], [0.9, 1, -0.9], [0.9, -0.9, 1]]", "[x1, x2, x3]", "dependence.correlation",
-                              "expected a positive definite matrix"),
+    "not positive definite": ("[[1, 0.9, 0.9], [0.9, 1, -0.9], [0.9, -0.9, 1]]", "[x1, x2, x3]",
+                              "dependence.correlation", "expected a positive definite matrix"),
     "perfect correlation": ("[[1, 1], [1, 1]]", None, "dependence.correlation", "smallest eigenvalue is"),
     "wrong size": ("[[1, 0.5], [0.5, 1]]", "[x1, x2, x3]", "dependence.correlation", "expected a 3 x 3 list of rows"),
     "short row": ("[[1, 0.5], [0.5]]", None, "dependence.correlation[1]", "expected a row of 2 numbers"),
@@ -206,7 +215,8 @@ def test_plan_exits_2_naming_file_and_field_and_a_uniform_rule_is_refused_for_th
     assert result.returncode == 2
     assert result.stderr.startswith(f"error: {path}: dependence.correlation[0][1]: expected a symmetric matrix")
     with pytest.raises(CampaignError, match="unknown key; did you mean parameters"):
-        parse_campaign(bad_campaign("[[1, 0.5], [0.5, 1]]", None).replace("correlation:", "parameter: [x1], correlation:"))
+        parse_campaign(bad_campaign("[[1, 0.5], [0.5, 1]]", None).replace("correlation:",
+                                                                         "parameter: [x1], correlation:"))
     with pytest.raises(CampaignError, match="expected one of gaussian_copula"):
         parse_campaign(bad_campaign("[[1, 0.5], [0.5, 1]]", None, kind="clayton"))
     grid = """

@@ -217,8 +217,8 @@ def _calibrate(results, data, out, outputs, noise, seed, walkers, steps, method,
         truth_row = np.array([truth.get(n, np.nan) for n in names]) if truth else None
         corner_plot(scratch / "plots/corner.png", kappa, names, truth_row)
         prior_xi = prior_draw(np.random.default_rng(seed + 2), 20000)[:, :d]
-        marginals_plot(scratch / "plots/marginals.png", to_physical(surrogate.parameters, prior_xi, dependence), kappa, names,
-                       truth_row)
+        prior_kappa = to_physical(surrogate.parameters, prior_xi, dependence)
+        marginals_plot(scratch / "plots/marginals.png", prior_kappa, kappa, names, truth_row)
         predictive_plot(scratch / "plots/predictive.png", flight.time, flight.values, at_data, band,
                         surrogate.units, int((~ok).sum()))
         summary["seconds"]["total"] = clock.perf_counter() - started
@@ -236,7 +236,8 @@ def normal_scores(parameters, kappa: np.ndarray, post: dict, prior: dict) -> np.
     calibrated.yaml gives them: the normal N(mean, std²) of an informed parameter's posterior (then the
     score's correlation is that of κ), the prior law of one kept at its prior. Their correlation is the
     Gaussian copula's (Nataf's ρ0) that `dependence:` takes."""
-    scores = np.column_stack([GERMS[p.germ].to_normal(x) for p, x in zip(parameters, to_standard(parameters, kappa).T)])
+    marginal_xi = to_standard(parameters, kappa)  # each parameter's own germ variable (no dependence)
+    scores = np.column_stack([GERMS[p.germ].to_normal(x) for p, x in zip(parameters, marginal_xi.T)])
     for k, p in enumerate(parameters):
         if informed(post[p.name], prior[p.name]):
             scores[:, k] = (kappa[:, k] - post[p.name]["mean"]) / post[p.name]["std"]
@@ -250,8 +251,8 @@ def _predictive(chain, posterior, surrogate, flight, rng, count):
     draws = chain.kept.transpose(1, 0, 2).reshape(-1, posterior.ndim)
     pick = rng.choice(len(draws), size=min(count, len(draws)), replace=False)
     xi = draws[pick, :len(surrogate.names)]
-    sim_time, runs, failures = simulate(surrogate.campaign, to_physical(surrogate.parameters, xi, surrogate.campaign.dependence),
-                                         list(flight.values))
+    kappa = to_physical(surrogate.parameters, xi, surrogate.campaign.dependence)
+    sim_time, runs, failures = simulate(surrogate.campaign, kappa, list(flight.values))
     ok = np.all([np.all(np.isfinite(runs[o]), axis=1) for o in runs], axis=0)
     errors = {}
     basis = surrogate.basis(xi[ok])

@@ -31,14 +31,14 @@ def correlation_problem(matrix: np.ndarray) -> tuple[str, str] | None:
     n = len(matrix)
     for i in range(n):
         for j in range(n):
-            value = matrix[i, j]
+            value, mirror = float(matrix[i, j]), float(matrix[j, i])
             if i == j and abs(value - 1.0) > TOLERANCE:
-                return f"[{i}][{j}]", f"expected 1 on the diagonal (a variable's correlation with itself), got {value!r}"
+                return f"[{i}][{j}]", f"expected 1 on the diagonal (a parameter with itself), got {value!r}"
             if not -1.0 <= value <= 1.0:
                 return f"[{i}][{j}]", f"expected a correlation in [-1, 1], got {value!r}"
-            if abs(value - matrix[j, i]) > TOLERANCE:
+            if abs(value - mirror) > TOLERANCE:
                 return f"[{i}][{j}]", (f"expected a symmetric matrix, but [{i}][{j}] = {value!r} and "
-                                       f"[{j}][{i}] = {matrix[j, i]!r}")
+                                       f"[{j}][{i}] = {mirror!r}")
     smallest = float(np.linalg.eigvalsh(matrix).min())
     if smallest <= EIGENVALUE_FLOOR:
         return "", (f"expected a positive definite matrix, but its smallest eigenvalue is {smallest:.3g} "
