@@ -59,6 +59,19 @@ def test_a_germs_quantile_maps_uniforms_to_its_law(germ):
         assert np.mean(xi**power) == pytest.approx(weights @ nodes**power, abs=5e-3)
 
 
+@pytest.mark.parametrize("germ", GERM_NAMES)
+def test_a_germs_normal_map_is_its_quantile_of_the_normal_cdf_and_inverts(germ):
+    # the Nataf transform's step (parameters.dependence): ξ = Q(Φ(z)), increasing, and back; |z| <= 6
+    # keeps Φ's tail to 1e-9 relative in the uniform germ, hence 1e-6 on z
+    from scipy import special
+
+    z = np.linspace(-6, 6, 49)
+    xi = GERMS[germ].from_normal(z)
+    np.testing.assert_allclose(xi, GERMS[germ].quantile(special.ndtr(z)), atol=1e-12)
+    assert np.all(np.diff(xi) > 0)
+    np.testing.assert_allclose(GERMS[germ].to_normal(xi), z, atol=1e-6)
+
+
 @pytest.mark.parametrize("name", [name for name, law in DISTRIBUTIONS.items() if law.polynomial])
 def test_a_distributions_maps_invert_and_its_moments_match_quadrature(name):
     parameter = make_parameter("p", "p", name, 2.0, interval_pct=30.0)

@@ -189,6 +189,9 @@ def plan(campaign: Path = typer.Argument(..., metavar="CAMPAIGN", help="Campaign
     for p in spec.parameters:
         echo(f"  {p.name:<10} {p.property:<18} {p.distribution:<16} nominal {p.nominal:<10.6g} "
              f"interval [{p.lower:.6g}, {p.upper:.6g}]")
+    if spec.dependence is not None:
+        echo(f"dependence: {spec.dependence.kind} over {', '.join(spec.dependence.names)} (standard-normal germs, "
+             "Cholesky in this order)")
     echo(describe(design))
     echo(f"method: {spec.method['kind']} (order {spec.method['order']})")
     runs = len(design.xi)
@@ -478,12 +481,10 @@ def design(
                                                      "kappa) and weight."),
 ):
     """Write a campaign's design (the points and weights the runs would use) as CSV, without running it."""
-    from .parameters import to_physical
-
     check_output(csv_path, "--csv")
     spec = _load(campaign)
     points = spec.design()
-    kappa = to_physical(spec.parameters, points.xi)
+    kappa = spec.to_physical(points.xi)
     names = [p.name for p in spec.parameters]
     try:
         with open(csv_path, "w", newline="") as fh:

@@ -48,7 +48,7 @@ from .campaign.reading import parameters_attribute
 from .campaign.schema import WORKER_BYTES
 from .console import clean
 from .designs import Design
-from .parameters import seed_names, to_physical
+from .parameters import seed_names
 from .store import ResultStore, Status, compact, open_for_campaign
 from .store.lock import LockHeld, ResultsLock
 from .worker import WorkerSpec
@@ -113,7 +113,7 @@ def prepare_store(campaign: Campaign, design: Design, out: Path, force: bool, pr
     """Open the campaign's results file to resume it, or create it with the design and provenance.
     `probed` = (time, outputs, units, seconds, trim repeatability) from a worker (`WorkerPool.probe`);
     measured here in a worker process when not given."""
-    kappa = to_physical(campaign.parameters, design.xi)
+    kappa = campaign.to_physical(design.xi)
     if probed is None:
         pool = WorkerPool(worker_spec(campaign), 1, PROBE_TIMEOUT_S)
         try:
@@ -129,6 +129,8 @@ def prepare_store(campaign: Campaign, design: Design, out: Path, force: bool, pr
     seeds = seed_names(campaign.parameters)
     if seeds:  # written only when there are any: files of other campaigns keep their attributes
         attrs["seeds"] = json.dumps(seeds)
+    if campaign.dependence is not None:  # likewise
+        attrs["dependence"] = json.dumps(campaign.dependence.summary())
     from .simulators import simulator_provenance
 
     attrs.update(simulator_provenance(campaign.simulator, Path(campaign.source).resolve().parent,
@@ -142,7 +144,7 @@ def prepare_store(campaign: Campaign, design: Design, out: Path, force: bool, pr
 
 
 def nominal_kappa(campaign: Campaign) -> np.ndarray:
-    return to_physical(campaign.parameters, np.zeros((1, len(campaign.parameters))))[0]
+    return campaign.to_physical(np.zeros((1, len(campaign.parameters))))[0]
 
 
 def worker_spec(campaign: Campaign) -> WorkerSpec:

@@ -127,6 +127,7 @@ class Statistics:
     from_runs: bool = False  # statistics of the runs themselves (a sampled design), not of a PCE
     replicates: int = 1  # independent randomised-QMC replicates of the design
     seeds: list[str] = field(default_factory=list)  # parameters that are random streams' seeds
+    dependence: dict | None = None  # the inputs' Gaussian copula (parameters.dependence.summary), None: independent
     quantities: dict[str, QuantityStatistics] = field(default_factory=dict)
 
 
@@ -201,6 +202,11 @@ def analyse(path, reference: str | None = None, options: Options | None = None, 
         if seeds and not (sampled and method_entry(method["kind"]).runs_on_sampled):
             problem = f"parameter {seeds[0]} is a seed: {SEED_REFUSAL}"
         stats.seeds = seeds
+        stats.dependence = json.loads(store.attrs.get("dependence", "null"))
+        if stats.dependence:
+            stats.notes.append(f"dependent inputs: {', '.join(stats.dependence['parameters'])} are correlated by a "
+                               "Gaussian copula (Nataf); the mean, variance, bands and densities are those of the "
+                               f"dependent inputs; the Sobol' indices are of the {stats.dependence['sobol_of']}")
         if problem:
             raise BadInput(f"{path}: method {method['kind']} order {method['order']}: {problem}")
         _note_runs(store, stats, sampled, allow_aliasing)
@@ -639,5 +645,6 @@ def summary_json(stats: Statistics) -> dict:
         "runs": stats.runs, "completed": stats.completed, "failed": stats.failed, "pending": stats.pending,
         "failure_probability": stats.failure_probability, "partial": stats.partial, "notes": stats.notes,
         "failures": stats.failures, "parameters": stats.parameter_names, "reference": stats.reference,
+        **({"dependence": stats.dependence} if stats.dependence else {}),
         "outputs": outputs,
         "quantities": {name: _quantity_json(quantity, stats.seeds) for name, quantity in stats.quantities.items()}})

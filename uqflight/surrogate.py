@@ -8,7 +8,8 @@
 The file holds everything needed to evaluate the expansion without uqflight's results file:
 the germs (standard variables), the multi-indices (total degree, one row per basis polynomial),
 the coefficients of the orthonormal basis per output and time, the parameters' distributions
-(name, distribution, lower, upper, nominal: κ ↔ ξ), the time grid, the method and its order.
+(name, distribution, lower, upper, nominal: κ ↔ ξ), their Gaussian copula when they are dependent
+(`dependence`: {kind, parameters, correlation}; see docs/dependence.md), the time grid, the method and its order.
 The PCE is fitted exactly as the statistics fit it (same runs, same method, same order).
 """
 from __future__ import annotations
@@ -41,14 +42,16 @@ class Surrogate:
     units: dict[str, str]
     method: dict
     campaign: str = ""
+    dependence: dict | None = None  # the inputs' Gaussian copula {kind, parameters, correlation}, None: independent
 
     @property
     def outputs(self) -> list[str]:
         return list(self.coefficients)
 
     def to_standard(self, kappa) -> np.ndarray:
-        """ξ (M, d) from physical values κ (M, d), column by column through each parameter's law."""
-        from .parameters import Parameter
+        """ξ (M, d) from physical values κ (M, d), column by column through each parameter's law (and the
+        inverse Nataf transform of the `dependence`, if any)."""
+        from .parameters import Parameter, to_standard
 
         kappa = np.atleast_2d(np.asarray(kappa, dtype=float))
         if kappa.shape[1] != len(self.parameters):
@@ -56,7 +59,7 @@ class Surrogate:
                              f"({', '.join(p['name'] for p in self.parameters)}), got {kappa.shape[1]}")
         laws = [Parameter(p["name"], p.get("property", p["name"]), p["distribution"], p["nominal"], p["lower"],
                           p["upper"]) for p in self.parameters]
-        return np.column_stack([law.to_standard(kappa[:, j]) for j, law in enumerate(laws)])
+        return to_standard(laws, kappa, _copula(self.dependence))
 
     def evaluate(self, kappa=None, *, xi=None) -> dict[str, np.ndarray]:
         """{output: (M, T)} at M points given as physical values κ (M, d) or standard variables ξ."""
@@ -96,9 +99,27 @@ def fit_surrogate(path, method: dict | None = None, partial: bool = False,
     with ResultStore.open(path) as store:
         parameters, units, time = _parameters(store), dict(store.units), np.asarray(store.time, dtype=float)
     first = next(iter(pces.values()))
+    dependence = {k: v for k, v in stats.dependence.items() if k != "sobol_of"} if stats.dependence else None
     return Surrogate(parameters, list(first.germs), np.asarray(first.indices, dtype=int), time,
                      {name: np.asarray(pce.coefficients, dtype=float) for name, pce in pces.items()}, units,
-                     stats.method, stats.campaign_name)
+                     stats.method, stats.campaign_name, dependence)
+
+
+def _copula(dependence: dict | None):
+    """The GaussianCopula of a `dependence` mapping (ValueError naming the key when it is not one)."""
+    from .parameters.dependence import KINDS, GaussianCopula
+
+    if dependence is None:
+        return None
+    if not isinstance(dependence, dict) or dependence.get("kind") not in KINDS:
+        raise ValueError(f"dependence.kind: expected one of {', '.join(KINDS)}")
+    names, rows = dependence.get("parameters"), dependence.get("correlation")
+    if not isinstance(names, list) or not all(isinstance(n, str) for n in names):
+        raise ValueError(f"dependence.parameters: expected a list of parameter names, got {_shown(names)}")
+    try:
+        return GaussianCopula(tuple(names), _array(rows, "dependence.correlation", (len(names), len(names))))
+    except ValueError as exc:
+        raise ValueError(str(exc) if str(exc).startswith("dependence") else f"dependence.{exc}") from None
 
 
 def _parameters(store) -> list[dict]:
@@ -123,6 +144,7 @@ def surrogate_json(surrogate: Surrogate, results: str = "") -> dict:
         "split": bool(surrogate.method.get("split", False)),
         "basis": "orthonormal polynomials of the germs (Hermite for normal, Legendre for uniform), total degree",
         "parameters": surrogate.parameters, "germs": surrogate.germs,
+        **({"dependence": surrogate.dependence} if surrogate.dependence else {}),
         "multi_indices": surrogate.indices.tolist(), "time": surrogate.time.tolist(),
         "outputs": {name: {"units": surrogate.units.get(name, ""), "coefficients": numbers(c)}
                     for name, c in surrogate.coefficients.items()},
@@ -189,6 +211,7 @@ def _checked(data: dict) -> Surrogate:
         raise ValueError(f"germs: unknown {unknown} (known: {', '.join(GERMS)})")
     d = len(germs)
     parameters = data["parameters"]
+    copula = _copula(data.get("dependence"))
     if not isinstance(parameters, list) or len(parameters) != d or not all(
             isinstance(p, dict) and {"name", "distribution", "lower", "upper", "nominal"} <= set(p) for p in parameters):
         raise ValueError(f"parameters: expected {d} entries with name, distribution, lower, upper, nominal")
@@ -200,9 +223,13 @@ def _checked(data: dict) -> Surrogate:
             _number(p[key], f"parameters[{j}].{key}")
         law = Parameter(p["name"], p.get("property", p["name"]), p["distribution"], p["nominal"], p["lower"],
                         p["upper"])
-        if law.germ != germs[j]:
-            raise ValueError(f"parameters[{j}] ({p['name']}): a {p['distribution']} law is driven by a {law.germ} "
-                             f"germ, but germs[{j}] is {germs[j]}")
+        germ = "normal" if copula is not None and law.name in copula.names else law.germ
+        if germ != germs[j]:
+            raise ValueError(f"parameters[{j}] ({p['name']}): a {p['distribution']} law is driven by a {germ} "
+                             f"germ{' (dependence:)' if germ != law.germ else ''}, but germs[{j}] is {germs[j]}")
+    unknown = set(copula.names) - {p["name"] for p in parameters} if copula is not None else set()
+    if unknown:
+        raise ValueError(f"dependence.parameters: {sorted(unknown)} are not among the parameters")
     order = data["order"]
     if isinstance(order, bool) or not isinstance(order, int) or not 0 <= order <= MAX_DEGREE:
         raise ValueError(f"order: expected an integer in [0, {MAX_DEGREE}], got {_shown(order)}")
@@ -232,7 +259,7 @@ def _checked(data: dict) -> Surrogate:
     return Surrogate(parameters, germs, indices, time, coefficients,
                      {name: o.get("units", "") for name, o in outputs.items()},
                      {"kind": data["method"], "order": order, "split": data.get("split", False)},
-                     data.get("campaign", ""))
+                     data.get("campaign", ""), data.get("dependence"))
 
 
 MAX_DEGREE = 1000  # a multi-index entry or order beyond this is refused (a PCE of useful size stays far below)

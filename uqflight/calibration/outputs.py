@@ -14,6 +14,26 @@ from ..statistics import json_ready as strict
 OUTPUT_FILES = ("posterior.h5", "summary.json", "calibrated.yaml", "plots/corner.png", "plots/marginals.png",
                 "plots/predictive.png")
 INFORMED = 0.9  # posterior std below this fraction of the prior's: the parameter gets the posterior marginal
+DEPENDENT = 0.1  # a posterior correlation (of normal scores) this large puts both parameters in dependence:
+STRONG = 0.3  # correlations listed in calibrated.yaml's comments
+EIGENVALUE_LIFT = 1e-8  # the written correlation's smallest eigenvalue at least this (the schema refuses <= 1e-10)
+
+
+def informed(post: dict, prior: dict) -> bool:
+    """Whether the data narrowed a parameter enough for calibrated.yaml to give it its posterior marginal."""
+    return post["std"] < INFORMED * prior["std"]
+
+
+def copula_correlation(scores: np.ndarray) -> tuple[np.ndarray, float]:
+    """The correlation of normal scores (M, d), symmetric with a unit diagonal, and the share s of the
+    identity mixed in ((1 − s) R + s I) to keep its smallest eigenvalue >= EIGENVALUE_LIFT (0: none)."""
+    with np.errstate(invalid="ignore", divide="ignore"):
+        r = np.corrcoef(scores, rowvar=False) if scores.shape[1] > 1 else np.ones((1, 1))
+    r = np.where(np.isfinite(r), 0.5 * (r + r.T), 0.0)  # a parameter that does not vary: uncorrelated
+    np.fill_diagonal(r, 1.0)
+    smallest = float(np.linalg.eigvalsh(r).min())
+    share = 0.0 if smallest >= EIGENVALUE_LIFT else (EIGENVALUE_LIFT - smallest) / (1.0 - smallest)
+    return (1.0 - share) * r + share * np.eye(len(r)), share
 
 
 def marginal(values: np.ndarray) -> dict:
@@ -54,12 +74,16 @@ def write_posterior(path: Path, names, properties, xi, kappa, noise_names, sigma
             f.attrs[key] = value
 
 
-def calibrated_campaign(mapping: dict, specs: dict, posterior: dict, prior: dict, correlation: np.ndarray,
+def calibrated_campaign(mapping: dict, specs: dict, posterior: dict, prior: dict, scores: np.ndarray,
                         names: list[str], function_path: str | None, source: str) -> str:
-    """The campaign text with the posterior marginals as its parameters (normal, mean ± 3σ).
+    """The campaign text with the posterior marginals as its parameters (normal, mean ± 3σ) and their
+    posterior dependence as a Gaussian copula (`dependence:`).
 
     Parameters whose posterior std is not below INFORMED × the prior's keep their prior: the data
-    say nothing about them, and a normal approximation would only change their shape."""
+    say nothing about them, and a normal approximation would only change their shape. `scores` (M, d)
+    are the posterior draws as normal scores under those marginals (`run.normal_scores`): their
+    correlation is the copula's; the parameters with a correlation of at least DEPENDENT with another
+    form the `dependence:` group (the others stay independent; an earlier `dependence:` is replaced)."""
     mapping = dict(mapping)
     name = str(mapping.get("name", "campaign"))
     mapping["name"] = f"{name}-calibrated"
@@ -73,7 +97,7 @@ def calibrated_campaign(mapping: dict, specs: dict, posterior: dict, prior: dict
     for pname in names:
         original = dict(mapping["parameters"][pname])
         post, pri = posterior[pname], prior[pname]
-        if not post["std"] < INFORMED * pri["std"]:
+        if not informed(post, pri):
             parameters[pname] = original
             kept.append(pname)
             continue
@@ -82,21 +106,35 @@ def calibrated_campaign(mapping: dict, specs: dict, posterior: dict, prior: dict
         entry.update({"distribution": "normal", "nominal": float(mean),
                       "lower": float(mean - 3 * std), "upper": float(mean + 3 * std)})
         parameters[pname] = entry
-    mapping["parameters"] = parameters
+    correlation, lift = copula_correlation(scores)
+    d = len(names)
+    group = [k for k in range(d) if any(abs(correlation[k, j]) >= DEPENDENT for j in range(d) if j != k)]
+    rebuilt = {}
+    for key, value in mapping.items():
+        if key == "dependence":
+            continue
+        rebuilt[key] = parameters if key == "parameters" else value
+        if key == "parameters" and group:
+            rebuilt["dependence"] = {"kind": "gaussian_copula", "parameters": [names[k] for k in group],
+                                     "correlation": correlation[np.ix_(group, group)].tolist()}
     lines = [f"# {name}, calibrated by `uqflight calibrate` ({source}).",
              "# Informed parameters: normal with the posterior mean as nominal and [lower, upper] = mean ± 3 posterior std",
              "# (the campaign schema's 99.7 % interval)."]
     if kept:
         lines.append(f"# Kept at their prior (posterior std ≥ {INFORMED:g} × prior std): {', '.join(kept)}.")
-    strong = [(names[i], names[j], correlation[i, j]) for i in range(len(names)) for j in range(i + 1, len(names))
-              if np.isfinite(correlation[i, j]) and abs(correlation[i, j]) >= 0.3]
-    if strong:
-        lines.append("# Posterior correlations |r| ≥ 0.3, LOST here (campaign parameters are independent):")
+    strong = [(names[i], names[j], correlation[i, j]) for i in range(d) for j in range(i + 1, d)
+              if abs(correlation[i, j]) >= STRONG]
+    if group:
+        lines.append(f"# dependence: the posterior's Gaussian copula over the parameters with a correlation |r| ≥ "
+                     f"{DEPENDENT:g} (r of the draws' normal scores under the marginals below; for normal ones, "
+                     "of the draws themselves).")
         lines += [f"#   {a} - {b}: r = {r:+.2f}" for a, b, r in sorted(strong, key=lambda x: -abs(x[2]))]
-        lines.append("# The joint posterior is in posterior.h5 (draws/kappa); summary.json has the full matrix.")
+        if lift:
+            lines.append(f"# (mixed with {lift:.2g} of the identity to keep the matrix positive definite)")
     else:
-        lines.append("# No posterior correlation reaches |r| = 0.3: independent marginals lose little.")
-    body = yaml.safe_dump(mapping, sort_keys=False, default_flow_style=None, allow_unicode=True, width=100)
+        lines.append(f"# No posterior correlation reaches |r| = {DEPENDENT:g}: the parameters stay independent.")
+    lines.append("# The joint posterior is in posterior.h5 (draws/kappa); summary.json has the full matrix.")
+    body = yaml.safe_dump(rebuilt, sort_keys=False, default_flow_style=None, allow_unicode=True, width=100)
     return "\n".join(lines) + "\n" + body
 
 

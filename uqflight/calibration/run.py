@@ -15,12 +15,12 @@ from threadpoolctl import threadpool_limits
 from ..parameters.germs import GERMS
 
 from .likelihood import DataError, LogPosterior, interpolate_in_time, parse_noise, read_flight_csv
-from .outputs import (OUTPUT_FILES, calibrated_campaign, corner_plot, marginal, marginals_plot, predictive_plot,
-                      write_json, write_posterior)
+from .outputs import (OUTPUT_FILES, calibrated_campaign, corner_plot, informed, marginal, marginals_plot,
+                      predictive_plot, write_json, write_posterior)
 from .sampler import sample
 from .size import PREDICTIVE_NOISE_DRAWS, check_size
 from .surrogate import (SurrogateError, campaign_folder, campaign_mapping, check_campaign_text, fit_surrogate,
-                        parameter_specs, prior_summaries, simulate, to_physical)
+                        parameter_specs, prior_summaries, simulate, to_physical, to_standard)
 
 TIME_HANDLING = ("PCE coefficients (and the surrogate's error variance) interpolated linearly in time "
                  "onto the data times; data times outside the results file's time range are refused")
@@ -126,7 +126,8 @@ def _calibrate(results, data, out, outputs, noise, seed, walkers, steps, method,
     diagnostics = chain.diagnostics
     log_prob = chain.log_prob[chain.burn:].T.reshape(-1)
     xi = draws[:, :d]
-    kappa = to_physical(surrogate.parameters, xi)
+    dependence = surrogate.campaign.dependence
+    kappa = to_physical(surrogate.parameters, xi, dependence)
     sigmas = posterior.sigmas(draws)
     sigma_matrix = np.column_stack([sigmas[o] for o in flight.values])
 
@@ -208,15 +209,16 @@ def _calibrate(results, data, out, outputs, noise, seed, walkers, steps, method,
         if sim["kind"] == "python" and ".py:" in sim["function"]:
             file, _, attr = sim["function"].rpartition(":")
             function_path = f"{(campaign_folder(surrogate.campaign) / file).resolve()}:{attr}"
-        text = calibrated_campaign(campaign_mapping(surrogate.campaign), specs, post, prior, correlation, names,
+        scores = normal_scores(surrogate.parameters, kappa, post, prior)
+        text = calibrated_campaign(campaign_mapping(surrogate.campaign), specs, post, prior, scores, names,
                                    function_path, f"{results}, {data}")
         check_campaign_text(text, str(out / "calibrated.yaml"))  # loadable by `uqflight plan`, or a bug here
         (scratch / "calibrated.yaml").write_text(text, encoding="utf-8")
         truth_row = np.array([truth.get(n, np.nan) for n in names]) if truth else None
         corner_plot(scratch / "plots/corner.png", kappa, names, truth_row)
         prior_xi = prior_draw(np.random.default_rng(seed + 2), 20000)[:, :d]
-        marginals_plot(scratch / "plots/marginals.png", to_physical(surrogate.parameters, prior_xi), kappa, names,
-                       truth_row)
+        prior_kappa = to_physical(surrogate.parameters, prior_xi, dependence)
+        marginals_plot(scratch / "plots/marginals.png", prior_kappa, kappa, names, truth_row)
         predictive_plot(scratch / "plots/predictive.png", flight.time, flight.values, at_data, band,
                         surrogate.units, int((~ok).sum()))
         summary["seconds"]["total"] = clock.perf_counter() - started
@@ -229,6 +231,19 @@ def _calibrate(results, data, out, outputs, noise, seed, walkers, steps, method,
     return Calibration(out, summary, list(OUTPUT_FILES))
 
 
+def normal_scores(parameters, kappa: np.ndarray, post: dict, prior: dict) -> np.ndarray:
+    """The posterior draws κ (M, d) as standard-normal scores Φ⁻¹(F_k(κ_k)) under the marginals F_k that
+    calibrated.yaml gives them: the normal N(mean, std²) of an informed parameter's posterior (then the
+    score's correlation is that of κ), the prior law of one kept at its prior. Their correlation is the
+    Gaussian copula's (Nataf's ρ0) that `dependence:` takes."""
+    marginal_xi = to_standard(parameters, kappa)  # each parameter's own germ variable (no dependence)
+    scores = np.column_stack([GERMS[p.germ].to_normal(x) for p, x in zip(parameters, marginal_xi.T)])
+    for k, p in enumerate(parameters):
+        if informed(post[p.name], prior[p.name]):
+            scores[:, k] = (kappa[:, k] - post[p.name]["mean"]) / post[p.name]["std"]
+    return scores
+
+
 def _predictive(chain, posterior, surrogate, flight, rng, count):
     """Posterior draws (walker by walker), `count` of them flown with the real simulator, and the
     surrogate's error at those draws and the data times: {output: (K, n)} (data minus nothing: the
@@ -236,7 +251,8 @@ def _predictive(chain, posterior, surrogate, flight, rng, count):
     draws = chain.kept.transpose(1, 0, 2).reshape(-1, posterior.ndim)
     pick = rng.choice(len(draws), size=min(count, len(draws)), replace=False)
     xi = draws[pick, :len(surrogate.names)]
-    sim_time, runs, failures = simulate(surrogate.campaign, to_physical(surrogate.parameters, xi), list(flight.values))
+    kappa = to_physical(surrogate.parameters, xi, surrogate.campaign.dependence)
+    sim_time, runs, failures = simulate(surrogate.campaign, kappa, list(flight.values))
     ok = np.all([np.all(np.isfinite(runs[o]), axis=1) for o in runs], axis=0)
     errors = {}
     basis = surrogate.basis(xi[ok])

@@ -86,14 +86,14 @@ class Surrogate:
         return c[constant].sum(axis=0), (c[~constant] ** 2).sum(axis=0)
 
 
-def to_physical(parameters, xi) -> np.ndarray:
-    """κ (M, d) from ξ (M, d)."""
-    return _to_physical(parameters, np.atleast_2d(xi))
+def to_physical(parameters, xi, dependence=None) -> np.ndarray:
+    """κ (M, d) from ξ (M, d) (by the Nataf transform of the campaign's `dependence`, if any)."""
+    return _to_physical(parameters, np.atleast_2d(xi), dependence)
 
 
-def to_standard(parameters, kappa) -> np.ndarray:
-    """ξ (M, d) from κ (M, d)."""
-    return _to_standard(parameters, np.atleast_2d(kappa))
+def to_standard(parameters, kappa, dependence=None) -> np.ndarray:
+    """ξ (M, d) from κ (M, d): the inverse of to_physical."""
+    return _to_standard(parameters, np.atleast_2d(kappa), dependence)
 
 
 def load_campaign_file(path) -> Campaign:

@@ -10,10 +10,12 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Callable
 
+import numpy as np
 import yaml
 
 from ..designs import SAMPLED_DESIGNS, Design, build_design
-from ..parameters import Parameter, seed_names
+from ..parameters import Parameter, germs_of, seed_names, to_physical
+from ..parameters.dependence import GaussianCopula
 from ..quantities.spec import check_quantities
 from ..simulators.jsbsim import NAMED_OUTPUTS
 from ..simulators.kinds import simulator_entry
@@ -40,10 +42,15 @@ class Campaign:
     limits: dict = field(default_factory=lambda: dict(schema.DEFAULT_LIMITS))
     runs: int | None = None  # the design's size, known once validated
     quantities: dict = field(default_factory=dict)  # name -> checked spec (uqflight.quantities)
+    dependence: GaussianCopula | None = None  # `dependence:` (parameters.dependence), None: independent
 
     @property
     def germs(self) -> list[str]:
-        return [p.germ for p in self.parameters]
+        return germs_of(self.parameters, self.dependence)
+
+    def to_physical(self, xi: np.ndarray) -> np.ndarray:
+        """κ (N, d) = T(ξ) of the design's ξ (N, d): what the simulator is given."""
+        return to_physical(self.parameters, xi, self.dependence)
 
     def design(self) -> Design:
         return build_design(self.design_spec, self.germs, self.seed)
@@ -93,9 +100,10 @@ def parse_campaign(text: str, source: str = "<campaign>", probe: PropertyProbe |
     schema.check_fixed_properties(check, simulator, parameters, aircraft)
     quantities = check_quantities(check, data.get("quantities"), simulator, aircraft)
     campaign = build_campaign(check, data, simulator, parameters, text, quantities)
+    schema.check_dependence_design(check, data["design"], campaign.dependence, parameters)
     if isinstance(data["design"], dict):  # sizes from the campaign alone, before building anything
         schema.check_size(check, data, simulator, parameters, campaign.method, campaign.execution,
-                          campaign.storage, campaign.limits)
+                          campaign.storage, campaign.limits, campaign.germs)
     try:
         design = campaign.design()
     except ValueError as exc:
@@ -144,5 +152,6 @@ def build_campaign(check: Checker, data: dict, simulator: dict, parameters: list
         quantities = check_quantities(check, data.get("quantities"), simulator)
     analysis = schema.analysis(check, data.get("analysis", {}), quantities)
     limits = schema.limits(check, data.get("limits", {}))
+    dependence = schema.dependence(check, data.get("dependence"), parameters, simulator)
     return Campaign(check.source, text, name, data.get("seed", 0), simulator, parameters, data["design"], method,
-                    execution, storage, analysis, limits, quantities=quantities)
+                    execution, storage, analysis, limits, quantities=quantities, dependence=dependence)

@@ -7,6 +7,7 @@ import math
 import re
 from collections.abc import Hashable
 
+import numpy as np
 import yaml
 
 from ..designs import DESIGN_KINDS, SAMPLED_DESIGNS, Design, design_size, is_sampled
@@ -14,6 +15,8 @@ from ..methods import METHOD_KINDS, method_entry
 from ..methods.exactness import exact_total_degree, max_projection_order
 from ..methods.validity import MAX_TERMS, method_problem
 from ..parameters import DISTRIBUTIONS, Parameter, make_parameter, seed_names
+from ..parameters.dependence import KINDS as DEPENDENCE_KINDS
+from ..parameters.dependence import GaussianCopula, correlation_problem
 from ..parameters.distributions import SEED_REFUSAL
 from ..simulators.patch import patch_kind
 from ..simulators.kinds import REGISTRY as SIMULATORS
@@ -21,7 +24,7 @@ from ..simulators.kinds import SIMULATOR_KINDS, simulator_entry
 
 EXECUTORS = ("local", "dask")
 TOP_KEYS = ("name", "description", "seed", "simulator", "parameters", "design", "method",
-            "execution", "storage", "analysis", "limits", "quantities")
+            "execution", "storage", "analysis", "limits", "quantities", "dependence")
 PARAMETER_KEYS = ("property", "function", "perturbation", "distribution", "nominal", "interval_pct", "lower", "upper")
 PERTURBATIONS = ("scale", "offset", "offset_value")
 METHOD_KEYS = ("kind", "order", "split", "allow_aliasing")
@@ -29,6 +32,7 @@ EXECUTION_KEYS = ("workers", "executor", "scheduler", "chunk", "timeout_s")
 STORAGE_KEYS = ("path", "raw", "tsvd")
 TSVD_KEYS = ("tol", "batch")
 DEFAULT_ORDER = 2
+DEPENDENCE_KEYS = ("kind", "parameters", "correlation")
 ANALYSIS_KEYS = ("band_samples", "bootstrap", "quantiles", "exceedance")
 # Refused before anything is built (see `check_size`); a campaign raises them under `limits:`.
 WORKER_BYTES = 60e6  # memory of one local worker process: Python, numpy, JSBSim, the aircraft (52 MB measured)
@@ -357,6 +361,69 @@ def check_seeds(check: Checker, parameters: list[Parameter], design_kind, method
                           "a random stream has no polynomial expansion for a grid to integrate")
     if not method_entry(method["kind"]).runs_on_sampled:  # it would fit a PCE in the seed's ξ
         check.fail(where, f"{SEED_REFUSAL} ({method['kind']})")
+
+
+def dependence(check: Checker, value, parameters: list[Parameter], simulator: dict) -> GaussianCopula | None:
+    """`dependence: {kind: gaussian_copula, parameters: [...], correlation: [[...]]}`: the copula over
+    the named parameters (default: every parameter but a seed, in campaign order), or None."""
+    if value is None:
+        return None
+    value = check.mapping(value, "dependence", DEPENDENCE_KEYS, required=("kind", "correlation"))
+    check.string(value["kind"], "dependence.kind", DEPENDENCE_KINDS)
+    seeds = seed_names(parameters)
+    known = [p.name for p in parameters]
+    names = value.get("parameters", [name for name in known if name not in seeds])
+    if not isinstance(names, list) or len(names) < 2:
+        check.fail("dependence.parameters", f"expected a list of at least two parameter names, got {shown(names)}")
+    fixed = simulator.get("properties", {})
+    for i, name in enumerate(names):
+        path = f"dependence.parameters[{i}]"
+        if not isinstance(name, str) or name not in known:
+            what = (" is a fixed property (simulator.properties), not an uncertain parameter" if name in fixed
+                    else "")
+            check.fail(path, f"expected one of the campaign's parameters ({', '.join(known)}), got {shown(name)}{what}")
+        if name in seeds:
+            check.fail(path, f"{name} is a seed: a random stream's seed cannot be correlated")
+        if name in names[:i]:
+            check.fail(path, f"{name} is listed twice")
+    n = len(names)
+    rows = value["correlation"]
+    size = f"a {n} x {n} list of rows (one per parameter: {', '.join(names)})"
+    if not isinstance(rows, list) or len(rows) != n:
+        check.fail("dependence.correlation", f"expected {size}, got {shown(rows)}"
+                                             + (f" of {len(rows)} rows" if isinstance(rows, list) else ""))
+    for i, row in enumerate(rows):
+        if not isinstance(row, list) or len(row) != n:
+            check.fail(f"dependence.correlation[{i}]", f"expected a row of {n} numbers ({size}), got {shown(row)}"
+                                                       + (f" of {len(row)}" if isinstance(row, list) else ""))
+        for j, entry in enumerate(row):
+            check.number(entry, f"dependence.correlation[{i}][{j}]")
+    matrix = np.array(rows, dtype=float)
+    problem = correlation_problem(matrix)
+    if problem:
+        check.fail(f"dependence.correlation{problem[0]}", problem[1])
+    return GaussianCopula(tuple(names), matrix)
+
+
+def check_dependence_design(check: Checker, design_spec, copula: GaussianCopula | None,
+                            parameters: list[Parameter]) -> None:
+    """A grid over correlated parameters integrates in their standard-normal germs: a uniform rule named
+    for every dimension cannot serve them."""
+    rule = design_spec.get("rule") if isinstance(design_spec, dict) else None
+    if copula is None or not isinstance(rule, str):
+        return
+    from ..designs.rules import RULE_TABLE
+
+    entry = RULE_TABLE.get(rule)
+    if entry is not None and entry.germ != "normal" and any(p.germ == entry.germ for p in parameters
+                                                            if p.name in copula.names):
+        check.fail("design.rule", f"rule {rule} is for {entry.germ} germs, but the parameters in dependence: "
+                                  f"({', '.join(copula.names)}) are driven by standard-normal germs (the Nataf "
+                                  "transform works in normal space): give a normal rule (gauss_hermite, "
+                                  "genz_keister) or a mapping germ -> rule, e.g. {normal: gauss_hermite, "
+                                  "uniform: gauss_legendre}")
+
+
 def patch_nominal(check: Checker, prop: str, path: str, aircraft) -> float:
     """The nominal of a property that asks for a patch itself (`aero/uq/offset/CDo`), checked as
     `function:` with `perturbation:` is."""
@@ -485,13 +552,13 @@ def limits(check: Checker, value) -> dict:
 
 
 def check_size(check: Checker, data: dict, simulator: dict, parameters: list, method: dict, execution: dict,
-               storage: dict, limits: dict) -> dict:
+               storage: dict, limits: dict, germs: list[str] | None = None) -> dict:
     """The design's size, its memory and disk estimate and the PCE size, from the campaign alone
     (nothing built): refused beyond `limits` (CampaignError naming the figure and the limit).
     Returns the figures {"runs", "memory_gb", "disk_gb", "pce_terms"}."""
     d = len(parameters)
     try:  # the design kind's own size (designs.DesignKind.size); an unknown kind is refused when built
-        points = design_size(data["design"], [p.germ for p in parameters])
+        points = design_size(data["design"], germs or [p.germ for p in parameters])
     except ValueError as exc:
         field_path, _, message = str(exc).partition(": ")
         check.fail(field_path, message)

@@ -118,9 +118,9 @@ def seed_names(params) -> list[str]:
     return [p.name for p in params if not p.law.polynomial]
 
 
-def germs_of(params) -> list[str]:
-    """The germ of each parameter, in order."""
-    return [p.germ for p in params]
+def germs_of(params, dependence=None) -> list[str]:
+    """The germ of each parameter, in order (standard normal for those a `dependence` correlates)."""
+    return dependence.germs(params) if dependence is not None else [p.germ for p in params]
 
 
 def _map_columns(params, values: np.ndarray, label: str, parameter_map) -> np.ndarray:
@@ -134,14 +134,17 @@ def _map_columns(params, values: np.ndarray, label: str, parameter_map) -> np.nd
     return mapped
 
 
-def to_physical(params, xi: np.ndarray) -> np.ndarray:
-    """κ (N, d) from ξ (N, d), column k through parameter k."""
-    return _map_columns(params, xi, "xi", Parameter.to_physical)
+def to_physical(params, xi: np.ndarray, dependence=None) -> np.ndarray:
+    """κ (N, d) from ξ (N, d), column k through parameter k, or by the Nataf transform of a
+    `dependence` (`parameters.dependence.GaussianCopula`)."""
+    kappa = _map_columns(params, xi, "xi", Parameter.to_physical)
+    return kappa if dependence is None else dependence.to_physical(params, np.asarray(xi, dtype=float), kappa)
 
 
-def to_standard(params, kappa: np.ndarray) -> np.ndarray:
-    """ξ (N, d) from κ (N, d), column k through parameter k."""
-    return _map_columns(params, kappa, "kappa", Parameter.to_standard)
+def to_standard(params, kappa: np.ndarray, dependence=None) -> np.ndarray:
+    """ξ (N, d) from κ (N, d): the inverse of to_physical."""
+    xi = _map_columns(params, kappa, "kappa", Parameter.to_standard)
+    return xi if dependence is None else dependence.to_standard(params, xi)
 
 
 __all__ = ["DISTRIBUTIONS", "GERMS", "Parameter", "germs_of", "make_parameter", "seed_names", "to_physical",

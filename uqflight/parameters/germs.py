@@ -46,6 +46,14 @@ class Germ(ABC):
         """n independent draws of ξ from `rng`."""
         return self.quantile(rng.random(n))
 
+    @abstractmethod
+    def from_normal(self, z: np.ndarray) -> np.ndarray:
+        """ξ = F⁻¹(Φ(z)) of a standard normal z: this germ's variable with the same rank (the Nataf map)."""
+
+    @abstractmethod
+    def to_normal(self, xi: np.ndarray) -> np.ndarray:
+        """z = Φ⁻¹(F(ξ)): the inverse of from_normal."""
+
 
 class NormalGerm(Germ):
     """ξ ~ N(0, 1); orthonormal Hermite polynomials He_n/√n!."""
@@ -64,6 +72,12 @@ class NormalGerm(Germ):
 
     def sample(self, rng, n):
         return rng.standard_normal(n)
+
+    def from_normal(self, z):
+        return np.asarray(z, dtype=float)
+
+    def to_normal(self, xi):
+        return np.asarray(xi, dtype=float)
 
 
 class UniformGerm(Germ):
@@ -84,6 +98,15 @@ class UniformGerm(Germ):
 
     def sample(self, rng, n):
         return rng.uniform(-1.0, 1.0, n)
+
+    def from_normal(self, z):  # each tail from its own side: no loss of precision near ±1
+        z = np.asarray(z, dtype=float)
+        return np.where(z > 0, 1.0 - 2.0 * special.ndtr(-z), 2.0 * special.ndtr(z) - 1.0)
+
+    def to_normal(self, xi):
+        xi = np.asarray(xi, dtype=float)
+        return np.where(xi > 0, -special.ndtri(np.clip(0.5 * (1.0 - xi), *_OPEN_UNIT)),
+                        special.ndtri(np.clip(0.5 * (1.0 + xi), *_OPEN_UNIT)))
 
 
 GERMS: dict[str, Germ] = {germ.name: germ for germ in (NormalGerm(), UniformGerm())}
