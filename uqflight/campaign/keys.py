@@ -2,8 +2,8 @@
 lists and the registries of scenarios, designs, methods, distributions, rules and quantities), with
 its description from KEYS (and each kind's from VALUES or its registry entry's docstring).
 
-`reference_page()` is docs/reference/campaign-keys.md (the MkDocs build generates it from here);
-`python -m uqflight.campaign.keys` prints it. A key or kind without a description is an error
+`reference_page()` is docs/reference/campaign-keys.md (the MkDocs build generates it from here; the
+committed copy is rewritten by `python -m uqflight.campaign.keys > docs/reference/campaign-keys.md`). A key or kind without a description is an error
 (`missing_descriptions`, checked by tests/test_docs.py), so the reference cannot fall behind the code.
 """
 from __future__ import annotations
