@@ -102,7 +102,8 @@ def write_report(results, out=None, reference=None, method=None, times=(10.0, 25
     """Write the report of one results file or a list of them into `out` (default RESULTS-report/ beside
     the first), as `uqflight report` does; returns the paths written. `method`: "KIND[:ORDER]", a mapping
     or a list of them (compared on the same runs); `times`: the tables' times (inf: the final one);
-    `baseline`: also write the baseline of `uqflight check`. Raises BadInput as `analyse`."""
+    `baseline`: also write the baseline of `uqflight check`. Raises BadInput as `analyse`. An example:
+    docs/python.md."""
     from pathlib import Path
 
     from .report import write_report as write
@@ -171,7 +172,7 @@ def calibrate(results, data, out, noise: dict | None = None, outputs: list[str] 
     summary.json, calibrated.yaml and plots/ into `out` and returns the Calibration (`.summary`: the
     summary.json mapping, `.written`). `noise`: {output: known noise std}; the others are inferred.
     Raises DataError / SurrogateError (bad input), ValueError, NotConverged (`uqflight.calibration.run`:
-    `.diagnostics["problems"]` says what to change)."""
+    `.diagnostics["problems"]` says what to change). An example: docs/python.md."""
     from .calibration.run import calibrate as calibration
 
     given = [f"{name}={sigma!r}" for name, sigma in (noise or {}).items()]
