@@ -91,10 +91,12 @@ KEYS = {
     "design.replicates": "`sobol`: R independent scrambles of `samples` points (randomised QMC), giving every "
                          "statistic's standard error. Default 1. `replicates: 16`",
     "design.level": "Sparse-grid level, 0-1000. `level: 2`",
-    "design.rule": "The 1-D rule (below). Default: the germ's (Gauss–Hermite for normal inputs, "
-                   "Gauss–Legendre for uniform ones). `rule: gauss_hermite`",
-    "design.nested": "Sparse grids: the nested variant of the rule (`gauss_hermite` nested is Genz–Keister). "
-                     "`nested: true`",
+    "design.rule": "The 1-D rule (below) for every dimension, or a mapping germ -> rule "
+                   "(`rule: {normal: gauss_hermite, uniform: clenshaw_curtis}`). Default: each germ's Gauss rule "
+                   "(Gauss–Hermite for normal inputs, Gauss–Legendre for uniform ones).",
+    "design.nested": "Sparse grids: true swaps each default rule for its germ's nested one (Hermite -> "
+                     "Genz–Keister, Legendre -> Patterson); false refuses nested rules. Default: the rules as "
+                     "named. `nested: true`",
     "design.growth": "Sparse grids: `linear` (default; level i exact to degree 2i−1) or `exponential` (the "
                      "rules' own nested sequences).",
     "design.points": "Tensor grids: points per dimension, >= 1. `points: 5`",
