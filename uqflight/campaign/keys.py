@@ -9,6 +9,7 @@ committed copy is rewritten by `python -m uqflight.campaign.keys > docs/referenc
 from __future__ import annotations
 
 import inspect
+import re
 from dataclasses import dataclass
 
 # The meaning of each key, its default and an example, by its path (NAME: a name the user chooses).
@@ -207,17 +208,18 @@ def _paths(prefix: str, keys) -> list[str]:
     return [f"{prefix}.{k}" if prefix else k for k in keys]
 
 
-def design_keys(kind: str, entry) -> tuple[str, ...]:
-    """The keys a design kind accepts, as its builder states them when it refuses an unknown key
-    (designs.spec.check_keys: '... accepted keys: kind, samples')."""
+def refused_keys(call) -> tuple[str, ...]:
+    """The keys a check accepts, as it lists them when it refuses an unknown key: `call()` feeds it one
+    ('... unknown key; expected one of a, b' from the schema's Checker, '... accepted keys: a, b' from
+    designs.spec.check_keys) and must raise."""
     try:
-        entry.build({"kind": kind, "?": 0}, ["normal"], 0)
-    except ValueError as exc:
-        _, found, accepted = str(exc).partition("accepted keys: ")
+        call()
+    except ValueError as exc:  # CampaignError too
+        found = re.search(r"(?:expected one of|accepted keys:) ([^;]+)$", str(exc))
         if found:
-            return tuple(k.strip() for k in accepted.split(","))
-    raise RuntimeError(f"design kind {kind!r} does not refuse an unknown key with designs.spec.check_keys: "
-                       "the reference cannot list its keys")
+            return tuple(k.strip() for k in found.group(1).split(","))
+        raise RuntimeError(f"the reference cannot read the accepted keys from: {exc}") from exc
+    raise RuntimeError(f"{call} accepted an unknown key: the reference cannot list its keys")
 
 
 def accepted_keys() -> list[Key]:
@@ -234,8 +236,11 @@ def accepted_keys() -> list[Key]:
     from . import schema
 
     found = [Key(k, "Top level") for k in schema.TOP_KEYS]
+    own = {k for scenario in SCENARIOS.values() for k in scenario.keys}  # listed with their scenario
+    keys = dict.fromkeys(k for kind in schema.SIMULATOR_KINDS for k in refused_keys(
+        lambda: schema.simulator(schema.Checker("<reference>"), {"kind": kind, "?": 0})) if k not in own)
     found += [Key(p, "simulator", {k: None for k in schema.SIMULATOR_KINDS} if p == "simulator.kind" else None)
-              for p in _paths("simulator", dict.fromkeys((*schema.JSBSIM_KEYS, *schema.PYTHON_KEYS)))]
+              for p in _paths("simulator", keys)]
     found.append(Key("simulator.scenario.kind", "simulator", dict(SCENARIOS)))
     for name, scenario in SCENARIOS.items():
         section = f"simulator, scenario `{name}`"
@@ -246,7 +251,8 @@ def accepted_keys() -> list[Key]:
     found += [Key(p, "parameters", dict(DISTRIBUTIONS) if p.endswith(".distribution") else None)
               for p in _paths("parameters.NAME", schema.PARAMETER_KEYS)]
     design = {"kind": dict(DESIGNS), "rule": dict(RULE_TABLE)}
-    keys = dict.fromkeys(k for kind, entry in DESIGNS.items() for k in design_keys(kind, entry))
+    keys = dict.fromkeys(k for kind, entry in DESIGNS.items()
+                         for k in refused_keys(lambda: entry.build({"kind": kind, "?": 0}, ["normal"], 0)))
     found += [Key(f"design.{k}", "design", design.get(k)) for k in keys]
     found += [Key(p, "method", dict(METHODS) if p == "method.kind" else None)
               for p in _paths("method", schema.METHOD_KEYS)]
