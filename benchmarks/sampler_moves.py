@@ -16,7 +16,7 @@ function), τ_max and the acceptance fraction.
 
     .venv/bin/python benchmarks/sampler_moves.py [--seeds 2] [--steps 5000]
 
-On 2026-12-01 (the README's table): DE alone is unbiased with the smallest τ, and `calibrate` uses it.
+On 2026-12-01 (the table of docs/calibration.md): DE alone is unbiased with the smallest τ, and `calibrate` uses it.
 """
 from __future__ import annotations
 

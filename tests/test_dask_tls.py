@@ -1,4 +1,4 @@
-"""`run --executor dask` over TLS, as the README's security section says: a `tls://` scheduler address,
+"""`run --executor dask` over TLS, as docs/security.md says: a `tls://` scheduler address,
 and the client's certificates from dask's own configuration (`distributed.comm.tls.*`, here through
 its environment variables), which dask's Client reads when given no security of its own. A
 separately started scheduler and worker that require TLS; a client without the certificates cannot

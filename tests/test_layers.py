@@ -25,8 +25,8 @@ LAYERS = [
 
 
 def layer(module: str) -> int:
-    if module == "uqflight":  # the package's own __init__: its version only
-        return 0
+    if module == "uqflight":  # the package's own __init__: the Python API beside the CLI (lazy imports)
+        return len(LAYERS) - 1
     matches = [(len(prefix), i) for i, prefixes in enumerate(LAYERS) for prefix in prefixes
                if module == prefix or module.startswith(prefix + ".")]
     assert matches, f"{module} has no layer: add it to LAYERS"

@@ -36,7 +36,7 @@ def test_locate_project_jsbsim_and_path(tmp_path):
 
 
 def test_bacm_hash_is_the_documented_length_prefixed_sha256():
-    """Recomputed by hand from README's definition: per file in key order, the 8-byte big-endian
+    """Recomputed by hand from the definition in docs/own-aircraft.md: per file in key order, the 8-byte big-endian
     length of its key, the key, the length of its bytes, the bytes."""
     digest = hashlib.sha256()
     folder = REPO_ROOT / "aircraft" / "bacm"

@@ -1,2 +1,180 @@
-"""uqflight: uncertainty quantification campaigns on a JSBSim flight-dynamics model."""
+"""uqflight: uncertainty quantification campaigns on a JSBSim flight-dynamics model.
+
+The Python API, one function per command; each imports what it needs when called, so `import uqflight`
+stays cheap. A campaign from file to statistics, on a closed-form python model (docs/python.md):
+
+>>> import pathlib, tempfile, uqflight
+>>> scratch = tempfile.TemporaryDirectory()
+>>> folder = pathlib.Path(scratch.name)
+>>> _ = (folder / "decay.yaml").write_text('''
+... name: decay
+... simulator: {kind: python, function: "uqflight.simulators.models:exp_decay"}
+... parameters: {a: {distribution: normal, nominal: 1.0, interval_pct: 30}}
+... design: {kind: sparse_grid, level: 4}
+... method: {kind: pseudo_galerkin, order: 4}
+... ''')
+>>> campaign = uqflight.load_campaign(folder / "decay.yaml")
+>>> campaign.runs
+5
+>>> summary = uqflight.run(campaign, out=folder / "decay.h5")
+>>> summary.ran, sum(summary.failures.values())
+(5, 0)
+>>> stats = uqflight.analyse(summary.path)
+>>> x = stats.outputs["x"]    # x(t) = exp(-a t), a ~ N(1, 0.1²): E[x(1)] = exp(-1 + 0.01/2)
+>>> round(float(x.mean[10]), 4), round(float(x.time[10]), 1)
+(0.3697, 1.0)
+>>> _ = uqflight.export_surrogate(summary.path, folder / "pce.json")
+>>> pce = uqflight.load_surrogate(folder / "pce.json")
+>>> round(float(pce.evaluate([[1.0]])["x"][0, 10]), 4)    # at a = 1: exp(-1) = 0.3679
+0.3679
+>>> scratch.cleanup()
+"""
+from __future__ import annotations
+
 __version__ = "0.1.0"
+__all__ = ["analyse", "calibrate", "export_surrogate", "load_campaign", "load_surrogate", "run", "simulate",
+           "write_report"]
+
+
+def load_campaign(path, probe: bool = True):
+    """The validated campaign (`uqflight.campaign.Campaign`) of a campaign file, checked as `uqflight plan`
+    checks it. `probe`: a JSBSim campaign's property and output names are checked against its aircraft and
+    the nominal values read from it (JSBSim loads the aircraft); False skips that, and nominal values must
+    then be given. A python simulator's module is imported: its code runs. Raises
+    `uqflight.campaign.CampaignError` naming the file, the field and what was expected."""
+    from .campaign import load_campaign as load
+    from .simulators.jsbsim_probe import jsbsim_probe
+
+    return load(path, probe=jsbsim_probe if probe else None)
+
+
+def run(campaign, out=None, workers: int | None = None, executor: str | None = None,
+        scheduler: str | None = None, force: bool = False, restart: bool = False, progress: bool = False):
+    """Run a campaign (a Campaign, or a campaign file loaded with `load_campaign`) into its results file
+    (`out`, default `storage.path`), resuming a file of this campaign begun before, as `uqflight run` does;
+    returns the `uqflight.execution.RunSummary` (`.path`, `.ran`, `.skipped`, `.failures`). The other
+    arguments are `run`'s options. Raises CampaignError, LockHeld, FileExistsError, DiskFull, WorkerError
+    (`uqflight.execution`). With `executor="dask"` and no scheduler, call it under
+    `if __name__ == "__main__":` (a LocalCluster starts processes)."""
+    from .execution import run_campaign
+
+    if not hasattr(campaign, "design_spec"):
+        campaign = load_campaign(campaign)
+    return run_campaign(campaign, out=out, workers=workers, executor=executor, scheduler=scheduler, force=force,
+                        progress=progress, restart=restart)
+
+
+def _methods(method) -> list[dict] | None:
+    """`KIND[:ORDER]` strings or {"kind", "order"} mappings (one or a list) into method overrides."""
+    from .report.loading import parse_methods
+
+    if method is None:
+        return None
+    items = method if isinstance(method, (list, tuple)) else [method]
+    return [m if isinstance(m, dict) else parse_methods([m])[0] for m in items]
+
+
+def analyse(results, method=None, reference=None, partial: bool = False, allow_aliasing: bool = False):
+    """The statistics (`uqflight.statistics.Statistics`) of a results file, as `uqflight report` computes
+    them: `.outputs[NAME]` (mean, variance, std, band99, quantiles, sobol_first, sobol_total, ... over
+    time), `.quantities[NAME]`, `.notes`, `.failure_probability`. `method`: "KIND[:ORDER]" or
+    {"kind", "order"} instead of the campaign's; `reference`: a results file for the errors ε_m, ε_v and
+    the KLD; `partial`, `allow_aliasing`: as `report --partial`, `--allow-aliasing`. Never runs campaign
+    code. Raises `uqflight.statistics.BadInput` (one line naming the file and what to do) when the file
+    cannot give right numbers."""
+    from .statistics import BadInput
+    from .statistics import analyse as statistics
+
+    methods = _methods(method)
+    if methods and len(methods) > 1:
+        raise ValueError("analyse takes one method; report compares several")
+    try:
+        return statistics(results, reference=reference, method=methods[0] if methods else None, partial=partial,
+                          allow_aliasing=allow_aliasing)
+    except BadInput:
+        raise
+    except (OSError, KeyError) as exc:
+        raise BadInput(f"{results}: cannot analyse the results file ({' '.join(str(exc).split())})") from exc
+
+
+def write_report(results, out=None, reference=None, method=None, times=(10.0, 25.0, float("inf")),
+           baseline=None, partial: bool = False, allow_aliasing: bool = False) -> list:
+    """Write the report of one results file or a list of them into `out` (default RESULTS-report/ beside
+    the first), as `uqflight report` does; returns the paths written. `method`: "KIND[:ORDER]", a mapping
+    or a list of them (compared on the same runs); `times`: the tables' times (inf: the final one);
+    `baseline`: also write the baseline of `uqflight check`. Raises BadInput as `analyse`. An example:
+    docs/python.md."""
+    from pathlib import Path
+
+    from .report import write_report as write
+
+    paths = [Path(p) for p in (results if isinstance(results, (list, tuple)) else [results])]
+    return write(paths, out, reference=reference, times=times, baseline=baseline, method=_methods(method),
+                        partial=partial, allow_aliasing=allow_aliasing)
+
+
+def export_surrogate(results, out, method=None):
+    """Write the PCE of every output of a results file as JSON (`uqflight surrogate export`); returns the
+    path. `method`: "KIND[:ORDER]" or a mapping instead of the campaign's. Raises SurrogateError."""
+    from .surrogate import export
+
+    methods = _methods(method)
+    return export(results, out, methods[0] if methods else None)
+
+
+def load_surrogate(path):
+    """The PCE surrogate of an exported JSON file (`uqflight.surrogate.Surrogate`): `.evaluate(kappa)` or
+    `.evaluate(xi=...)` gives {output: (M, T)} at M points, `.mean()`, `.variance()` {output: (T,)}. The
+    file is checked before anything is evaluated: SurrogateError names the file and the key."""
+    from .surrogate import load
+
+    return load(path)
+
+
+def simulate(settings: dict | None = None, *, aircraft: str = "bacm", altitude_ft: float | None = None,
+             airspeed_ktas: float | None = None, excitation: str = "pulse", amplitude_deg: float = 1.0,
+             start_s: float = 1.0, pulse_duration_s: float = 1.0, duration_s: float = 50.0,
+             output_rate_hz: float = 20.0, outputs=(), trim: str = "newton"):
+    """Fly one flight as `uqflight simulate` does: trim in level flight (default: the aircraft's
+    condition), excite the elevator and record the outputs (alpha_deg, theta_deg, h_ft, q_degps, vtas_kt
+    and the JSBSim properties in `outputs`). `settings`: {property: value} set before the trim, e.g.
+    {"aero/uq/CL0": 0.22}. Returns a FlightResult (`.time`, `.outputs[NAME]`, `.trim`); raises FlightError
+    (`uqflight.simulators.base`) when the trim or the flight fails.
+
+    >>> flight = simulate({"aero/uq/CL0": 0.22}, duration_s=2.0)
+    >>> float(flight.time[-1]), sorted(flight.outputs)[:2]
+    (2.0, ['alpha_deg', 'h_ft'])
+    """
+    from pathlib import Path
+
+    from .simulators.aircraft import default_condition
+    from .simulators.jsbsim import DEFAULT_OUTPUTS, Excitation, FlightSetup, JSBSimFlight
+    from .simulators.patch import PreparedAircraft
+
+    located = PreparedAircraft(aircraft, Path.cwd())
+    condition = default_condition(located.name)
+    setup = FlightSetup(
+        aircraft=located.name, root=located.root,
+        altitude_ft=condition["altitude_ft"] if altitude_ft is None else altitude_ft,
+        airspeed_ktas=condition["airspeed_ktas"] if airspeed_ktas is None else airspeed_ktas,
+        excitation=Excitation(kind=excitation, amplitude_deg=amplitude_deg, start_s=start_s,
+                              duration_s=pulse_duration_s),
+        duration_s=duration_s, output_rate_hz=output_rate_hz, outputs=tuple(DEFAULT_OUTPUTS) + tuple(outputs),
+        trim=trim)
+    return JSBSimFlight(setup).fly(dict(settings or {}))
+
+
+def calibrate(results, data, out, noise: dict | None = None, outputs: list[str] | None = None, seed: int = 0,
+              walkers: int | None = None, steps: int = 6000, method: str | None = None, order: int | None = None,
+              campaign=None, predictive_draws: int = 50):
+    """Calibrate the parameters of the campaign of `results` on flight data (a CSV as `uqflight simulate
+    --out` writes it), as `uqflight calibrate` does (docs/calibration.md); writes posterior.h5,
+    summary.json, calibrated.yaml and plots/ into `out` and returns the Calibration (`.summary`: the
+    summary.json mapping, `.written`). `noise`: {output: known noise std}; the others are inferred.
+    Raises DataError / SurrogateError (bad input), ValueError, NotConverged (`uqflight.calibration.run`:
+    `.diagnostics["problems"]` says what to change). An example: docs/python.md."""
+    from .calibration.run import calibrate as calibration
+
+    given = [f"{name}={sigma!r}" for name, sigma in (noise or {}).items()]
+    return calibration(results, data, out, outputs=outputs, noise=given, seed=seed, walkers=walkers, steps=steps,
+                       method=method, order=order, campaign=campaign, predictive_draws=predictive_draws)

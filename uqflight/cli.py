@@ -397,7 +397,7 @@ def report(
     """Statistics, tables, plots and a report page of one or more results files.
 
     Several files (and methods) are compared side by side (labelled campaign: method, runs). OUT gets:
-    summary.json (the first file; schema in DESIGN.md), summaries/<stem>.json (every file, when
+    summary.json (the first file; schema in docs/summary-json.md), summaries/<stem>.json (every file, when
     several), tables/*.csv (campaign, parameters, statistics over time per file and output,
     statistics and Sobol' indices at the selected times, errors against the reference),
     plots/*.png, report.html (self-contained, plots embedded) and report.md (linking plots/).

@@ -610,7 +610,7 @@ def variance_split(out: OutputStatistics, seed: str) -> dict:
 
 
 def summary_json(stats: Statistics) -> dict:
-    """summary.json: the fixed schema of DESIGN.md plus the run counts, the failure probability, the
+    """summary.json: the fixed schema of docs/summary-json.md plus the run counts, the failure probability, the
     notes, and per output std, CoV, quantiles, skewness, kurtosis, resolution, the fits' leave-one-out
     error, the projections' convergence estimate, and the errors against a reference with their floors.
     Undefined values are None (null): the result dumps as strict JSON."""

@@ -2,7 +2,7 @@
 one page, as self-contained HTML and as Markdown.
 
 Layout of the report directory:
-    summary.json               the first file's statistics (the fixed schema of DESIGN.md)
+    summary.json               the first file's statistics (the fixed schema of docs/summary-json.md)
     summaries/<stem>.json      every file's, when several are given
     tables/*.csv               statistics over time per file and output, statistics and Sobol' indices
                                at selected times, errors against the reference, PCE vs Monte Carlo

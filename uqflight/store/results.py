@@ -1,7 +1,7 @@
 """The HDF5 results file of a campaign: the design, the status of every run, and the time histories
 (raw, or compressed on the fly by the incremental thin SVD), appended batch by batch and resumable.
 
-Layout (fixed by DESIGN.md; N runs, d parameters, T recorded times):
+Layout (docs/results-file.md; N runs, d parameters, T recorded times):
     /samples/xi (N, d)  /samples/kappa (N, d; attr names)  /samples/weight (N)
     /samples/status (N int8, see Status)  /samples/reason (N str of at most 256 UTF-8 bytes, "" when ok)
     /time (T)

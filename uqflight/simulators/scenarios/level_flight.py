@@ -13,13 +13,14 @@ from ..jsbsim import Excitation, FlightSetup, JSBSimFlight
 
 KEYS = ("flight", "excitation", "duration_s", "output_rate_hz", "trim")
 EXCITATION_KEYS = ("kind", "amplitude_deg", "start_s", "duration_s")
+FLIGHT_KEYS = ("altitude_ft", "airspeed_ktas")
 
 
 def check(check, sim: dict, folder: Path) -> dict:
     """The scenario's keys checked (`check` is the campaign's Checker); the timing by FlightSetup itself."""
     if "trim" in sim:
         check.string(sim["trim"], "simulator.trim", FlightSetup.TRIMS)
-    flight = check.mapping(sim.get("flight", {}), "simulator.flight", ("altitude_ft", "airspeed_ktas"))
+    flight = check.mapping(sim.get("flight", {}), "simulator.flight", FLIGHT_KEYS)
     if "altitude_ft" in flight:
         check.number(flight["altitude_ft"], "simulator.flight.altitude_ft", 0.0)
     if "airspeed_ktas" in flight:

@@ -1,0 +1,322 @@
+"""The campaign-key reference: every key the schema accepts, gathered from the code (the schema's key
+lists and the registries of scenarios, designs, methods, distributions, rules and quantities), with
+its description from KEYS (and each kind's from VALUES or its registry entry's docstring).
+
+`reference_page()` is docs/reference/campaign-keys.md (the MkDocs build generates it from here; the
+committed copy is rewritten by `python -m uqflight.campaign.keys > docs/reference/campaign-keys.md`). A key or kind without a description is an error
+(`missing_descriptions`, checked by tests/test_docs.py), so the reference cannot fall behind the code.
+"""
+from __future__ import annotations
+
+import inspect
+import re
+from dataclasses import dataclass
+
+# The meaning of each key, its default and an example, by its path (NAME: a name the user chooses).
+KEYS = {
+    "name": "Required. 1-100 characters among `A-Za-z0-9_.-`, not starting with `.` or `-`; the default "
+            "results file is `results/NAME.h5`. `name: paper-pg2-l2`",
+    "description": "Free text for people; not read. `description: the paper's level-2 grid`",
+    "seed": "Seeds every random choice (designs, bands, bootstrap, seed parameters). Default 0. `seed: 20261124`",
+    "simulator": "Required. What flies each run: `{kind: jsbsim, ...}` or `{kind: python, function: ...}`.",
+    "parameters": "Required. One entry per uncertain input: `parameters: {CL0: {property: aero/uq/CL0, "
+                  "distribution: normal, interval_pct: 23.05}}`",
+    "design": "Required. Where the runs are: `design: {kind: sparse_grid, rule: gauss_hermite, level: 2}`",
+    "method": "How the statistics are computed. Default `{kind: monte_carlo}` for sampled designs, "
+              "`{kind: integration}` for grids. `method: {kind: pseudo_galerkin, order: 2}`",
+    "execution": "How the runs are executed: `execution: {workers: 2, executor: local, chunk: 16}`",
+    "storage": "Where and how the results are stored: `storage: {path: results/x.h5, raw: true}`",
+    "analysis": "Options of the statistics: `analysis: {band_samples: 20000, bootstrap: 200}`",
+    "limits": "Size limits checked before anything is built (exit 2 beyond them): "
+              "`limits: {max_runs: 1000000}`",
+    "quantities": "Quantities of interest, one number per run, stored in `/quantities/NAME`: "
+                  "`quantities: {peak_alpha: {of: alpha_deg, take: max}}` (see [quantities](../quantities.md))",
+    # simulator (both kinds)
+    "simulator.kind": "Required. `jsbsim` (a JSBSim flight) or `python` (a Python function).",
+    "simulator.outputs": "The recorded outputs. JSBSim: named outputs (`alpha_deg`, `theta_deg`, `h_ft`, "
+                         "`q_degps`, `vtas_kt`, the default) and/or any JSBSim property; python: the names of the "
+                         "function's outputs (default: all it returns). `outputs: [alpha_deg, h_ft]`",
+    "simulator.function": "python only, required. `package.module:callable` or `file.py:callable` (relative "
+                          "to the campaign file); called with {parameter: value}, returns {output: array or "
+                          "scalar} and optionally `time`. `function: \"uqflight.simulators.models:linear\"`",
+    # jsbsim
+    "simulator.aircraft": "A project or JSBSim aircraft name, or a folder (relative to the campaign file). "
+                          "Default `bacm` (level flight); a script names its own. `aircraft: c172p`",
+    "simulator.scenario": "How a JSBSim run is flown: `{kind: level_flight}` (the default) or `{kind: script, "
+                          "script: NAME_OR_PATH}`.",
+    "simulator.scenario.kind": "The scenario kind (below). Default `level_flight`.",
+    "simulator.properties": "`{PROPERTY: VALUE}` set for every run (`ic/...` before the reset, the others "
+                            "after it; level flight applies `atmosphere/...` after the trim). "
+                            "`properties: {atmosphere/turb-type: 3}`",
+    "simulator.output_rate_hz": "Recording rate [Hz]; must divide the integration rate (120 Hz for level "
+                                "flight, the script's own). Default 20. `output_rate_hz: 10`",
+    # level_flight
+    "simulator.trim": "`newton` (uqflight's trim, JSBSim's as fallback; the default) or `jsbsim` (JSBSim's "
+                      "own trim for every sample).",
+    "simulator.flight": "The trim condition; default: the aircraft's (bacm 15,000 ft, 200 KTAS). "
+                        "`flight: {altitude_ft: 15000, airspeed_ktas: 200}`",
+    "simulator.flight.altitude_ft": "Trim altitude [ft], >= 0. `altitude_ft: 8000`",
+    "simulator.flight.airspeed_ktas": "Trim true airspeed [kt], > 0. `airspeed_ktas: 150`",
+    "simulator.excitation": "The elevator excitation after the trim. Default a 1° pulse at 1 s for 1 s. "
+                            "`excitation: {kind: doublet, amplitude_deg: 2}`",
+    "simulator.excitation.kind": "`pulse` (default), `step`, `doublet` or `none`.",
+    "simulator.excitation.amplitude_deg": "Amplitude [deg], positive trailing edge down. Default 1.",
+    "simulator.excitation.start_s": "Start [s] after the trim, >= 0. Default 1.",
+    "simulator.excitation.duration_s": "Duration [s] of a pulse or doublet, >= 0. Default 1.",
+    "simulator.duration_s": "Flight time after the trim [s], > 0. Default 50.",
+    # script
+    "simulator.scenario.script": "Required for `script`: a JSBSim run script, a file relative to the campaign "
+                                 "file or the name of one shipped with JSBSim (without `.xml`). "
+                                 "`script: c172_cruise_8K`",
+    "simulator.scenario.end_s": "Ends the run before the script's `<run end=>` [s]. `end_s: 20`",
+    # parameters
+    "parameters.NAME.property": "The property the parameter sets (JSBSim: before the trim, `ic/...` too; "
+                                "python: the function's argument). Default for python: NAME. "
+                                "`property: aero/uq/CL0`",
+    "parameters.NAME.function": "JSBSim: an aerodynamic function of the aircraft to perturb instead of a "
+                                "`property` (full name, or its last component when unique). `function: CLwbh`",
+    "parameters.NAME.perturbation": "With `function`: `scale` (multiplied, nominal 1), `offset` (a "
+                                    "coefficient increment ΔC, nominal 0) or `offset_value` (in the function's "
+                                    "own unit, nominal 0). `perturbation: scale`",
+    "parameters.NAME.distribution": "Required. The parameter's law (kinds below). `distribution: normal`",
+    "parameters.NAME.nominal": "The centre value. Default: the aircraft's value of the property (python: "
+                               "required with `interval_pct`, else the interval's midpoint). `nominal: 0.2`",
+    "parameters.NAME.interval_pct": "± percent of the nominal (the paper's Table 1), > 0; or give `lower` and "
+                                    "`upper`. `interval_pct: 23.05`",
+    "parameters.NAME.lower": "The interval's lower end (with `upper`, instead of `interval_pct`). `lower: 195`",
+    "parameters.NAME.upper": "The interval's upper end, > `lower`. `upper: 205`",
+    # design
+    "design.kind": "Required. The design kind (below).",
+    "design.samples": "Number of points (`pick_freeze`: base rows n, N = n(d + 2) runs), >= 1. `samples: 1024`",
+    "design.scramble": "Scramble the QMC points with the seed. Default true. `scramble: false`",
+    "design.replicates": "`sobol`: R independent scrambles of `samples` points (randomised QMC), giving every "
+                         "statistic's standard error. Default 1. `replicates: 16`",
+    "design.level": "Sparse-grid level, 0-1000. `level: 2`",
+    "design.rule": "The 1-D rule (below) for every dimension, or a mapping germ -> rule "
+                   "(`rule: {normal: gauss_hermite, uniform: clenshaw_curtis}`). Default: each germ's Gauss rule "
+                   "(Gauss–Hermite for normal inputs, Gauss–Legendre for uniform ones).",
+    "design.nested": "Sparse grids: true swaps each default rule for its germ's nested one (Hermite -> "
+                     "Genz–Keister, Legendre -> Patterson); false refuses nested rules. Default: the rules as "
+                     "named. `nested: true`",
+    "design.growth": "Sparse grids: `linear` (default; level i exact to degree 2i−1) or `exponential` (the "
+                     "rules' own nested sequences).",
+    "design.points": "Tensor grids: points per dimension, >= 1. `points: 5`",
+    # method
+    "method.kind": "The method (below).",
+    "method.order": "Total degree of the PCE, >= 0. Default 2, or the largest a grid's projection allows. "
+                    "`order: 3`",
+    "method.split": "Use the paper's split form x = x0 + S (Eq. 22–24) for projections. Default false.",
+    "method.allow_aliasing": "Let a projection's order exceed what the grid integrates exactly (refused "
+                             "otherwise; the report says so). Default false.",
+    # execution
+    "execution.workers": "Worker processes, >= 1. Default 1; `run --workers` overrides.",
+    "execution.executor": "`local` (a pool of worker processes, the default) or `dask`.",
+    "execution.scheduler": "A Dask scheduler address (`tcp://HOST:8786`, `tls://...`); without it `dask` "
+                           "starts a LocalCluster.",
+    "execution.chunk": "Samples per task, >= 1 (the design's last 4 × chunk in chunks of chunk/4). Default 16.",
+    "execution.timeout_s": "Per-run time limit [s], > 0; a run past it is stopped and recorded as `timeout`. "
+                           "Default max(60 s, 50 × one nominal flight).",
+    # storage
+    "storage.path": "The results file, relative to the working directory. Default `results/NAME.h5`.",
+    "storage.raw": "Keep the N × T time histories in `/outputs/NAME`. Default true; false needs `tsvd`.",
+    "storage.tsvd": "Compress the outputs on the fly by an incremental thin SVD into `/tsvd/NAME`. "
+                    "`tsvd: {tol: 1e-8, batch: 1000}`",
+    "storage.tsvd.tol": "Relative truncation tolerance in (0, 1). Default 1e-8.",
+    "storage.tsvd.batch": "Runs per SVD update, >= 1. Default 1000.",
+    # analysis
+    "analysis.band_samples": "Draws of the PCE for the bands and PDFs, >= 100. Default 20000.",
+    "analysis.bootstrap": "Resamplings for the pick-freeze Sobol' intervals, >= 0 (0: none). Default 200.",
+    "analysis.quantiles": "1-20 probabilities in (0, 1) reported over time in summary.json. Default "
+                          "[0.005, 0.995]. `quantiles: [0.05, 0.5, 0.95]`",
+    "analysis.exceedance": "`{QUANTITY: [{above: X}, {below: Y}]}`: P(QUANTITY > X) and P(QUANTITY < Y). "
+                           "`exceedance: {peak_load_factor: [{above: 3}]}`",
+    "analysis.exceedance.QUANTITY[i].above": "The threshold of P(QUANTITY > X).",
+    "analysis.exceedance.QUANTITY[i].below": "The threshold of P(QUANTITY < Y).",
+    # limits
+    "limits.max_runs": "The design's runs (sparse grids: points built before merging). Default 1000000.",
+    "limits.max_memory_gb": "Memory of the run (60 MB per local worker process). Default 8.",
+    "limits.max_disk_gb": "Size of the results file. Default 100.",
+    "limits.max_pce_terms": "Terms of the PCE. Default 100000.",
+    # quantities
+    "quantities.NAME.of": "The output, JSBSim property or python output the quantity reads. `of: h_ft`",
+    "quantities.NAME.take": "Required. What is taken of it (kinds below). `take: max`",
+    "quantities.NAME.at_s": "With `take: at`: the time [s]. `at_s: 20`",
+    "quantities.NAME.when": "With `at_first`, `time_of_first`: the event, `{of: Y, above: A}` or `{of: Y, "
+                            "below: B}`.",
+    "quantities.NAME.after_s": "Restricts the window to t >= after_s (not `at` or the modes).",
+    "quantities.NAME.before_s": "Restricts the window to t <= before_s (not `at` or the modes).",
+    "quantities.NAME.when.of": "The output or property whose crossing is the event.",
+    "quantities.NAME.when.above": "The event: the first step where `of` > above.",
+    "quantities.NAME.when.below": "The event: the first step where `of` < below.",
+}
+
+# The meaning of a kind, where its registry entry's docstring does not say it.
+VALUES = {
+    "simulator.kind": {"jsbsim": "A JSBSim flight (scenario below).",
+                       "python": "A Python function (see `simulator.function`); it is code: see "
+                                 "[security](../security.md)."},
+    "simulator.scenario.kind": {
+        "level_flight": "Trim in unaccelerated level flight, elevator excitation, record (keys `flight`, "
+                        "`excitation`, `duration_s`, `output_rate_hz`, `trim`).",
+        "script": "Fly a JSBSim run script as JSBSim does, its events included (keys `scenario.script`, "
+                  "`scenario.end_s`, `output_rate_hz`)."},
+    "method.kind": {
+        "integration": "Weighted sums of the runs (Eq. 17); on a grid the PCE for bands, PDFs and Sobol' "
+                       "indices is the projection.",
+        "pseudo_galerkin": "Projection of the runs on the PCE (Eq. 19–21); moments from the PCE.",
+        "interpolation": "Moments from the weights (Eq. 32–34), PCE by projection.",
+        "regression": "Least-squares fit of the PCE, weights ignored (Eq. 35–37).",
+        "least_squares": "Weighted least-squares fit of the PCE (Eq. 43–48).",
+        "monte_carlo": "Sample moments of the runs; sampled designs only."},
+    "design.rule": {
+        "gauss_hermite": "Gauss–Hermite (normal inputs; nested: Genz–Keister).",
+        "genz_keister": "Genz–Keister, nested (normal inputs).",
+        "gauss_legendre": "Gauss–Legendre (uniform inputs).",
+        "clenshaw_curtis": "Clenshaw–Curtis, nested (uniform inputs).",
+        "gauss_patterson": "Gauss–Patterson, nested (uniform inputs)."},
+    "quantities.NAME.take": {
+        "max": "The largest value over the steps in the window.",
+        "min": "The smallest value over the steps in the window.",
+        "final": "The last step's value.",
+        "drop": "How far `of` falls below its value at the window's first step (first − min, 0 if it never "
+                "falls): `{of: h_ft, take: drop}` is an altitude loss.",
+        "mean": "Time average by the trapezoid rule over the window.",
+        "at": "Linear interpolation at `at_s`.",
+        "at_first": "The value of `of` at the first step meeting `when`, no interpolation: the touchdown sink "
+                    "rate `{of: velocities/h-dot-fps, take: at_first, when: {of: \"gear/unit[1]/WOW\", above: 0.5}}`.",
+        "time_of_first": "The time of the first step meeting `when`.",
+        "phugoid_period_s": "The phugoid's damped period 2π/Im λ [s] of JSBSim's linearised model at the "
+                            "level-flight trim.",
+        "phugoid_damping": "The phugoid's damping ratio −Re λ/|λ| at the level-flight trim.",
+        "short_period_frequency_rad_s": "The short period's natural frequency |λ| [rad/s] at the level-flight "
+                                        "trim.",
+        "short_period_damping": "The short period's damping ratio at the level-flight trim."},
+}
+
+
+@dataclass(frozen=True)
+class Key:
+    """A key the schema accepts: its path, the section of the reference it belongs to, and for a key
+    that names a kind, the kinds {name: registry object or None}."""
+
+    path: str
+    section: str
+    kinds: dict | None = None
+
+
+def _paths(prefix: str, keys) -> list[str]:
+    return [f"{prefix}.{k}" if prefix else k for k in keys]
+
+
+def refused_keys(call) -> tuple[str, ...]:
+    """The keys a check accepts, as it lists them when it refuses an unknown key: `call()` feeds it one
+    ('... unknown key; expected one of a, b' from the schema's Checker, '... accepted keys: a, b' from
+    designs.spec.check_keys) and must raise."""
+    try:
+        call()
+    except ValueError as exc:  # CampaignError too
+        found = re.search(r"(?:expected one of|accepted keys:) ([^;]+)$", str(exc))
+        if found:
+            return tuple(k.strip() for k in found.group(1).split(","))
+        raise RuntimeError(f"the reference cannot read the accepted keys from: {exc}") from exc
+    raise RuntimeError(f"{call} accepted an unknown key: the reference cannot list its keys")
+
+
+def accepted_keys() -> list[Key]:
+    """Every key the campaign schema accepts, in the order of the reference."""
+    from ..designs import REGISTRY as DESIGNS
+    from ..designs.rules import RULE_TABLE
+    from ..methods import METHODS
+    from ..parameters import DISTRIBUTIONS
+    from ..quantities import REGISTRY as TAKES
+    from ..quantities.spec import KEYS as QUANTITY_KEYS
+    from ..quantities.spec import WHEN_KEYS
+    from ..simulators.scenarios import REGISTRY as SCENARIOS
+    from ..simulators.scenarios.level_flight import EXCITATION_KEYS, FLIGHT_KEYS
+    from . import schema
+
+    found = [Key(k, "Top level") for k in schema.TOP_KEYS]
+    own = {k for scenario in SCENARIOS.values() for k in scenario.keys}  # listed with their scenario
+    keys = dict.fromkeys(k for kind in schema.SIMULATOR_KINDS for k in refused_keys(
+        lambda: schema.simulator(schema.Checker("<reference>"), {"kind": kind, "?": 0})) if k not in own)
+    found += [Key(p, "simulator", {k: None for k in schema.SIMULATOR_KINDS} if p == "simulator.kind" else None)
+              for p in _paths("simulator", keys)]
+    found.append(Key("simulator.scenario.kind", "simulator", dict(SCENARIOS)))
+    for name, scenario in SCENARIOS.items():
+        section = f"simulator, scenario `{name}`"
+        found += [Key(p, section) for p in _paths("simulator", scenario.keys)]
+        found += [Key(p, section) for p in _paths("simulator.scenario", scenario.scenario_keys)]
+    found += [Key(p, "simulator, scenario `level_flight`") for p in
+              _paths("simulator.flight", FLIGHT_KEYS) + _paths("simulator.excitation", EXCITATION_KEYS)]
+    found += [Key(p, "parameters", dict(DISTRIBUTIONS) if p.endswith(".distribution") else None)
+              for p in _paths("parameters.NAME", schema.PARAMETER_KEYS)]
+    design = {"kind": dict(DESIGNS), "rule": dict(RULE_TABLE)}
+    keys = dict.fromkeys(k for kind, entry in DESIGNS.items()
+                         for k in refused_keys(lambda: entry.build({"kind": kind, "?": 0}, ["normal"], 0)))
+    found += [Key(f"design.{k}", "design", design.get(k)) for k in keys]
+    found += [Key(p, "method", dict(METHODS) if p == "method.kind" else None)
+              for p in _paths("method", schema.METHOD_KEYS)]
+    found += [Key(p, "execution") for p in _paths("execution", schema.EXECUTION_KEYS)]
+    found += [Key(p, "storage") for p in _paths("storage", schema.STORAGE_KEYS) + _paths("storage.tsvd",
+                                                                                           schema.TSVD_KEYS)]
+    found += [Key(p, "analysis") for p in _paths("analysis", schema.ANALYSIS_KEYS)]
+    from ..quantities.spec import BOUNDS
+
+    found += [Key(p, "analysis") for p in _paths("analysis.exceedance.QUANTITY[i]", BOUNDS)]
+    found += [Key(p, "limits") for p in _paths("limits", schema.LIMIT_KEYS)]
+    found += [Key(p, "quantities", dict(TAKES) if p.endswith(".take") else None)
+              for p in _paths("quantities.NAME", QUANTITY_KEYS) + _paths("quantities.NAME.when", WHEN_KEYS)]
+    return found
+
+
+def kind_description(path: str, kind: str, entry) -> str | None:
+    """A kind's meaning: VALUES, else the first paragraph of its registry entry's docstring (a design's
+    builder, a distribution's class)."""
+    if kind in VALUES.get(path, {}):
+        return VALUES[path][kind]
+    target = getattr(entry, "build", None) or (entry if inspect.isclass(entry) else None)
+    doc = inspect.getdoc(target) if target is not None else None
+    return " ".join(doc.split("\n\n")[0].split()) if doc else None
+
+
+def missing_descriptions() -> list[str]:
+    """Keys and kinds the reference cannot describe, and descriptions of keys the schema no longer has."""
+    keys = accepted_keys()
+    missing = [k.path for k in keys if not KEYS.get(k.path)]
+    missing += [f"{k.path}: {kind}" for k in keys for kind, entry in (k.kinds or {}).items()
+                if not kind_description(k.path, kind, entry)]
+    paths = {k.path for k in keys}
+    missing += [f"{path} (described, but the schema has no such key)" for path in KEYS if path not in paths]
+    missing += [f"{path}: {kind} (described, but no such kind)" for path, kinds in VALUES.items()
+                for kind in kinds if kind not in next((k.kinds for k in keys if k.path == path), {})]
+    return missing
+
+
+def _cell(text: str) -> str:
+    return text.replace("|", "\\|").replace("\n", " ")
+
+
+def reference_page() -> str:
+    """The Markdown of docs/reference/campaign-keys.md; RuntimeError when a key has no description."""
+    missing = missing_descriptions()
+    if missing:
+        raise RuntimeError("campaign keys without a description in uqflight/campaign/keys.py: " + "; ".join(missing))
+    lines = ["# Campaign keys", "",
+             "Every key a campaign file accepts, generated from the code (`uqflight/campaign/schema.py` and the "
+             "registries of scenarios, designs, methods, distributions, rules and quantities; descriptions in "
+             "`uqflight/campaign/keys.py`). `NAME` is a name you choose. An unknown key is refused (exit 2) "
+             "with the closest known one. The guide is [campaign files](../campaigns.md)."]
+    keys = accepted_keys()
+    for section in dict.fromkeys(k.section for k in keys):
+        inside = [k for k in keys if k.section == section]
+        lines += ["", f"## {section}", "", "| key | meaning |", "|---|---|"]
+        lines += [f"| `{k.path}` | {_cell(KEYS[k.path])} |" for k in inside]
+        for k in (k for k in inside if k.kinds):
+            lines += ["", f"### `{k.path}`", "", "| kind | meaning |", "|---|---|"]
+            lines += [f"| `{kind}` | {_cell(kind_description(k.path, kind, entry))} |"
+                      for kind, entry in k.kinds.items()]
+    return "\n".join(lines) + "\n"
+
+
+if __name__ == "__main__":
+    print(reference_page(), end="")
