@@ -133,6 +133,15 @@ KEYS = {
     "analysis.exceedance.QUANTITY[i].above": "The threshold of P(QUANTITY > X).",
     "analysis.exceedance.QUANTITY[i].below": "The threshold of P(QUANTITY < Y).",
     # limits
+    "dependence": "Dependent inputs: a Gaussian copula (Nataf) over named parameters; the design and PCE "
+                  "stay in independent standard variables (see [dependence](../dependence.md)). "
+                  "`dependence: {kind: gaussian_copula, parameters: [CD0, k1], correlation: [[1, 0.8], [0.8, 1]]}`",
+    "dependence.kind": "Required. The kind (below).",
+    "dependence.parameters": "The correlated parameters, in the order of the matrix rows (the Cholesky order "
+                             "the Sobol' indices follow). Default: every non-seed parameter in campaign order.",
+    "dependence.correlation": "Required. The copula's correlation matrix ρ0 (of the normal scores Φ⁻¹(F(κ))): "
+                              "symmetric, unit diagonal, entries in [-1, 1], positive definite; for normal "
+                              "marginals the Pearson correlation of the parameters.",
     "limits.max_runs": "The design's runs (sparse grids: points built before merging). Default 1000000.",
     "limits.max_memory_gb": "Memory of the run (60 MB per local worker process). Default 8.",
     "limits.max_disk_gb": "Size of the results file. Default 100.",
@@ -152,6 +161,8 @@ KEYS = {
 
 # The meaning of a kind, where its registry entry's docstring does not say it.
 VALUES = {
+    "dependence.kind": {"gaussian_copula": "The Nataf transform: correlated standard normals z = Lξ, then Φ, then "
+                                           "each marginal's inverse CDF."},
     "simulator.kind": {"jsbsim": "A JSBSim flight (scenario below).",
                        "python": "A Python function (see `simulator.function`); it is code: see "
                                  "[security](../security.md)."},
@@ -264,6 +275,8 @@ def accepted_keys() -> list[Key]:
 
     found += [Key(p, "analysis") for p in _paths("analysis.exceedance.QUANTITY[i]", BOUNDS)]
     found += [Key(p, "limits") for p in _paths("limits", schema.LIMIT_KEYS)]
+    found += [Key(p, "dependence", {"gaussian_copula": None} if p == "dependence.kind" else None)
+              for p in _paths("dependence", schema.DEPENDENCE_KEYS)]
     found += [Key(p, "quantities", dict(TAKES) if p.endswith(".take") else None)
               for p in _paths("quantities.NAME", QUANTITY_KEYS) + _paths("quantities.NAME.when", WHEN_KEYS)]
     return found
