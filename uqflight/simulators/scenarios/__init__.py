@@ -28,6 +28,7 @@ class ScenarioKind:
     files(config) -> {name: bytes}: files beyond the aircraft's that a worker needs; localize(config,
     folder) -> config reading them from `folder`. provenance(config) -> results-file attributes.
     resolution(setup, settings, outputs) -> {output: (T,)} or None: the simulator's own resolution.
+    facts(config) -> {"flight": text, "excitation": text}: what is flown, defaults resolved (the report).
     """
 
     keys: tuple[str, ...]
@@ -41,18 +42,19 @@ class ScenarioKind:
     provenance: Callable
     resolution: Callable
     example: dict  # a small `simulator:` mapping of this kind (tests)
+    facts: Callable
 
 
 REGISTRY: dict[str, ScenarioKind] = {
     "level_flight": ScenarioKind(
         level_flight.KEYS, (), level_flight.check, level_flight.setup, level_flight.flight, level_flight.times,
         level_flight.files, level_flight.localize, level_flight.provenance, level_flight.resolution,
-        {"kind": "jsbsim", "duration_s": 2.0, "output_rate_hz": 10.0}),
+        {"kind": "jsbsim", "duration_s": 2.0, "output_rate_hz": 10.0}, facts=level_flight.facts),
     "script": ScenarioKind(
         script.KEYS, script.SCENARIO_KEYS, script.check, script.setup, script.flight, script.times,
         script.files, script.localize, script.provenance, script.resolution,
         {"kind": "jsbsim", "scenario": {"kind": "script", "script": "c172_cruise_8K", "end_s": 2.0},
-         "output_rate_hz": 10.0}),
+         "output_rate_hz": 10.0}, facts=script.facts),
 }
 SCENARIO_KINDS = tuple(REGISTRY)
 DEFAULT = "level_flight"

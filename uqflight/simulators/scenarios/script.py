@@ -412,6 +412,13 @@ def provenance(config: dict) -> dict:
                                     "sha256": AircraftFiles("", files(config)).hash()})}
 
 
+def facts(config: dict) -> dict[str, str]:
+    """The script flown, as the campaign names it (the report's campaign table)."""
+    scenario = config.get("scenario") or {}
+    end = f", cut at {scenario['end_s']:g} s" if isinstance(scenario.get("end_s"), (int, float)) else ""
+    return {"flight": f"script {scenario.get('script', '?')}{end}", "excitation": "the script's events"}
+
+
 def resolution(setup: ScriptSetup, settings, ours=None) -> None:
     """A script has no second way of flying it: no resolution of its own."""
     return None
