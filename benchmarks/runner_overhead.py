@@ -30,7 +30,7 @@ import jsbsim
 import numpy as np
 
 from uqflight.campaign import load_campaign, parse_campaign
-from uqflight.simulators.jsbsim_probe import jsbsim_probe
+from uqflight.simulators.validation_view import validation_view
 from uqflight.execution import run_campaign
 from uqflight.paper import table1_parameters_yaml
 from uqflight.parameters import to_physical
@@ -86,7 +86,7 @@ def bare_loop(kappa: np.ndarray, properties: list[str]) -> np.ndarray:
 
 def campaign(samples: int, tag: str):
     text = CAMPAIGN.format(parameters=table1_parameters_yaml(), samples=samples, tag=tag)
-    return parse_campaign(text, "bench.yaml", jsbsim_probe)
+    return parse_campaign(text, "bench.yaml", validation_view)
 
 
 def timed_run(spec, workers: int, executor: str = "local") -> float:
@@ -163,7 +163,7 @@ def overhead(samples: int, repeats: int) -> None:
 
 
 def scaling(repeats: int) -> None:
-    spec = load_campaign(CAMPAIGNS / "grid-gh-l3.yaml", jsbsim_probe)
+    spec = load_campaign(CAMPAIGNS / "grid-gh-l3.yaml", validation_view)
     runs = len(spec.design().xi)
     rows = {"bare processes, 1": lambda: bare_processes(spec, 1),
             "bare processes, 2": lambda: bare_processes(spec, 2),

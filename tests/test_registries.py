@@ -196,11 +196,11 @@ class _Altitude:
 def test_a_scenario_counts_its_times_from_the_campaign_and_its_observers_see_what_it_records(kind, tmp_path):
     from uqflight.campaign import parse_campaign
     from uqflight.simulators import make_simulator
-    from uqflight.simulators.jsbsim_probe import jsbsim_probe
+    from uqflight.simulators.validation_view import validation_view
 
     entry = SCENARIOS[kind]
     campaign = parse_campaign(_scenario_campaign({**entry.example, "outputs": ["h_ft"]}), str(tmp_path / "x.yaml"),
-                              jsbsim_probe)
+                              validation_view)
     simulator = make_simulator(campaign.simulator, ["wind"], ["atmosphere/wind-north-fps"], tmp_path)
     time = simulator.setup.time
     assert entry.times(campaign.simulator) == len(time)  # the size estimate is the flight's own grid

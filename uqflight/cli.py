@@ -192,11 +192,11 @@ def _prepared(aircraft: str, scale: list[str], offset: list[str], offset_value: 
 def _load(path: Path):
     """The validated campaign, or exit 2 with the validation message (no traceback)."""
     from .campaign import CampaignError, load_campaign
-    from .simulators.jsbsim_probe import jsbsim_probe
+    from .simulators.validation_view import validation_view
 
     check_campaign_file(path)
     try:
-        return load_campaign(path, probe=jsbsim_probe)
+        return load_campaign(path, view=validation_view)
     except CampaignError as exc:
         echo(f"error: {exc}", err=True)
         raise typer.Exit(2)

@@ -315,7 +315,7 @@ class ScriptFlight(PropertyAccess):
         self._bind(fdm, s.aircraft)
         self._recorded = [self._output_source(name) for name in s.outputs]
 
-    def prepare_probe(self) -> None:
+    def prepare_validation_view(self) -> None:
         """The state campaign validation reads nominal values in: the script loaded, before run_ic."""
 
     def property_value(self, name: str) -> float | None:
