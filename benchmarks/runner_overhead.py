@@ -112,10 +112,10 @@ def bare_processes(campaign_spec, processes: int) -> float:
     """Seconds for `processes` fresh Python processes (importing what a worker imports) to fly the
     campaign's chunks, dealt out in turn."""
     from uqflight.execution import nominal_kappa, pending_chunks, worker_spec
-    from uqflight.worker import probe
+    from uqflight.worker import nominal_flight
 
     spec, kappa = worker_spec(campaign_spec), to_physical(campaign_spec.parameters, campaign_spec.design().xi)
-    time_grid, outputs = probe(spec, nominal_kappa(campaign_spec))[:2]
+    time_grid, outputs = nominal_flight(spec, nominal_kappa(campaign_spec))[:2]
     chunks = pending_chunks(np.arange(len(kappa)), campaign_spec.execution["chunk"], len(kappa))
     with tempfile.TemporaryDirectory() as tmp:
         shares = []

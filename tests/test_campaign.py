@@ -165,9 +165,9 @@ def test_a_python_file_is_found_relative_to_the_campaign_not_the_working_directo
     assert (tmp_path / "r.h5").is_file()
 
 
-def test_without_a_probe_interval_pct_needs_a_nominal():
+def test_without_a_validation_view_interval_pct_needs_a_nominal():
     text = """
-name: no-probe
+name: no-view
 simulator: {kind: jsbsim}
 parameters:
   CL0: {property: aero/uq/CL0, distribution: normal, interval_pct: 10}

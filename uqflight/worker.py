@@ -107,13 +107,13 @@ def run_chunk(spec: WorkerSpec, indices: np.ndarray, kappa: np.ndarray, n_times:
     return indices, status, reasons, values
 
 
-def probe(spec: WorkerSpec, kappa: np.ndarray, resolution: bool = True):
+def nominal_flight(spec: WorkerSpec, kappa: np.ndarray, resolution: bool = True):
     """(time, output names, units, seconds of one flight at `kappa`, the simulator's trim repeatability
     at `kappa` or None): what the runner needs to create the results file and derive the default per-run
     time limit, measured here, not in the runner. `resolution` false: no repeatability (None), for a
     worker that only warms up."""
     simulator = spec.build()
-    time_grid, outputs = simulator.probe(kappa)
+    time_grid, outputs = simulator.layout(kappa)
     observers = (QuantityRecorder(spec.quantities, simulator.source),) if spec.quantities else ()
     started = time.perf_counter()
     try:  # with the quantities: a linearisation costs more than the flight (5 s for bacm's two turboprops)
@@ -168,8 +168,8 @@ def main(argv=None) -> None:
             if kind == "chunk":
                 result = run_chunk(*args, on_start=lambda row: conn.send(("start", row)))
                 conn.send(("done", result))
-            elif kind == "probe":
-                conn.send(("probe", probe(*args)))
+            elif kind == "nominal":
+                conn.send(("nominal", nominal_flight(*args)))
             else:
                 conn.send(("error", f"unknown request {kind!r}"))
         except (BrokenPipeError, ConnectionResetError):

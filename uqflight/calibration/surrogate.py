@@ -196,7 +196,7 @@ def simulate(campaign: Campaign, kappa: np.ndarray, outputs: list[str]):
     names = [p.name for p in campaign.parameters]
     properties = [p.property for p in campaign.parameters]
     simulator = make_simulator(campaign.simulator, names, properties, Path(campaign.source).resolve().parent)
-    time, _ = simulator.probe(np.asarray(kappa)[0])
+    time, _ = simulator.layout(np.asarray(kappa)[0])
     values = {name: np.full((len(kappa), len(time)), np.nan) for name in outputs}
     failures = []
     for row, k in enumerate(np.asarray(kappa, dtype=float)):

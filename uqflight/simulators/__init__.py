@@ -1,6 +1,6 @@
 """Simulators: one object per worker that turns a row of physical values κ into outputs.
 
-Both kinds offer `probe(kappa) -> (time, output names)`, `evaluate(kappa) -> {name: (T,)}`
+Both kinds offer `layout(kappa) -> (time, output names)`, `evaluate(kappa) -> {name: (T,)}`
 (raising a FlightError subclass for a failed sample) and `restart()`.
 """
 from __future__ import annotations
@@ -30,7 +30,7 @@ class JSBSimSimulator:
         self._flown = False
         self.units = {name: UNITS.get(name, "") for name in self.setup.outputs}
 
-    def probe(self, kappa: np.ndarray) -> tuple[np.ndarray, list[str]]:
+    def layout(self, kappa: np.ndarray) -> tuple[np.ndarray, list[str]]:
         return self.setup.time, list(self.setup.outputs)
 
     def evaluate(self, kappa: np.ndarray, observers=()) -> dict[str, np.ndarray]:
