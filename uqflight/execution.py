@@ -111,7 +111,7 @@ def versions() -> dict[str, str]:
 def prepare_store(campaign: Campaign, design: Design, out: Path, force: bool, nominal=None,
                   restart: bool = False) -> ResultStore:
     """Open the campaign's results file to resume it, or create it with the design and provenance.
-    `nominal` = (time, outputs, units, seconds, trim repeatability) from a worker (`WorkerPool.nominal_flight`);
+    `nominal` = (time, outputs, units, seconds, the simulator's resolution) from a worker (`WorkerPool.nominal_flight`);
     measured here in a worker process when not given."""
     kappa = to_physical(campaign.parameters, design.xi)
     if nominal is None:
@@ -120,7 +120,7 @@ def prepare_store(campaign: Campaign, design: Design, out: Path, force: bool, no
             nominal = pool.nominal_flight(nominal_kappa(campaign))
         finally:
             pool.close()
-    time_grid, outputs, units, _, repeatability = nominal
+    time_grid, outputs, units, _, resolution = nominal
     attrs = {"versions": json.dumps(versions()), "campaign_name": campaign.name,
              "campaign_path": str(Path(campaign.source).resolve()), "parameters": parameters_attribute(campaign),
              "method": json.dumps(campaign.method), "germs": json.dumps(campaign.germs),
@@ -138,7 +138,7 @@ def prepare_store(campaign: Campaign, design: Design, out: Path, force: bool, no
         out, campaign_text=campaign.text, force=force, restart=restart, xi=design.xi, kappa=kappa, weights=design.weights,
         parameter_names=[p.name for p in campaign.parameters], outputs=outputs, time=time_grid,
         raw=campaign.storage["raw"], tsvd=campaign.storage.get("tsvd"), attrs=attrs, units=units,
-        batch_rows=campaign.execution["chunk"], repeatability=repeatability, quantities=list(campaign.quantities))
+        batch_rows=campaign.execution["chunk"], resolution=resolution, quantities=list(campaign.quantities))
 
 
 def nominal_kappa(campaign: Campaign) -> np.ndarray:
@@ -448,7 +448,7 @@ class WorkerPool:
         self.slots: list[WorkerProcess] = []
 
     def nominal_flight(self, kappa: np.ndarray):
-        """(time, outputs, units, seconds of a nominal flight, trim repeatability or None), from a worker:
+        """(time, outputs, units, seconds of a nominal flight, the simulator's resolution or None), from a worker:
         `start_warmup`, then `warmup_result`."""
         self.start_warmup(kappa)
         return self.warmup_result()

@@ -107,10 +107,10 @@ def run_chunk(spec: WorkerSpec, indices: np.ndarray, kappa: np.ndarray, n_times:
     return indices, status, reasons, values
 
 
-def nominal_flight(spec: WorkerSpec, kappa: np.ndarray, resolution: bool = True):
-    """(time, output names, units, seconds of one flight at `kappa`, the simulator's trim repeatability
+def nominal_flight(spec: WorkerSpec, kappa: np.ndarray, measure_resolution: bool = True):
+    """(time, output names, units, seconds of one flight at `kappa`, the simulator's resolution
     at `kappa` or None): what the runner needs to create the results file and derive the default per-run
-    time limit, measured here, not in the runner. `resolution` false: no repeatability (None), for a
+    time limit, measured here, not in the runner. `measure_resolution` false: no resolution (None), for a
     worker that only warms up."""
     simulator = spec.build()
     time_grid, outputs = simulator.layout(kappa)
@@ -121,9 +121,9 @@ def nominal_flight(spec: WorkerSpec, kappa: np.ndarray, resolution: bool = True)
     except Exception:  # a failed nominal flight still measures the cost of a flight
         flown = None
     seconds = time.perf_counter() - started
-    repeatability = getattr(simulator, "trim_repeatability", None)
+    resolution = getattr(simulator, "resolution", None)
     return (np.asarray(time_grid, dtype=float), list(outputs), dict(getattr(simulator, "units", {}) or {}), seconds,
-            repeatability(kappa, flown) if resolution and repeatability and flown is not None else None)
+            resolution(kappa, flown) if measure_resolution and resolution and flown is not None else None)
 
 
 def _die_with_parent(parent: int) -> None:

@@ -48,7 +48,7 @@ class JSBSimSimulator:
         """The property a quantity's `of:` reads and its scale: a named output's, else the property."""
         return NAMED_OUTPUTS.get(name, (name, 1.0))
 
-    def trim_repeatability(self, kappa: np.ndarray, ours: dict[str, np.ndarray] | None = None
+    def resolution(self, kappa: np.ndarray, ours: dict[str, np.ndarray] | None = None
                            ) -> dict[str, np.ndarray] | None:
         """{output: (T,)}: the simulator's own resolution at `kappa` as its scenario states it (level
         flight: the drift between its two valid trims; see `level_flight.resolution`), or None."""
