@@ -115,7 +115,8 @@ def bare_processes(campaign_spec, processes: int) -> float:
     from uqflight.worker import nominal_flight
 
     spec, kappa = worker_spec(campaign_spec), to_physical(campaign_spec.parameters, campaign_spec.design().xi)
-    time_grid, outputs = nominal_flight(spec, nominal_kappa(campaign_spec))[:2]
+    nominal = nominal_flight(spec, nominal_kappa(campaign_spec))
+    time_grid, outputs = nominal.time, nominal.outputs
     chunks = pending_chunks(np.arange(len(kappa)), campaign_spec.execution["chunk"], len(kappa))
     with tempfile.TemporaryDirectory() as tmp:
         shares = []

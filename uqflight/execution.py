@@ -51,7 +51,7 @@ from .designs import Design
 from .parameters import seed_names, to_physical
 from .store import ResultStore, Status, compact, open_for_campaign
 from .store.lock import LockHeld, ResultsLock
-from .worker import WorkerSpec
+from .worker import NominalFlight, WorkerSpec
 
 DEFAULT_TIMEOUT_FLOOR_S = 60.0   # default timeout: max(this, TIMEOUT_FLIGHTS x one nominal flight)
 TIMEOUT_FLIGHTS = 50
@@ -111,7 +111,7 @@ def versions() -> dict[str, str]:
 def prepare_store(campaign: Campaign, design: Design, out: Path, force: bool, nominal=None,
                   restart: bool = False) -> ResultStore:
     """Open the campaign's results file to resume it, or create it with the design and provenance.
-    `nominal` = (time, outputs, units, seconds, the simulator's resolution) from a worker (`WorkerPool.nominal_flight`);
+    `nominal`: the NominalFlight a worker measured (`WorkerPool.nominal_flight`);
     measured here in a worker process when not given."""
     kappa = to_physical(campaign.parameters, design.xi)
     if nominal is None:
@@ -120,7 +120,6 @@ def prepare_store(campaign: Campaign, design: Design, out: Path, force: bool, no
             nominal = pool.nominal_flight(nominal_kappa(campaign))
         finally:
             pool.close()
-    time_grid, outputs, units, _, resolution = nominal
     attrs = {"versions": json.dumps(versions()), "campaign_name": campaign.name,
              "campaign_path": str(Path(campaign.source).resolve()), "parameters": parameters_attribute(campaign),
              "method": json.dumps(campaign.method), "germs": json.dumps(campaign.germs),
@@ -136,9 +135,10 @@ def prepare_store(campaign: Campaign, design: Design, out: Path, force: bool, no
     out.parent.mkdir(parents=True, exist_ok=True)
     return open_for_campaign(
         out, campaign_text=campaign.text, force=force, restart=restart, xi=design.xi, kappa=kappa, weights=design.weights,
-        parameter_names=[p.name for p in campaign.parameters], outputs=outputs, time=time_grid,
-        raw=campaign.storage["raw"], tsvd=campaign.storage.get("tsvd"), attrs=attrs, units=units,
-        batch_rows=campaign.execution["chunk"], resolution=resolution, quantities=list(campaign.quantities))
+        parameter_names=[p.name for p in campaign.parameters], outputs=nominal.outputs, time=nominal.time,
+        raw=campaign.storage["raw"], tsvd=campaign.storage.get("tsvd"), attrs=attrs, units=nominal.units,
+        batch_rows=campaign.execution["chunk"], resolution=nominal.resolution,
+        quantities=list(campaign.quantities))
 
 
 def nominal_kappa(campaign: Campaign) -> np.ndarray:
@@ -253,7 +253,7 @@ def run_campaign(campaign: Campaign, out: Path | None = None, workers: int | Non
         pool.start_warmup(nominal_kappa(campaign))
         design = campaign.design()  # built while the workers start
         nominal = pool.warmup_result()
-        seconds = nominal[3]
+        seconds = nominal.seconds
         timeout = execution.get("timeout_s") or default_timeout(seconds)
         pool.timeout = timeout
         # One BLAS thread here, for the folds on opening too: the workers keep every core busy, a
@@ -447,8 +447,8 @@ class WorkerPool:
         self.spec, self.workers, self.timeout = spec, max(1, int(workers)), float(timeout)
         self.slots: list[WorkerProcess] = []
 
-    def nominal_flight(self, kappa: np.ndarray):
-        """(time, outputs, units, seconds of a nominal flight, the simulator's resolution or None), from a worker:
+    def nominal_flight(self, kappa: np.ndarray) -> NominalFlight:
+        """The NominalFlight at `kappa` (worker.nominal_flight), from a worker:
         `start_warmup`, then `warmup_result`."""
         self.start_warmup(kappa)
         return self.warmup_result()
@@ -466,7 +466,7 @@ class WorkerPool:
         if not slot.send(("nominal", self.spec, kappa)):
             raise WorkerError(death_reason(self._drop(slot)))
 
-    def warmup_result(self):
+    def warmup_result(self) -> NominalFlight:
         """The first worker's answer to `start_warmup`. The others' answers are not awaited: `run`
         reads them before their workers' first chunk, so that no worker waits for the slowest start."""
         slot = self.slots[0]

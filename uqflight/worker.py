@@ -107,11 +107,22 @@ def run_chunk(spec: WorkerSpec, indices: np.ndarray, kappa: np.ndarray, n_times:
     return indices, status, reasons, values
 
 
-def nominal_flight(spec: WorkerSpec, kappa: np.ndarray, measure_resolution: bool = True):
-    """(time, output names, units, seconds of one flight at `kappa`, the simulator's resolution
-    at `kappa` or None): what the runner needs to create the results file and derive the default per-run
-    time limit, measured here, not in the runner. `measure_resolution` false: no resolution (None), for a
-    worker that only warms up."""
+@dataclass(frozen=True)
+class NominalFlight:
+    """What the runner needs to create the results file and derive the default per-run time limit,
+    measured in a worker: the recorded times, the output names and units, the seconds one flight at the
+    nominal took, and the simulator's resolution there ({output: (T,)}, or None)."""
+
+    time: np.ndarray
+    outputs: list[str]
+    units: dict[str, str]
+    seconds: float
+    resolution: dict[str, np.ndarray] | None
+
+
+def nominal_flight(spec: WorkerSpec, kappa: np.ndarray, measure_resolution: bool = True) -> NominalFlight:
+    """The nominal flight at `kappa`, measured here, not in the runner. `measure_resolution` false: no
+    resolution (None), for a worker that only warms up."""
     simulator = spec.build()
     time_grid, outputs = simulator.layout(kappa)
     observers = (QuantityRecorder(spec.quantities, simulator.source),) if spec.quantities else ()
@@ -122,8 +133,9 @@ def nominal_flight(spec: WorkerSpec, kappa: np.ndarray, measure_resolution: bool
         flown = None
     seconds = time.perf_counter() - started
     resolution = getattr(simulator, "resolution", None)
-    return (np.asarray(time_grid, dtype=float), list(outputs), dict(getattr(simulator, "units", {}) or {}), seconds,
-            resolution(kappa, flown) if measure_resolution and resolution and flown is not None else None)
+    return NominalFlight(np.asarray(time_grid, dtype=float), list(outputs), dict(getattr(simulator, "units", {}) or {}),
+                         seconds, resolution(kappa, flown) if measure_resolution and resolution and flown is not None
+                         else None)
 
 
 def _die_with_parent(parent: int) -> None:
@@ -180,5 +192,7 @@ def main(argv=None) -> None:
             conn.send(("error", f"{type(exc).__name__}: {exc}"))
 
 
-if __name__ == "__main__":
-    main()
+if __name__ == "__main__":  # `python -m uqflight.worker`: the imported module's main, so that the
+    from uqflight.worker import main as serve  # records it sends pickle as uqflight.worker.NominalFlight
+
+    serve()
