@@ -203,26 +203,26 @@ def _load(path: Path):
 
 
 @app.command()
-def plan(campaign: Path = typer.Argument(..., metavar="CAMPAIGN", help="Campaign YAML file.")):
+def plan(campaign_file: Path = typer.Argument(..., metavar="CAMPAIGN", help="Campaign YAML file.")):
     """Validate a campaign and print its design, the number of runs and an estimated time."""
     from .designs import describe
 
-    spec = _load(campaign)
-    design = spec.design()
-    echo(f"campaign: {spec.name} ({campaign})")
+    campaign = _load(campaign_file)
+    design = campaign.design()
+    echo(f"campaign: {campaign.name} ({campaign_file})")
     echo("parameters:")
-    for p in spec.parameters:
+    for p in campaign.parameters:
         echo(f"  {p.name:<10} {p.property:<18} {p.distribution:<16} nominal {p.nominal:<10.6g} "
              f"interval [{p.lower:.6g}, {p.upper:.6g}]")
     echo(describe(design))
-    kind = spec.method["kind"]
-    echo(f"method: {kind}" + (f" (order {spec.method['order']})" if _has_order(kind, design.kind) else ""))
+    kind = campaign.method["kind"]
+    echo(f"method: {kind}" + (f" (order {campaign.method['order']})" if _has_order(kind, design.kind) else ""))
     runs = len(design.xi)
     echo(f"runs: {runs}")
-    echo(f"results: {Path(spec.storage['path']).resolve()} (storage.path, from the working directory; "
+    echo(f"results: {Path(campaign.storage['path']).resolve()} (storage.path, from the working directory; "
          "--out to choose)")
-    seconds = _seconds_per_run(spec)
-    workers = min(spec.execution["workers"], CORES)
+    seconds = _seconds_per_run(campaign)
+    workers = min(campaign.execution["workers"], CORES)
     echo(f"estimated time: {runs * seconds / workers:.0f} s with {workers} worker(s) "
          f"({seconds * 1e3:.0f} ms per run, one nominal run timed now on this machine)")
 
@@ -239,7 +239,7 @@ def _has_order(kind: str, design_kind: str) -> bool:
     return entry.pce is not None and not (entry.runs_on_sampled and is_sampled(design_kind))
 
 
-def _seconds_per_run(spec) -> float:
+def _seconds_per_run(campaign) -> float:
     """One nominal run of the campaign's simulator, timed here (after a first, warming run)."""
     import time
 
@@ -247,10 +247,10 @@ def _seconds_per_run(spec) -> float:
 
     from .quantities.recorder import QuantityRecorder
 
-    simulator = worker_spec(spec).build()
-    nominal = np.array([p.nominal for p in spec.parameters])
+    simulator = worker_spec(campaign).build()
+    nominal = np.array([p.nominal for p in campaign.parameters])
     # the timed run computes the quantities too: a linearisation costs more than the flight
-    observers = (QuantityRecorder(spec.quantities, simulator.source),) if spec.quantities else ()
+    observers = (QuantityRecorder(campaign.quantities, simulator.source),) if campaign.quantities else ()
     for timed in (False, True):  # the first run loads what every later one reuses (the Newton trim's nominal)
         simulator.restart()
         started = time.perf_counter()
@@ -263,7 +263,7 @@ def _seconds_per_run(spec) -> float:
 
 @app.command()
 def run(
-    campaign: Path = typer.Argument(..., metavar="CAMPAIGN", help="Campaign YAML file."),
+    campaign_file: Path = typer.Argument(..., metavar="CAMPAIGN", help="Campaign YAML file."),
     workers: Optional[int] = typer.Option(None, help="Worker processes (default: execution.workers)."),
     out: Optional[Path] = typer.Option(None, help="Results file (default: storage.path)."),
     executor: Optional[str] = typer.Option(None, help="local or dask (default: execution.executor)."),
@@ -282,22 +282,22 @@ def run(
     from .execution import DiskFull, IncompleteFile, WorkerError, run_campaign
     from .store import CorruptFile
 
-    spec = _load(campaign)
-    check_output(out or Path(spec.storage["path"]), "--out" if out else "storage.path", create=True)
+    campaign = _load(campaign_file)
+    check_output(out or Path(campaign.storage["path"]), "--out" if out else "storage.path", create=True)
     if executor not in (None, "local", "dask"):
         echo(f"error: --executor: expected local or dask, got {executor!r}", err=True)
         raise typer.Exit(2)
     if workers is not None and workers < 1:
         echo(f"error: --workers: expected an integer >= 1, got {workers}", err=True)
         raise typer.Exit(2)
-    resume = f"uqflight run {campaign}" + (f" --out {out}" if out else "")
+    resume = f"uqflight run {campaign_file}" + (f" --out {out}" if out else "")
     if signal.getsignal(signal.SIGINT) is signal.SIG_IGN:
         # started with SIGINT ignored (a script's `uqflight run ... &`, some test harnesses): Ctrl-C or
         # kill -INT would be lost and a run waiting on workers would never stop; it stops cleanly instead
         signal.signal(signal.SIGINT, signal.default_int_handler)
     previous = _stop_on_sigterm()
     try:
-        summary = run_campaign(spec, out=out, workers=workers, executor=executor, scheduler=scheduler,
+        summary = run_campaign(campaign, out=out, workers=workers, executor=executor, scheduler=scheduler,
                                force=force, progress=True, restart=restart)
     except DiskFull as exc:
         echo(f"\nerror: {exc.strerror}", err=True)
@@ -309,7 +309,7 @@ def run(
         echo(f"error: {exc}", err=True)
         _exit_now(1)
     except (FileExistsError, ValueError, WorkerError) as exc:
-        echo(f"error: {campaign}: {exc}", err=True)
+        echo(f"error: {campaign_file}: {exc}", err=True)
         raise typer.Exit(2)
     except KeyboardInterrupt as exc:
         code = 143 if isinstance(exc, Terminated) else 130
@@ -532,7 +532,7 @@ class _status:
 
 @app.command()
 def design(
-    campaign: Path = typer.Argument(..., metavar="CAMPAIGN", help="Campaign YAML file."),
+    campaign_file: Path = typer.Argument(..., metavar="CAMPAIGN", help="Campaign YAML file."),
     csv_path: Optional[Path] = typer.Option(None, "--csv", help="Write the design to this CSV file instead of "
                                             "standard output ('-': standard output): one row per run, columns "
                                             "run, xi_<name> (standard variables), <name> (physical values "
@@ -544,10 +544,10 @@ def design(
     to_stdout = csv_path is None or str(csv_path) == "-"
     if not to_stdout:
         check_output(csv_path, "--csv")
-    spec = _load(campaign)
-    points = spec.design()
-    kappa = to_physical(spec.parameters, points.xi)
-    names = [p.name for p in spec.parameters]
+    campaign = _load(campaign_file)
+    points = campaign.design()
+    kappa = to_physical(campaign.parameters, points.xi)
+    names = [p.name for p in campaign.parameters]
     rows = [["run", *(f"xi_{n}" for n in names), *names, "weight"]]
     rows += [[j, *map(repr, map(float, x)), *map(repr, map(float, k)), repr(float(w))]
              for j, (x, k, w) in enumerate(zip(points.xi, kappa, points.weights))]
