@@ -33,7 +33,7 @@ from uqflight.analysis.errors import relative_errors
 from uqflight.analysis.floors import floors_from_moments
 from uqflight.campaign import load_campaign
 from uqflight.execution import run_campaign
-from uqflight.simulators.jsbsim_probe import jsbsim_probe
+from uqflight.simulators.validation_view import validation_view
 from uqflight.statistics import BadInput, Options, analyse
 from uqflight.store import ResultStore
 
@@ -53,7 +53,7 @@ def ensure_results(results: Path) -> None:
                 if store.pending().size == 0:
                     continue
         print(f"running campaigns/{name}.yaml into {path} ...", flush=True)
-        run_campaign(load_campaign(CAMPAIGNS / f"{name}.yaml", jsbsim_probe), out=path)
+        run_campaign(load_campaign(CAMPAIGNS / f"{name}.yaml", validation_view), out=path)
 
 
 def monte_carlo_floor(reference, name: str, n: int) -> np.ndarray:

@@ -38,11 +38,11 @@ def ensure_results(path: Path) -> Path:
     if path.is_file():
         return path
     from uqflight.campaign import load_campaign
-    from uqflight.simulators.jsbsim_probe import jsbsim_probe
+    from uqflight.simulators.validation_view import validation_view
     from uqflight.execution import run_campaign
 
     print(f"running campaigns/grid-gh-l2.yaml into {path} (113 flights)")
-    run_campaign(load_campaign(ROOT / "campaigns/grid-gh-l2.yaml", probe=jsbsim_probe), out=path)
+    run_campaign(load_campaign(ROOT / "campaigns/grid-gh-l2.yaml", view=validation_view), out=path)
     return path
 
 

@@ -30,7 +30,7 @@ import jsbsim
 import numpy as np
 
 from uqflight.campaign import load_campaign, parse_campaign
-from uqflight.simulators.jsbsim_probe import jsbsim_probe
+from uqflight.simulators.validation_view import validation_view
 from uqflight.execution import run_campaign
 from uqflight.paper import table1_parameters_yaml
 from uqflight.parameters import to_physical
@@ -86,7 +86,7 @@ def bare_loop(kappa: np.ndarray, properties: list[str]) -> np.ndarray:
 
 def campaign(samples: int, tag: str):
     text = CAMPAIGN.format(parameters=table1_parameters_yaml(), samples=samples, tag=tag)
-    return parse_campaign(text, "bench.yaml", jsbsim_probe)
+    return parse_campaign(text, "bench.yaml", validation_view)
 
 
 def timed_run(spec, workers: int, executor: str = "local") -> float:
@@ -112,10 +112,11 @@ def bare_processes(campaign_spec, processes: int) -> float:
     """Seconds for `processes` fresh Python processes (importing what a worker imports) to fly the
     campaign's chunks, dealt out in turn."""
     from uqflight.execution import nominal_kappa, pending_chunks, worker_spec
-    from uqflight.worker import probe
+    from uqflight.worker import nominal_flight
 
     spec, kappa = worker_spec(campaign_spec), to_physical(campaign_spec.parameters, campaign_spec.design().xi)
-    time_grid, outputs = probe(spec, nominal_kappa(campaign_spec))[:2]
+    nominal = nominal_flight(spec, nominal_kappa(campaign_spec))
+    time_grid, outputs = nominal.time, nominal.outputs
     chunks = pending_chunks(np.arange(len(kappa)), campaign_spec.execution["chunk"], len(kappa))
     with tempfile.TemporaryDirectory() as tmp:
         shares = []
@@ -163,7 +164,7 @@ def overhead(samples: int, repeats: int) -> None:
 
 
 def scaling(repeats: int) -> None:
-    spec = load_campaign(CAMPAIGNS / "grid-gh-l3.yaml", jsbsim_probe)
+    spec = load_campaign(CAMPAIGNS / "grid-gh-l3.yaml", validation_view)
     runs = len(spec.design().xi)
     rows = {"bare processes, 1": lambda: bare_processes(spec, 1),
             "bare processes, 2": lambda: bare_processes(spec, 2),

@@ -20,7 +20,7 @@ from pathlib import Path
 import numpy as np
 
 from uqflight.campaign import parse_campaign
-from uqflight.simulators.jsbsim_probe import jsbsim_probe
+from uqflight.simulators.validation_view import validation_view
 from uqflight.execution import run_campaign
 from uqflight.paper import table1_parameters_yaml
 from uqflight.store import ResultStore, Status
@@ -57,7 +57,7 @@ def main():
     ran, seconds = 0, 0.0
     if not args.out.exists():  # an existing file is reused as it is (delete it to measure the runs again)
         text = CAMPAIGN.format(parameters=table1_parameters_yaml(), samples=args.samples, workers=args.workers)
-        summary = run_campaign(parse_campaign(text, "tsvd.yaml", jsbsim_probe), out=args.out)
+        summary = run_campaign(parse_campaign(text, "tsvd.yaml", validation_view), out=args.out)
         ran, seconds = summary.ran, summary.seconds
     with ResultStore.open(args.out) as store:
         ok = store.status == Status.OK

@@ -8,13 +8,13 @@ import subprocess
 
 from conftest import ROOT, UQFLIGHT
 from uqflight.campaign import load_campaign
-from uqflight.simulators.jsbsim_probe import jsbsim_probe
+from uqflight.simulators.validation_view import validation_view
 from uqflight.execution import run_campaign
 
 
 
 def test_small_campaign_matches_the_committed_baseline(tmp_path):
-    campaign = load_campaign(ROOT / "campaigns" / "ci-small.yaml", jsbsim_probe)
+    campaign = load_campaign(ROOT / "campaigns" / "ci-small.yaml", validation_view)
     summary = run_campaign(campaign, out=tmp_path / "ci.h5", workers=2)
     assert summary.ran == 113 and not summary.failures
     check = subprocess.run([UQFLIGHT, "check", str(tmp_path / "ci.h5"), "--baseline",

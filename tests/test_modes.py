@@ -9,7 +9,7 @@ from conftest import ROOT
 from uqflight.campaign import load_campaign
 from uqflight.quantities.modes import classified_modes
 from uqflight.quantities.recorder import QuantityRecorder
-from uqflight.simulators.jsbsim_probe import jsbsim_probe
+from uqflight.simulators.validation_view import validation_view
 
 NAMES = ["Vt", "Alpha", "Theta", "Q", "Rpm0", "Rpm1", "Beta", "Phi", "P", "Psi", "R", "Latitude", "Longitude",
          "Alt"]
@@ -48,7 +48,7 @@ def test_an_overdamped_short_period_is_undefined():
 def test_bacm_nominal_modes_match_the_flight_and_leave_the_flight_as_it_was():
     from uqflight.simulators import make_simulator
 
-    campaign = load_campaign(ROOT / "campaigns" / "bacm-modes.yaml", probe=jsbsim_probe)
+    campaign = load_campaign(ROOT / "campaigns" / "bacm-modes.yaml", view=validation_view)
     names = [p.name for p in campaign.parameters]
     properties = [p.property for p in campaign.parameters]
     nominal = np.array([p.nominal for p in campaign.parameters])
@@ -79,7 +79,7 @@ def test_a_runs_modes_do_not_depend_on_the_run_flown_before_it_in_its_chunk():
     from uqflight.parameters import to_physical
     from uqflight.worker import run_chunk
 
-    campaign = load_campaign(ROOT / "campaigns" / "bacm-modes.yaml", probe=jsbsim_probe)
+    campaign = load_campaign(ROOT / "campaigns" / "bacm-modes.yaml", view=validation_view)
     kappa = to_physical(campaign.parameters, campaign.design().xi)[16:18]
     spec, outputs = worker_spec(campaign), list(campaign.simulator["outputs"])
     pair = run_chunk(spec, np.arange(16, 18), kappa, 1001, outputs)[3]

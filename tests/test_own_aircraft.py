@@ -12,7 +12,7 @@ from conftest import cli_in_process
 from uqflight.campaign import CampaignError, load_campaign
 from uqflight.simulators.aircraft import AircraftFiles, AircraftNotFound, locate
 from uqflight.simulators.jsbsim import REPO_ROOT, JSBSimFlight, flight_setup_from, quiet_jsbsim
-from uqflight.simulators.jsbsim_probe import jsbsim_probe
+from uqflight.simulators.validation_view import validation_view
 from uqflight.simulators.patch import PreparedAircraft
 
 CAMPAIGNS = REPO_ROOT / "campaigns"
@@ -81,11 +81,11 @@ def test_unknown_function_is_refused_with_suggestions(tmp_path):
     text = (CAMPAIGNS / "c172p-scale-l2.yaml").read_text().replace("aero/coefficient/CLwbh", "aero/coefficient/CLwb")
     (tmp_path / "bad.yaml").write_text(text)
     with pytest.raises(CampaignError, match=r"parameters\.CL\.function: .*did you mean aero/coefficient/CLwbh"):
-        load_campaign(tmp_path / "bad.yaml", probe=jsbsim_probe)
+        load_campaign(tmp_path / "bad.yaml", view=validation_view)
 
 
 def test_function_parameters_have_nominal_one_and_set_the_patch_property():
-    campaign = load_campaign(CAMPAIGNS / "c172p-scale-l2.yaml", probe=jsbsim_probe)
+    campaign = load_campaign(CAMPAIGNS / "c172p-scale-l2.yaml", view=validation_view)
     assert [p.property for p in campaign.parameters] == [
         "aero/uq/scale/CLwbh", "aero/uq/scale/CDwbh", "aero/uq/scale/Cmalpha"]
     assert all(p.nominal == 1.0 and p.lower == pytest.approx(0.9) for p in campaign.parameters)
@@ -137,7 +137,7 @@ def test_an_aircraft_that_would_kill_the_process_is_refused_with_exit_2(tmp_path
     text = (CAMPAIGNS / "c172p-scale-l2.yaml").read_text().replace("aircraft: c172p", f"aircraft: {aircraft}")
     (tmp_path / "c.yaml").write_text(text)
     with pytest.raises(CampaignError, match="simulator.aircraft: " + message):
-        load_campaign(tmp_path / "c.yaml", probe=jsbsim_probe)  # in this process: it survives
+        load_campaign(tmp_path / "c.yaml", view=validation_view)  # in this process: it survives
     for command in (["plan", tmp_path / "c.yaml"], ["aircraft", aircraft]):
         result = cli_in_process(*command, cwd=tmp_path)
         assert result.returncode == 2 and re.search(message, result.stderr), result.stderr

@@ -167,13 +167,13 @@ def test_a_jsbsim_run_stores_the_nominal_values_it_read_from_the_aircraft(tmp_pa
     from uqflight.campaign import parse_campaign
     from uqflight.campaign.reading import parameter_rows, stored_parameters
     from uqflight.execution import run_campaign
-    from uqflight.simulators.jsbsim_probe import jsbsim_probe
+    from uqflight.simulators.validation_view import validation_view
     from uqflight.store import ResultStore
 
-    campaign = parse_campaign(JSBSIM, str(tmp_path / "c.yaml"), jsbsim_probe)
+    campaign = parse_campaign(JSBSIM, str(tmp_path / "c.yaml"), validation_view)
     run_campaign(campaign, out=tmp_path / "j.h5")
     expected = parameter_rows(campaign.parameters)
-    assert expected[0]["nominal"] == jsbsim_probe(campaign.simulator).value("aero/uq/CL0")  # not in the campaign
+    assert expected[0]["nominal"] == validation_view(campaign.simulator).value("aero/uq/CL0")  # not in the campaign
     for path in (tmp_path / "j.h5", without_parameters_attribute(tmp_path / "j.h5", tmp_path / "old.h5")):
         with ResultStore.open(path) as store:
             assert stored_parameters(store.attrs) == expected

@@ -492,7 +492,8 @@ def test_an_idle_worker_gets_its_next_chunk_before_the_runner_writes(tmp_path):
     tasks = [Task(np.arange(i, i + 2), kappa[i:i + 2]) for i in (0, 2, 4)]
     pool = WorkerPool(worker_spec(spec), 1, 60.0)
     try:
-        time_grid, outputs = pool.probe(nominal_kappa(spec))[:2]
+        nominal = pool.nominal_flight(nominal_kappa(spec))
+        time_grid, outputs = nominal.time, nominal.outputs
         results = pool.run(tasks, len(time_grid), outputs)
         first = next(results)
         assert first[0].tolist() == [0, 1] and pool.slots[0].task is tasks[1]

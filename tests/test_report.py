@@ -11,7 +11,7 @@ import pytest
 
 from conftest import UQFLIGHT, cli, cli_in_process, read_summary
 from uqflight.campaign import parse_campaign
-from uqflight.simulators.jsbsim_probe import jsbsim_probe
+from uqflight.simulators.validation_view import validation_view
 from uqflight.execution import run_campaign
 from uqflight.report import write_report
 from uqflight.statistics import analyse
@@ -54,8 +54,8 @@ analysis: {band_samples: 1000}
 """
 
 
-def run(template: str, path: Path, probe=None, **fields) -> Path:
-    campaign = parse_campaign(template.format(**fields) if fields else template, str(path.with_suffix(".yaml")), probe)
+def run(template: str, path: Path, view=None, **fields) -> Path:
+    campaign = parse_campaign(template.format(**fields) if fields else template, str(path.with_suffix(".yaml")), view)
     run_campaign(campaign, out=path, workers=1)
     return path
 
@@ -148,7 +148,7 @@ def test_pce_against_pick_freeze_and_two_monte_carlo_files(files, tmp_path):
 
 @pytest.mark.slow
 def test_report_of_a_jsbsim_campaign_and_its_check(tmp_path):
-    results = run(JSBSIM, tmp_path / "jsbsim.h5", probe=jsbsim_probe)
+    results = run(JSBSIM, tmp_path / "jsbsim.h5", view=validation_view)
     baseline = tmp_path / "baseline.json"
     result = cli("report", results, "--out", tmp_path / "report", "--write-baseline", baseline)
     assert result.returncode == 0, result.stderr

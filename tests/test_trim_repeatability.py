@@ -8,7 +8,7 @@ from conftest import ROOT, run_python_campaign
 from test_trust import NORMAL_2D, campaign, strict_json
 
 from uqflight.campaign import load_campaign
-from uqflight.simulators.jsbsim_probe import jsbsim_probe
+from uqflight.simulators.validation_view import validation_view
 from uqflight.execution import nominal_kappa, run_campaign, worker_spec
 from uqflight.statistics import analyse, summary_json
 from uqflight.store import ResultStore
@@ -32,16 +32,16 @@ def test_a_spread_below_the_recorded_resolution_is_unresolved(tmp_path):
 
 
 @pytest.fixture(scope="module")
-def nominal_repeatability():
-    campaign = load_campaign(ROOT / "campaigns" / "ci-small.yaml", jsbsim_probe)
+def nominal_resolution():
+    campaign = load_campaign(ROOT / "campaigns" / "ci-small.yaml", validation_view)
     simulator = worker_spec(campaign).build()
-    return simulator.setup.time, simulator.trim_repeatability(nominal_kappa(campaign))
+    return simulator.setup.time, simulator.resolution(nominal_kappa(campaign))
 
 
-def test_the_aircraft_trims_drift_apart_slowly_and_monotonically(nominal_repeatability):
+def test_the_aircraft_trims_drift_apart_slowly_and_monotonically(nominal_resolution):
     """bacm nominal, Newton against JSBSim's trim (measured 2026-11-26: q 8.6e-6 deg/s, h 6.9e-5 ft at
     1.4 s): zero at t = 0 for q and h, never decreasing, and far below the spread the pulse makes."""
-    time, drift = nominal_repeatability
+    time, drift = nominal_resolution
     assert set(drift) == {"alpha_deg", "theta_deg", "h_ft", "q_degps", "vtas_kt"}
     for name, values in drift.items():
         assert values.shape == time.shape and np.all(np.diff(values) >= 0), name
@@ -52,12 +52,12 @@ def test_the_aircraft_trims_drift_apart_slowly_and_monotonically(nominal_repeata
 
 
 @pytest.mark.slow
-def test_the_aircraft_file_records_it_and_q_before_the_pulse_is_unresolved(tmp_path, nominal_repeatability):
+def test_the_aircraft_file_records_it_and_q_before_the_pulse_is_unresolved(tmp_path, nominal_resolution):
     """ci-small: q's spread before the pulse (~5e-8 deg/s, trim residuals) is below the trims' drift
     (~1e-6): its Sobol' indices are null there, and defined once the pulse moves q (std ~1e-2)."""
     out = tmp_path / "ci.h5"
-    run_campaign(load_campaign(ROOT / "campaigns" / "ci-small.yaml", jsbsim_probe), out=out, workers=1)
-    time, drift = nominal_repeatability
+    run_campaign(load_campaign(ROOT / "campaigns" / "ci-small.yaml", validation_view), out=out, workers=1)
+    time, drift = nominal_resolution
     with ResultStore.open(out) as store:
         np.testing.assert_array_equal(store.resolution("q_degps"), drift["q_degps"])
     q = analyse(out).outputs["q_degps"]

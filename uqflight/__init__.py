@@ -36,16 +36,16 @@ __all__ = ["analyse", "calibrate", "export_surrogate", "load_campaign", "load_su
            "write_report"]
 
 
-def load_campaign(path, probe: bool = True):
+def load_campaign(path, check_aircraft: bool = True):
     """The validated campaign (`uqflight.campaign.Campaign`) of a campaign file, checked as `uqflight plan`
-    checks it. `probe`: a JSBSim campaign's property and output names are checked against its aircraft and
+    checks it. `check_aircraft`: a JSBSim campaign's property and output names are checked against its aircraft and
     the nominal values read from it (JSBSim loads the aircraft); False skips that, and nominal values must
     then be given. A python simulator's module is imported: its code runs. Raises
     `uqflight.campaign.CampaignError` naming the file, the field and what was expected."""
     from .campaign import load_campaign as load
-    from .simulators.jsbsim_probe import jsbsim_probe
+    from .simulators.validation_view import validation_view
 
-    return load(path, probe=jsbsim_probe if probe else None)
+    return load(path, view=validation_view if check_aircraft else None)
 
 
 def run(campaign, out=None, workers: int | None = None, executor: str | None = None,
@@ -66,7 +66,7 @@ def run(campaign, out=None, workers: int | None = None, executor: str | None = N
 
 def _methods(method) -> list[dict] | None:
     """`KIND[:ORDER]` strings or {"kind", "order"} mappings (one or a list) into method overrides."""
-    from .report.loading import parse_methods
+    from .methods.parsing import parse_methods
 
     if method is None:
         return None

@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import csv
+import io
 import os
 import signal
 from collections import Counter
@@ -21,6 +22,8 @@ from .simulators.aircraft import default_condition
 from .simulators.jsbsim import DEFAULT_OUTPUTS, Excitation, FlightSetup, JSBSimFlight
 
 CONTEXT = {"help_option_names": ["-h", "--help"]}
+# simulate's CSV and plot, beside the campaigns' results (results/ is in .gitignore)
+DEFAULT_CSV, DEFAULT_PLOT = Path("results/flight.csv"), Path("results/flight.png")
 # rich_markup_mode=None: help text is shown as written, so units such as [ft], [kt], [deg], [s] are
 # not swallowed as rich markup
 app = typer.Typer(help="Uncertainty quantification campaigns on a JSBSim flight-dynamics model.",
@@ -45,8 +48,8 @@ def cli(version: bool = typer.Option(False, "--version", callback=_version, is_e
     """Uncertainty quantification campaigns on a JSBSim flight-dynamics model."""
 
 
-def parse_settings(pairs: list[str]) -> dict[str, float]:
-    """`PROPERTY=VALUE` pairs into a dict; a malformed pair is a usage error naming it."""
+def parse_settings(pairs: list[str], option: str = "--set") -> dict[str, float]:
+    """`PROPERTY=VALUE` pairs into a dict; a malformed pair is a usage error naming it and `option`."""
     settings = {}
     for pair in pairs:
         name, sep, value = pair.partition("=")
@@ -55,7 +58,7 @@ def parse_settings(pairs: list[str]) -> dict[str, float]:
                 raise ValueError
             settings[name.strip()] = float(value)
         except ValueError:
-            raise typer.BadParameter(f"expected PROPERTY=NUMBER, got {pair!r}", param_hint="--set")
+            raise typer.BadParameter(f"expected NAME=NUMBER, got {pair!r}", param_hint=option)
     return settings
 
 
@@ -79,14 +82,31 @@ def simulate(
     output: List[str] = typer.Option([], "--output", metavar="PROPERTY", help="Extra JSBSim property to record (repeatable)."),
     aircraft: str = typer.Option("bacm", help="Aircraft: a name in the project's aircraft/ or JSBSim's, or a "
                                               "path to an aircraft folder (`uqflight aircraft --list`)."),
-    out: Optional[Path] = typer.Option(None, help="Write the time histories to this CSV file."),
-    plot: Optional[Path] = typer.Option(None, help="Write a PNG plot of the outputs."),
+    noise: List[str] = typer.Option([], "--noise", metavar="OUTPUT=SIGMA", help="OUTPUT=SIGMA: add Gaussian "
+                                    "noise of std SIGMA (in the output's unit) to the written data, e.g. "
+                                    "alpha_deg=0.05 (repeatable; seeded by --seed)."),
+    seed: int = typer.Option(0, help="Seeds the --noise draws: the same seed gives the same data."),
+    out: Path = typer.Option(DEFAULT_CSV, help="Write the time histories to this CSV file (the default's folder "
+                                               "is made when missing)."),
+    plot: Path = typer.Option(DEFAULT_PLOT, help="Write a PNG plot of the outputs (the default's folder is made "
+                                                 "when missing)."),
+    no_files: bool = typer.Option(False, "--no-files", help="Write neither the CSV nor the plot: print only."),
 ):
-    """Trim one flight in level flight, excite the elevator and record the outputs."""
+    """Trim one flight in level flight, excite the elevator and record the outputs (by default into
+    results/flight.csv and results/flight.png, from the working directory)."""
+    from .simulators.noise import add_noise, check_noise
+
     settings = parse_settings(set_)
-    for path, option in ((out, "--out"), (plot, "--plot")):
-        if path:
-            check_output(path, option)
+    sigmas = parse_settings(noise, "--noise")
+    recorded = tuple(DEFAULT_OUTPUTS) + tuple(output)
+    try:
+        check_noise(recorded, sigmas, seed)
+    except ValueError as exc:
+        echo(f"error: {exc}", err=True)
+        raise typer.Exit(2)
+    files = [] if no_files else [(out, "--out"), (plot, "--plot")]
+    for path, option in files:
+        check_output(path, option, create=path in (DEFAULT_CSV, DEFAULT_PLOT))
     try:
         located = _prepared(aircraft, scale, offset, offset_value)
         settings.update(located.settings)
@@ -98,9 +118,10 @@ def simulate(
             excitation=Excitation(kind=excitation, amplitude_deg=amplitude_deg, start_s=start_s,
                                   duration_s=pulse_duration_s),
             duration_s=duration_s, output_rate_hz=output_rate_hz,
-            outputs=tuple(DEFAULT_OUTPUTS) + tuple(output))
+            outputs=recorded)
         flight = JSBSimFlight(setup)
         result = flight.fly(settings)
+        outputs = add_noise(result.outputs, sigmas, seed)
     except FlightError as exc:
         echo(f"flight failed: {exc}", err=True)
         raise typer.Exit(1)
@@ -110,20 +131,24 @@ def simulate(
     echo(result.trim.describe())
     for line in _offset_lines(located, flight):
         echo(line)
-    for name, values in result.outputs.items():
+    if sigmas:
+        echo(f"noise added (seed {seed}): " + ", ".join(f"{name} sigma {sigma:g}" for name, sigma in sigmas.items()))
+    for name, values in outputs.items():
         echo(f"{name:>12}: start {values[0]:12.4f}  min {values.min():12.4f}  max {values.max():12.4f}")
-    if out:
+    for path, _ in files:
+        path.parent.mkdir(parents=True, exist_ok=True)  # results/ for the defaults; a given folder exists
+    if files:
         with open(out, "w", newline="") as fh:
             writer = csv.writer(fh)
-            writer.writerow(["time_s", *result.outputs])
+            writer.writerow(["time_s", *outputs])
             for i, t in enumerate(result.time):
-                writer.writerow([f"{t:g}", *(repr(float(v[i])) for v in result.outputs.values())])
+                writer.writerow([f"{t:g}", *(repr(float(v[i])) for v in outputs.values())])
         echo(f"wrote {out}")
-    if plot:
         from .report.plots import plot_flight
 
-        plot_flight(result.time, result.outputs, plot,
-                    title=f"{setup.aircraft}: {excitation} {amplitude_deg:g} deg at {altitude_ft:g} ft, {airspeed_ktas:g} KTAS")
+        plot_flight(result.time, outputs, plot,
+                    title=f"{setup.aircraft}: {excitation} {amplitude_deg:g} deg at {altitude_ft:g} ft, {airspeed_ktas:g} KTAS"
+                    + (" (noise added)" if sigmas else ""))
         echo(f"wrote {plot}")
 
 
@@ -155,7 +180,7 @@ def _prepared(aircraft: str, scale: list[str], offset: list[str], offset_value: 
         raise ValueError(str(exc)) from None
     pairs = []
     for kind, items in (("scale", scale), ("offset", offset), ("offset_value", offset_value)):
-        for name, value in parse_settings(items).items():
+        for name, value in parse_settings(items, "--" + kind.replace("_", "-")).items():
             function = resolve_function(name, plain.functions)
             pairs.append((function, kind, patch_property(function, kind, plain.functions), value))
     prepared = PreparedAircraft(aircraft, Path.cwd(), patches=[(f, k) for f, k, _, _ in pairs]) if pairs else plain
@@ -167,39 +192,40 @@ def _prepared(aircraft: str, scale: list[str], offset: list[str], offset_value: 
 def _load(path: Path):
     """The validated campaign, or exit 2 with the validation message (no traceback)."""
     from .campaign import CampaignError, load_campaign
-    from .simulators.jsbsim_probe import jsbsim_probe
+    from .simulators.validation_view import validation_view
 
     check_campaign_file(path)
     try:
-        return load_campaign(path, probe=jsbsim_probe)
+        return load_campaign(path, view=validation_view)
     except CampaignError as exc:
         echo(f"error: {exc}", err=True)
         raise typer.Exit(2)
 
 
 @app.command()
-def plan(campaign: Path = typer.Argument(..., metavar="CAMPAIGN", help="Campaign YAML file.")):
+def plan(campaign_file: Path = typer.Argument(..., metavar="CAMPAIGN", help="Campaign YAML file.")):
     """Validate a campaign and print its design, the number of runs and an estimated time."""
     from .designs import describe
 
-    spec = _load(campaign)
-    design = spec.design()
-    echo(f"campaign: {spec.name} ({campaign})")
+    campaign = _load(campaign_file)
+    design = campaign.design()
+    echo(f"campaign: {campaign.name} ({campaign_file})")
     echo("parameters:")
-    for p in spec.parameters:
+    for p in campaign.parameters:
         echo(f"  {p.name:<10} {p.property:<18} {p.distribution:<16} nominal {p.nominal:<10.6g} "
              f"interval [{p.lower:.6g}, {p.upper:.6g}]")
-    if spec.dependence is not None:
-        echo(f"dependence: {spec.dependence.kind} over {', '.join(spec.dependence.names)} (standard-normal germs, "
+    if campaign.dependence is not None:
+        echo(f"dependence: {campaign.dependence.kind} over {', '.join(campaign.dependence.names)} (standard-normal germs, "
              "Cholesky in this order)")
     echo(describe(design))
-    echo(f"method: {spec.method['kind']} (order {spec.method['order']})")
+    kind = campaign.method["kind"]
+    echo(f"method: {kind}" + (f" (order {campaign.method['order']})" if _has_order(kind, design.kind) else ""))
     runs = len(design.xi)
     echo(f"runs: {runs}")
-    echo(f"results: {Path(spec.storage['path']).resolve()} (storage.path, from the working directory; "
+    echo(f"results: {Path(campaign.storage['path']).resolve()} (storage.path, from the working directory; "
          "--out to choose)")
-    seconds = _seconds_per_run(spec)
-    workers = min(spec.execution["workers"], CORES)
+    seconds = _seconds_per_run(campaign)
+    workers = min(campaign.execution["workers"], CORES)
     echo(f"estimated time: {runs * seconds / workers:.0f} s with {workers} worker(s) "
          f"({seconds * 1e3:.0f} ms per run, one nominal run timed now on this machine)")
 
@@ -207,7 +233,16 @@ def plan(campaign: Path = typer.Argument(..., metavar="CAMPAIGN", help="Campaign
 CORES = os.cpu_count() or 1
 
 
-def _seconds_per_run(spec) -> float:
+def _has_order(kind: str, design_kind: str) -> bool:
+    """Whether method `kind` builds a PCE on this design, so that its order means something."""
+    from .designs import is_sampled
+    from .methods import method_entry
+
+    entry = method_entry(kind)
+    return entry.pce is not None and not (entry.runs_on_sampled and is_sampled(design_kind))
+
+
+def _seconds_per_run(campaign) -> float:
     """One nominal run of the campaign's simulator, timed here (after a first, warming run)."""
     import time
 
@@ -215,10 +250,10 @@ def _seconds_per_run(spec) -> float:
 
     from .quantities.recorder import QuantityRecorder
 
-    simulator = worker_spec(spec).build()
-    nominal = np.array([p.nominal for p in spec.parameters])
+    simulator = worker_spec(campaign).build()
+    nominal = np.array([p.nominal for p in campaign.parameters])
     # the timed run computes the quantities too: a linearisation costs more than the flight
-    observers = (QuantityRecorder(spec.quantities, simulator.source),) if spec.quantities else ()
+    observers = (QuantityRecorder(campaign.quantities, simulator.source),) if campaign.quantities else ()
     for timed in (False, True):  # the first run loads what every later one reuses (the Newton trim's nominal)
         simulator.restart()
         started = time.perf_counter()
@@ -231,7 +266,7 @@ def _seconds_per_run(spec) -> float:
 
 @app.command()
 def run(
-    campaign: Path = typer.Argument(..., metavar="CAMPAIGN", help="Campaign YAML file."),
+    campaign_file: Path = typer.Argument(..., metavar="CAMPAIGN", help="Campaign YAML file."),
     workers: Optional[int] = typer.Option(None, help="Worker processes (default: execution.workers)."),
     out: Optional[Path] = typer.Option(None, help="Results file (default: storage.path)."),
     executor: Optional[str] = typer.Option(None, help="local or dask (default: execution.executor)."),
@@ -250,22 +285,22 @@ def run(
     from .execution import DiskFull, IncompleteFile, WorkerError, run_campaign
     from .store import CorruptFile
 
-    spec = _load(campaign)
-    check_output(out or Path(spec.storage["path"]), "--out" if out else "storage.path", create=True)
+    campaign = _load(campaign_file)
+    check_output(out or Path(campaign.storage["path"]), "--out" if out else "storage.path", create=True)
     if executor not in (None, "local", "dask"):
         echo(f"error: --executor: expected local or dask, got {executor!r}", err=True)
         raise typer.Exit(2)
     if workers is not None and workers < 1:
         echo(f"error: --workers: expected an integer >= 1, got {workers}", err=True)
         raise typer.Exit(2)
-    resume = f"uqflight run {campaign}" + (f" --out {out}" if out else "")
+    resume = f"uqflight run {campaign_file}" + (f" --out {out}" if out else "")
     if signal.getsignal(signal.SIGINT) is signal.SIG_IGN:
         # started with SIGINT ignored (a script's `uqflight run ... &`, some test harnesses): Ctrl-C or
         # kill -INT would be lost and a run waiting on workers would never stop; it stops cleanly instead
         signal.signal(signal.SIGINT, signal.default_int_handler)
     previous = _stop_on_sigterm()
     try:
-        summary = run_campaign(spec, out=out, workers=workers, executor=executor, scheduler=scheduler,
+        summary = run_campaign(campaign, out=out, workers=workers, executor=executor, scheduler=scheduler,
                                force=force, progress=True, restart=restart)
     except DiskFull as exc:
         echo(f"\nerror: {exc.strerror}", err=True)
@@ -277,7 +312,7 @@ def run(
         echo(f"error: {exc}", err=True)
         _exit_now(1)
     except (FileExistsError, ValueError, WorkerError) as exc:
-        echo(f"error: {campaign}: {exc}", err=True)
+        echo(f"error: {campaign_file}: {exc}", err=True)
         raise typer.Exit(2)
     except KeyboardInterrupt as exc:
         code = 143 if isinstance(exc, Terminated) else 130
@@ -378,8 +413,10 @@ def report(
                                                   "results file). Replaced only when the new report is complete."),
     reference: Optional[Path] = typer.Option(None, help="Monte Carlo results file: the errors ε_m, ε_v (Eq. 49) "
                                                         "and KLD (Eq. 50) of every file are taken against it."),
-    times: str = typer.Option("10,25,end", help="Comma-separated times in seconds for the tables at selected times "
-                                                "(the nearest recorded times; 'end' is the final time)."),
+    times: Optional[str] = typer.Option(None, help="Comma-separated times in seconds for the tables at selected "
+                                                   "times (the nearest recorded times; 'end' is the final time; a time "
+                                                   "outside the flight is refused). Default: 10,25,end, where 10 and 25 "
+                                                   "beyond a shorter flight are its end."),
     write_baseline: Optional[Path] = typer.Option(None, help="Also write the first file's statistics to this "
                                                              "JSON file, the baseline of `uqflight check`."),
     method: List[str] = typer.Option([], metavar="KIND[:ORDER]", help="KIND[:ORDER], repeatable: analyse every file with each method "
@@ -403,11 +440,12 @@ def report(
     plots/*.png, report.html (self-contained, plots embedded) and report.md (linking plots/).
     The report is written to a temporary folder and moved into place when complete.
     """
-    from .report import default_out_dir, parse_methods, write_report
+    from .report import DEFAULT_TIMES, default_out_dir, parse_methods, write_report
     from .statistics import BadInput
 
     try:
-        selected = [float("inf") if t.strip() == "end" else float(t) for t in times.split(",")]
+        selected = (list(DEFAULT_TIMES) if times is None else
+                    [float("inf") if t.strip() == "end" else float(t) for t in times.split(",")])
     except ValueError:
         raise typer.BadParameter(f"expected comma-separated seconds or 'end', got {times!r}", param_hint="--times")
     if order is not None and order < 0:
@@ -425,6 +463,8 @@ def report(
         check_output(out, "--out", folder=True, create=True)
     if write_baseline:
         check_output(write_baseline, "--write-baseline")
+    if times is not None:
+        _check_times(times, selected, results)
     try:
         with _status("report") as tell:
             written = write_report(results, out, reference=reference, times=selected, baseline=write_baseline,
@@ -443,6 +483,26 @@ def report(
     echo(f"wrote {len(in_report)} files to {out}: open {out / 'report.html'}")
     if write_baseline:
         echo(f"wrote baseline {write_baseline}")
+
+
+def _check_times(text: str, selected: list[float], results: list[Path]) -> None:
+    """Exit 2 naming --times and the flight's time range when a time lies outside a file's recorded
+    times (more than half a recording step); 'end' is always inside. An unreadable file is the
+    report's to refuse."""
+    from .store import ResultStore
+
+    for path in results:
+        try:
+            with ResultStore.open(path) as store:
+                time = store.time
+        except (OSError, KeyError, ValueError):
+            continue
+        half = (time[-1] - time[0]) / max(len(time) - 1, 1) / 2
+        outside = [t for t in selected if np.isfinite(t) and not time[0] - half <= t <= time[-1] + half]
+        if outside:
+            echo(f"error: --times {text}: {', '.join(f'{t:g}' for t in outside)} s outside the flight of {path}, "
+                 f"which records {time[0]:g} to {time[-1]:g} s; choose times in that range or 'end'", err=True)
+            raise typer.Exit(2)
 
 
 class _status:
@@ -475,28 +535,36 @@ class _status:
 
 @app.command()
 def design(
-    campaign: Path = typer.Argument(..., metavar="CAMPAIGN", help="Campaign YAML file."),
-    csv_path: Path = typer.Option(..., "--csv", help="Write the design to this CSV file: one row per run, columns "
-                                                     "xi_<name> (standard variables), <name> (physical values "
-                                                     "kappa) and weight."),
+    campaign_file: Path = typer.Argument(..., metavar="CAMPAIGN", help="Campaign YAML file."),
+    csv_path: Optional[Path] = typer.Option(None, "--csv", help="Write the design to this CSV file instead of "
+                                            "standard output ('-': standard output): one row per run, columns "
+                                            "run, xi_<name> (standard variables), <name> (physical values "
+                                            "kappa) and weight."),
 ):
-    """Write a campaign's design (the points and weights the runs would use) as CSV, without running it."""
-    check_output(csv_path, "--csv")
-    spec = _load(campaign)
-    points = spec.design()
-    kappa = spec.to_physical(points.xi)
-    names = [p.name for p in spec.parameters]
-    try:
-        with open(csv_path, "w", newline="") as fh:
-            writer = csv.writer(fh)
-            writer.writerow(["run", *(f"xi_{n}" for n in names), *names, "weight"])
-            for j, (x, k, w) in enumerate(zip(points.xi, kappa, points.weights)):
-                writer.writerow([j, *map(repr, map(float, x)), *map(repr, map(float, k)), repr(float(w))])
-    except OSError as exc:
-        echo(f"error: cannot write {csv_path}: {exc.strerror}", err=True)
-        raise typer.Exit(2)
-    echo(f"wrote {csv_path}: {len(points.xi)} points of a {points.kind} design in {len(names)} parameters "
-         f"({', '.join(names)})")
+    """Print a campaign's design (the points and weights the runs would use) as CSV, without running it."""
+    to_stdout = csv_path is None or str(csv_path) == "-"
+    if not to_stdout:
+        check_output(csv_path, "--csv")
+    campaign = _load(campaign_file)
+    points = campaign.design()
+    kappa = campaign.to_physical(points.xi)
+    names = [p.name for p in campaign.parameters]
+    rows = [["run", *(f"xi_{n}" for n in names), *names, "weight"]]
+    rows += [[j, *map(repr, map(float, x)), *map(repr, map(float, k)), repr(float(w))]
+             for j, (x, k, w) in enumerate(zip(points.xi, kappa, points.weights))]
+    if to_stdout:  # through echo: a closed pipe (`| head`) ends quietly
+        text = io.StringIO()
+        csv.writer(text, lineterminator="\n").writerows(rows)
+        echo(text.getvalue(), nl=False)
+    else:
+        try:
+            with open(csv_path, "w", newline="") as fh:
+                csv.writer(fh).writerows(rows)
+        except OSError as exc:
+            echo(f"error: cannot write {csv_path}: {exc.strerror}", err=True)
+            raise typer.Exit(2)
+    echo(f"wrote {'the design' if to_stdout else csv_path}: {len(points.xi)} points of a {points.kind} design in "
+         f"{len(names)} parameters ({', '.join(names)})", err=to_stdout)
 
 
 @surrogate_app.command("export")
@@ -529,7 +597,7 @@ def surrogate_export(
 
 
 def parse_method_option(method: str | None) -> dict | None:
-    from .report.loading import parse_methods
+    from .methods.parsing import parse_methods
 
     return parse_methods([method])[0] if method else None
 

@@ -51,11 +51,11 @@ from .designs import Design
 from .parameters import seed_names
 from .store import ResultStore, Status, compact, open_for_campaign
 from .store.lock import LockHeld, ResultsLock
-from .worker import WorkerSpec
+from .worker import NominalFlight, WorkerSpec
 
 DEFAULT_TIMEOUT_FLOOR_S = 60.0   # default timeout: max(this, TIMEOUT_FLIGHTS x one nominal flight)
 TIMEOUT_FLIGHTS = 50
-PROBE_TIMEOUT_S = 600.0          # the nominal flight that measures the cost (no limit known yet)
+NOMINAL_TIMEOUT_S = 600.0          # the nominal flight that measures the cost (no limit known yet)
 STARTUP_GRACE_S = 60.0           # a chunk's limit before its first sample (worker start, simulator build)
 SPACE_MARGIN_BYTES = 1 << 20     # free space kept beyond a batch's estimate (HDF5 metadata)
 TAPER = 4                        # the design's last TAPER chunks are flown in chunks TAPER times smaller
@@ -108,19 +108,18 @@ def versions() -> dict[str, str]:
     return found
 
 
-def prepare_store(campaign: Campaign, design: Design, out: Path, force: bool, probed=None,
+def prepare_store(campaign: Campaign, design: Design, out: Path, force: bool, nominal=None,
                   restart: bool = False) -> ResultStore:
     """Open the campaign's results file to resume it, or create it with the design and provenance.
-    `probed` = (time, outputs, units, seconds, trim repeatability) from a worker (`WorkerPool.probe`);
+    `nominal`: the NominalFlight a worker measured (`WorkerPool.nominal_flight`);
     measured here in a worker process when not given."""
     kappa = campaign.to_physical(design.xi)
-    if probed is None:
-        pool = WorkerPool(worker_spec(campaign), 1, PROBE_TIMEOUT_S)
+    if nominal is None:
+        pool = WorkerPool(worker_spec(campaign), 1, NOMINAL_TIMEOUT_S)
         try:
-            probed = pool.probe(nominal_kappa(campaign))
+            nominal = pool.nominal_flight(nominal_kappa(campaign))
         finally:
             pool.close()
-    time_grid, outputs, units, _, repeatability = probed
     attrs = {"versions": json.dumps(versions()), "campaign_name": campaign.name,
              "campaign_path": str(Path(campaign.source).resolve()), "parameters": parameters_attribute(campaign),
              "method": json.dumps(campaign.method), "germs": json.dumps(campaign.germs),
@@ -138,9 +137,10 @@ def prepare_store(campaign: Campaign, design: Design, out: Path, force: bool, pr
     out.parent.mkdir(parents=True, exist_ok=True)
     return open_for_campaign(
         out, campaign_text=campaign.text, force=force, restart=restart, xi=design.xi, kappa=kappa, weights=design.weights,
-        parameter_names=[p.name for p in campaign.parameters], outputs=outputs, time=time_grid,
-        raw=campaign.storage["raw"], tsvd=campaign.storage.get("tsvd"), attrs=attrs, units=units,
-        batch_rows=campaign.execution["chunk"], repeatability=repeatability, quantities=list(campaign.quantities))
+        parameter_names=[p.name for p in campaign.parameters], outputs=nominal.outputs, time=nominal.time,
+        raw=campaign.storage["raw"], tsvd=campaign.storage.get("tsvd"), attrs=attrs, units=nominal.units,
+        batch_rows=campaign.execution["chunk"], resolution=nominal.resolution,
+        quantities=list(campaign.quantities))
 
 
 def nominal_kappa(campaign: Campaign) -> np.ndarray:
@@ -251,11 +251,11 @@ def run_campaign(campaign: Campaign, out: Path | None = None, workers: int | Non
     pool = None
     try:
         pool = WorkerPool(spec, workers if executor == "local" else 1,
-                          execution.get("timeout_s") or PROBE_TIMEOUT_S)
-        pool.start_probe(nominal_kappa(campaign))
+                          execution.get("timeout_s") or NOMINAL_TIMEOUT_S)
+        pool.start_warmup(nominal_kappa(campaign))
         design = campaign.design()  # built while the workers start
-        probed = pool.probe_answer()
-        seconds = probed[3]
+        nominal = pool.warmup_result()
+        seconds = nominal.seconds
         timeout = execution.get("timeout_s") or default_timeout(seconds)
         pool.timeout = timeout
         # One BLAS thread here, for the folds on opening too: the workers keep every core busy, a
@@ -263,7 +263,7 @@ def run_campaign(campaign: Campaign, out: Path | None = None, workers: int | Non
         # depend on where a resume starts (the same limit for every fold makes them bit-identical).
         with threadpool_limits(limits=1):
             try:
-                store = prepare_store(campaign, design, out, force, probed=probed, restart=restart)
+                store = prepare_store(campaign, design, out, force, nominal=nominal, restart=restart)
             except (OSError, RuntimeError) as exc:
                 if is_disk_full(exc) and not isinstance(exc, FileExistsError):
                     raise DiskFull(errno.ENOSPC, disk_full_message(out, 0)) from exc
@@ -449,27 +449,27 @@ class WorkerPool:
         self.spec, self.workers, self.timeout = spec, max(1, int(workers)), float(timeout)
         self.slots: list[WorkerProcess] = []
 
-    def probe(self, kappa: np.ndarray):
-        """(time, outputs, units, seconds of a nominal flight, trim repeatability or None), from a worker:
-        `start_probe`, then `probe_answer`."""
-        self.start_probe(kappa)
-        return self.probe_answer()
+    def nominal_flight(self, kappa: np.ndarray) -> NominalFlight:
+        """The NominalFlight at `kappa` (worker.nominal_flight), from a worker:
+        `start_warmup`, then `warmup_result`."""
+        self.start_warmup(kappa)
+        return self.warmup_result()
 
-    def start_probe(self, kappa: np.ndarray) -> None:
+    def start_warmup(self, kappa: np.ndarray) -> None:
         """Start every worker of the pool and ask each to fly the nominal `kappa`, so that all are warm
         (imports, aircraft, the Newton trim's nominal) when the chunks start. Returns at once: the
-        caller may work meanwhile, then call `probe_answer`."""
+        caller may work meanwhile, then call `warmup_result`."""
         slot = self._slot()
         while len(self.slots) < self.workers:
             self.slots.append(WorkerProcess())
         for other in self.slots[1:]:  # a warm-up only: the trims' drift is measured once, by the first
-            if not other.send(("probe", self.spec, kappa, False)):
+            if not other.send(("nominal", self.spec, kappa, False)):
                 self._drop(other)
-        if not slot.send(("probe", self.spec, kappa)):
+        if not slot.send(("nominal", self.spec, kappa)):
             raise WorkerError(death_reason(self._drop(slot)))
 
-    def probe_answer(self):
-        """The first worker's answer to `start_probe`. The others' answers are not awaited: `run`
+    def warmup_result(self) -> NominalFlight:
+        """The first worker's answer to `start_warmup`. The others' answers are not awaited: `run`
         reads them before their workers' first chunk, so that no worker waits for the slowest start."""
         slot = self.slots[0]
         limit = self.timeout + STARTUP_GRACE_S  # the worker starts, imports and builds its simulator first
@@ -481,7 +481,7 @@ class WorkerPool:
             kind, payload = slot.conn.recv()
         except (EOFError, OSError):
             raise WorkerError(death_reason(self._drop(slot)) + " during the nominal flight") from None
-        if kind != "probe":
+        if kind != "nominal":
             raise WorkerError(str(payload))
         return payload
 
@@ -520,7 +520,7 @@ class WorkerPool:
                         break
                     if kind == "start":
                         slot.row, slot.since = payload, time.monotonic()
-                    elif kind == "probe":  # the warm-up `start_probe` asked for
+                    elif kind == "nominal":  # the warm-up `start_warmup` asked for
                         pass
                     elif kind == "done":
                         task = slot.task

@@ -336,8 +336,8 @@ def _output_statistics(store: ResultStore, name: str, method: dict, germs: list[
                                len(store.parameter_names) if pick_freeze else 0, options, from_runs)
     magnitude = np.max(np.sqrt(mean**2 + np.maximum(variance, 0.0)))  # the output's own size over its history
     rtol = JSBSIM_RESOLUTION if "aircraft_hash" in store.attrs else RESOLUTION_RTOL
-    repeatability = store.resolution(name)  # the simulator's own resolution: its two valid trims' drift
-    atol = truncation if repeatability is None else np.maximum(truncation, repeatability)
+    resolution = store.resolution(name)  # the simulator's own resolution: its two valid trims' drift
+    atol = truncation if resolution is None else np.maximum(truncation, resolution)
     resolved = resolved_variance(variance, mean, scale=magnitude, rtol=rtol, n=int(ok.sum()),
                                  weights=None if from_runs else weights, atol=atol)
     stats = OutputStatistics(name, store.units.get(name, ""), store.time, mean, variance, blocks["band"],

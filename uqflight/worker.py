@@ -107,13 +107,24 @@ def run_chunk(spec: WorkerSpec, indices: np.ndarray, kappa: np.ndarray, n_times:
     return indices, status, reasons, values
 
 
-def probe(spec: WorkerSpec, kappa: np.ndarray, resolution: bool = True):
-    """(time, output names, units, seconds of one flight at `kappa`, the simulator's trim repeatability
-    at `kappa` or None): what the runner needs to create the results file and derive the default per-run
-    time limit, measured here, not in the runner. `resolution` false: no repeatability (None), for a
-    worker that only warms up."""
+@dataclass(frozen=True)
+class NominalFlight:
+    """What the runner needs to create the results file and derive the default per-run time limit,
+    measured in a worker: the recorded times, the output names and units, the seconds one flight at the
+    nominal took, and the simulator's resolution there ({output: (T,)}, or None)."""
+
+    time: np.ndarray
+    outputs: list[str]
+    units: dict[str, str]
+    seconds: float
+    resolution: dict[str, np.ndarray] | None
+
+
+def nominal_flight(spec: WorkerSpec, kappa: np.ndarray, measure_resolution: bool = True) -> NominalFlight:
+    """The nominal flight at `kappa`, measured here, not in the runner. `measure_resolution` false: no
+    resolution (None), for a worker that only warms up."""
     simulator = spec.build()
-    time_grid, outputs = simulator.probe(kappa)
+    time_grid, outputs = simulator.layout(kappa)
     observers = (QuantityRecorder(spec.quantities, simulator.source),) if spec.quantities else ()
     started = time.perf_counter()
     try:  # with the quantities: a linearisation costs more than the flight (5 s for bacm's two turboprops)
@@ -122,9 +133,9 @@ def probe(spec: WorkerSpec, kappa: np.ndarray, resolution: bool = True):
         raise nominal_failed(spec.parameter_names, kappa, exc, "fly them with `uqflight simulate`, its --set and "
                                                               "the campaign's flight") from exc
     seconds = time.perf_counter() - started
-    repeatability = getattr(simulator, "trim_repeatability", None)
-    return (np.asarray(time_grid, dtype=float), list(outputs), dict(getattr(simulator, "units", {}) or {}), seconds,
-            repeatability(kappa, flown) if resolution and repeatability else None)
+    resolution = getattr(simulator, "resolution", None)
+    return NominalFlight(np.asarray(time_grid, dtype=float), list(outputs), dict(getattr(simulator, "units", {}) or {}),
+                         seconds, resolution(kappa, flown) if measure_resolution and resolution else None)
 
 
 def _die_with_parent(parent: int) -> None:
@@ -169,8 +180,8 @@ def main(argv=None) -> None:
             if kind == "chunk":
                 result = run_chunk(*args, on_start=lambda row: conn.send(("start", row)))
                 conn.send(("done", result))
-            elif kind == "probe":
-                conn.send(("probe", probe(*args)))
+            elif kind == "nominal":
+                conn.send(("nominal", nominal_flight(*args)))
             else:
                 conn.send(("error", f"unknown request {kind!r}"))
         except (BrokenPipeError, ConnectionResetError):
@@ -181,5 +192,7 @@ def main(argv=None) -> None:
             conn.send(("error", f"{type(exc).__name__}: {exc}"))
 
 
-if __name__ == "__main__":
-    main()
+if __name__ == "__main__":  # `python -m uqflight.worker`: the imported module's main, so that the
+    from uqflight.worker import main as serve  # records it sends pickle as uqflight.worker.NominalFlight
+
+    serve()

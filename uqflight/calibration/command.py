@@ -31,8 +31,9 @@ def calibrate_command(
     walkers: Optional[int] = typer.Option(None, help="Ensemble walkers (even, >= 2 x dimensions; default "
                                                      "max(32, 2 x dimensions + 2))."),
     steps: int = typer.Option(6000, help="Steps per walker; the first half is burn-in."),
-    method: Optional[str] = typer.Option(None, help="Surrogate method (default: the results file's): "
-                                                    "pseudo_galerkin, least_squares, regression, ..."),
+    method: Optional[str] = typer.Option(None, metavar="KIND[:ORDER]", help="Surrogate method (default: the "
+                                         "results file's), as report and surrogate export take it: "
+                                         "pseudo_galerkin, least_squares:3, regression, ..."),
     order: Optional[int] = typer.Option(None, help="Total degree of the surrogate PCE (default: the file's)."),
     campaign: Optional[Path] = typer.Option(None, help="The campaign file, when the one stored in the results "
                                                        "file cannot be rebuilt (a python model file elsewhere)."),
@@ -55,6 +56,8 @@ def calibrate_command(
     if order is not None and order < 0:
         echo(f"error: --order: expected an integer >= 0, got {order}", err=True)
         raise typer.Exit(EXIT_BAD_INPUT)
+    if method is not None:
+        method, order = _method(method, order)
     if predictive_draws < 1:
         echo(f"error: --predictive-draws: expected an integer >= 1, got {predictive_draws}", err=True)
         raise typer.Exit(EXIT_BAD_INPUT)
@@ -107,6 +110,21 @@ def calibrate_command(
     echo(f"posterior predictive ({pred['draws']} simulator runs, {pred['failed']} failed): data inside the "
          f"95 % band: {cover}")
     echo(f"wrote {', '.join(result.written)} to {out} ({summary['seconds']['total']:.1f} s)")
+
+
+def _method(text: str, order: int | None) -> tuple[str, int | None]:
+    """--method KIND[:ORDER] (the report's parser) and --order into (kind, order); exit 2 naming the option."""
+    from ..methods.parsing import parse_methods
+
+    try:
+        parsed = parse_methods([text])[0]
+    except ValueError as exc:
+        echo(f"error: --method: {exc}", err=True)
+        raise typer.Exit(EXIT_BAD_INPUT)
+    if order is not None and parsed.get("order", order) != order:
+        echo(f"error: --method {text} and --order {order} give two orders: give one", err=True)
+        raise typer.Exit(EXIT_BAD_INPUT)
+    return parsed["kind"], parsed.get("order", order)
 
 
 def _interrupted(signum, frame):

@@ -63,79 +63,148 @@ def calibrate(results, data, out, outputs: list[str] | None = None, noise: list[
 
 def _calibrate(results, data, out, outputs, noise, seed, walkers, steps, method, order, campaign,
                predictive_draws, truth, progress) -> Calibration:
+    """The steps of `calibrate`: fit, sample (and refine), summarise, write."""
     started = clock.perf_counter()
     out = Path(out)
-    surrogate = fit_surrogate(results, method=method, order=order, campaign_path=campaign)
-    flight = read_flight_csv(data, outputs, surrogate.outputs)
-    given = parse_noise(list(noise), list(flight.values))
-    names, germs = surrogate.names, surrogate.germs
-    posterior = LogPosterior.build(surrogate.time, surrogate.coefficients, surrogate.error_factors, germs,
-                                   names, surrogate.basis, flight, given)
+    surrogate, flight, given, posterior = _fitted(results, data, outputs, noise, method, order, campaign)
     walkers = walkers or max(32, 2 * posterior.ndim + 2)
     if steps < 100:
         raise ValueError(f"--steps: expected at least 100, got {steps}")
     fitted = clock.perf_counter()
+    sampling = Sampling(surrogate, flight, given, walkers, steps, seed, out, progress)
+    chain, posterior, predictive, check = sampling.run(posterior, predictive_draws)
+    draws, pick, sim_time, runs, failures, ok, _ = predictive
+    sampled = sampling.first_sampled
+    xi = draws[:, :len(surrogate.names)]
+    kappa = to_physical(surrogate.parameters, xi, surrogate.campaign.dependence)
+    sigmas = posterior.sigmas(draws)
+    specs = parameter_specs(surrogate.campaign)
+    prior = prior_summaries(surrogate.parameters)
+    post = {name: marginal(kappa[:, k]) for k, name in enumerate(surrogate.names)}
+    correlation = _correlation(kappa)
+    parameters = _parameter_summaries(surrogate.names, specs, prior, post, xi, truth)
+    at_data, band, coverage = _predictive_band(flight, runs, ok, sim_time, sigmas, pick, sampling.rng)
+    predicted = clock.perf_counter()
+    summary = {
+        "results": str(results), "data": str(data), "campaign": surrogate.campaign.name,
+        "seed": seed,
+        "surrogate": {**surrogate.method, "runs": surrogate.runs, "time_handling": TIME_HANDLING,
+                      "error": "mean square leave-one-out residual of the weighted least-squares fit of the same "
+                               "basis (or the surrogate's own misfit at the runs, if larger), per output and time, "
+                               "added to the noise variance"},
+        "noise_model": NOISE_PRIOR,
+        "noise": _noise_summary(flight, posterior, surrogate, given, sigmas),
+        "parameters": parameters,
+        "correlation": {"names": surrogate.names, "matrix": correlation},
+        "diagnostics": chain.diagnostics,
+        "surrogate_check": check,
+        "predictive": {"draws": int(len(pick)), "failed": int((~ok).sum()), "failures": failures,
+                       "coverage95": coverage,
+                       "band": "2.5 % and 97.5 % quantiles of simulator runs + noise draws at the data times"},
+        "seconds": {"surrogate": fitted - started, "first_sampling": sampled - fitted,
+                    "predictive_and_refinement": predicted - sampled},
+    }
+    posterior_draws = PosteriorDraws(xi, kappa, np.column_stack([sigmas[o] for o in flight.values]),
+                                     chain.log_prob[chain.burn:].T.reshape(-1), post, prior, specs, correlation)
+    _write_outputs(out, results, data, seed, surrogate, flight, posterior, chain, posterior_draws, truth,
+                   sampling, at_data, band, int((~ok).sum()), summary, started)
+    return Calibration(out, summary, list(OUTPUT_FILES))
 
-    def prior_draw(rng, n):
+
+def _fitted(results, data, outputs, noise, method, order, campaign):
+    """The surrogate of `results`, the flight data, the given noise and the log-posterior."""
+    surrogate = fit_surrogate(results, method=method, order=order, campaign_path=campaign)
+    flight = read_flight_csv(data, outputs, surrogate.outputs)
+    given = parse_noise(list(noise), list(flight.values))
+    posterior = LogPosterior.build(surrogate.time, surrogate.coefficients, surrogate.error_factors,
+                                   surrogate.germs, surrogate.names, surrogate.basis, flight, given)
+    return surrogate, flight, given, posterior
+
+
+@dataclass
+class Sampling:
+    """The sampling step: the chain, its convergence rule, the predictive runs at its draws and, when
+    the surrogate's error measured there exceeds the assumed one, the error model refined and the
+    posterior sampled again. `rng` (seed + 1) picks the predictive draws, then the band's noise."""
+
+    surrogate: object
+    flight: object
+    given: dict
+    walkers: int
+    steps: int
+    seed: int
+    out: Path
+    progress: bool
+    first_sampled: float = 0.0
+
+    def __post_init__(self):
+        self.rng = np.random.default_rng(self.seed + 1)
+
+    def prior_draw(self, posterior, rng, n):
+        """`n` draws of the prior in ξ, the noise parameters at their start."""
+        germs = self.surrogate.germs
         xi = np.column_stack([GERMS[g].sample(rng, n) for g in germs])
         rest = np.tile(posterior.start()[len(germs):], (n, 1))
         return np.hstack([xi, rest])
 
-    def converged(chain):
-        if not chain.diagnostics["converged"]:
-            kept = chain.kept.reshape(-1, chain.kept.shape[2])
-            for j, term in enumerate(posterior.inferred):
-                sigma = float(np.exp(np.median(kept[:, len(germs) + j])))
-                if sigma < NOISE_FREE * term.scale:
-                    chain.diagnostics["problems"].append(
-                        f"the inferred noise of {term.name} is {sigma:.2g}, {sigma / term.scale:.1g} of the data's "
-                        f"scale: are the data noise-free (simulated)? Then the posterior is limited only by the "
-                        f"surrogate's error and hard to sample: give the measurement noise, --noise {term.name}=SIGMA")
-            removed = []
-            for name in OUTPUT_FILES:  # outputs of an earlier run in DIR would look like this run's
-                if (out / name).is_file():
-                    (out / name).unlink()
-                    removed.append(name)
-            raise NotConverged(chain.diagnostics, removed)
-        return chain
+    def chain(self, posterior, seed):
+        """A converged chain of `posterior`, or NotConverged (with a hint for noise-free data)."""
+        chain = sample(posterior, posterior.ndim, posterior.labels, posterior.start(),
+                       lambda rng, n: self.prior_draw(posterior, rng, n), self.walkers, self.steps, seed,
+                       progress=self.progress)
+        if chain.diagnostics["converged"]:
+            return chain
+        germs = self.surrogate.germs
+        kept = chain.kept.reshape(-1, chain.kept.shape[2])
+        for j, term in enumerate(posterior.inferred):
+            sigma = float(np.exp(np.median(kept[:, len(germs) + j])))
+            if sigma < NOISE_FREE * term.scale:
+                chain.diagnostics["problems"].append(
+                    f"the inferred noise of {term.name} is {sigma:.2g}, {sigma / term.scale:.1g} of the data's "
+                    f"scale: are the data noise-free (simulated)? Then the posterior is limited only by the "
+                    f"surrogate's error and hard to sample: give the measurement noise, --noise {term.name}=SIGMA")
+        removed = []
+        for name in OUTPUT_FILES:  # outputs of an earlier run in DIR would look like this run's
+            if (self.out / name).is_file():
+                (self.out / name).unlink()
+                removed.append(name)
+        raise NotConverged(chain.diagnostics, removed)
 
-    chain = converged(sample(posterior, posterior.ndim, posterior.labels, posterior.start(), prior_draw, walkers,
-                             steps, seed, progress=progress))
-    sampled = clock.perf_counter()
-    d = len(names)
-    rng = np.random.default_rng(seed + 1)
-    draws, pick, sim_time, runs, failures, ok, errors = _predictive(chain, posterior, surrogate, flight, rng,
-                                                                    predictive_draws)
-    # The surrogate's error measured where the posterior is (the real simulator at its draws): when it
-    # is larger than the error model assumed and not negligible against the noise, it joins the error
-    # model (as curves over time) and the posterior is sampled again.
-    check = _surrogate_check(posterior, errors, draws[pick][ok])
-    if check["refine"]:
-        extra = {o: _full_rows(flight.values[o], errors[o].T / math.sqrt(errors[o].shape[0])) for o in errors}
-        posterior = LogPosterior.build(surrogate.time, surrogate.coefficients, surrogate.error_factors, germs,
-                                       names, surrogate.basis, flight, given, extra_error=extra)
-        chain = converged(sample(posterior, posterior.ndim, posterior.labels, posterior.start(), prior_draw,
-                                 walkers, steps, seed + 1, progress=progress))
-        draws, pick, sim_time, runs, failures, ok, errors = _predictive(chain, posterior, surrogate, flight, rng,
-                                                                        predictive_draws)
-        check = {**_surrogate_check(posterior, errors, draws[pick][ok]), "refined": True,
-                 "first_pass": {k: v for k, v in check.items() if k != "refine"}}
-    else:
-        check["refined"] = False
-    check.pop("refine")
-    diagnostics = chain.diagnostics
-    log_prob = chain.log_prob[chain.burn:].T.reshape(-1)
-    xi = draws[:, :d]
-    dependence = surrogate.campaign.dependence
-    kappa = to_physical(surrogate.parameters, xi, dependence)
-    sigmas = posterior.sigmas(draws)
-    sigma_matrix = np.column_stack([sigmas[o] for o in flight.values])
+    def run(self, posterior, predictive_draws: int):
+        """(chain, posterior, the _predictive tuple, surrogate_check) after sampling and any refinement."""
+        surrogate, flight = self.surrogate, self.flight
+        chain = self.chain(posterior, self.seed)
+        self.first_sampled = clock.perf_counter()
+        predictive = _predictive(chain, posterior, surrogate, flight, self.rng, predictive_draws)
+        draws, pick, _, _, _, ok, errors = predictive
+        # The surrogate's error measured where the posterior is (the real simulator at its draws): when it
+        # is larger than the error model assumed and not negligible against the noise, it joins the error
+        # model (as curves over time) and the posterior is sampled again.
+        check = _surrogate_check(posterior, errors, draws[pick][ok])
+        if check["refine"]:
+            extra = {o: _full_rows(flight.values[o], errors[o].T / math.sqrt(errors[o].shape[0])) for o in errors}
+            posterior = LogPosterior.build(surrogate.time, surrogate.coefficients, surrogate.error_factors,
+                                           surrogate.germs, surrogate.names, surrogate.basis, flight, self.given,
+                                           extra_error=extra)
+            chain = self.chain(posterior, self.seed + 1)
+            predictive = _predictive(chain, posterior, surrogate, flight, self.rng, predictive_draws)
+            draws, pick, _, _, _, ok, errors = predictive
+            check = {**_surrogate_check(posterior, errors, draws[pick][ok]), "refined": True,
+                     "first_pass": {k: v for k, v in check.items() if k != "refine"}}
+        else:
+            check["refined"] = False
+        check.pop("refine")
+        return chain, posterior, predictive, check
 
-    specs = parameter_specs(surrogate.campaign)
-    prior = prior_summaries(surrogate.parameters)
-    post = {name: marginal(kappa[:, k]) for k, name in enumerate(names)}
+
+def _correlation(kappa: np.ndarray) -> np.ndarray:
+    """The posterior correlation matrix of the parameters (1 for a single one)."""
     with np.errstate(invalid="ignore", divide="ignore"):
-        correlation = np.corrcoef(kappa, rowvar=False) if d > 1 else np.ones((1, 1))
+        return np.corrcoef(kappa, rowvar=False) if kappa.shape[1] > 1 else np.ones((1, 1))
+
+
+def _parameter_summaries(names, specs, prior, post, xi, truth) -> dict:
+    """summary.json's `parameters`: prior and posterior per parameter, the narrowing, and the truth when given."""
     parameters = {}
     for k, name in enumerate(names):
         ratio = post[name]["std"] / prior[name]["std"] if prior[name]["std"] > 0 else float("nan")
@@ -149,7 +218,12 @@ def _calibrate(results, data, out, outputs, noise, seed, walkers, steps, method,
             t = float(truth[name])
             parameters[name]["truth"] = t
             parameters[name]["truth_in_ci95"] = bool(post[name]["ci95"][0] <= t <= post[name]["ci95"][1])
+    return parameters
 
+
+def _predictive_band(flight, runs, ok, sim_time, sigmas, pick, rng):
+    """Per output: the predictive runs at the data times, the 95 % band of runs + noise, and the share
+    of the data inside it (None without a successful run)."""
     at_data, band, coverage = {}, {}, {}
     for o in flight.values:
         at_data[o] = interpolate_in_time(runs[o][ok], sim_time, flight.time)
@@ -161,8 +235,11 @@ def _calibrate(results, data, out, outputs, noise, seed, walkers, steps, method,
         present = np.isfinite(y)
         coverage[o] = float(np.mean((y[present] >= lower[present]) & (y[present] <= upper[present]))) if ok.any() \
             else None
-    predicted = clock.perf_counter()
+    return at_data, band, coverage
 
+
+def _noise_summary(flight, posterior, surrogate, given, sigmas) -> dict:
+    """summary.json's `noise`: given or inferred per output, with the surrogate's error there."""
     noise_summary = {}
     for j, o in enumerate(flight.values):
         term = posterior.terms[j]
@@ -175,52 +252,55 @@ def _calibrate(results, data, out, outputs, noise, seed, walkers, steps, method,
                                 "median": float(np.median(resolved)) if resolved.size else None,
                                 "max": float(np.max(resolved)) if resolved.size else None},
                             "data_points": int(term.y.size)}
-    summary = {
-        "results": str(results), "data": str(data), "campaign": surrogate.campaign.name,
-        "seed": seed,
-        "surrogate": {**surrogate.method, "runs": surrogate.runs, "time_handling": TIME_HANDLING,
-                      "error": "mean square leave-one-out residual of the weighted least-squares fit of the same "
-                               "basis (or the surrogate's own misfit at the runs, if larger), per output and time, "
-                               "added to the noise variance"},
-        "noise_model": NOISE_PRIOR,
-        "noise": noise_summary,
-        "parameters": parameters,
-        "correlation": {"names": names, "matrix": correlation},
-        "diagnostics": diagnostics,
-        "surrogate_check": check,
-        "predictive": {"draws": int(len(pick)), "failed": int((~ok).sum()), "failures": failures,
-                       "coverage95": coverage,
-                       "band": "2.5 % and 97.5 % quantiles of simulator runs + noise draws at the data times"},
-        "seconds": {"surrogate": fitted - started, "first_sampling": sampled - fitted,
-                    "predictive_and_refinement": predicted - sampled},
-    }
+    return noise_summary
 
-    # write into a scratch folder first, then move: an interrupted run leaves no half set of outputs
+
+@dataclass
+class PosteriorDraws:
+    """The kept draws in ξ and κ, the noise σ per output (columns), their log-probabilities, and the
+    marginal summaries, parameter specs and correlation the outputs are written from."""
+
+    xi: np.ndarray
+    kappa: np.ndarray
+    sigma: np.ndarray
+    log_prob: np.ndarray
+    post: dict
+    prior: dict
+    specs: dict
+    correlation: np.ndarray
+
+
+def _write_outputs(out, results, data, seed, surrogate, flight, posterior, chain, draws: PosteriorDraws, truth,
+                   sampling: Sampling, at_data, band, failed: int, summary: dict, started: float) -> None:
+    """posterior.h5, calibrated.yaml, the plots and summary.json, written into a scratch folder first,
+    then moved: an interrupted run leaves no half set of outputs."""
+    names, specs = surrogate.names, draws.specs
     out.mkdir(parents=True, exist_ok=True)
     scratch = Path(tempfile.mkdtemp(prefix=".calibrate-", dir=out))
     try:
         (scratch / "plots").mkdir()
         attrs = {"results": str(results), "data": str(data), "campaign": surrogate.campaign.text,
                  "seed": seed, "labels": json.dumps(posterior.labels)}
-        write_posterior(scratch / "posterior.h5", names, [specs[n]["property"] for n in names], xi, kappa,
-                        list(flight.values), sigma_matrix, log_prob, chain.samples, posterior.labels, chain.burn, attrs)
+        write_posterior(scratch / "posterior.h5", names, [specs[n]["property"] for n in names], draws.xi, draws.kappa,
+                        list(flight.values), draws.sigma, draws.log_prob, chain.samples, posterior.labels, chain.burn,
+                        attrs)
         function_path = None
         sim = surrogate.campaign.simulator
         if sim["kind"] == "python" and ".py:" in sim["function"]:
             file, _, attr = sim["function"].rpartition(":")
             function_path = f"{(campaign_folder(surrogate.campaign) / file).resolve()}:{attr}"
-        scores = normal_scores(surrogate.parameters, kappa, post, prior)
-        text = calibrated_campaign(campaign_mapping(surrogate.campaign), specs, post, prior, scores, names,
-                                   function_path, f"{results}, {data}")
+        scores = normal_scores(surrogate.parameters, draws.kappa, draws.post, draws.prior)
+        text = calibrated_campaign(campaign_mapping(surrogate.campaign), specs, draws.post, draws.prior,
+                                   scores, names, function_path, f"{results}, {data}")
         check_campaign_text(text, str(out / "calibrated.yaml"))  # loadable by `uqflight plan`, or a bug here
         (scratch / "calibrated.yaml").write_text(text, encoding="utf-8")
         truth_row = np.array([truth.get(n, np.nan) for n in names]) if truth else None
-        corner_plot(scratch / "plots/corner.png", kappa, names, truth_row)
-        prior_xi = prior_draw(np.random.default_rng(seed + 2), 20000)[:, :d]
-        prior_kappa = to_physical(surrogate.parameters, prior_xi, dependence)
-        marginals_plot(scratch / "plots/marginals.png", prior_kappa, kappa, names, truth_row)
+        corner_plot(scratch / "plots/corner.png", draws.kappa, names, truth_row)
+        prior_xi = sampling.prior_draw(posterior, np.random.default_rng(seed + 2), 20000)[:, :len(names)]
+        prior_kappa = to_physical(surrogate.parameters, prior_xi, surrogate.campaign.dependence)
+        marginals_plot(scratch / "plots/marginals.png", prior_kappa, draws.kappa, names, truth_row)
         predictive_plot(scratch / "plots/predictive.png", flight.time, flight.values, at_data, band,
-                        surrogate.units, int((~ok).sum()))
+                        surrogate.units, failed)
         summary["seconds"]["total"] = clock.perf_counter() - started
         write_json(scratch / "summary.json", summary)
         (out / "plots").mkdir(exist_ok=True)
@@ -228,7 +308,6 @@ def _calibrate(results, data, out, outputs, noise, seed, walkers, steps, method,
             (scratch / name).replace(out / name)
     finally:
         shutil.rmtree(scratch, ignore_errors=True)
-    return Calibration(out, summary, list(OUTPUT_FILES))
 
 
 def normal_scores(parameters, kappa: np.ndarray, post: dict, prior: dict) -> np.ndarray:

@@ -26,7 +26,7 @@ from ..parameters import to_standard as _to_standard
 from ..parameters.germs import GERMS
 from ..simulators import make_simulator
 from ..simulators.base import FlightError
-from ..simulators.jsbsim_probe import jsbsim_probe
+from ..simulators.validation_view import validation_view
 from ..statistics import BadInput, Options, analyse, output_basis
 from ..store import ResultStore, Status
 from .likelihood import error_factors_of
@@ -98,7 +98,7 @@ def to_standard(parameters, kappa, dependence=None) -> np.ndarray:
 
 def load_campaign_file(path) -> Campaign:
     """A campaign file (for --campaign), validated against its aircraft."""
-    return load_campaign(path, probe=jsbsim_probe)
+    return load_campaign(path, view=validation_view)
 
 
 def _campaign_of(store: ResultStore, results: Path, campaign_path: Path | None) -> Campaign:
@@ -196,7 +196,7 @@ def simulate(campaign: Campaign, kappa: np.ndarray, outputs: list[str]):
     names = [p.name for p in campaign.parameters]
     properties = [p.property for p in campaign.parameters]
     simulator = make_simulator(campaign.simulator, names, properties, Path(campaign.source).resolve().parent)
-    time, _ = simulator.probe(np.asarray(kappa)[0])
+    time, _ = simulator.layout(np.asarray(kappa)[0])
     values = {name: np.full((len(kappa), len(time)), np.nan) for name in outputs}
     failures = []
     for row, k in enumerate(np.asarray(kappa, dtype=float)):
@@ -242,4 +242,4 @@ def campaign_folder(campaign: Campaign) -> Path:
 
 def check_campaign_text(text: str, source: str) -> None:
     """Validate campaign text as `uqflight plan` does (CampaignError when it would be refused)."""
-    parse_campaign(text, source, probe=jsbsim_probe)
+    parse_campaign(text, source, view=validation_view)

@@ -22,7 +22,7 @@ from ..simulators.kinds import simulator_entry
 from . import schema
 from .schema import TOP_KEYS, CampaignError, CampaignLoader, Checker, yaml_error
 
-PropertyProbe = Callable[[dict], object]  # simulator config -> its aircraft's properties (see jsbsim_probe)
+ValidationView = Callable[[dict], object]  # simulator config -> its aircraft's properties (see validation_view)
 
 @dataclass
 class Campaign:
@@ -56,11 +56,11 @@ class Campaign:
         return build_design(self.design_spec, self.germs, self.seed)
 
 
-def load_campaign(path: str | Path, probe: PropertyProbe | None = None) -> Campaign:
+def load_campaign(path: str | Path, view: ValidationView | None = None) -> Campaign:
     """Read and validate a campaign file.
 
-    `probe(simulator_config)` gives the aircraft's properties
-    (`uqflight.simulators.jsbsim_probe.jsbsim_probe`); it is used for
+    `view(simulator_config)` gives the aircraft's properties
+    (`uqflight.simulators.validation_view.validation_view`); it is used for
     JSBSim campaigns to check property and output names and to read nominal values from the
     aircraft. Without it, those checks are skipped and nominal values must be given.
     """
@@ -77,19 +77,19 @@ def load_campaign(path: str | Path, probe: PropertyProbe | None = None) -> Campa
     except UnicodeDecodeError as exc:
         raise CampaignError(source, "", f"expected UTF-8 text, got byte {exc.object[exc.start]:#04x} "
                                         f"at position {exc.start}") from exc
-    return parse_campaign(text, source, probe)
+    return parse_campaign(text, source, view)
 
 
-def parse_campaign(text: str, source: str = "<campaign>", probe: PropertyProbe | None = None) -> Campaign:
+def parse_campaign(text: str, source: str = "<campaign>", view: ValidationView | None = None) -> Campaign:
     """Validate campaign text; see `load_campaign`. A python simulator's module is imported (its code
     runs): this is for campaigns about to be planned or run; results are read with
     `campaign.reading.results_campaign`, which never resolves the simulator."""
     check, data, simulator = read_settings(text, source)
     schema.resolve_simulator(check, simulator, source)
     aircraft = None
-    if probe and simulator_entry(simulator).aircraft:
+    if view and simulator_entry(simulator).aircraft:
         try:
-            aircraft = probe(simulator)
+            aircraft = view(simulator)
         except (FileNotFoundError, RuntimeError) as exc:  # no such aircraft, or JSBSim cannot load it
             check.fail("simulator.aircraft", str(exc))
         for i, output in enumerate(simulator.get("outputs", ())):

@@ -90,13 +90,13 @@ def _stored(check: Checker, data: dict, value) -> list[Parameter]:
 def _from_aircraft(check: Checker, data: dict, simulator: dict, attrs: dict) -> list[Parameter]:
     """An older file's parameters with nominal values from its JSBSim aircraft, located from the folder
     of the campaign file the run recorded (`campaign_path`)."""
-    from ..simulators.jsbsim_probe import jsbsim_probe
+    from ..simulators.validation_view import validation_view
 
     recorded = str(attrs.get("campaign_path", "")) or "<results file>"  # no path: the working directory
     simulator = dict(simulator)
     locate_aircraft(check, simulator, str(Path(recorded)))
     try:
-        aircraft = jsbsim_probe(simulator)
+        aircraft = validation_view(simulator)
     except (FileNotFoundError, RuntimeError) as exc:
         check.fail("simulator.aircraft", str(exc))
     return schema.parameters(check, data["parameters"], "jsbsim", aircraft)

@@ -22,7 +22,8 @@ from pathlib import Path
 
 from ..check import write_baseline
 from .files import _write_text, write_csv, write_statistics_tables, write_summaries
-from .loading import Entry, load_entries, parse_methods
+from ..methods.parsing import parse_methods
+from .loading import Entry, load_entries
 from .render import render_html, render_markdown
 from .replace import check_replaceable, make_staging, replace_dir
 from .sections import Table, build_sections, files_section

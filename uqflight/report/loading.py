@@ -75,29 +75,20 @@ def campaign_settings(campaign_text: str) -> dict:
     return data if isinstance(data, dict) else {}
 
 
-def parse_methods(methods: list[str], order: int | None = None) -> list[dict]:
-    """`KIND[:ORDER]` strings into method overrides; a bare KIND takes `order` (when given).
-    ValueError naming the bad item."""
-    from ..methods import METHOD_KINDS
+def flight_facts(simulator: dict) -> dict[str, str]:
+    """What a campaign's simulator flies ({"flight": ..., "excitation": ...}), defaults resolved by its
+    kind (and scenario kind); as written when that fails (a results file of an older version), {} for a
+    python model."""
+    from ..simulators.kinds import REGISTRY
 
-    parsed = []
-    for text in methods:
-        kind, sep, number = text.partition(":")
-        kind = kind.strip()
-        if kind not in METHOD_KINDS:
-            raise ValueError(f"expected KIND[:ORDER] with KIND one of {', '.join(METHOD_KINDS)}, got {text!r}")
-        method = {"kind": kind}
-        if sep:
-            try:
-                method["order"] = int(number)
-            except ValueError:
-                raise ValueError(f"expected an integer ORDER >= 0 after {kind}:, got {text!r}") from None
-            if method["order"] < 0:
-                raise ValueError(f"expected an integer ORDER >= 0 after {kind}:, got {text!r}")
-        elif order is not None:
-            method["order"] = order
-        parsed.append(method)
-    return parsed
+    entry = REGISTRY.get(simulator.get("kind")) if isinstance(simulator, dict) else None
+    if entry is None:
+        return {}
+    try:
+        return entry.facts(simulator)
+    except (TypeError, ValueError, KeyError, AttributeError):
+        return {key: ", ".join(f"{k} {v}" for k, v in value.items()) if isinstance(value, dict) else str(value)
+                for key in ("flight", "excitation") if (value := simulator.get(key)) is not None}
 
 
 def load_entries(paths: list[Path], reference: Path | None, method: dict | list[dict] | None = None,

@@ -9,7 +9,7 @@ import numpy as np
 
 from . import plots
 from ..campaign.reading import stored_parameters
-from .loading import Entry, _same_file, campaign_settings, design_info, file_name, method_label
+from .loading import Entry, _same_file, campaign_settings, design_info, file_name, flight_facts, method_label
 
 BELOW_FLOOR = "below reference resolution"
 UNRESOLVED = "unresolved"
@@ -118,8 +118,8 @@ def run_section(entries: list[Entry], out_dir: Path) -> Section:
         counts = f"{e.stats.runs} runs, {failed} failed"
         if getattr(e.stats, "pending", 0):
             counts += f", {e.stats.pending} not run"
-        facts.append([e.stem, ("flight", _mapping(simulator.get("flight")) or "default"),
-                      ("excitation", _mapping(simulator.get("excitation")) or "default"),
+        flown = flight_facts(simulator)
+        facts.append([e.stem, ("flight", flown.get("flight", "-")), ("excitation", flown.get("excitation", "-")),
                       ("simulator", ", ".join(f"{k} {simulator[k]}" for k in ("kind", "aircraft", "function",
                                                                               "duration_s", "output_rate_hz")
                                               if k in simulator)),

@@ -1,6 +1,6 @@
 """Simulators: one object per worker that turns a row of physical values κ into outputs.
 
-Every kind (simulators/kinds) offers `probe(kappa) -> (time, output names)`, `evaluate(kappa) -> {name:
+Every kind (simulators/kinds) offers `layout(kappa) -> (time, output names)`, `evaluate(kappa) -> {name:
 (T,)}` (raising a FlightError subclass for a failed sample) and `restart()`.
 """
 from __future__ import annotations

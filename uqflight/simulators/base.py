@@ -42,7 +42,7 @@ class DivergenceError(FlightError):
 
 
 class NominalFailed(RuntimeError):
-    """The nominal sample, which `probe` runs before any other to learn the outputs, failed: the
+    """The nominal sample, which `layout` runs before any other to learn the outputs, failed: the
     message names it, gives its values and says what to do; `run` stops there (exit 2)."""
 
 
@@ -62,7 +62,7 @@ class Simulator(Protocol):
 
     units: dict[str, str]
 
-    def probe(self, kappa: np.ndarray) -> tuple[np.ndarray, list[str]]:
+    def layout(self, kappa: np.ndarray) -> tuple[np.ndarray, list[str]]:
         """The recorded times and the output names (one call at the nominal point, if needed)."""
 
     def evaluate(self, kappa: np.ndarray, observers=()) -> dict[str, np.ndarray]:

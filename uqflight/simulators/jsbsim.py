@@ -283,7 +283,7 @@ class JSBSimFlight(PropertyAccess):
             return self._touched[name]
         return self.node(name).get_double_value() if self.has_property(name) else None
 
-    def prepare_probe(self) -> None:
+    def prepare_validation_view(self) -> None:
         """The state campaign validation reads nominal values in: the flight condition's initial
         conditions set, as `trim` sets them (so `ic/vc-kts` reads the matching calibrated airspeed)."""
         self.fdm["ic/h-sl-ft"] = self.setup.altitude_ft
@@ -373,10 +373,16 @@ class JSBSimFlight(PropertyAccess):
         worst = max(ratios, key=ratios.get)
         acc = ", ".join(f"{k.split('/')[-1].split('-')[0]} = {fdm[k]:.3g}" for k in TRIM_TOLERANCES)
         thr = ", ".join(f"{fdm[f'fcs/throttle-cmd-norm[{i}]']:.3f}" for i in range(self._engines))
-        return (f"JSBSim trim failed ({str(exc).strip() or 'no convergence'}) at {self.setup.altitude_ft:g} ft, "
-                f"{self.setup.airspeed_ktas:g} KTAS: {worst.split('/')[-1].split('-')[0]} not trimmable "
-                f"({acc}; alpha = {fdm['aero/alpha-deg']:.2f} deg, throttle = [{thr}], "
-                f"pitch trim = {fdm['fcs/pitch-trim-cmd-norm']:.3f}, elevator = {fdm['fcs/elevator-pos-deg']:.2f} deg)")
+        left = (f"{acc}; alpha = {fdm['aero/alpha-deg']:.2f} deg, throttle = [{thr}], "
+                f"pitch trim = {fdm['fcs/pitch-trim-cmd-norm']:.3f}, elevator = {fdm['fcs/elevator-pos-deg']:.2f} deg")
+        where = (f"JSBSim trim failed ({str(exc).strip() or 'no convergence'}) at {self.setup.altitude_ft:g} ft, "
+                 f"{self.setup.airspeed_ktas:g} KTAS")
+        from .trim import lift_shortfall  # trim imports this module
+
+        stall = lift_shortfall(self)
+        if stall:
+            return f"{where}: {stall} (JSBSim's trim left {left})"
+        return f"{where}: {worst.split('/')[-1].split('-')[0]} not trimmable ({left})"
 
     def _apply(self, settings: dict[str, float]) -> None:
         for name, value in settings.items():

@@ -70,7 +70,7 @@ class PythonSimulator:
         self.outputs = config.get("outputs")
         self.units: dict[str, str] = {}
 
-    def probe(self, kappa: np.ndarray) -> tuple[np.ndarray, list[str]]:
+    def layout(self, kappa: np.ndarray) -> tuple[np.ndarray, list[str]]:
         """Time and output names, from one call at `kappa` (the nominal point); NominalFailed when the
         function fails there."""
         try:

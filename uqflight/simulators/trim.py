@@ -244,3 +244,53 @@ class LevelTrim:
         if refined is None:
             raise RuntimeError("the Newton trim does not converge at the nominal")
         self.nominal = refined
+
+
+# -- why a level trim cannot exist: the stall -------------------------------------------------
+STALL_SWEEP_DEG = np.arange(0.0, 30.01, 0.25)  # α swept at dt = 0 (three ~0.1-ms runs a point)
+
+
+def lift_shortfall(flight) -> str | None:
+    """When level flight needs more lift than the aircraft gives before its stall: the reason and
+    what to do, else None. Called after a failed trim (it moves `ic/alpha-deg` and the pitch trim).
+
+    Needed: CL = W / (q̄ S) (lift = weight at γ = 0; the thrust's share is neglected). Available: the
+    largest trimmed CL(α) of a dt = 0 sweep of α from 0 up to the stall, where CL first stops
+    increasing, the aircraft's stall property (`aero/coefficient/CL-stall` on bacm) turns non-zero or
+    the pitch trim saturates, whichever comes first. Trimmed: at each α the pitch trim that zeroes q̇
+    (q̇ is linear in it: one secant step), since the elevator's own lift is a few % of CL. CL is
+    JSBSim's stability-axis aerodynamic force over q̄ S. The slowest level flight is then
+    V √(CL needed / CL max) at this altitude and weight."""
+    from .jsbsim import STALL_PROPERTY
+
+    fdm = flight.fdm
+    fdm["ic/alpha-deg"] = 0.0
+    fdm.run_ic()
+    area, weight, qbar = fdm["metrics/Sw-sqft"], fdm["inertia/weight-lbs"], fdm["aero/qbar-psf"]
+    if not (area > 0 and weight > 0 and qbar > 0):
+        return None
+    stall_property = flight.has_property(STALL_PROPERTY)
+    best, best_alpha = -math.inf, 0.0
+    for alpha in STALL_SWEEP_DEG:
+        fdm["ic/alpha-deg"] = float(alpha)
+        qdot = []
+        for pitch in (0.0, 0.1):
+            fdm["fcs/pitch-trim-cmd-norm"] = pitch
+            fdm.run_ic()
+            qdot.append(fdm["accelerations/qdot-rad_sec2"])
+        if qdot[1] == qdot[0]:
+            return None
+        pitch = -0.1 * qdot[0] / (qdot[1] - qdot[0])
+        fdm["fcs/pitch-trim-cmd-norm"] = pitch
+        fdm.run_ic()
+        lift = fdm["forces/fsz-aero-lbs"] / (qbar * area)
+        if lift <= best or abs(pitch) >= 1.0 or (stall_property and fdm[STALL_PROPERTY] != 0.0):
+            break
+        best, best_alpha = lift, float(alpha)
+    needed = weight / (qbar * area)
+    if not needed > best:
+        return None
+    slowest = flight.setup.airspeed_ktas * math.sqrt(needed / best)
+    return (f"the stall: level flight needs a lift coefficient W/(qbar S) = {needed:.3f}, above the {best:.3f} "
+            f"the aircraft reaches trimmed before it stalls (at alpha {best_alpha:.1f} deg); fly faster than "
+            f"{math.ceil(slowest)} KTAS at this altitude, or lower, or lighter")

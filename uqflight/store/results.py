@@ -10,8 +10,8 @@ Layout (docs/results-file.md; N runs, d parameters, T recorded times):
     /tsvd/<name>/buffer (m, T), buffer_index (m)          ok runs not folded into the factors yet
     /quantities/<name> (N)  optional: one number per run (uqflight.quantities), NaN where undefined in
                             the run, not run or failed
-    /resolution/<name> (T)  optional: the simulator's own resolution of the output (its trim
-                            repeatability, see JSBSimSimulator.trim_repeatability); a spread below it
+    /resolution/<name> (T)  optional: the simulator's own resolution of the output (level flight:
+                            its two trims' drift, see JSBSimSimulator.resolution); a spread below it
                             is not the inputs'
     root attributes: campaign (YAML text), campaign_hash (its sha256), created, and the caller's
     (versions, aircraft_hash, ...)
@@ -128,14 +128,14 @@ class ResultStore:
     def create(cls, path, *, campaign_text: str, xi, kappa, weights, parameter_names, outputs, time,
                raw: bool = True, tsvd: dict | None = None, attrs: dict | None = None,
                units: dict | None = None, batch_rows: int | None = None,
-               repeatability: dict | None = None, quantities=()) -> ResultStore:
+               resolution: dict | None = None, quantities=()) -> ResultStore:
         """A new file (refused if `path` exists) holding the design, with every run pending.
 
         `tsvd` = {"tol": ..., "batch": ...} turns on compression (batch defaults to the paper's 1000
         samples); `attrs` become root attributes (dicts as JSON text); `units` maps output name → unit.
         `batch_rows`: the runs the writer stores at a time (the runner's chunk): raw chunks of that many
         rows (at least 64 KiB, at most ~1 MiB), so that a batch fills whole HDF5 chunks instead of
-        rewriting part-filled ones. `repeatability` maps output name → (T,) the simulator's own resolution.
+        rewriting part-filled ones. `resolution` maps output name → (T,) the simulator's own resolution.
         `quantities`: the names of the campaign's quantities of interest, one value per run each.
         """
         xi, kappa = np.atleast_2d(xi).astype(float), np.atleast_2d(kappa).astype(float)
@@ -170,13 +170,13 @@ class ResultStore:
         samples.create_dataset("reason", shape=(n,), dtype=h5py.string_dtype("utf-8", REASON_BYTES),
                                chunks=(min(n, REASON_ROWS),), fletcher32=True)
         f.create_dataset("time", data=time, **CHECKED).attrs["units"] = "s"
-        if repeatability:
+        if resolution:
             group = f.create_group("resolution", track_order=True)
             group.attrs["description"] = ("per output and time, how far the nominal flights with two trims that "
                                           "both pass the checks drift apart (max so far): a spread below this is "
                                           "not resolved by the simulator")
             for name in outputs:
-                group.create_dataset(_key(name), data=np.asarray(repeatability[name], dtype=float), **CHECKED)
+                group.create_dataset(_key(name), data=np.asarray(resolution[name], dtype=float), **CHECKED)
         if raw:
             group = f.create_group("outputs", track_order=True)
             rows = min(chunk_rows(time.size, n), max(batch_rows or n, -(-MIN_CHUNK_BYTES // (8 * time.size))))
@@ -306,7 +306,7 @@ class ResultStore:
         return self._file["quantities"][_key(name)][()]
 
     def resolution(self, name: str) -> np.ndarray | None:
-        """(T,) the simulator's own resolution of output `name` (its trim repeatability), None when the
+        """(T,) the simulator's own resolution of output `name` (level flight: its two trims' drift), None when the
         file holds none (a Python simulator, a file from before it was recorded)."""
         group = self._file.get("resolution")
         return None if group is None or _key(name) not in group else group[_key(name)][()]

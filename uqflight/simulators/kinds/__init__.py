@@ -32,7 +32,8 @@ class SimulatorKind:
     the flight's last time [s], or None. check_source(checker, name, path, config, aircraft): a name a
     quantity reads. aircraft: parameters set properties of an aircraft (`property` or `function`
     required, checked against the probed aircraft). integer_seeds: a seed parameter reaches the model
-    as an int (JSBSim properties are doubles). example: a small `simulator:` mapping of this kind and the
+    as an int (JSBSim properties are doubles). facts(config) -> {"flight": text, "excitation": text}: what
+    is flown, defaults resolved (the report; {} for a model). example: a small `simulator:` mapping of this kind and the
     `parameters:` of a campaign on it (tests).
     """
 
@@ -48,19 +49,20 @@ class SimulatorKind:
     check_source: Callable
     aircraft: bool
     integer_seeds: bool
+    facts: Callable
     example: tuple[dict, dict]
 
 
 REGISTRY: dict[str, SimulatorKind] = {
     "jsbsim": SimulatorKind(jsbsim.KEYS, jsbsim.check, jsbsim.resolve, jsbsim.make, jsbsim.bundle,
                             jsbsim.provenance, jsbsim.relocated, jsbsim.recorded, jsbsim.span, jsbsim.check_source,
-                            aircraft=True, integer_seeds=False,
+                            aircraft=True, integer_seeds=False, facts=jsbsim.facts,
                             example=({"kind": "jsbsim", "duration_s": 1.0, "output_rate_hz": 10.0},
                                      {"CL0": {"property": "aero/uq/CL0", "distribution": "normal",
                                               "interval_pct": 20}})),
     "python": SimulatorKind(python.KEYS, python.check, python.resolve, python.make, python.bundle,
                             python.provenance, python.relocated, python.recorded, python.span, python.check_source,
-                            aircraft=False, integer_seeds=True,
+                            aircraft=False, integer_seeds=True, facts=python.facts,
                             example=({"kind": "python", "function": "uqflight.simulators.models:exp_decay"},
                                      {"a": {"distribution": "normal", "nominal": 1.0, "lower": 0.9, "upper": 1.1}})),
 }

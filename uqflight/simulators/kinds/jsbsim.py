@@ -85,7 +85,7 @@ class JSBSimSimulator:
         self._flown = False
         self.units = {name: UNITS.get(name, "") for name in self.setup.outputs}
 
-    def probe(self, kappa: np.ndarray) -> tuple[np.ndarray, list[str]]:
+    def layout(self, kappa: np.ndarray) -> tuple[np.ndarray, list[str]]:
         return self.setup.time, list(self.setup.outputs)
 
     def evaluate(self, kappa: np.ndarray, observers=()) -> dict[str, np.ndarray]:
@@ -103,8 +103,7 @@ class JSBSimSimulator:
         """The property a quantity's `of:` reads and its scale: a named output's, else the property."""
         return NAMED_OUTPUTS.get(name, (name, 1.0))
 
-    def trim_repeatability(self, kappa: np.ndarray, ours: dict[str, np.ndarray] | None = None
-                           ) -> dict[str, np.ndarray] | None:
+    def resolution(self, kappa: np.ndarray, ours: dict[str, np.ndarray] | None = None) -> dict[str, np.ndarray] | None:
         """{output: (T,)}: the simulator's own resolution at `kappa` as its scenario states it (level
         flight: the drift between its two valid trims; see `level_flight.resolution`), or None."""
         return self.scenario.resolution(self.setup, self.settings(kappa), ours)
@@ -156,6 +155,10 @@ def recorded(config: dict) -> tuple[int, int]:
 
 def span(config: dict) -> float | None:
     return scenario_entry(config).span(config)
+
+
+def facts(config: dict) -> dict[str, str]:
+    return scenario_entry(config).facts(config)
 
 
 def check_source(check, name, path: str, config: dict, aircraft) -> None:

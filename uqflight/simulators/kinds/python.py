@@ -59,6 +59,11 @@ def span(config: dict) -> None:
     return None
 
 
+def facts(config: dict) -> dict:
+    """A model has no flight condition or excitation."""
+    return {}
+
+
 def check_source(check, name, path: str, config: dict, aircraft) -> None:
     """One of the model's outputs, when the campaign lists them."""
     check.string(name, path)

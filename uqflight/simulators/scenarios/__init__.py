@@ -30,6 +30,7 @@ class ScenarioKind:
     relative to the campaign's `folder` made absolute. provenance(config) -> results-file attributes. span(config)
     -> the flight's last time [s] from the campaign alone (once a script is resolved, its own end), or None.
     resolution(setup, settings, outputs) -> {output: (T,)} or None: the simulator's own resolution.
+    facts(config) -> {"flight": text, "excitation": text}: what is flown, defaults resolved (the report).
     """
 
     keys: tuple[str, ...]
@@ -45,6 +46,7 @@ class ScenarioKind:
     resolution: Callable
     span: Callable
     example: dict  # a small `simulator:` mapping of this kind (tests)
+    facts: Callable
 
 
 REGISTRY: dict[str, ScenarioKind] = {
@@ -52,13 +54,13 @@ REGISTRY: dict[str, ScenarioKind] = {
         level_flight.KEYS, (), level_flight.check, level_flight.setup, level_flight.flight, level_flight.times,
         level_flight.files, level_flight.localize, level_flight.relocated,
         level_flight.provenance, level_flight.resolution, level_flight.span,
-        {"kind": "jsbsim", "duration_s": 2.0, "output_rate_hz": 10.0}),
+        {"kind": "jsbsim", "duration_s": 2.0, "output_rate_hz": 10.0}, facts=level_flight.facts),
     "script": ScenarioKind(
         script.KEYS, script.SCENARIO_KEYS, script.check, script.setup, script.flight, script.times,
         script.files, script.localize, script.relocated, script.provenance,
         script.resolution, script.span,
         {"kind": "jsbsim", "scenario": {"kind": "script", "script": "c172_cruise_8K", "end_s": 2.0},
-         "output_rate_hz": 10.0}),
+         "output_rate_hz": 10.0}, facts=script.facts),
 }
 SCENARIO_KINDS = tuple(REGISTRY)
 DEFAULT = "level_flight"

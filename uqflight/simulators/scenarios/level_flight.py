@@ -88,6 +88,21 @@ def setup(config: dict, root: Path | None = None, base: Path | None = None, prop
     )
 
 
+def facts(config: dict) -> dict[str, str]:
+    """The flight condition and excitation a campaign's `simulator:` mapping flies, defaults resolved
+    (the report's campaign table), without locating the aircraft."""
+    from ..aircraft import default_condition
+
+    condition = {**default_condition(str(config.get("aircraft", "bacm"))), **(config.get("flight") or {})}
+    excitation = Excitation(**(config.get("excitation") or {}))
+    shape = (f"{excitation.kind}" if excitation.kind == "none" else
+             f"{excitation.kind} {excitation.amplitude_deg:g} deg at {excitation.start_s:g} s"
+             + (f" for {excitation.duration_s:g} s" if excitation.kind != "step" else ""))
+    return {"flight": f"level, {condition['altitude_ft']:g} ft, {condition['airspeed_ktas']:g} KTAS, "
+                      f"trim {config.get('trim', 'newton')}",
+            "excitation": f"elevator {shape}"}
+
+
 def flight(setup: FlightSetup, preflight: bool = True) -> JSBSimFlight:
     return JSBSimFlight(setup, preflight=preflight)
 

@@ -324,7 +324,7 @@ class ScriptFlight(PropertyAccess):
         self._bind(fdm, s.aircraft)
         self._recorded = [self._output_source(name) for name in s.outputs]
 
-    def prepare_probe(self) -> None:
+    def prepare_validation_view(self) -> None:
         """The state campaign validation reads nominal values in: the script loaded, before run_ic."""
 
     def property_value(self, name: str) -> float | None:
@@ -428,6 +428,13 @@ def provenance(config: dict) -> dict:
     """The scenario and the sha256 of the script's files, for the results file."""
     return {"scenario": json.dumps({"kind": "script", "script": Path(config["script_path"]).name,
                                     "sha256": AircraftFiles("", files(config)).hash()})}
+
+
+def facts(config: dict) -> dict[str, str]:
+    """The script flown, as the campaign names it (the report's campaign table)."""
+    scenario = config.get("scenario") or {}
+    end = f", cut at {scenario['end_s']:g} s" if isinstance(scenario.get("end_s"), (int, float)) else ""
+    return {"flight": f"script {scenario.get('script', '?')}{end}", "excitation": "the script's events"}
 
 
 def resolution(setup: ScriptSetup, settings, ours=None) -> None:

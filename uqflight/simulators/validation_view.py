@@ -24,7 +24,7 @@ class AircraftProperties:
         self.functions = [f.name for f in aero_functions(xml)]
         self.references = references(xml)  # each function's unit and reference factor
         self._flight = scenario_entry(simulator).flight(setup)
-        self._flight.prepare_probe()
+        self._flight.prepare_validation_view()
 
     def value(self, name: str) -> float | None:
         """The property's value (None when the aircraft has no such property)."""
@@ -38,6 +38,6 @@ class AircraftProperties:
         return self._flight.property_hint(name)
 
 
-def jsbsim_probe(simulator: dict) -> AircraftProperties:
-    """The campaign aircraft's properties, for `load_campaign(..., probe=jsbsim_probe)`."""
+def validation_view(simulator: dict) -> AircraftProperties:
+    """The campaign aircraft's properties, for `load_campaign(..., view=validation_view)`."""
     return AircraftProperties(simulator)

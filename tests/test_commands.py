@@ -1,0 +1,88 @@
+"""The small commands say what they do: plan's method line, design on standard output, report's times
+inside the flight, one KIND[:ORDER] for every --method, the campaign table's resolved flight."""
+import csv
+import io
+
+import pytest
+import yaml
+from conftest import cli_in_process, run_python_campaign
+from test_trust import NORMAL_2D, campaign
+
+from uqflight.calibration.command import _method
+from uqflight.cli import _check_times
+from uqflight.report.loading import flight_facts
+
+GRID = campaign("sq", "sum_of_squares", NORMAL_2D, "{kind: tensor_grid, points: 3}",
+                "method: {kind: pseudo_galerkin, order: 2}\n")  # 9 runs, times 0, 0.25, ..., 1 s
+SAMPLED = campaign("mc", "sum_of_squares", NORMAL_2D, "{kind: monte_carlo, samples: 8}", "method: {kind: monte_carlo}\n")
+
+
+@pytest.fixture(scope="module")
+def results(tmp_path_factory):
+    return run_python_campaign(tmp_path_factory.mktemp("commands"), GRID)
+
+
+def test_report_refuses_a_time_outside_the_flight(results, tmp_path):
+    refused = cli_in_process("report", results, "--times", "0.5,99", "--out", tmp_path / "r")
+    assert refused.returncode == 2
+    assert refused.stderr == (f"error: --times 0.5,99: 99 s outside the flight of {results}, which records 0 to 1 s; "
+                              "choose times in that range or 'end'\n")
+    assert not (tmp_path / "r").exists()
+    # within half a recording step of the last time (0.25 s apart) is the last time, as before
+    _check_times("1.1,end", [1.1, float("inf")], [results])
+
+
+def test_plan_prints_an_order_only_for_a_method_that_has_one(tmp_path):
+    for text, line in ((GRID, "method: pseudo_galerkin (order 2)\n"), (SAMPLED, "method: monte_carlo\n")):
+        (tmp_path / "c.yaml").write_text(text)
+        planned = cli_in_process("plan", tmp_path / "c.yaml")
+        assert planned.returncode == 0, planned.stderr
+        assert line in planned.stdout
+
+
+def test_design_prints_csv_on_standard_output_without_csv_or_with_dash(results, tmp_path):
+    yaml_path = results.with_suffix(".yaml")
+    written = cli_in_process("design", yaml_path, "--csv", tmp_path / "d.csv")
+    assert written.returncode == 0
+    from_file = list(csv.reader(open(tmp_path / "d.csv", newline="")))
+    assert len(from_file) == 10 and from_file[0] == ["run", "xi_x1", "xi_x2", "x1", "x2", "weight"]
+    for args in ((), ("--csv", "-")):
+        printed = cli_in_process("design", yaml_path, *args, cwd=tmp_path)
+        assert printed.returncode == 0, printed.stderr
+        assert list(csv.reader(io.StringIO(printed.stdout))) == from_file  # the CSV alone on stdout
+        assert "wrote the design: 9 points" in printed.stderr
+    assert not (tmp_path / "-").exists()
+
+
+def test_calibrate_takes_kind_colon_order_as_report_does():
+    assert _method("least_squares:2", None) == ("least_squares", 2)
+    assert _method("least_squares", 3) == ("least_squares", 3)
+    assert _method("least_squares:3", 3) == ("least_squares", 3)
+
+
+@pytest.mark.parametrize("args, message", [
+    (("--method", "least_squares:2", "--order", "3"), "error: --method least_squares:2 and --order 3 give two orders"),
+    (("--method", "lsq:2"), "error: --method: expected KIND[:ORDER] with KIND one of"),
+    (("--method", "least_squares:x"), "error: --method: expected an integer ORDER >= 0 after least_squares:"),
+])
+def test_calibrate_refuses_a_bad_method_before_any_work(results, tmp_path, args, message):
+    data = tmp_path / "flight.csv"
+    data.write_text("time_s,y\n0,15000\n1,15002\n")
+    refused = cli_in_process("calibrate", results, "--data", data, "--out", tmp_path / "cal", *args)
+    assert refused.returncode == 2 and refused.stderr.startswith(message), refused.stderr
+    assert not (tmp_path / "cal").exists()
+
+
+def test_the_campaign_table_shows_the_flight_and_excitation_flown():
+    paper = yaml.safe_load(open("campaigns/paper-pg2-l2.yaml"))["simulator"]
+    assert flight_facts(paper) == {"flight": "level, 15000 ft, 200 KTAS, trim newton",
+                                   "excitation": "elevator pulse 1 deg at 1 s for 1 s"}
+    given = {"kind": "jsbsim", "aircraft": "c172p", "flight": {"airspeed_ktas": 90},
+             "excitation": {"kind": "step", "amplitude_deg": -2}, "trim": "jsbsim"}
+    assert flight_facts(given) == {"flight": "level, 4000 ft, 90 KTAS, trim jsbsim",
+                                   "excitation": "elevator step -2 deg at 1 s"}
+    script = yaml.safe_load(open("campaigns/c172p-landing.yaml"))["simulator"]
+    assert flight_facts(script) == {"flight": "script scripts/c172p-landing.xml", "excitation": "the script's events"}
+    cut = {"kind": "jsbsim", "scenario": {"kind": "script", "script": "c172_cruise_8K", "end_s": 2}}
+    assert flight_facts(cut)["flight"] == "script c172_cruise_8K, cut at 2 s"
+    assert flight_facts({"kind": "python", "function": "m.py:f"}) == {}
