@@ -1,0 +1,158 @@
+"""The runs themselves: a spaghetti plot of a seeded subset of runs per output with the mean and the 99 %
+band, and each output (at one time) and each quantity against the inputs in physical values (κ),
+coloured by the most influential other input. Only the drawn runs are read (or rebuilt from the tSVD
+factors)."""
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+from matplotlib.collections import LineCollection
+from matplotlib.lines import Line2D
+from matplotlib.ticker import MaxNLocator
+
+from ..simulators.base import Status
+from ..store import ResultStore
+from . import plots
+
+SPAGHETTI_RUNS = 50  # runs drawn per output
+SCATTER_RUNS = 1000  # points drawn per scatter panel at most
+SCATTER_INPUTS = 4  # inputs shown per output: the most influential
+COLOR_MAP = "viridis"
+
+
+def run_subset(status: np.ndarray, count: int, seed: int) -> np.ndarray:
+    """`count` successful runs (all when fewer), drawn without replacement with `seed`, ascending: the same
+    runs for the same file and seed, whatever else the report draws."""
+    ok = np.flatnonzero(status == Status.OK)
+    if ok.size <= count:
+        return ok
+    return np.sort(np.random.default_rng(seed).choice(ok, size=count, replace=False))
+
+
+def plot_spaghetti(results: Path, outputs: dict, path: Path, title: str, seed: int,
+                   count: int = SPAGHETTI_RUNS) -> tuple[Path, int]:
+    """One panel per output over time: the subset's runs thin, the mean and the 99 % band of `outputs`
+    (the file's statistics) on top. Returns the PNG and the number of runs drawn."""
+    names = [name for name, out in outputs.items() if out.time.size > 1]
+    with ResultStore.open(results) as store:
+        rows = run_subset(store.status, count, seed)
+        histories = {name: store.output_matrix(name, rows) for name in names}
+    fig, axes = plots._panels(len(names), title)
+    for ax, name in zip(axes, names):
+        out = outputs[name]
+        runs = histories[name]
+        segments = np.stack([np.broadcast_to(out.time, runs.shape), runs], axis=-1)
+        ax.add_collection(LineCollection(segments, colors=plots.COLORS[0], linewidths=0.5, alpha=0.45))
+        ax.plot(out.time, out.mean, color="k", lw=1.4)
+        for bound in out.band99:
+            ax.plot(out.time, bound, color="k", lw=0.9, ls="--")
+        ax.autoscale_view()
+        plots._style(ax, out)
+    handles = [Line2D([], [], color=plots.COLORS[0], lw=0.8), Line2D([], [], color="k", lw=1.4),
+               Line2D([], [], color="k", lw=0.9, ls="--")]
+    labels = [f"{rows.size} runs", "mean", "99 % band"]
+    return plots._save(fig, path, (handles, labels), legend_columns=3), int(rows.size)
+
+
+def _influence(sobol_total: dict, i: int, kappa: np.ndarray, y: np.ndarray, names: list[str]) -> np.ndarray:
+    """Each input's influence on y: its total Sobol' index at time index i, or, without indices, its
+    squared correlation with y over the drawn runs."""
+    if sobol_total:
+        return np.array([np.nan_to_num(float(sobol_total[p][i]), nan=-1.0) if p in sobol_total else -1.0
+                         for p in names])
+    spread = kappa.std(axis=0) * y.std()
+    covariance = ((kappa - kappa.mean(axis=0)) * (y - y.mean())[:, None]).mean(axis=0)
+    return np.divide(covariance, spread, out=np.zeros_like(spread), where=spread > 0) ** 2
+
+
+def scatter_rows(results: Path, outputs: dict, quantities: dict, time: float, seed: int) -> dict:
+    """What `plot_scatter` draws, for a seeded subset of at most SCATTER_RUNS successful runs: their
+    inputs in physical values ("kappa", "names"), and per row ("outputs": each output over time at the
+    recorded time nearest `time`, labelled "NAME at T s [unit]"; "quantities": each defined quantity)
+    (the runs' values, the total Sobol' indices {parameter: (T,)}, the time index)."""
+    with ResultStore.open(results) as store:
+        drawn = run_subset(store.status, SCATTER_RUNS, seed)
+        at_time = {}
+        for name, out in outputs.items():
+            if out.time.size > 1:
+                i = plots.time_indices(out.time, [time])[0]
+                unit = f" [{out.units}]" if out.units else ""
+                at_time[f"{plots.short_label(name)} at {out.time[i]:g} s{unit}"] = (
+                    store.output_matrix(name, drawn)[:, i], out.sobol_total, i)
+        of_quantities = {name: (store.quantity(name)[drawn], q.output.sobol_total, 0)
+                         for name, q in quantities.items() if q.output is not None}
+        return {"kappa": store.kappa[drawn], "names": store.parameter_names, "outputs": at_time,
+                "quantities": of_quantities}
+
+
+def plot_scatter(kappa: np.ndarray, names: list[str], rows_of: dict, path: Path, title: str) -> Path | None:
+    """One row per output or quantity (`rows_of` as `scatter_rows` gives them), one panel per input among
+    its SCATTER_INPUTS most influential, against the input's physical value; each panel coloured by the
+    most influential other input, from its low to its high value among the drawn runs. None without rows
+    or with fewer than two inputs."""
+    if not rows_of or len(names) < 2:
+        return None
+    shown = min(SCATTER_INPUTS, len(names))
+    fig, axes = plots.plt.subplots(len(rows_of), shown, figsize=(3.3 * shown + 1.0, 2.4 * len(rows_of) + 1.0),
+                                   squeeze=False)
+    for row, (text, (values, sobol_total, i)) in zip(axes, rows_of.items()):
+        keep = np.isfinite(values)
+        x, y = kappa[keep], values[keep]
+        influence = _influence(sobol_total, i, x, y, names)
+        ranked = list(np.argsort(-influence, kind="stable"))
+        for ax, j in zip(row, ranked[:shown]):
+            other = next(k for k in ranked if k != j)
+            low, high = x[:, other].min(initial=np.inf), x[:, other].max(initial=-np.inf)
+            shade = (x[:, other] - low) / (high - low) if high > low else np.full(len(x), 0.5)
+            ax.scatter(x[:, j], y, c=shade, cmap=COLOR_MAP, vmin=0, vmax=1, s=9, lw=0)
+            ax.set_xlabel(names[j], fontsize=8)
+            ax.set_title(f"colour: {names[other]}", fontsize=8)
+            ax.tick_params(labelsize=7)
+            ax.xaxis.set_major_locator(MaxNLocator(4))
+            ax.grid(alpha=0.3)
+        row[0].set_ylabel(text, fontsize=8)
+    fig.suptitle(title, fontsize=12)
+    fig.tight_layout(rect=(0, 0, 0.92, 1))
+    bar = fig.colorbar(plots.plt.cm.ScalarMappable(cmap=COLOR_MAP), ax=list(axes.flat), fraction=0.02, pad=0.01)
+    bar.set_ticks([0, 1], labels=["low", "high"])
+    bar.set_label("the colouring input (named above each panel)", fontsize=8)
+    fig.savefig(path, dpi=plots.DPI)
+    plots.plt.close(fig)
+    return Path(path)
+
+
+def trajectories_section(entries: list, times: list[float], out_dir: Path):
+    """Per results file: the spaghetti plot and the scatter of the outputs at the last of `times` and of the
+    quantities against the inputs, seeded by the campaign's seed (the same runs on every report)."""
+    from ..designs import is_sampled
+    from .loading import campaign_settings
+    from .sections import Figure, Section, _file_stem, _files, _rel
+
+    blocks = []
+    for e in _files(entries):
+        results, stem = Path(e.path or e.stats.path), _file_stem(e)
+        seed = int(campaign_settings(str(e.attrs.get("campaign", ""))).get("seed", 0) or 0)
+        nodes = ("" if is_sampled(e.stats.design_kind) else
+                 f" The points are the {e.stats.design_kind}'s nodes, not random draws: how they spread says "
+                 "nothing of the inputs' distribution.")
+        path, drawn = plot_spaghetti(results, e.outputs, out_dir / "plots" / f"spaghetti_{stem}.png",
+                                     f"Runs, mean and 99 % band: {e.label}", seed)
+        blocks.append(Figure(_rel(path, out_dir), f"{drawn} of the {e.stats.completed} successful runs of {stem} "
+                             f"(drawn with the campaign's seed {seed}, at most {SPAGHETTI_RUNS}), thin, with the "
+                             f"mean (solid) and the 99 % band (dashed) of {e.label}." + nodes))
+        rows = scatter_rows(results, e.outputs, e.stats.quantities, times[-1], seed)
+        how = ("coloured by the other input with the largest total Sobol' index" if e.has_sobol else
+               "coloured by the other input most correlated with it (squared correlation; the file has no "
+               "Sobol' indices)")
+        for key, what, name in (("outputs", "each output at the last selected time", "scatter"),
+                                ("quantities", "each quantity of interest", "scatter_quantities")):
+            path = plot_scatter(rows["kappa"], rows["names"], rows[key], out_dir / "plots" / f"{name}_{stem}.png",
+                                f"{what.capitalize()} against the inputs: {e.label}")
+            if path is not None:
+                blocks.append(Figure(_rel(path, out_dir), f"{what.capitalize()} of {stem} against its "
+                                     f"{SCATTER_INPUTS} most influential inputs in physical values, "
+                                     f"{len(rows['kappa'])} runs (at most {SCATTER_RUNS}, seed {seed}), each "
+                                     f"panel {how}, low to high." + nodes))
+    return Section("Trajectories and scatter", "trajectories", "The runs themselves: what the statistics "
+                   "summarise, and where the outliers are.", blocks)
