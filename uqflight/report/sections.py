@@ -60,7 +60,9 @@ def build_sections(entries: list[Entry], ref: Entry | None, times: list[float], 
     tell("drawing the statistics over time")
     sections.append(statistics_section(entries, ref, times, out_dir))
     tell("drawing the runs")
-    sections.append(trajectories_section(entries, times, out_dir))
+    runs = trajectories_section(entries, times, out_dir)
+    if runs is not None:
+        sections.append(runs)
     if any(e.has_errors for e in entries):
         tell("drawing the errors against the reference")
         sections.append(accuracy_section(entries, out_dir))

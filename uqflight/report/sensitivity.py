@@ -9,6 +9,7 @@ import numpy as np
 from matplotlib.patches import Patch
 
 from . import plots
+from .trajectories import save_fixed
 
 NEGLIGIBLE = 1e-4  # a variance below this share of its largest over time (std < 1 % of its largest) is negligible
 TINY_INDEX = 1e-3  # indices below this print as "<0.001"
@@ -69,28 +70,31 @@ def _spans(mask: np.ndarray, time: np.ndarray) -> list[tuple[float, float]]:
     return [(edges[a], edges[b]) for a, b in zip(change[::2], change[1::2])]
 
 
-def _indices_panel(ax, out, indices: dict, grey: list, ylabel: str) -> None:
+def _indices_panel(ax, out, grey: list) -> None:
+    """First-order (solid) and total (dashed) indices over time, the spans in `grey` shaded."""
     low, high = -0.05, 1.05
-    for color, values in zip(plots.COLORS, indices.values()):
-        values = np.asarray(values, dtype=float)
-        ax.plot(out.time, values, color=color, lw=1.1)
-        finite = values[np.isfinite(values)]
-        if finite.size:  # estimator noise outside [0, 1] is shown, not clipped
-            low, high = min(low, finite.min() - 0.05), max(high, finite.max() + 0.05)
+    for color, parameter in zip(plots.COLORS, out.sobol_first):
+        for indices, style in ((out.sobol_first, "-"), (out.sobol_total, "--")):
+            values = np.asarray(indices[parameter], dtype=float)
+            ax.plot(out.time, values, color=color, lw=1.0, ls=style)
+            finite = values[np.isfinite(values)]
+            if finite.size:  # estimator noise outside [0, 1] is shown, not clipped
+                low, high = min(low, finite.min() - 0.05), max(high, finite.max() + 0.05)
     for start, end in grey:
         ax.axvspan(start, end, color=GREY, lw=0, zorder=0)
     ax.set_ylim(low, high)
-    plots._style(ax, out, ylabel=ylabel)
+    plots._style(ax, out, ylabel="Sobol' index [-]")
+    ax.set_title(f"{plots.short_label(out.name)}: S_i solid, S_Ti dashed", fontsize=10)
 
 
 def plot_sensitivity(outputs: dict, path: Path, title: str) -> Path | None:
     """Per output over time (a row each): the stacked partial variances S_i·Var with the interactions on
-    top (the stack's height is Var(t)), the first-order indices S_i and the total indices S_Ti, the times
-    of negligible variance greyed on the indices. None when no output over time has indices."""
+    top (the stack's height is Var(t)), and beside them the first-order indices S_i and the total
+    indices S_Ti, the times of negligible variance greyed. None when no output over time has indices."""
     names = [name for name, out in outputs.items() if out.sobol_first and out.time.size > 1]
     if not names:
         return None
-    fig, axes = plots.plt.subplots(len(names), 3, figsize=(15, 2.5 * len(names) + 1.0), squeeze=False)
+    fig, axes = plots.plt.subplots(len(names), 2, figsize=(12.4, 2.5 * len(names) + 1.2), squeeze=False)
     parameters = list(outputs[names[0]].sobol_first)
     for row, name in zip(axes, names):
         out = outputs[name]
@@ -98,15 +102,10 @@ def plot_sensitivity(outputs: dict, path: Path, title: str) -> Path | None:
         row[0].stackplot(out.time, *parts.values(), np.maximum(rest, 0.0),
                          colors=[*plots.COLORS[:len(parts)], INTERACTIONS], lw=0)
         row[0].plot(out.time, np.maximum(out.variance, 0.0), color="k", lw=0.8)
-        unit = f" [{out.units}²]" if out.units else " [-]"
-        plots._style(row[0], out, ylabel=f"partial variance{unit}")
-        row[0].set_title(f"{plots.short_label(name)}: S_i·Var", fontsize=10)
-        grey = _spans(negligible(out), out.time)
-        _indices_panel(row[1], out, out.sobol_first, grey, "first-order S_i [-]")
-        _indices_panel(row[2], out, out.sobol_total, grey, "total S_Ti [-]")
-        row[1].set_title(f"{plots.short_label(name)}: first-order", fontsize=10)
-        row[2].set_title(f"{plots.short_label(name)}: total", fontsize=10)
+        plots._style(row[0], out, ylabel=f"S_i·Var [{out.units}²]" if out.units else "S_i·Var [-]")
+        row[0].set_title(f"{plots.short_label(name)}: partial variances", fontsize=10)
+        _indices_panel(row[1], out, _spans(negligible(out), out.time))
     handles = [Patch(color=c) for c in (*plots.COLORS[:len(parameters)], INTERACTIONS, "k", GREY)]
     labels = [*parameters, "interactions", "Var(t)", f"variance < {NEGLIGIBLE:g} of its max, or unresolved"]
     fig.suptitle(title, fontsize=12)
-    return plots._save(fig, path, (handles, labels), legend_columns=5)
+    return save_fixed(fig, path, (handles, labels), legend_columns=6)

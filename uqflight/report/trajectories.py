@@ -17,8 +17,22 @@ from . import plots
 
 SPAGHETTI_RUNS = 50  # runs drawn per output
 SCATTER_RUNS = 1000  # points drawn per scatter panel at most
-SCATTER_INPUTS = 4  # inputs shown per output: the most influential
+SCATTER_INPUTS = 2  # inputs shown per output: the most influential
 COLOR_MAP = "viridis"
+
+
+def save_fixed(fig, path: Path, legend=None, legend_columns: int = 4, right: float = 0.2) -> Path:
+    """Lay the panels out with fixed margins in inches (matplotlib's tight layout would draw the figure
+    once more to measure it) and write the PNG; `legend` (handles, labels) goes under the panels."""
+    width, height = fig.get_size_inches()
+    bottom = 0.55 + (0.25 * -(-len(legend[1]) // legend_columns) if legend else 0.0)
+    fig.subplots_adjust(left=0.75 / width, right=1 - right / width, top=1 - 0.75 / height, bottom=bottom / height,
+                        hspace=0.62, wspace=0.3)
+    if legend:
+        fig.legend(*legend, loc="lower center", ncol=legend_columns, fontsize=8, frameon=False)
+    fig.savefig(path, dpi=plots.DPI)
+    plots.plt.close(fig)
+    return Path(path)
 
 
 def run_subset(status: np.ndarray, count: int, seed: int) -> np.ndarray:
@@ -38,7 +52,7 @@ def plot_spaghetti(results: Path, outputs: dict, path: Path, title: str, seed: i
     with ResultStore.open(results) as store:
         rows = run_subset(store.status, count, seed)
         histories = {name: store.output_matrix(name, rows) for name in names}
-    fig, axes = plots._panels(len(names), title)
+    fig, axes = plots._panels(len(names), title, row_height=2.6)
     for ax, name in zip(axes, names):
         out = outputs[name]
         runs = histories[name]
@@ -52,7 +66,7 @@ def plot_spaghetti(results: Path, outputs: dict, path: Path, title: str, seed: i
     handles = [Line2D([], [], color=plots.COLORS[0], lw=0.8), Line2D([], [], color="k", lw=1.4),
                Line2D([], [], color="k", lw=0.9, ls="--")]
     labels = [f"{rows.size} runs", "mean", "99 % band"]
-    return plots._save(fig, path, (handles, labels), legend_columns=3), int(rows.size)
+    return save_fixed(fig, path, (handles, labels), 3), int(rows.size)
 
 
 def _influence(sobol_total: dict, i: int, kappa: np.ndarray, y: np.ndarray, names: list[str]) -> np.ndarray:
@@ -69,17 +83,17 @@ def _influence(sobol_total: dict, i: int, kappa: np.ndarray, y: np.ndarray, name
 def scatter_rows(results: Path, outputs: dict, quantities: dict, time: float, seed: int) -> dict:
     """What `plot_scatter` draws, for a seeded subset of at most SCATTER_RUNS successful runs: their
     inputs in physical values ("kappa", "names"), and per row ("outputs": each output over time at the
-    recorded time nearest `time`, labelled "NAME at T s [unit]"; "quantities": each defined quantity)
+    recorded time nearest `time`, labelled "NAME at T s [unit]", or its one value; "quantities": each
+    defined quantity)
     (the runs' values, the total Sobol' indices {parameter: (T,)}, the time index)."""
     with ResultStore.open(results) as store:
         drawn = run_subset(store.status, SCATTER_RUNS, seed)
         at_time = {}
         for name, out in outputs.items():
-            if out.time.size > 1:
-                i = plots.time_indices(out.time, [time])[0]
-                unit = f" [{out.units}]" if out.units else ""
-                at_time[f"{plots.short_label(name)} at {out.time[i]:g} s{unit}"] = (
-                    store.output_matrix(name, drawn)[:, i], out.sobol_total, i)
+            i = plots.time_indices(out.time, [time])[0]
+            at = f" at {out.time[i]:g} s" if out.time.size > 1 else ""
+            at_time[f"{plots.short_label(name)}{at}" + (f" [{out.units}]" if out.units else "")] = (
+                store.output_matrix(name, drawn)[:, i], out.sobol_total, i)
         of_quantities = {name: (store.quantity(name)[drawn], q.output.sobol_total, 0)
                          for name, q in quantities.items() if q.output is not None}
         return {"kappa": store.kappa[drawn], "names": store.parameter_names, "outputs": at_time,
@@ -94,7 +108,7 @@ def plot_scatter(kappa: np.ndarray, names: list[str], rows_of: dict, path: Path,
     if not rows_of or len(names) < 2:
         return None
     shown = min(SCATTER_INPUTS, len(names))
-    fig, axes = plots.plt.subplots(len(rows_of), shown, figsize=(3.3 * shown + 1.0, 2.4 * len(rows_of) + 1.0),
+    fig, axes = plots.plt.subplots(len(rows_of), shown, figsize=(3.6 * shown + 2.0, 2.2 * len(rows_of) + 1.0),
                                    squeeze=False)
     for row, (text, (values, sobol_total, i)) in zip(axes, rows_of.items()):
         keep = np.isfinite(values)
@@ -110,21 +124,20 @@ def plot_scatter(kappa: np.ndarray, names: list[str], rows_of: dict, path: Path,
             ax.set_title(f"colour: {names[other]}", fontsize=8)
             ax.tick_params(labelsize=7)
             ax.xaxis.set_major_locator(MaxNLocator(4))
+            ax.yaxis.set_major_locator(MaxNLocator(4))
             ax.grid(alpha=0.3)
         row[0].set_ylabel(text, fontsize=8)
     fig.suptitle(title, fontsize=12)
-    fig.tight_layout(rect=(0, 0, 0.92, 1))
-    bar = fig.colorbar(plots.plt.cm.ScalarMappable(cmap=COLOR_MAP), ax=list(axes.flat), fraction=0.02, pad=0.01)
+    bar = fig.colorbar(plots.plt.cm.ScalarMappable(cmap=COLOR_MAP), cax=fig.add_axes((1 - 0.9 / fig.get_size_inches()[0], 0.15, 0.012, 0.7)))
     bar.set_ticks([0, 1], labels=["low", "high"])
-    bar.set_label("the colouring input (named above each panel)", fontsize=8)
-    fig.savefig(path, dpi=plots.DPI)
-    plots.plt.close(fig)
-    return Path(path)
+    bar.set_label("the colouring input, named above each panel", fontsize=8)
+    return save_fixed(fig, path, right=1.4)  # the colour bar in the right margin
 
 
 def trajectories_section(entries: list, times: list[float], out_dir: Path):
     """Per results file: the spaghetti plot and the scatter of the outputs at the last of `times` and of the
-    quantities against the inputs, seeded by the campaign's seed (the same runs on every report)."""
+    quantities against the inputs, seeded by the campaign's seed (the same runs on every report); None
+    when there is nothing to draw (one input and no output over time)."""
     from ..designs import is_sampled
     from .loading import campaign_settings
     from .sections import Figure, Section, _file_stem, _files, _rel
@@ -136,23 +149,26 @@ def trajectories_section(entries: list, times: list[float], out_dir: Path):
         nodes = ("" if is_sampled(e.stats.design_kind) else
                  f" The points are the {e.stats.design_kind}'s nodes, not random draws: how they spread says "
                  "nothing of the inputs' distribution.")
-        path, drawn = plot_spaghetti(results, e.outputs, out_dir / "plots" / f"spaghetti_{stem}.png",
-                                     f"Runs, mean and 99 % band: {e.label}", seed)
-        blocks.append(Figure(_rel(path, out_dir), f"{drawn} of the {e.stats.completed} successful runs of {stem} "
-                             f"(drawn with the campaign's seed {seed}, at most {SPAGHETTI_RUNS}), thin, with the "
-                             f"mean (solid) and the 99 % band (dashed) of {e.label}." + nodes))
+        if any(out.time.size > 1 for out in e.outputs.values()):
+            path, drawn = plot_spaghetti(results, e.outputs, out_dir / "plots" / f"spaghetti_{stem}.png",
+                                         f"Runs, mean and 99 % band: {e.label}", seed)
+            blocks.append(Figure(_rel(path, out_dir), f"{drawn} of the {e.stats.completed} successful runs of {stem} "
+                                 f"(drawn with the campaign's seed {seed}, at most {SPAGHETTI_RUNS}), thin, with "
+                                 f"the mean (solid) and the 99 % band (dashed) of {e.label}." + nodes))
         rows = scatter_rows(results, e.outputs, e.stats.quantities, times[-1], seed)
         how = ("coloured by the other input with the largest total Sobol' index" if e.has_sobol else
                "coloured by the other input most correlated with it (squared correlation; the file has no "
                "Sobol' indices)")
-        for key, what, name in (("outputs", "each output at the last selected time", "scatter"),
-                                ("quantities", "each quantity of interest", "scatter_quantities")):
-            path = plot_scatter(rows["kappa"], rows["names"], rows[key], out_dir / "plots" / f"{name}_{stem}.png",
-                                f"{what.capitalize()} against the inputs: {e.label}")
-            if path is not None:
-                blocks.append(Figure(_rel(path, out_dir), f"{what.capitalize()} of {stem} against its "
-                                     f"{SCATTER_INPUTS} most influential inputs in physical values, "
-                                     f"{len(rows['kappa'])} runs (at most {SCATTER_RUNS}, seed {seed}), each "
-                                     f"panel {how}, low to high." + nodes))
+        path = plot_scatter(rows["kappa"], rows["names"], {**rows["outputs"], **rows["quantities"]},
+                            out_dir / "plots" / f"scatter_{stem}.png", f"Outputs and quantities against the "
+                            f"inputs: {e.label}")
+        if path is not None:
+            blocks.append(Figure(_rel(path, out_dir), f"Each output (at the last selected time)"
+                                 + (" and each quantity of interest" if rows["quantities"] else "")
+                                 + f" of {stem} (a row each) against its {SCATTER_INPUTS} most influential inputs "
+                                 f"in physical values, {len(rows['kappa'])} runs (at most {SCATTER_RUNS}, seed "
+                                 f"{seed}), each panel {how}, low to high." + nodes))
+    if not blocks:
+        return None
     return Section("Trajectories and scatter", "trajectories", "The runs themselves: what the statistics "
                    "summarise, and where the outliers are.", blocks)
