@@ -104,6 +104,7 @@ def plot_sensitivity(outputs: dict, path: Path, title: str) -> Path | None:
         row[0].plot(out.time, np.maximum(out.variance, 0.0), color="k", lw=0.8)
         plots._style(row[0], out, ylabel=f"S_i·Var [{out.units}²]" if out.units else "S_i·Var [-]")
         row[0].set_title(f"{plots.short_label(name)}: partial variances", fontsize=10)
+        row[0].ticklabel_format(axis="y", style="sci", scilimits=(-3, 4))  # 1.2e-4 as 1.2 ×1e-4
         _indices_panel(row[1], out, _spans(negligible(out), out.time))
     handles = [Patch(color=c) for c in (*plots.COLORS[:len(parameters)], INTERACTIONS, "k", GREY)]
     labels = [*parameters, "interactions", "Var(t)", f"variance < {NEGLIGIBLE:g} of its max, or unresolved"]

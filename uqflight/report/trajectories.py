@@ -26,7 +26,7 @@ def save_fixed(fig, path: Path, legend=None, legend_columns: int = 4, right: flo
     once more to measure it) and write the PNG; `legend` (handles, labels) goes under the panels."""
     width, height = fig.get_size_inches()
     bottom = 0.55 + (0.25 * -(-len(legend[1]) // legend_columns) if legend else 0.0)
-    fig.subplots_adjust(left=0.75 / width, right=1 - right / width, top=1 - 0.75 / height, bottom=bottom / height,
+    fig.subplots_adjust(left=0.95 / width, right=1 - right / width, top=1 - 0.75 / height, bottom=bottom / height,
                         hspace=0.62, wspace=0.3)
     if legend:
         fig.legend(*legend, loc="lower center", ncol=legend_columns, fontsize=8, frameon=False)
