@@ -34,7 +34,8 @@ analysis: {band_samples: 500}
 
 @pytest.mark.parametrize("value, text", [(0.62, "0.620"), (1.0, "1.00"), (0.00123, "0.00123"), (3.3e-10, "<0.001"),
                                          (-3.3e-10, "<0.001"), (-0.0512, "-0.0512"), (0.9996, "1.00"),
-                                         (float("nan"), "unresolved"), (None, "unresolved"), (123.4, "123")])
+                                         (float("nan"), "unresolved"), (None, "unresolved"), (123.4, "123"),
+                                         ("", "")])
 def test_sobol_indices_print_with_three_significant_digits(value, text):
     assert index_text(value) == text
 

@@ -52,7 +52,7 @@ def headline_section(entry: Entry, times: list[float]) -> Section:
     """The headline table of `entry` (tables/headline.csv at full precision, the page rounded to the std)."""
     rows, page = [], []
     for name, out in entry.outputs.items():
-        for i in plots.time_indices(out.time, times) if out.time.size > 1 else [0]:
+        for i in plots.time_indices(out.time, times):
             csv_row, page_row = _row(name, out, i, out.time[i])
             rows.append([entry.label, *csv_row])
             page.append(page_row)
@@ -69,12 +69,10 @@ def headline_section(entry: Entry, times: list[float]) -> Section:
               contributors]
     table = Table(f"Key numbers of {entry.label}", header, rows, "tables/headline.csv",
                   page=(["output or quantity", "time [s]", "mean ± std", "99 % band", contributors], page))
-    text = ("Per output at the selected times (--times) and per quantity of interest (no time: one number per run): "
-            "the mean ± the standard deviation, the 99 % band (0.5 % and 99.5 % quantiles) and the inputs with "
-            "the largest first-order Sobol' indices S_i, as shares of the variance (up to three, each at least "
-            "1 %; 'interactions' is 1 − Σ S_i when it is 5 % or more; 'unresolved' where the variance is at "
-            "the simulator's noise). Numbers rounded to two digits of the std; tables/headline.csv has them "
-            "in full, as summary.json.")
+    text = ("Mean ± std, the 99 % band (0.5 % to 99.5 % quantiles) and the largest first-order Sobol' shares of "
+            "the variance (up to three, each ≥ 1 %; 'interactions' = 1 − Σ S_i when ≥ 5 %; 'unresolved': a variance "
+            "at the simulator's noise), per output at the selected times (--times) and per quantity of interest. "
+            "Rounded to two digits of the std; in full in tables/headline.csv, as in summary.json.")
     if entry.stats.notes:
         text += " Read the notes below before these numbers."
     return Section("Headline", "headline", text, [table], lead=True)

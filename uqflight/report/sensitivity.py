@@ -23,9 +23,9 @@ INTERACTIONS = "0.6"  # the interactions' part of the stack
 
 def index_text(value) -> str:
     """A Sobol' index for the page: 3 significant digits, "<0.001" below 0.001 in magnitude (estimator
-    noise or nothing), "unresolved" where the variance is not resolved (NaN or None)."""
-    if isinstance(value, str):
-        return value or UNRESOLVED
+    noise or nothing), "unresolved" where the variance is not resolved (NaN or None); text as it is."""
+    if isinstance(value, str):  # "" for a parameter the file does not have, or already text
+        return value
     if value is None or not np.isfinite(value):
         return UNRESOLVED
     value = float(value)
