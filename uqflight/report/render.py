@@ -22,8 +22,12 @@ figcaption{font-size:.9em;color:#444}pre{background:#f6f6f6;padding:.5em;overflo
 
 def render_html(title: str, sections: list[Section], out_dir: Path) -> str:
     """One self-contained page: the plots as base64 PNG data URIs, a table of contents, the tables."""
-    toc, body = [], []
+    toc, body, lead = [], [], []
     for s in sections:
+        if s.lead:  # before the contents, not in them
+            lead += [f'<h2 id="{s.anchor}">{html.escape(s.title)}</h2>', f"<p>{html.escape(s.text)}</p>"]
+            lead += [_html_block(s.anchor, n, block, out_dir) for n, block in enumerate(s.blocks)]
+            continue
         toc.append(f'<li><a href="#{s.anchor}">{html.escape(s.title)}</a>' + _html_toc(s) + "</li>")
         if s.notes:
             items = "".join(f"<li>{html.escape(line.removeprefix('- '))}</li>" for line in s.text.splitlines())
@@ -39,7 +43,8 @@ def render_html(title: str, sections: list[Section], out_dir: Path) -> str:
     stamp = datetime.now(timezone.utc).isoformat(timespec="seconds")
     return (f'<!DOCTYPE html>\n<html lang="en"><head><meta charset="utf-8"><title>{html.escape(title)}</title>'
             f"<style>{STYLE}</style></head><body>\n<h1>{html.escape(title)}</h1>\n<p>Written {stamp} by uqflight.</p>\n"
-            f"<h2>Contents</h2><ul>{''.join(toc)}</ul>\n" + "\n".join(body) + "\n</body></html>\n")
+            + "\n".join(lead) + f"\n<h2>Contents</h2><ul>{''.join(toc)}</ul>\n" + "\n".join(body)
+            + "\n</body></html>\n")
 
 
 def _html_toc(section: Section) -> str:
@@ -57,8 +62,12 @@ def _html_block(anchor: str, n: int, block, out_dir: Path) -> str:
         data = base64.b64encode((out_dir / block.file).read_bytes()).decode("ascii")
         return (f'<figure id="{anchor}-{n}"><img src="data:image/png;base64,{data}" alt="{html.escape(block.file)}">'
                 f"<figcaption>{html.escape(block.caption)} ({html.escape(block.file)})</figcaption></figure>")
-    head = "".join(f"<th>{html.escape(h)}</th>" for h in block.header)
-    rows = "".join("<tr>" + "".join(f"<td>{html.escape(_cell(v))}</td>" for v in row) + "</tr>" for row in block.rows)
+    header, groups = page_view(block)
+    head = "".join(f"<th>{html.escape(h)}</th>" for h in header)
+    rows = "".join((f'<tr><th colspan="{len(header)}" style="text-align:left">{html.escape(group)}</th></tr>'
+                    if group is not None else "")
+                   + "".join("<tr>" + "".join(f"<td>{html.escape(_cell(v))}</td>" for v in row) + "</tr>"
+                             for row in rows) for group, rows in groups)
     return (f'<h3 id="{anchor}-{n}">{html.escape(block.caption)}</h3><p>({html.escape(block.file)})</p>'
             f"<table><tr>{head}</tr>{rows}</table>")
 
@@ -66,9 +75,12 @@ def _html_block(anchor: str, n: int, block, out_dir: Path) -> str:
 def render_markdown(title: str, sections: list[Section]) -> str:
     """The same page in Markdown, linking the PNGs in plots/. Every name, reason and caption is
     escaped (`md`); the campaign text sits in a fence longer than any run of backticks in it."""
-    lines = [f"# {md(title)}", "", "## Contents", ""]
-    lines += [f"- [{md(s.title)}](#{s.anchor})" for s in sections]
-    for s in sections:
+    lines = [f"# {md(title)}"]
+    lead = [s for s in sections if s.lead]
+    for s in lead + [None] + [s for s in sections if not s.lead]:
+        if s is None:
+            lines += ["", "## Contents", ""] + [f"- [{md(s.title)}](#{s.anchor})" for s in sections if not s.lead]
+            continue
         text = "\n".join(md(line) for line in s.text.splitlines())
         if s.preformatted:
             fence = "`" * max(3, 1 + max((len(run) for run in re.findall("`+", s.text)), default=0))
@@ -80,10 +92,26 @@ def render_markdown(title: str, sections: list[Section]) -> str:
             if isinstance(block, Figure):
                 lines += ["", f"![{md(block.caption)}]({block.file})", "", f"*{md(block.caption)}* ({md(block.file)})"]
             else:
+                header, groups = page_view(block)
                 lines += ["", f"### {md(block.caption)}", "", f"({md(block.file)})", "",
-                          "| " + " | ".join(md(h) for h in block.header) + " |", "|" + "---|" * len(block.header)]
-                lines += ["| " + " | ".join(md(_cell(v)) for v in row) + " |" for row in block.rows]
+                          "| " + " | ".join(md(h) for h in header) + " |", "|" + "---|" * len(header)]
+                for group, rows in groups:
+                    if group is not None:
+                        lines.append(f"| **{md(group)}** |" + " |" * (len(header) - 1))
+                    lines += ["| " + " | ".join(md(_cell(v)) for v in row) + " |" for row in rows]
     return "\n".join(lines) + "\n"
+
+
+def page_view(table) -> tuple[list[str], list[tuple[str | None, list[list]]]]:
+    """The header and rows a table shows on the page (its `page` view, else its CSV's), in groups: for a
+    grouped table one group per value of its first column, that column then left out; else one group."""
+    header, rows = table.page or (table.header, table.rows)
+    if not table.grouped:
+        return list(header), [(None, rows)]
+    groups: dict[str, list[list]] = {}
+    for row in rows:
+        groups.setdefault(str(row[0]), []).append(row[1:])
+    return list(header[1:]), list(groups.items())
 
 
 MARKDOWN_SPECIAL = re.compile(r"([\\`*_{}\[\]<>|#!~])")

@@ -8,6 +8,7 @@ from pathlib import Path
 import numpy as np
 
 from . import plots
+from .sensitivity import NEGLIGIBLE, index_text, plot_sensitivity
 from ..campaign.reading import stored_parameters
 from .loading import Entry, _same_file, campaign_settings, design_info, file_name, flight_facts, method_label
 
@@ -26,6 +27,8 @@ class Table:
     header: list[str]
     rows: list[list]
     file: str  # the CSV, relative to the report directory
+    page: tuple[list[str], list[list]] | None = None  # (header, rows) the page shows instead, e.g. rounded
+    grouped: bool = False  # the page shows the first column once, as a heading row over its rows
 
 
 @dataclass
@@ -36,13 +39,17 @@ class Section:
     blocks: list = field(default_factory=list)
     preformatted: bool = False  # the text as written (the campaign YAML)
     notes: bool = False  # a box at the top the reader must see
+    lead: bool = False  # shown before the table of contents (the headline)
 
 
 def build_sections(entries: list[Entry], ref: Entry | None, times: list[float], out_dir: Path,
                    progress=None) -> list[Section]:
     """The report's sections, drawing their plots into out_dir/plots."""
+    from .headline import headline_section
+    from .trajectories import trajectories_section
+
     tell = progress or (lambda text: None)
-    sections = []
+    sections = [headline_section(entries[0], times)]
     notes = notes_section(entries)
     if notes is not None:
         sections.append(notes)
@@ -52,6 +59,10 @@ def build_sections(entries: list[Entry], ref: Entry | None, times: list[float], 
         sections.append(failures)
     tell("drawing the statistics over time")
     sections.append(statistics_section(entries, ref, times, out_dir))
+    tell("drawing the runs")
+    runs = trajectories_section(entries, times, out_dir)
+    if runs is not None:
+        sections.append(runs)
     if any(e.has_errors for e in entries):
         tell("drawing the errors against the reference")
         sections.append(accuracy_section(entries, out_dir))
@@ -358,6 +369,15 @@ def sensitivity_section(entries: list[Entry], times: list[float], out_dir: Path)
         blocks.append(Figure(_rel(path, out_dir), f"First-order Sobol' indices over time of {entry.label} "
                                                   "(paper Fig. 21)" + (", bootstrap 95 % intervals shaded."
                                                                        if entry.pick_freeze else ".")))
+        path = plot_sensitivity(entry.outputs, out_dir / "plots" / f"sensitivity_{entry.stem}.png",
+                                f"Partial variances and Sobol' indices: {entry.label}")
+        if path is not None:
+            blocks.append(Figure(_rel(path, out_dir), f"Per output of {entry.label}: the partial variances "
+                                 "S_i(t)·Var(t) stacked, in the output's unit squared, the interactions "
+                                 "Var − Σ S_i·Var on top, so the stack's height is the variance; beside them the "
+                                 "first-order S_i and total S_Ti indices, greyed where the variance is below "
+                                 f"{NEGLIGIBLE:g} of its largest over time (std under 1 % of its largest) or "
+                                 "unresolved: there an index is the share of almost nothing."))
     if len(with_sobol) >= 2:
         path = plots.plot_sobol_compared([(e.label, e.outputs) for e in with_sobol],
                                          out_dir / "plots" / "sobol_compared.png",
@@ -369,7 +389,9 @@ def sensitivity_section(entries: list[Entry], times: list[float], out_dir: Path)
         rows = [[e.label, name, out.time[i], *(_at(getattr(out, kind), p, i) for p in parameters)]
                 for e in with_sobol for name, out in e.outputs.items() for i in plots.time_indices(out.time, times)]
         caption = f"{what} Sobol' indices at the selected times" + (" (paper Table 3)" if kind == "sobol_first" else "")
-        blocks.append(Table(caption, ["file", "output", "time [s]", *parameters], rows, f"tables/{kind}.csv"))
+        page = [[label, name, f"{time:g}", *map(index_text, values)] for label, name, time, *values in rows]
+        blocks.append(Table(caption, ["file", "output", "time [s]", *parameters], rows, f"tables/{kind}.csv",
+                            page=(["file", "output", "time [s]", *parameters], page), grouped=True))
     if any(e.pick_freeze for e in with_sobol) and any(not e.pick_freeze for e in with_sobol):
         blocks.append(pce_vs_mc_table(with_sobol, parameters))
     return Section("Sensitivity: Sobol' indices", "sensitivity",
@@ -393,8 +415,9 @@ def pce_vs_mc_table(entries: list[Entry], parameters: list[str]) -> Table:
                     ci = other.sobol_first_ci.get(parameter) if other else None
                     row += [ci[0][-1], ci[1][-1]] if ci is not None else ["", ""]
             rows.append(row)
+    page = [[name, f"{time:g}", parameter, *map(index_text, values)] for name, time, parameter, *values in rows]
     return Table("First-order Sobol' indices at the final time: PCE against Monte Carlo pick-freeze (paper Table 4)",
-                 header, rows, "tables/sobol_pce_vs_mc.csv")
+                 header, rows, "tables/sobol_pce_vs_mc.csv", page=(header, page))
 
 
 def _at(indices: dict, parameter: str, i: int):
