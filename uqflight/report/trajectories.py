@@ -163,7 +163,7 @@ def trajectories_section(entries: list, times: list[float], out_dir: Path):
                             out_dir / "plots" / f"scatter_{stem}.png", f"Outputs and quantities against the "
                             f"inputs: {e.label}")
         if path is not None:
-            blocks.append(Figure(_rel(path, out_dir), f"Each output (at the last selected time)"
+            blocks.append(Figure(_rel(path, out_dir), "Each output (at the last selected time)"
                                  + (" and each quantity of interest" if rows["quantities"] else "")
                                  + f" of {stem} (a row each) against its {SCATTER_INPUTS} most influential inputs "
                                  f"in physical values, {len(rows['kappa'])} runs (at most {SCATTER_RUNS}, seed "
