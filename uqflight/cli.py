@@ -381,7 +381,8 @@ def report(
                                                              "JSON file, the baseline of `uqflight check`."),
     method: List[str] = typer.Option([], metavar="KIND[:ORDER]", help="KIND[:ORDER], repeatable: analyse every file with each method "
                                               "instead of its campaign's, overlaid in the plots, e.g. --method "
-                                              "pseudo_galerkin:2 --method least_squares:3. KIND: "
+                                              "pseudo_galerkin:2 --method least_squares:3 --method sparse:4:selection=omp,q=0.75 "
+                                              "(KIND:ORDER:KEY=VALUE,... for a kind's own settings). KIND: "
                                               + ", ".join(METHOD_KINDS) + " (the runs of one grid serve every "
                                               "method)."),
     order: Optional[int] = typer.Option(None, help="Polynomial order for a --method given without :ORDER "

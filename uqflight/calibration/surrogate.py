@@ -17,7 +17,7 @@ import numpy as np
 from ..campaign import Campaign, CampaignError, load_campaign, parse_campaign
 from ..campaign.reading import results_campaign
 from ..designs import is_sampled
-from ..methods import METHOD_KINDS
+from ..methods import METHOD_KINDS, exported_kind, normalised
 from ..methods.basis import orthonormal_basis
 from ..methods.loo import loo_residuals, relative_loo_error
 from ..parameters import Parameter
@@ -48,6 +48,9 @@ class Surrogate:
     residual curves √w_i (y_i − ŷ_(−i)) of the least-squares fit of the same basis on the same runs
     (or the surrogate's own misfit curves at the runs, when larger), compressed by an SVD.
     `error_variance[o]` (T,) is its diagonal: the mean square error per time (absolute units²).
+    Each output has its own basis (`output_indices[o]`: a sparse PCE's selected terms); `indices` is
+    their union and `coefficients[o]` is on it, zero for the terms of other outputs, so that one
+    evaluation of the basis serves every output.
     """
 
     campaign: Campaign
@@ -62,6 +65,7 @@ class Surrogate:
     units: dict[str, str]
     runs: int
     relative_error: dict[str, np.ndarray]  # relative LOO error per time (NaN where the output does not vary)
+    output_indices: dict[str, np.ndarray]  # each output's own basis; `indices` is their union, for evaluating all at once
 
     @property
     def parameters(self) -> list[Parameter]:
@@ -140,7 +144,7 @@ def fit_surrogate(results, method: str | None = None, order: int | None = None,
         raise SurrogateError(f"{results}: {exc}") from exc
     with store:
         campaign = _campaign_of(store, results, Path(campaign_path) if campaign_path else None)
-        stored = json.loads(store.attrs["method"])
+        stored = normalised(json.loads(store.attrs["method"]))
         germs = json.loads(store.attrs["germs"])
         design_kind = store.attrs.get("design_kind", "")
         kind = method or stored["kind"]
@@ -148,10 +152,7 @@ def fit_surrogate(results, method: str | None = None, order: int | None = None,
         if kind not in METHOD_KINDS:
             raise SurrogateError(f"--method: expected one of {', '.join(METHOD_KINDS)}, got {kind!r}")
         sampled = is_sampled(design_kind)
-        if kind in ("monte_carlo", "integration"):
-            kind = "least_squares" if sampled else "pseudo_galerkin"
-        if kind == "interpolation":  # its PCE is the projection
-            kind = "pseudo_galerkin"
+        kind = exported_kind(kind, sampled)
         ok = store.status == Status.OK
         names = store.output_names if outputs is None else outputs
         missing = [name for name in names if name not in store.output_names]
@@ -164,8 +165,8 @@ def fit_surrogate(results, method: str | None = None, order: int | None = None,
         except BadInput as exc:
             raise SurrogateError(str(exc)) from exc
         xi, weights = store.xi[ok], store.weights[ok]
-        indices = stats.outputs[names[0]].pce.indices
-        design = orthonormal_basis(germs, indices, xi)
+        own = {name: np.asarray(stats.outputs[name].pce.indices) for name in names}
+        indices = _union(list(own.values()))
         error_weights = np.full(len(xi), 1.0) if sampled else np.abs(weights)
         error_weights = error_weights / error_weights.sum()
         coefficients, error_variance, error_factors, relative = {}, {}, {}, {}
@@ -173,19 +174,36 @@ def fit_surrogate(results, method: str | None = None, order: int | None = None,
             rows, scale = output_basis(store, name, ok)
             Y = rows if scale is None else rows @ scale
             pce = stats.outputs[name].pce
+            design = orthonormal_basis(germs, own[name], xi)  # the output's own basis (sparse: its terms)
             try:
                 loo = loo_residuals(design, Y, error_weights)
                 relative[name] = relative_loo_error(design, Y, error_weights)
             except ValueError as exc:
                 raise SurrogateError(f"{results}: output {name!r}: {exc}") from exc
             misfit = Y - design @ pce.coefficients
-            coefficients[name] = pce.coefficients
+            coefficients[name] = _on_basis(indices, own[name], pce.coefficients)
             curves = loo if error_weights @ (loo**2).sum(axis=1) >= error_weights @ (misfit**2).sum(axis=1) else misfit
             error_factors[name] = error_factors_of(np.sqrt(error_weights)[:, None] * curves)
             error_variance[name] = (error_factors[name] ** 2).sum(axis=1)
         return Surrogate(campaign, str(results), {"kind": kind, "order": order}, list(germs), indices,
                          store.time, coefficients, error_variance, error_factors, store.units, int(ok.sum()),
-                         relative)
+                         relative, own)
+
+
+def _union(bases: list[np.ndarray]) -> np.ndarray:
+    """The rows of every basis, each once, in the order first met (one basis: itself)."""
+    seen: dict[tuple, None] = {}
+    for basis in bases:
+        seen.update(dict.fromkeys(map(tuple, basis.tolist())))
+    return np.array(list(seen), dtype=int).reshape(len(seen), bases[0].shape[1])
+
+
+def _on_basis(indices: np.ndarray, own: np.ndarray, coefficients: np.ndarray) -> np.ndarray:
+    """Coefficients (Z_own, T) of the basis `own` as coefficients of `indices` (zero for the other terms)."""
+    row_of = {row: i for i, row in enumerate(map(tuple, indices.tolist()))}
+    out = np.zeros((len(indices), coefficients.shape[1]))
+    out[[row_of[row] for row in map(tuple, own.tolist())]] = coefficients
+    return out
 
 
 def simulate(campaign: Campaign, kappa: np.ndarray, outputs: list[str]):

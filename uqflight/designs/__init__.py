@@ -29,12 +29,14 @@ class DesignKind:
     germs) -> the runs it builds, from the spec alone and without building anything (for the campaign's
     limits; a sparse grid's points before merging; None when the spec is malformed, so that the
     builder's own checks speak); and whether its points are random draws (`sampled`: moments are sample
-    averages, valid on any subset of runs) or a quadrature grid (its weights are valid only all together)."""
+    averages, valid on any subset of runs) or a quadrature grid (its weights are valid only all together);
+    `sobol_from_runs`: its runs give Sobol' indices themselves (pick-freeze estimators), without a PCE."""
 
     build: Callable
     size: Callable
     sampled: bool
     example: dict  # a small `design:` mapping of this kind (help text and tests)
+    sobol_from_runs: bool = False
 
 
 REGISTRY: dict[str, DesignKind] = {
@@ -45,7 +47,8 @@ REGISTRY: dict[str, DesignKind] = {
                                   {"kind": "latin_hypercube", "samples": 64}),
     "sparse_grid": DesignKind(sparse_grid_design, sparse_grid_size, False, {"kind": "sparse_grid", "level": 2}),
     "tensor_grid": DesignKind(tensor_grid_design, tensor_grid_size, False, {"kind": "tensor_grid", "points": 4}),
-    "pick_freeze": DesignKind(pick_freeze_design, pick_freeze_size, True, {"kind": "pick_freeze", "samples": 16}),
+    "pick_freeze": DesignKind(pick_freeze_design, pick_freeze_size, True, {"kind": "pick_freeze", "samples": 16},
+                              sobol_from_runs=True),
 }
 DESIGN_KINDS = tuple(REGISTRY)
 SAMPLED_DESIGNS = tuple(kind for kind, entry in REGISTRY.items() if entry.sampled)

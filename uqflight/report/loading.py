@@ -8,10 +8,9 @@ from pathlib import Path
 
 import yaml
 
+from ..designs import REGISTRY as DESIGNS
+from ..methods import method_entry
 from ..statistics import Statistics, add_reference_errors, read_statistics
-
-METHOD_NAMES = {"integration": "Int", "pseudo_galerkin": "PG", "interpolation": "interpolation",
-                "regression": "regression", "least_squares": "least squares", "monte_carlo": "MC"}
 
 
 @dataclass
@@ -32,11 +31,11 @@ class Entry:
 
     @property
     def monte_carlo(self) -> bool:
-        return self.stats.method["kind"] == "monte_carlo"
+        return method_entry(self.stats.method["kind"]).pce is None
 
     @property
     def pick_freeze(self) -> bool:
-        return self.stats.design_kind == "pick_freeze"
+        return DESIGNS[self.stats.design_kind].sobol_from_runs
 
     @property
     def has_sobol(self) -> bool:
@@ -50,9 +49,9 @@ class Entry:
 
 def method_label(method: dict) -> str:
     """A method as in the paper's legends, e.g. "PG order 2", "MC"."""
-    kind = method["kind"]
-    name = METHOD_NAMES.get(kind, kind)
-    if kind == "monte_carlo":
+    entry = method_entry(method["kind"])
+    name = entry.label
+    if entry.pce is None:
         return name
     return f"{name} order {method['order']}" + (" split" if method.get("split") else "")
 
@@ -76,13 +75,15 @@ def campaign_settings(campaign_text: str) -> dict:
 
 
 def parse_methods(methods: list[str], order: int | None = None) -> list[dict]:
-    """`KIND[:ORDER]` strings into method overrides; a bare KIND takes `order` (when given).
-    ValueError naming the bad item."""
+    """`KIND[:ORDER[:KEY=VALUE,...]]` strings into method overrides (KEY one of the kind's settings,
+    e.g. `sparse:4:selection=omp,q=0.75`); a bare KIND takes `order` (when given). ValueError naming
+    the bad item."""
     from ..methods import METHOD_KINDS
 
     parsed = []
     for text in methods:
-        kind, sep, number = text.partition(":")
+        kind, sep, rest = text.partition(":")
+        number, more, pairs = rest.partition(":")
         kind = kind.strip()
         if kind not in METHOD_KINDS:
             raise ValueError(f"expected KIND[:ORDER] with KIND one of {', '.join(METHOD_KINDS)}, got {text!r}")
@@ -96,8 +97,30 @@ def parse_methods(methods: list[str], order: int | None = None) -> list[dict]:
                 raise ValueError(f"expected an integer ORDER >= 0 after {kind}:, got {text!r}")
         elif order is not None:
             method["order"] = order
+        if more:
+            method.update(_settings(kind, pairs, text))
         parsed.append(method)
     return parsed
+
+
+def _settings(kind: str, pairs: str, text: str) -> dict:
+    """The KEY=VALUE,... after KIND:ORDER: as settings of `kind` (numbers where they parse)."""
+    entry = method_entry(kind)
+    known = [key for key, _ in entry.settings]
+    settings = {}
+    for pair in pairs.split(","):
+        key, equals, value = (part.strip() for part in pair.partition("="))
+        if not equals or key not in known:
+            raise ValueError(f"expected KIND:ORDER:KEY=VALUE,... with KEY one of {', '.join(known) or '(none)'} "
+                             f"for {kind}, got {text!r}")
+        try:
+            settings[key] = float(value)
+        except ValueError:
+            settings[key] = value
+    problem = entry.settings_problem(settings) if entry.settings_problem else None
+    if problem:
+        raise ValueError(f"{text!r}: {problem[0]}: {problem[1]}")
+    return settings
 
 
 def load_entries(paths: list[Path], reference: Path | None, method: dict | list[dict] | None = None,
