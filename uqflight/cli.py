@@ -503,8 +503,10 @@ def design(
 def surrogate_export(
     results: Path = typer.Argument(..., metavar="RESULTS", help="Results file (.h5)."),
     out: Path = typer.Option(..., help="JSON file to write (strict JSON)."),
-    method: Optional[str] = typer.Option(None, help="KIND[:ORDER] instead of the campaign's method, "
-                                                    "e.g. least_squares:3 (a PCE method)."),
+    method: Optional[str] = typer.Option(None, help="KIND[:ORDER[:KEY=VALUE,...]] instead of the campaign's "
+                                                    "method, e.g. least_squares:3 or sparse:4; a method without a "
+                                                    "PCE of its own (monte_carlo) exports as least squares on a "
+                                                    "sampled design, pseudo-Galerkin on a grid, as calibrate does."),
 ):
     """Export the PCE of every output over time as JSON: germs, multi-indices, coefficients per output
     and time, the parameters' distributions (name, distribution, lower, upper, nominal), the time

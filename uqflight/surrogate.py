@@ -27,7 +27,8 @@ MAX_FILE_BYTES = 64 << 20  # 64 MiB of JSON (about 3 million coefficients); pars
 
 
 class SurrogateError(ValueError):
-    """A results file that has no PCE (e.g. Monte Carlo) or a malformed surrogate file."""
+    """A results file or method that gives no usable surrogate, or a malformed surrogate file; the message
+    names the file (and the key) and says what to do."""
 
 
 @dataclass
@@ -78,25 +79,30 @@ class Surrogate:
         return {name: (c[self.indices[name].any(axis=1)] ** 2).sum(axis=0) for name, c in self.coefficients.items()}
 
 
-def fit_surrogate(path, method: dict | None = None, partial: bool = False,
-                  allow_aliasing: bool = False) -> Surrogate:
+def fit_surrogate(path, method: dict | None = None, partial: bool = False, allow_aliasing: bool = False,
+                  options=None) -> Surrogate:
     """The PCE of every output of the results file `path`, exactly as `uqflight.statistics.analyse`
     fits it (with `method` overriding the campaign's), after the same checks: pending or failed runs,
     a projection the grid cannot integrate and a rank-deficient fit are refused (statistics.BadInput).
-    SurrogateError when the method builds no PCE."""
+    A method that builds no PCE of its own on this design is exported as its registry entry says
+    (`exported_as`: monte_carlo, and integration on a sampled design, as least squares). The export
+    and the calibration both fit here. `options`: statistics.Options (the bands' draws)."""
+    from .designs import REGISTRY as DESIGNS
+    from .methods import METHOD_KINDS, exported_kind, normalised
     from .statistics import analyse
     from .store import ResultStore
 
-    stats = analyse(path, method=method, partial=partial, allow_aliasing=allow_aliasing)
-    pces = {name: out.pce for name, out in stats.outputs.items()}
-    if any(pce is None for pce in pces.values()):
-        raise SurrogateError(f"{path}: method {stats.method['kind']} on a {stats.design_kind} design builds no PCE; "
-                             "give a PCE method, e.g. --method least_squares:2")
     with ResultStore.open(path) as store:
+        stored, design_kind = normalised(json.loads(store.attrs["method"])), store.attrs.get("design_kind", "")
         parameters, units, time = _parameters(store), dict(store.units), np.asarray(store.time, dtype=float)
-    first = next(iter(pces.values()))
-    return Surrogate(parameters, list(first.germs), {name: np.asarray(pce.indices, dtype=int) for name, pce in pces.items()},
-                     time,
+    override = dict(method or {})
+    kind = override.get("kind", stored.get("kind"))
+    if design_kind in DESIGNS and isinstance(kind, str) and kind in METHOD_KINDS:  # else analyse refuses
+        override["kind"] = exported_kind(kind, DESIGNS[design_kind].sampled)
+    stats = analyse(path, method=override, partial=partial, allow_aliasing=allow_aliasing, options=options)
+    pces = {name: out.pce for name, out in stats.outputs.items()}
+    return Surrogate(parameters, list(next(iter(pces.values())).germs),
+                     {name: np.asarray(pce.indices, dtype=int) for name, pce in pces.items()}, time,
                      {name: np.asarray(pce.coefficients, dtype=float) for name, pce in pces.items()}, units,
                      stats.method, stats.campaign_name)
 

@@ -19,7 +19,7 @@ from .outputs import (OUTPUT_FILES, calibrated_campaign, corner_plot, marginal, 
                       write_json, write_posterior)
 from .sampler import sample
 from .size import PREDICTIVE_NOISE_DRAWS, check_size
-from .surrogate import (SurrogateError, campaign_folder, campaign_mapping, check_campaign_text, fit_surrogate,
+from .surrogate import (SurrogateError, calibration_surrogate, campaign_folder, campaign_mapping, check_campaign_text,
                         parameter_specs, prior_summaries, simulate, to_physical)
 
 TIME_HANDLING = ("PCE coefficients (and the surrogate's error variance) interpolated linearly in time "
@@ -65,7 +65,7 @@ def _calibrate(results, data, out, outputs, noise, seed, walkers, steps, method,
                predictive_draws, truth, progress) -> Calibration:
     started = clock.perf_counter()
     out = Path(out)
-    surrogate = fit_surrogate(results, method=method, order=order, campaign_path=campaign)
+    surrogate = calibration_surrogate(results, method=method, order=order, campaign_path=campaign)
     flight = read_flight_csv(data, outputs, surrogate.outputs)
     given = parse_noise(list(noise), list(flight.values))
     names, germs = surrogate.names, surrogate.germs
@@ -130,7 +130,7 @@ def _calibrate(results, data, out, outputs, noise, seed, walkers, steps, method,
     sigmas = posterior.sigmas(draws)
     sigma_matrix = np.column_stack([sigmas[o] for o in flight.values])
 
-    specs = parameter_specs(surrogate.campaign)
+    specs = parameter_specs(surrogate.parameters)
     prior = prior_summaries(surrogate.parameters)
     post = {name: marginal(kappa[:, k]) for k, name in enumerate(names)}
     with np.errstate(invalid="ignore", divide="ignore"):
