@@ -33,6 +33,21 @@ def _true_case():
     return indices, np.array(list(TRUE_TERMS.values()))
 
 
+def test_the_corrected_loo_error_of_every_prefix_is_chapelles_from_the_plain_leave_one_out_error():
+    # one QR for every prefix against the direct formula per prefix: ε_LOO (methods.loo, summed over the
+    # columns) · N / (N − Z) · (1 + tr((ΨᵀΨ)⁻¹)); rounding only (1e-12)
+    from uqflight.methods.sparse import _corrected_loo
+
+    rng = np.random.default_rng(0)
+    X, y = rng.normal(size=(40, 6)), rng.normal(size=(40, 3))
+    X[:, 0] = 1
+    deviations = ((y - y.mean(axis=0)) ** 2).sum(axis=0)
+    for z, error in enumerate(_corrected_loo(X, y), start=1):
+        plain = (relative_loo_error(X[:, :z], y) * deviations).sum() / deviations.sum()
+        correction = 40 / (40 - z) * (1 + np.trace(np.linalg.inv(X[:, :z].T @ X[:, :z])))
+        assert error == pytest.approx(plain * correction, rel=1e-12)
+
+
 def test_sparse_pce_recovers_a_sparse_20_input_polynomial_where_least_squares_is_refused():
     # The model is in the candidate basis, so the fit is exact up to rounding: 1e-6 is far above the
     # ~1e-14 of a least-squares solve on 200 points, and far below any missed or spurious term (>= 0.09
