@@ -210,7 +210,8 @@ def main():
                 needs.append("-" if fewest is None else f"{fewest}" + ("?" if unresolved else ""))
             cells.append(" / ".join(needs))
         print(f"| {kind} | " + " | ".join(cells) + " |")
-    print("\n(-: no grid up to 2437 runs reaches it; ?: that Monte Carlo error is within 2 floors of the "
+    largest = max((runs for rows in best.values() for runs, _ in rows), default=0)
+    print(f"\n(-: no grid up to {largest} runs reaches it; ?: that Monte Carlo error is within 2 floors of the "
           "RQMC reference, so the comparison is at the reference's resolution)")
     if args.sparse:
         sparse_rows(args.results, reference, floor_m, floor_v)
