@@ -16,11 +16,14 @@ Tables:
    with 10^4 and with 10^5 runs (its floor at that N), per method.
 4. When results/mc-normal-1e5.h5 exists (campaigns/mc-normal-1e5.yaml, about 35 minutes on 2 cores):
    its floor measured from its own runs, and its distance from the RQMC reference.
+5. With --sparse: sparse PCE (LARS, max order 5, total degree) and least squares of order 3 on unscrambled
+   Sobol' designs of 128, 256 and 500 points (qmc-sobol-N: rqmc-normal's campaign with that design),
+   beside the grids, with each output's selected order and terms.
 
-Uses results/rqmc-normal.h5 and results/grid-gh-l*.h5 in --results, running the missing campaigns
-first (about 12 minutes on 2 quiet cores).
+Uses results/rqmc-normal.h5 and results/grid-gh-l*.h5 (--levels) in --results, running the missing
+campaigns first (about 12 minutes on 2 quiet cores).
 
-Run: .venv/bin/python benchmarks/accuracy.py [--results results]
+Run: .venv/bin/python benchmarks/accuracy.py [--results results] [--levels 1 2 3 4] [--sparse]
 """
 from __future__ import annotations
 
@@ -40,20 +43,68 @@ from uqflight.store import ResultStore
 OUTPUTS = ("theta_deg", "alpha_deg", "q_degps", "h_ft", "vtas_kt")
 METHODS = [("pseudo_galerkin", None), ("interpolation", None), ("least_squares", None), ("regression", None)]
 LEVELS = (1, 2, 3, 4)
+QMC_POINTS = (128, 256, 500)
+SPARSE = [("sparse", {"kind": "sparse", "order": 5, "selection": "lars", "q": 1.0}),
+          ("least_squares", {"kind": "least_squares", "order": 3})]
 CAMPAIGNS = Path(__file__).resolve().parents[1] / "campaigns"
 FAST = Options(band_samples=2000, bootstrap=0)
 
 
-def ensure_results(results: Path) -> None:
+def qmc_campaign(results: Path, n: int) -> Path:
+    """rqmc-normal's campaign with one Sobol' design of n points (no replicates), written beside the results."""
+    text = (CAMPAIGNS / "rqmc-normal.yaml").read_text()
+    text = text.replace("name: rqmc-normal", f"name: qmc-sobol-{n}").replace(
+        "design: {kind: sobol, samples: 1024, replicates: 16}", f"design: {{kind: sobol, samples: {n}}}")
+    path = results / f"qmc-sobol-{n}.yaml"
+    path.write_text(text)
+    return path
+
+
+def ensure_results(results: Path, levels, sparse: bool) -> None:
     """Run the campaigns whose results file is missing or incomplete (a partial file is resumed)."""
-    for name in ["rqmc-normal"] + [f"grid-gh-l{level}" for level in LEVELS]:
+    names = {name: CAMPAIGNS / f"{name}.yaml" for name in ["rqmc-normal"] + [f"grid-gh-l{level}" for level in levels]}
+    if sparse:
+        names.update({f"qmc-sobol-{n}": None for n in QMC_POINTS})
+    for name, campaign in names.items():
         path = results / f"{name}.h5"
         if path.exists():
             with ResultStore.open(path) as store:
                 if store.pending().size == 0:
                     continue
-        print(f"running campaigns/{name}.yaml into {path} ...", flush=True)
-        run_campaign(load_campaign(CAMPAIGNS / f"{name}.yaml", validation_view), out=path)
+        campaign = campaign or qmc_campaign(results, int(name.rsplit("-", 1)[1]))
+        print(f"running {campaign} into {path} ...", flush=True)
+        run_campaign(load_campaign(campaign, validation_view), out=path)
+
+
+def sparse_rows(results: Path, reference, floor_m: dict, floor_v: dict) -> None:
+    """Table 5: sparse PCE and least squares on the QMC designs against the reference."""
+    print("\n## Sparse PCE on QMC points: max over time of eps_m / eps_v against the RQMC reference (~: below 2 "
+          "floors)\n")
+    print("| design | runs | method | " + " | ".join(OUTPUTS) + " |")
+    print("|---|---|---|" + "---|" * len(OUTPUTS))
+    chosen = []
+    for n in QMC_POINTS:
+        path = results / f"qmc-sobol-{n}.h5"
+        for label, method in SPARSE:
+            try:
+                stats = analyse(path, options=FAST, method=method)
+            except BadInput as exc:
+                print(f"| Sobol' {n} | {n} | {label} {method['order']} | refused: {str(exc).split(': ', 2)[-1][:90]} |")
+                continue
+            cells = []
+            for name in OUTPUTS:
+                eps_m, eps_v = relative_errors(stats.outputs[name].mean, stats.outputs[name].variance,
+                                               reference.outputs[name].mean, reference.outputs[name].variance)
+                cells.append(f"{mark(eps_m.max(), floor_m[name])} / {mark(eps_v.max(), floor_v[name])}")
+            print(f"| Sobol' {n} | {n} | {label} {method['order']} | " + " | ".join(cells) + " |")
+            if label == "sparse":
+                chosen.append((n, {name: stats.outputs[name].selection for name in OUTPUTS}))
+    print("\n(sparse: order chosen / terms / corrected LOO error of each output's basis)\n")
+    print("| runs | " + " | ".join(OUTPUTS) + " |")
+    print("|---|" + "---|" * len(OUTPUTS))
+    for n, selections in chosen:
+        print(f"| {n} | " + " | ".join(f"{s['order']} / {len(s['terms'])} / {s['loo_error']:.1e}"
+                                        for s in selections.values()) + " |")
 
 
 def monte_carlo_floor(reference, name: str, n: int) -> np.ndarray:
@@ -95,8 +146,11 @@ def _fourth_central(path: str, name: str) -> np.ndarray:
 def main():
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--results", type=Path, default=Path("results"))
+    parser.add_argument("--levels", type=int, nargs="+", default=list(LEVELS), choices=LEVELS,
+                        help="Gauss-Hermite grid levels to compare (default: 1 2 3 4)")
+    parser.add_argument("--sparse", action="store_true", help="add sparse PCE on QMC designs (table 5)")
     args = parser.parse_args()
-    ensure_results(args.results)
+    ensure_results(args.results, args.levels, args.sparse)
     reference = analyse(args.results / "rqmc-normal.h5", options=FAST)
     floor_v = {name: reference.outputs[name].replicate_moments[1].std(axis=0, ddof=1).max()
                / np.sqrt(reference.replicates) / reference.outputs[name].variance.max() for name in OUTPUTS}
@@ -123,7 +177,7 @@ def main():
     print("| grid | runs | method | " + " | ".join(OUTPUTS) + " |")
     print("|---|---|---|" + "---|" * len(OUTPUTS))
     best: dict[str, list[tuple[int, dict]]] = {kind: [] for kind, _ in METHODS}
-    for level in LEVELS:
+    for level in args.levels:
         path = args.results / f"grid-gh-l{level}.h5"
         with ResultStore.open(path) as store:
             runs = store.status.size
@@ -156,8 +210,11 @@ def main():
                 needs.append("-" if fewest is None else f"{fewest}" + ("?" if unresolved else ""))
             cells.append(" / ".join(needs))
         print(f"| {kind} | " + " | ".join(cells) + " |")
-    print("\n(-: no grid up to 2437 runs reaches it; ?: that Monte Carlo error is within 2 floors of the "
+    largest = max((runs for rows in best.values() for runs, _ in rows), default=0)
+    print(f"\n(-: no grid up to {largest} runs reaches it; ?: that Monte Carlo error is within 2 floors of the "
           "RQMC reference, so the comparison is at the reference's resolution)")
+    if args.sparse:
+        sparse_rows(args.results, reference, floor_m, floor_v)
 
 
 if __name__ == "__main__":

@@ -28,7 +28,7 @@ sys.path.insert(0, str(ROOT))
 from uqflight.calibration.likelihood import FlightData, LogPosterior  # noqa: E402
 from uqflight.calibration.run import calibrate  # noqa: E402
 from uqflight.calibration.sampler import sample  # noqa: E402
-from uqflight.calibration.surrogate import fit_surrogate, prior_summaries, simulate, to_physical  # noqa: E402
+from uqflight.calibration.surrogate import calibration_surrogate, prior_summaries, simulate, to_physical  # noqa: E402
 
 TRUE_XI = {"CL0": 1.5, "k2": -1.2}
 NOISE = {"alpha_deg": 0.05, "theta_deg": 0.05, "h_ft": 1.0, "q_degps": 0.05, "vtas_kt": 0.1}
@@ -115,7 +115,7 @@ def main() -> None:
     parser.add_argument("--infer-noise", action="store_true", help="infer σ per output instead of giving it")
     args = parser.parse_args()
 
-    surrogate = fit_surrogate(ensure_results(args.results))
+    surrogate = calibration_surrogate(ensure_results(args.results))
     names = surrogate.names
     xi_true = np.array([TRUE_XI.get(n, 0.0) for n in names])
     kappa_true = to_physical(surrogate.parameters, xi_true[None])[0]

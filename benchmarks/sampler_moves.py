@@ -35,7 +35,7 @@ from tests.test_calibration_conjugate import (PRIOR_STD, SIGMA, conjugate, fligh
                                               make_results, std_z)
 from uqflight.calibration.likelihood import FlightData, LogPosterior  # noqa: E402
 from uqflight.calibration.sampler import sample  # noqa: E402
-from uqflight.calibration.surrogate import fit_surrogate  # noqa: E402
+from uqflight.calibration.surrogate import calibration_surrogate  # noqa: E402
 
 
 class SnookerMove(emcee.moves.RedBlueMove):
@@ -81,7 +81,7 @@ def gaussian_7d():
 
 def line_targets(folder: Path, seed: int):
     """(label, log posterior, start, exact std of ξ_a and ξ_b, prior draw) of both lines."""
-    surrogate = fit_surrogate(make_results(folder))
+    surrogate = calibration_surrogate(make_results(folder))
     y = flight(seed)
     data = FlightData("line", surrogate.time, {"y": y})
     out = []

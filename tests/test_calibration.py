@@ -16,7 +16,7 @@ from typer.testing import CliRunner
 from uqflight.calibration.command import register
 from uqflight.calibration.likelihood import FlightData, LogPosterior, interpolate_in_time, DataError
 from uqflight.calibration.sampler import sample, split_rhat
-from uqflight.calibration.surrogate import fit_surrogate, load_campaign_file
+from uqflight.calibration.surrogate import calibration_surrogate, load_campaign_file
 from uqflight.campaign import parse_campaign
 from uqflight.execution import run_campaign
 
@@ -94,7 +94,7 @@ def app():
 
 
 def test_surrogate_of_a_polynomial_model_is_exact(results):
-    surrogate = fit_surrogate(results)
+    surrogate = calibration_surrogate(results)
     assert surrogate.method == {"kind": "regression", "order": 2}
     assert max(float(v.max()) for v in surrogate.error_variance.values()) < 1e-20
     xi = np.array([[0.5, -1.0, 0.2]])
@@ -104,7 +104,7 @@ def test_surrogate_of_a_polynomial_model_is_exact(results):
 
 
 def test_posterior_matches_the_closed_form(results):
-    surrogate = fit_surrogate(results)
+    surrogate = calibration_surrogate(results)
     data = synthetic(0)
     posterior = LogPosterior.build(surrogate.time, surrogate.coefficients, surrogate.error_factors, surrogate.germs,
                                    surrogate.names, surrogate.basis, FlightData("test", TIME, data),
@@ -256,7 +256,7 @@ def test_aircraft_calibration_recovers_cl0_and_k2(tmp_path):
     campaign = load_campaign_file(root / "campaigns/grid-gh-l2.yaml")
     results = tmp_path / "grid-gh-l2.h5"
     run_campaign(campaign, out=results, workers=2)
-    surrogate = fit_surrogate(results)
+    surrogate = calibration_surrogate(results)
     xi = np.array([[1.5 if n == "CL0" else -1.2 if n == "k2" else 0.0 for n in surrogate.names]])
     kappa = to_physical(surrogate.parameters, xi)[0]
     time, clean, failures = simulate(surrogate.campaign, kappa[None], surrogate.outputs)

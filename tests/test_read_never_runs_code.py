@@ -102,12 +102,12 @@ def test_info_report_check_and_surrogate_export_import_no_model(world, name, tmp
 @pytest.mark.parametrize("name", ["file", "module"])
 def test_the_calibration_surrogate_imports_no_model(world, name, monkeypatch):
     """`calibrate` before its sampling: the campaign, the parameters and the PCE surrogate of the file."""
-    from uqflight.calibration.surrogate import fit_surrogate
+    from uqflight.calibration.surrogate import calibration_surrogate
 
     monkeypatch.chdir(world["cwd"])
     for folder in world["env"]["PYTHONPATH"].split(os.pathsep)[:2]:
         monkeypatch.syspath_prepend(folder)
-    surrogate = fit_surrogate(world["results"] / f"{name}.h5")
+    surrogate = calibration_surrogate(world["results"] / f"{name}.h5")
     assert [(p.name, p.lower, p.upper) for p in surrogate.parameters] == [
         (n, pytest.approx(lower, rel=1e-15), pytest.approx(upper, rel=1e-15)) for n, (lower, upper) in PARAMETERS.items()]
     assert ran_code(world) == {}

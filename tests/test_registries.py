@@ -10,7 +10,7 @@ import yaml
 from uqflight.designs import REGISTRY as DESIGNS
 from uqflight.designs import build_design, design_size
 from uqflight.designs.rules import RULE_TABLE, nodes_weights
-from uqflight.methods import METHODS, fit
+from uqflight.methods import METHODS, exported_kind, fit, method_entry
 from uqflight.methods.basis import orthonormal_basis, orthonormal_polynomials, total_degree_indices
 from uqflight.parameters import DISTRIBUTIONS, GERMS, make_parameter
 from uqflight.simulators.kinds import REGISTRY as SIMULATORS
@@ -188,6 +188,41 @@ def test_every_sampling_method_gives_the_sample_moments(kind):
     result = fit(kind, design.xi, design.weights, Y, germs)
     np.testing.assert_allclose(result.mean, Y.mean(axis=0), rtol=1e-14)
     np.testing.assert_allclose(result.variance, Y.var(axis=0, ddof=1), rtol=1e-12)
+
+
+@pytest.mark.parametrize("kind", [k for k, m in METHODS.items() if not m.sampled_only])
+def test_every_method_gives_the_same_pce_from_tsvd_factors_as_from_the_runs(kind):
+    # Y = rows @ scale as tSVD storage keeps it: a linear method is applied to the rows, the others are given
+    # the factors; either way the PCE is the one of Y itself, up to rounding (1e-10 of the coefficients).
+    germs, design, _, _ = _polynomial_case()
+    rows = np.column_stack([np.exp(0.3 * design.xi[:, 0]), np.sin(design.xi[:, 1]) + design.xi[:, 0]])
+    scale = np.random.default_rng(5).normal(size=(2, 4))
+    direct = fit(kind, design.xi, design.weights, rows @ scale, germs, order=2).pce
+    factored = fit(kind, design.xi, design.weights, rows, germs, order=2, scale=scale).pce
+    np.testing.assert_array_equal(direct.indices, factored.indices)
+    np.testing.assert_allclose(factored.coefficients, direct.coefficients, atol=1e-10 * np.abs(direct.coefficients).max())
+
+
+@pytest.mark.parametrize("kind", [k for k, m in METHODS.items() if m.pce is not None and m.rule != "projection"])
+def test_every_fit_weighs_the_runs_as_its_entry_says(kind):
+    # the same points and runs with other (positive) weights: a weighted fit changes, an unweighted one does not
+    germs = ["normal", "uniform"]
+    design = build_design({"kind": "monte_carlo", "samples": 40}, germs, 6)
+    Y = np.exp(0.5 * design.xi[:, 0]) * (1 + design.xi[:, 1] ** 3)
+    weights = np.random.default_rng(7).uniform(0.2, 1.0, 40)
+    equal = fit(kind, design.xi, design.weights, Y, germs, order=2).pce
+    other = fit(kind, design.xi, weights, Y, germs, order=2).pce
+    same = equal.indices.shape == other.indices.shape and np.allclose(equal.coefficients, other.coefficients,
+                                                                       rtol=1e-12, atol=1e-12)
+    assert same != method_entry(kind).weighted
+
+
+@pytest.mark.parametrize("kind", list(METHODS))
+def test_every_method_is_exported_as_a_kind_that_builds_its_own_pce(kind):
+    for sampled in (True, False):
+        target = method_entry(exported_kind(kind, sampled))
+        assert target.pce is not None and target.exported_as is None
+        assert not (sampled and target.runs_on_sampled)
 
 
 def _scenario_campaign(simulator: dict) -> str:

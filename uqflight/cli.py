@@ -421,7 +421,8 @@ def report(
                                                              "JSON file, the baseline of `uqflight check`."),
     method: List[str] = typer.Option([], metavar="KIND[:ORDER]", help="KIND[:ORDER], repeatable: analyse every file with each method "
                                               "instead of its campaign's, overlaid in the plots, e.g. --method "
-                                              "pseudo_galerkin:2 --method least_squares:3. KIND: "
+                                              "pseudo_galerkin:2 --method least_squares:3 --method sparse:4:selection=omp,q=0.75 "
+                                              "(KIND:ORDER:KEY=VALUE,... for a kind's own settings). KIND: "
                                               + ", ".join(METHOD_KINDS) + " (the runs of one grid serve every "
                                               "method)."),
     order: Optional[int] = typer.Option(None, help="Polynomial order for a --method given without :ORDER "
@@ -571,8 +572,10 @@ def design(
 def surrogate_export(
     results: Path = typer.Argument(..., metavar="RESULTS", help="Results file (.h5)."),
     out: Path = typer.Option(..., help="JSON file to write (strict JSON)."),
-    method: Optional[str] = typer.Option(None, help="KIND[:ORDER] instead of the campaign's method, "
-                                                    "e.g. least_squares:3 (a PCE method)."),
+    method: Optional[str] = typer.Option(None, help="KIND[:ORDER[:KEY=VALUE,...]] instead of the campaign's "
+                                                    "method, e.g. least_squares:3 or sparse:4; a method without a "
+                                                    "PCE of its own (monte_carlo) exports as least squares on a "
+                                                    "sampled design, pseudo-Galerkin on a grid, as calibrate does."),
 ):
     """Export the PCE of every output over time as JSON: germs, multi-indices, coefficients per output
     and time, the parameters' distributions (name, distribution, lower, upper, nominal), the time

@@ -143,6 +143,33 @@ def prepare_store(campaign: Campaign, design: Design, out: Path, force: bool, no
         quantities=list(campaign.quantities))
 
 
+def simulate(campaign: Campaign, kappa: np.ndarray, outputs: list[str]):
+    """Fly (or call) the campaign's simulator at every row of kappa (M, d) in this process, as a worker of
+    `uqflight run` does (e.g. the calibration's posterior-predictive runs).
+
+    Returns (time (T,), {output: (M, T)} with NaN rows for failed runs, [failure reasons]).
+    """
+    from .simulators import make_simulator
+    from .simulators.base import FlightError
+
+    names = [p.name for p in campaign.parameters]
+    properties = [p.property for p in campaign.parameters]
+    simulator = make_simulator(campaign.simulator, names, properties, Path(campaign.source).resolve().parent)
+    time, _ = simulator.layout(np.asarray(kappa)[0])
+    values = {name: np.full((len(kappa), len(time)), np.nan) for name in outputs}
+    failures = []
+    for row, k in enumerate(np.asarray(kappa, dtype=float)):
+        simulator.restart()  # each run as from a fresh worker: independent of the order of the draws
+        try:
+            result = simulator.evaluate(k)
+        except FlightError as exc:
+            failures.append(str(exc))
+            continue
+        for name in outputs:
+            values[name][row] = result[name]
+    return np.asarray(time, dtype=float), values, failures
+
+
 def nominal_kappa(campaign: Campaign) -> np.ndarray:
     return campaign.to_physical(np.zeros((1, len(campaign.parameters))))[0]
 

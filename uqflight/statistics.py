@@ -41,7 +41,7 @@ from .analysis.resolution import RESOLUTION_RTOL, resolved_variance
 from .analysis.sobol import pick_freeze_indices
 from .designs import REGISTRY as DESIGNS
 from .designs import is_sampled
-from .methods import PCE, METHODS, failed_runs_note, method_entry
+from .methods import PCE, METHODS, failed_runs_note, fit, method_entry, method_settings, normalised
 from .methods.basis import orthonormal_basis
 from .methods.loo import relative_loo_error
 from .methods.validity import method_problem
@@ -94,6 +94,7 @@ class OutputStatistics:
     sobol_first_ci: dict[str, np.ndarray] = field(default_factory=dict)  # (2, T) per parameter
     sobol_total_ci: dict[str, np.ndarray] = field(default_factory=dict)
     loo_error: np.ndarray | None = None  # relative leave-one-out error of a fit, (T,)
+    selection: dict | None = None  # what a selecting method (sparse) chose: terms, order, corrected LOO error
     convergence: dict | None = None  # difference to the next lower order of a projection
     coefficient_decay: dict[int, np.ndarray] | None = None  # degree -> RSS of its PCE coefficients (T,)
     final_samples: np.ndarray | None = None  # runs or surrogate draws at the final time, for the KLD
@@ -179,7 +180,7 @@ def analyse(path, reference: str | None = None, options: Options | None = None, 
     """
     with ResultStore.open(path) as store:
         stored_method, germs, analysis = campaign_facts(store)
-        method = {"order": 2, **stored_method, **(method or {})}
+        method = {"order": 2, **normalised(stored_method), **normalised(method or {})}
         allow_aliasing = allow_aliasing or bool(method.get("allow_aliasing"))
         options = options or Options(**{k: (tuple(v) if k == "quantiles" else v) for k, v in analysis.items()
                                         if k in ("band_samples", "bootstrap", "quantiles")})
@@ -306,32 +307,26 @@ def _output_statistics(store: ResultStore, name: str, method: dict, germs: list[
     entry = method_entry(kind)
     basis, scale = output_basis(store, name, ok)
     truncation = _tsvd_resolution(store, scale, int(ok.sum()))
-    from_runs = entry.runs_on_sampled and is_sampled(design_kind)
+    sampled = is_sampled(design_kind)
     x0 = None
     # x = x0 + S with each run's initial value (needs the runs themselves); only the projections use
     # it: the other kinds fit the constant term themselves, where the split would change nothing
-    if method.get("split") and not from_runs and entry.split:
+    if method.get("split") and not (sampled and entry.runs_on_sampled) and entry.split:
         basis = basis if scale is None else basis @ scale
         scale, x0 = None, basis[:, :1]
 
     def expand(a):
         return a if scale is None else a @ scale
 
-    pce = None
-    if from_runs:  # sample moments; bands, PDFs and pick-freeze indices from the runs themselves
-        sample = entry.moments == "sample"
-        mean, variance = weighted_moments(basis, None if sample else weights, scale, unbiased=sample)
-        rows, row_scale, band_weights = basis, scale, (None if sample else weights / weights.sum())
+    result = fit(kind, xi, weights, basis, germs, order, x0, scale=scale, sampled=sampled,
+                 settings=method_settings(method))
+    mean, variance, pce, from_runs = result.mean, result.variance, result.pce, result.from_runs
+    if from_runs:  # bands, PDFs and pick-freeze indices from the runs themselves
+        rows, row_scale, band_weights = basis, scale, (None if entry.moments == "sample" else weights / weights.sum())
     else:
-        fitted = entry.pce(xi, weights, basis, germs, order, x0)
-        pce = PCE(fitted.germs, fitted.indices, expand(fitted.coefficients))
-        if entry.moments == "weights":  # quadrature moments; the PCE serves bands, PDFs, Sobol'
-            mean, variance = weighted_moments(basis, weights, scale)
-        else:
-            mean, variance = pce.mean(), pce.variance()
         draws = draw_germs(germs, options.band_samples, options.seed)
         rows, row_scale, band_weights = orthonormal_basis(germs, pce.indices, draws), pce.coefficients, None
-    pick_freeze = pce is None and design_kind == "pick_freeze" and ok.all()
+    pick_freeze = from_runs and DESIGNS[design_kind].sobol_from_runs and ok.all()
     blocks = _over_time_blocks(rows, row_scale, store.time.size, band_weights,
                                len(store.parameter_names) if pick_freeze else 0, options, from_runs)
     magnitude = np.max(np.sqrt(mean**2 + np.maximum(variance, 0.0)))  # the output's own size over its history
@@ -355,11 +350,11 @@ def _output_statistics(store: ResultStore, name: str, method: dict, germs: list[
         stats.sobol_first = dict(zip(names, masked(pce.sobol_first())))
         stats.sobol_total = dict(zip(names, masked(pce.sobol_total())))
         stats.coefficient_decay = _coefficient_decay(pce)
-        if entry.rule == "fit":
-            stats.loo_error = _loo_error(kind, xi, weights, expand(basis) if scale is not None else basis,
-                                         germs, pce.indices)
+        stats.selection = pce.selection
+        if entry.rule in ("fit", "selection"):
+            stats.loo_error = _loo_error(entry, xi, weights, expand(basis), germs, pce.indices)
         elif entry.moments == "pce" and order >= 1:
-            stats.convergence = _lower_order_difference(entry, xi, weights, basis, scale, germs, order, x0, pce)
+            stats.convergence = _lower_order_difference(kind, xi, weights, basis, scale, germs, order, x0, pce)
     elif pick_freeze:
         stats.sobol_first = dict(zip(names, masked(blocks["first"])))
         stats.sobol_total = dict(zip(names, masked(blocks["total"])))
@@ -390,21 +385,19 @@ def _coefficient_decay(pce: PCE) -> dict[int, np.ndarray]:
     return {int(p): np.sqrt((pce.coefficients[degrees == p] ** 2).sum(axis=0)) for p in np.unique(degrees)}
 
 
-def _loo_error(kind, xi, weights, Y, germs, indices) -> np.ndarray:
+def _loo_error(entry, xi, weights, Y, germs, indices) -> np.ndarray:
     """The relative leave-one-out error of the fit over time (methods.loo), weighted as the fit is."""
     matrix = orthonormal_basis(germs, indices, xi)
     try:
-        return relative_loo_error(matrix, Y, None if kind == "regression" else np.abs(weights))
+        return relative_loo_error(matrix, Y, np.abs(weights) if entry.weighted else None)
     except ValueError:  # a point the fit interpolates: leaving it out is undefined
         return np.full(Y.shape[1], np.nan)
 
 
-def _lower_order_difference(entry, xi, weights, basis, scale, germs, order, x0, pce: PCE) -> dict:
+def _lower_order_difference(kind, xi, weights, basis, scale, germs, order, x0, pce: PCE) -> dict:
     """ε_m, ε_v (Eq. 49's normalisation) between this projection and the one of order − 1 on the same
     runs: a cheap estimate of the truncation error, with no reference needed."""
-    lower = entry.pce(xi, weights, basis, germs, order - 1, x0)
-    coefficients = lower.coefficients if scale is None else lower.coefficients @ scale
-    lower = PCE(lower.germs, lower.indices, coefficients)
+    lower = fit(kind, xi, weights, basis, germs, order - 1, x0, scale=scale).pce
     eps_m, eps_v = relative_errors(lower.mean(), lower.variance(), pce.mean(), pce.variance())
     return {"against": f"order {order - 1}", "eps_m": eps_m, "eps_v": eps_v}
 
@@ -563,6 +556,8 @@ def _quantity_json(quantity: QuantityStatistics, seeds: list[str]) -> dict:
             entry["variance_split"] = _at_first_time(variance_split(out, seeds[0]))
     if out.loo_error is not None:
         entry["loo_error"] = out.loo_error[0]
+    if out.selection is not None:
+        entry["selection"] = out.selection
     if out.convergence is not None:
         entry["convergence"] = {**out.convergence, "eps_m": out.convergence["eps_m"][0],
                                 "eps_v": out.convergence["eps_v"][0]}
@@ -630,6 +625,8 @@ def summary_json(stats: Statistics) -> dict:
             entry["variance_split"] = variance_split(out, stats.seeds[0])
         if out.loo_error is not None:
             entry["loo_error"] = out.loo_error
+        if out.selection is not None:
+            entry["selection"] = out.selection
         if out.convergence is not None:
             entry["convergence"] = out.convergence
         if out.errors:

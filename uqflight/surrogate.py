@@ -6,10 +6,11 @@
     >>> pce.evaluate(kappa=[[0.25, 5.1, ...]])["theta_deg"]     # (points, times)
 
 The file holds everything needed to evaluate the expansion without uqflight's results file:
-the germs (standard variables), the multi-indices (total degree, one row per basis polynomial),
-the coefficients of the orthonormal basis per output and time, the parameters' distributions
-(name, distribution, lower, upper, nominal: κ ↔ ξ), their Gaussian copula when they are dependent
-(`dependence`: {kind, parameters, correlation}; see docs/dependence.md), the time grid, the method and its order.
+the germs (standard variables), the multi-indices (one row per basis polynomial: total degree, or
+the terms a sparse PCE selected, then per output), the coefficients of the orthonormal basis per
+output and time, the parameters' distributions (name, distribution, lower, upper, nominal: κ ↔ ξ),
+their Gaussian copula when they are dependent (`dependence`: {kind, parameters, correlation}; see
+docs/dependence.md), the time grid, the method and its order.
 The PCE is fitted exactly as the statistics fit it (same runs, same method, same order).
 """
 from __future__ import annotations
@@ -27,7 +28,8 @@ MAX_FILE_BYTES = 64 << 20  # 64 MiB of JSON (about 3 million coefficients); pars
 
 
 class SurrogateError(ValueError):
-    """A results file that has no PCE (e.g. Monte Carlo) or a malformed surrogate file."""
+    """A results file or method that gives no usable surrogate, or a malformed surrogate file; the message
+    names the file (and the key) and says what to do."""
 
 
 @dataclass
@@ -36,7 +38,7 @@ class Surrogate:
 
     parameters: list[dict]
     germs: list[str]
-    indices: np.ndarray  # (Z, d) multi-indices
+    indices: dict[str, np.ndarray]  # output -> (Z, d) multi-indices of its basis
     time: np.ndarray  # (T,)
     coefficients: dict[str, np.ndarray]  # output -> (Z, T)
     units: dict[str, str]
@@ -70,37 +72,41 @@ class Surrogate:
         points = self.to_standard(kappa) if xi is None else np.atleast_2d(np.asarray(xi, dtype=float))
         if points.shape[1] != len(self.germs):
             raise ValueError(f"expected {len(self.germs)} standard variables per point, got {points.shape[1]}")
-        basis = orthonormal_basis(self.germs, self.indices, points)
-        return {name: basis @ c for name, c in self.coefficients.items()}
+        return {name: orthonormal_basis(self.germs, self.indices[name], points) @ c
+                for name, c in self.coefficients.items()}
 
     def mean(self) -> dict[str, np.ndarray]:
-        constant = ~self.indices.any(axis=1)
-        return {name: c[constant].sum(axis=0) for name, c in self.coefficients.items()}
+        return {name: c[~self.indices[name].any(axis=1)].sum(axis=0) for name, c in self.coefficients.items()}
 
     def variance(self) -> dict[str, np.ndarray]:
-        constant = ~self.indices.any(axis=1)
-        return {name: (c[~constant] ** 2).sum(axis=0) for name, c in self.coefficients.items()}
+        return {name: (c[self.indices[name].any(axis=1)] ** 2).sum(axis=0) for name, c in self.coefficients.items()}
 
 
-def fit_surrogate(path, method: dict | None = None, partial: bool = False,
-                  allow_aliasing: bool = False) -> Surrogate:
+def fit_surrogate(path, method: dict | None = None, partial: bool = False, allow_aliasing: bool = False,
+                  options=None) -> Surrogate:
     """The PCE of every output of the results file `path`, exactly as `uqflight.statistics.analyse`
     fits it (with `method` overriding the campaign's), after the same checks: pending or failed runs,
     a projection the grid cannot integrate and a rank-deficient fit are refused (statistics.BadInput).
-    SurrogateError when the method builds no PCE."""
+    A method that builds no PCE of its own on this design is exported as its registry entry says
+    (`exported_as`: monte_carlo, and integration on a sampled design, as least squares). The export
+    and the calibration both fit here. `options`: statistics.Options (the bands' draws)."""
+    from .designs import REGISTRY as DESIGNS
+    from .methods import METHOD_KINDS, exported_kind, normalised
     from .statistics import analyse
     from .store import ResultStore
 
-    stats = analyse(path, method=method, partial=partial, allow_aliasing=allow_aliasing)
-    pces = {name: out.pce for name, out in stats.outputs.items()}
-    if any(pce is None for pce in pces.values()):
-        raise SurrogateError(f"{path}: method {stats.method['kind']} on a {stats.design_kind} design builds no PCE; "
-                             "give a PCE method, e.g. --method least_squares:2")
     with ResultStore.open(path) as store:
+        stored, design_kind = normalised(json.loads(store.attrs["method"])), store.attrs.get("design_kind", "")
         parameters, units, time = _parameters(store), dict(store.units), np.asarray(store.time, dtype=float)
-    first = next(iter(pces.values()))
+    override = dict(method or {})
+    kind = override.get("kind", stored.get("kind"))
+    if design_kind in DESIGNS and isinstance(kind, str) and kind in METHOD_KINDS:  # else analyse refuses
+        override["kind"] = exported_kind(kind, DESIGNS[design_kind].sampled)
+    stats = analyse(path, method=override, partial=partial, allow_aliasing=allow_aliasing, options=options)
+    pces = {name: out.pce for name, out in stats.outputs.items()}
     dependence = {k: v for k, v in stats.dependence.items() if k != "sobol_of"} if stats.dependence else None
-    return Surrogate(parameters, list(first.germs), np.asarray(first.indices, dtype=int), time,
+    return Surrogate(parameters, list(next(iter(pces.values())).germs),
+                     {name: np.asarray(pce.indices, dtype=int) for name, pce in pces.items()}, time,
                      {name: np.asarray(pce.coefficients, dtype=float) for name, pce in pces.items()}, units,
                      stats.method, stats.campaign_name, dependence)
 
@@ -138,17 +144,24 @@ def surrogate_json(surrogate: Surrogate, results: str = "") -> dict:
     def numbers(a):
         return [[v if math.isfinite(v) else None for v in row] for row in np.asarray(a, dtype=float).tolist()]
 
-    return {
+    bases = list(surrogate.indices.values())
+    shared = all(np.array_equal(b, bases[0]) for b in bases)
+    data = {
         "format": FORMAT, "version": VERSION, "campaign": surrogate.campaign, "results": results,
         "method": surrogate.method["kind"], "order": surrogate.method["order"],
         "split": bool(surrogate.method.get("split", False)),
-        "basis": "orthonormal polynomials of the germs (Hermite for normal, Legendre for uniform), total degree",
+        "basis": "orthonormal polynomials of the germs (Hermite for normal, Legendre for uniform), " + (
+            "total degree" if shared else "each output's own terms (outputs.NAME.multi_indices)"),
         "parameters": surrogate.parameters, "germs": surrogate.germs,
         **({"dependence": surrogate.dependence} if surrogate.dependence else {}),
-        "multi_indices": surrogate.indices.tolist(), "time": surrogate.time.tolist(),
-        "outputs": {name: {"units": surrogate.units.get(name, ""), "coefficients": numbers(c)}
+        "multi_indices": bases[0].tolist(), "time": surrogate.time.tolist(),
+        "outputs": {name: {"units": surrogate.units.get(name, ""), "coefficients": numbers(c),
+                           **({} if shared else {"multi_indices": surrogate.indices[name].tolist()})}
                     for name, c in surrogate.coefficients.items()},
     }
+    if not shared:
+        del data["multi_indices"]
+    return data
 
 
 def export(results, out, method: dict | None = None) -> Path:
@@ -233,24 +246,21 @@ def _checked(data: dict) -> Surrogate:
     order = data["order"]
     if isinstance(order, bool) or not isinstance(order, int) or not 0 <= order <= MAX_DEGREE:
         raise ValueError(f"order: expected an integer in [0, {MAX_DEGREE}], got {_shown(order)}")
-    indices = _array(data["multi_indices"], "multi_indices", (None, d), integers=True)
-    if not len(indices) or indices.sum(axis=1).max() > order:
-        raise ValueError(f"multi_indices: expected rows of {d} integers of total degree <= order {order}, "
-                         f"got {len(indices)} rows of total degree up to {indices.sum(axis=1).max(initial=0)}")
-    rows = {}
-    for i, row in enumerate(map(tuple, indices.tolist())):
-        if row in rows:
-            raise ValueError(f"multi_indices: row {i} repeats row {rows[row]} ({list(row)})")
-        rows[row] = i
+    shared = _multi_indices(data["multi_indices"], "multi_indices", d, order) if "multi_indices" in data else None
     time = _array(data["time"], "time", (None,))
     if not time.size or np.any(np.diff(time) <= 0):
         raise ValueError("time: expected a list of strictly increasing numbers")
     outputs = data["outputs"]
     if not isinstance(outputs, dict) or not outputs:
         raise ValueError("outputs: expected a mapping of at least one output")
-    coefficients = {}
+    coefficients, indices = {}, {}
     for name, output in outputs.items():
-        coefficients[name] = _array(output["coefficients"], f"outputs.{name}.coefficients", (len(indices), time.size))
+        if shared is None or "multi_indices" in output:
+            indices[name] = _multi_indices(output["multi_indices"], f"outputs.{name}.multi_indices", d, order)
+        else:
+            indices[name] = shared
+        coefficients[name] = _array(output["coefficients"], f"outputs.{name}.coefficients",
+                                    (len(indices[name]), time.size))
         if not isinstance(output.get("units", ""), str):
             raise ValueError(f"outputs.{name}.units: expected a string, got {_shown(output['units'])}")
     for key, kind in (("method", str), ("split", bool), ("campaign", str)):
@@ -260,6 +270,20 @@ def _checked(data: dict) -> Surrogate:
                      {name: o.get("units", "") for name, o in outputs.items()},
                      {"kind": data["method"], "order": order, "split": data.get("split", False)},
                      data.get("campaign", ""), data.get("dependence"))
+
+
+def _multi_indices(value, key: str, d: int, order: int) -> np.ndarray:
+    """Rows of d integers of total degree <= order, none repeated (ValueError naming `key`)."""
+    indices = _array(value, key, (None, d), integers=True)
+    if not len(indices) or indices.sum(axis=1).max() > order:
+        raise ValueError(f"{key}: expected rows of {d} integers of total degree <= order {order}, "
+                         f"got {len(indices)} rows of total degree up to {indices.sum(axis=1).max(initial=0)}")
+    rows = {}
+    for i, row in enumerate(map(tuple, indices.tolist())):
+        if row in rows:
+            raise ValueError(f"{key}: row {i} repeats row {rows[row]} ({list(row)})")
+        rows[row] = i
+    return indices
 
 
 MAX_DEGREE = 1000  # a multi-index entry or order beyond this is refused (a PCE of useful size stays far below)

@@ -7,9 +7,9 @@ Model, per output o and data time t_k:
 f_o the PCE surrogate with its coefficients interpolated linearly in time onto the data times,
 σ_o the measurement noise (given, or inferred with a half-Cauchy prior of scale S_o on σ_o,
 sampled as log σ_o), s_o²(t) the surrogate's own error variance (mean square leave-one-out
-residual over the runs, interpolated the same way). Prior of ξ: the campaign's germs, N(0, 1) or
-U(−1, 1) per parameter. Plain arrays here: the surrogate reaches this module as its coefficients
-and a basis function.
+residual over the runs, interpolated the same way). Prior of ξ: the campaign's germs, each its own
+law (`Germ.log_density`, `support`; N(0, 1), U(−1, 1), ...). Plain arrays here: the surrogate
+reaches this module as its coefficients and a basis function.
 """
 from __future__ import annotations
 

@@ -19,7 +19,7 @@ from .outputs import (OUTPUT_FILES, calibrated_campaign, corner_plot, informed, 
                       predictive_plot, write_json, write_posterior)
 from .sampler import sample
 from .size import PREDICTIVE_NOISE_DRAWS, check_size
-from .surrogate import (SurrogateError, campaign_folder, campaign_mapping, check_campaign_text, fit_surrogate,
+from .surrogate import (SurrogateError, calibration_surrogate, campaign_folder, campaign_mapping, check_campaign_text,
                         parameter_specs, prior_summaries, simulate, to_physical, to_standard)
 
 TIME_HANDLING = ("PCE coefficients (and the surrogate's error variance) interpolated linearly in time "
@@ -78,7 +78,7 @@ def _calibrate(results, data, out, outputs, noise, seed, walkers, steps, method,
     xi = draws[:, :len(surrogate.names)]
     kappa = to_physical(surrogate.parameters, xi, surrogate.campaign.dependence)
     sigmas = posterior.sigmas(draws)
-    specs = parameter_specs(surrogate.campaign)
+    specs = parameter_specs(surrogate.parameters)
     prior = prior_summaries(surrogate.parameters)
     post = {name: marginal(kappa[:, k]) for k, name in enumerate(surrogate.names)}
     correlation = _correlation(kappa)
@@ -113,7 +113,7 @@ def _calibrate(results, data, out, outputs, noise, seed, walkers, steps, method,
 
 def _fitted(results, data, outputs, noise, method, order, campaign):
     """The surrogate of `results`, the flight data, the given noise and the log-posterior."""
-    surrogate = fit_surrogate(results, method=method, order=order, campaign_path=campaign)
+    surrogate = calibration_surrogate(results, method=method, order=order, campaign_path=campaign)
     flight = read_flight_csv(data, outputs, surrogate.outputs)
     given = parse_noise(list(noise), list(flight.values))
     posterior = LogPosterior.build(surrogate.time, surrogate.coefficients, surrogate.error_factors,

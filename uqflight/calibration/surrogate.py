@@ -1,10 +1,11 @@
-"""The calibration's view of a results file: the campaign, a PCE surrogate per output and time,
-its leave-one-out error, and the simulator for posterior-predictive runs.
+"""The calibration's view of a results file: the campaign, the PCE surrogate per output and time (the
+export's, `uqflight.surrogate`) with its leave-one-out error model, and the helpers it needs from the
+rest of uqflight (the simulator runs from `execution`, the campaign's text from `campaign.reading`, the
+parameters' summaries from `parameters.summaries`), re-exported here.
 
-This is the ONLY module of uqflight.calibration that imports other uqflight modules (results
-store, campaign loading, parameters, methods, statistics, simulators), but for the command line's
-helpers in command.py and the memory limit in size.py: after a restructure of the package,
-retarget the imports here.
+This is the ONLY module of uqflight.calibration that imports other uqflight modules, but for the
+command line's helpers in command.py and the memory limit in size.py: after a restructure of the
+package, retarget the imports here.
 """
 from __future__ import annotations
 
@@ -14,40 +15,41 @@ from pathlib import Path
 
 import numpy as np
 
-from ..campaign import Campaign, CampaignError, load_campaign, parse_campaign
-from ..campaign.reading import results_campaign
+from ..campaign import Campaign, CampaignError, load_campaign
+from ..campaign.reading import campaign_folder, campaign_mapping, check_campaign_text, results_campaign
 from ..designs import is_sampled
-from ..methods import METHOD_KINDS
+from ..execution import simulate
+from ..methods import METHOD_KINDS, normalised
 from ..methods.basis import orthonormal_basis
 from ..methods.loo import loo_residuals, relative_loo_error
 from ..parameters import Parameter
 from ..parameters import to_physical as _to_physical
 from ..parameters import to_standard as _to_standard
-from ..parameters.germs import GERMS
-from ..simulators import make_simulator
-from ..simulators.base import FlightError
+from ..parameters.summaries import parameter_specs, prior_summaries
 from ..simulators.validation_view import validation_view
-from ..statistics import BadInput, Options, analyse, output_basis
+from ..statistics import BadInput, Options, output_basis
 from ..store import ResultStore, Status
+from ..surrogate import SurrogateError, fit_surrogate
 from .likelihood import error_factors_of
 
-__all__ = ["CampaignError", "Surrogate", "SurrogateError", "fit_surrogate", "load_campaign_file",
+__all__ = ["CalibrationSurrogate", "CampaignError", "SurrogateError", "calibration_surrogate", "campaign_folder",
+           "campaign_mapping", "check_campaign_text", "load_campaign_file", "parameter_specs", "prior_summaries",
            "simulate", "to_physical", "to_standard"]
 
 
-class SurrogateError(ValueError):
-    """A results file or method that gives no usable surrogate; the message says what to do."""
-
-
 @dataclass
-class Surrogate:
-    """x_o(t, ξ) ≈ Σ_α c_α,o(t) Ψ_α(ξ) per output o, with its error variance per time.
+class CalibrationSurrogate:
+    """The surrogate (`uqflight.surrogate.fit_surrogate`, the export's) as the calibration uses it:
+    x_o(t, ξ) ≈ Σ_α c_α,o(t) Ψ_α(ξ) per output o, with its error variance per time.
 
     `coefficients[o]` is (Z, T) on the results file's `time`. The surrogate error is a random
     function of time with covariance F Fᵀ, `error_factors[o]` = F (T, r): the weighted leave-one-out
     residual curves √w_i (y_i − ŷ_(−i)) of the least-squares fit of the same basis on the same runs
     (or the surrogate's own misfit curves at the runs, when larger), compressed by an SVD.
     `error_variance[o]` (T,) is its diagonal: the mean square error per time (absolute units²).
+    Each output has its own basis (`output_indices[o]`: a sparse PCE's selected terms); `indices` is
+    their union and `coefficients[o]` is on it, zero for the terms of other outputs, so that one
+    evaluation of the basis serves every output.
     """
 
     campaign: Campaign
@@ -62,6 +64,7 @@ class Surrogate:
     units: dict[str, str]
     runs: int
     relative_error: dict[str, np.ndarray]  # relative LOO error per time (NaN where the output does not vary)
+    output_indices: dict[str, np.ndarray]  # each output's own basis; `indices` is their union, for evaluating all at once
 
     @property
     def parameters(self) -> list[Parameter]:
@@ -126,12 +129,12 @@ def _campaign_of(store: ResultStore, results: Path, campaign_path: Path | None) 
     return campaign
 
 
-def fit_surrogate(results, method: str | None = None, order: int | None = None,
-                  campaign_path=None, outputs: list[str] | None = None) -> Surrogate:
-    """Fit the PCE surrogate of every output (or of `outputs`) of a results file.
+def calibration_surrogate(results, method: str | None = None, order: int | None = None,
+                          campaign_path=None, outputs: list[str] | None = None) -> CalibrationSurrogate:
+    """The surrogate of every output (or of `outputs`) of a results file, with its error model.
 
-    Default: the file's method and order. Monte Carlo kinds (monte_carlo, integration) build no
-    PCE of their own: sampled designs then use least squares, grids pseudo-Galerkin projection.
+    Default: the file's method and order. The PCE is the export's (`uqflight.surrogate.fit_surrogate`):
+    a method without a PCE of its own is fitted as its registry entry's `exported_as` says.
     """
     results = Path(results)
     try:
@@ -140,18 +143,13 @@ def fit_surrogate(results, method: str | None = None, order: int | None = None,
         raise SurrogateError(f"{results}: {exc}") from exc
     with store:
         campaign = _campaign_of(store, results, Path(campaign_path) if campaign_path else None)
-        stored = json.loads(store.attrs["method"])
+        stored = normalised(json.loads(store.attrs["method"]))
         germs = json.loads(store.attrs["germs"])
-        design_kind = store.attrs.get("design_kind", "")
+        sampled = is_sampled(store.attrs.get("design_kind", ""))
         kind = method or stored["kind"]
         order = stored.get("order", 2) if order is None else order
         if kind not in METHOD_KINDS:
             raise SurrogateError(f"--method: expected one of {', '.join(METHOD_KINDS)}, got {kind!r}")
-        sampled = is_sampled(design_kind)
-        if kind in ("monte_carlo", "integration"):
-            kind = "least_squares" if sampled else "pseudo_galerkin"
-        if kind == "interpolation":  # its PCE is the projection
-            kind = "pseudo_galerkin"
         ok = store.status == Status.OK
         names = store.output_names if outputs is None else outputs
         missing = [name for name in names if name not in store.output_names]
@@ -159,87 +157,46 @@ def fit_surrogate(results, method: str | None = None, order: int | None = None,
             raise SurrogateError(f"{results} has no output {', '.join(map(repr, missing))} "
                                  f"(it has {', '.join(store.output_names)})")
         try:  # the statistics' own PCE, after their checks (pending or failed runs, aliasing, rank)
-            stats = analyse(results, method={"kind": kind, "order": order},
-                            options=Options(band_samples=200, bootstrap=0))
+            fitted = fit_surrogate(results, {"kind": kind, "order": order},
+                                   options=Options(band_samples=200, bootstrap=0))
         except BadInput as exc:
             raise SurrogateError(str(exc)) from exc
         xi, weights = store.xi[ok], store.weights[ok]
-        indices = stats.outputs[names[0]].pce.indices
-        design = orthonormal_basis(germs, indices, xi)
+        own = {name: fitted.indices[name] for name in names}
+        indices = _union(list(own.values()))
         error_weights = np.full(len(xi), 1.0) if sampled else np.abs(weights)
         error_weights = error_weights / error_weights.sum()
         coefficients, error_variance, error_factors, relative = {}, {}, {}, {}
         for name in names:
             rows, scale = output_basis(store, name, ok)
             Y = rows if scale is None else rows @ scale
-            pce = stats.outputs[name].pce
+            design = orthonormal_basis(germs, own[name], xi)  # the output's own basis (sparse: its terms)
             try:
                 loo = loo_residuals(design, Y, error_weights)
                 relative[name] = relative_loo_error(design, Y, error_weights)
             except ValueError as exc:
                 raise SurrogateError(f"{results}: output {name!r}: {exc}") from exc
-            misfit = Y - design @ pce.coefficients
-            coefficients[name] = pce.coefficients
+            misfit = Y - design @ fitted.coefficients[name]
+            coefficients[name] = _on_basis(indices, own[name], fitted.coefficients[name])
             curves = loo if error_weights @ (loo**2).sum(axis=1) >= error_weights @ (misfit**2).sum(axis=1) else misfit
             error_factors[name] = error_factors_of(np.sqrt(error_weights)[:, None] * curves)
             error_variance[name] = (error_factors[name] ** 2).sum(axis=1)
-        return Surrogate(campaign, str(results), {"kind": kind, "order": order}, list(germs), indices,
-                         store.time, coefficients, error_variance, error_factors, store.units, int(ok.sum()),
-                         relative)
+        return CalibrationSurrogate(campaign, str(results), {"kind": fitted.method["kind"], "order": order},
+                                    list(germs), indices, store.time, coefficients, error_variance, error_factors,
+                                    store.units, int(ok.sum()), relative, own)
 
 
-def simulate(campaign: Campaign, kappa: np.ndarray, outputs: list[str]):
-    """Fly (or call) the campaign's simulator at every row of kappa (M, d), as `uqflight run` does.
-
-    Returns (time (T,), {output: (M, T)} with NaN rows for failed runs, [failure reasons]).
-    """
-    names = [p.name for p in campaign.parameters]
-    properties = [p.property for p in campaign.parameters]
-    simulator = make_simulator(campaign.simulator, names, properties, Path(campaign.source).resolve().parent)
-    time, _ = simulator.layout(np.asarray(kappa)[0])
-    values = {name: np.full((len(kappa), len(time)), np.nan) for name in outputs}
-    failures = []
-    for row, k in enumerate(np.asarray(kappa, dtype=float)):
-        simulator.restart()  # each run as from a fresh worker: independent of the order of the draws
-        try:
-            result = simulator.evaluate(k)
-        except FlightError as exc:
-            failures.append(str(exc))
-            continue
-        for name in outputs:
-            values[name][row] = result[name]
-    return np.asarray(time, dtype=float), values, failures
+def _union(bases: list[np.ndarray]) -> np.ndarray:
+    """The rows of every basis, each once, in the order first met (one basis: itself)."""
+    seen: dict[tuple, None] = {}
+    for basis in bases:
+        seen.update(dict.fromkeys(map(tuple, basis.tolist())))
+    return np.array(list(seen), dtype=int).reshape(len(seen), bases[0].shape[1])
 
 
-def prior_summaries(parameters) -> dict[str, dict]:
-    """Prior mean, std and central 95 % interval of every parameter, in physical units."""
-    out = {}
-    for p in parameters:
-        lower, upper = (float(v) for v in p.to_physical(GERMS[p.germ].quantile(np.array([0.025, 0.975]))))
-        out[p.name] = {"mean": float(p.mean), "std": float(p.std), "ci95": [lower, upper]}
+def _on_basis(indices: np.ndarray, own: np.ndarray, coefficients: np.ndarray) -> np.ndarray:
+    """Coefficients (Z_own, T) of the basis `own` as coefficients of `indices` (zero for the other terms)."""
+    row_of = {row: i for i, row in enumerate(map(tuple, indices.tolist()))}
+    out = np.zeros((len(indices), coefficients.shape[1]))
+    out[[row_of[row] for row in map(tuple, own.tolist())]] = coefficients
     return out
-
-
-def parameter_specs(campaign: Campaign) -> dict[str, dict]:
-    """Each parameter as plain data: property, distribution, germ, nominal, lower, upper."""
-    return {p.name: {"property": p.property, "distribution": p.distribution, "germ": p.germ,
-                     "nominal": float(p.nominal), "lower": float(p.lower), "upper": float(p.upper)}
-            for p in campaign.parameters}
-
-
-def campaign_mapping(campaign: Campaign) -> dict:
-    """The campaign file as a YAML mapping (read as `uqflight` reads it), and the folder it is in."""
-    import yaml
-
-    from ..campaign.schema import CampaignLoader
-
-    return yaml.load(campaign.text, Loader=CampaignLoader)
-
-
-def campaign_folder(campaign: Campaign) -> Path:
-    return Path(campaign.source).resolve().parent
-
-
-def check_campaign_text(text: str, source: str) -> None:
-    """Validate campaign text as `uqflight plan` does (CampaignError when it would be refused)."""
-    parse_campaign(text, source, view=validation_view)

@@ -105,6 +105,12 @@ KEYS = {
     "method.kind": "The method (below).",
     "method.order": "Total degree of the PCE, >= 0. Default 2, or the largest a grid's projection allows. "
                     "`order: 3`",
+    "method.max_order": "sparse only: the largest total degree of the candidate terms, >= 1. Default 2. "
+                        "`max_order: 5`",
+    "method.selection": "sparse only: `lars` (least-angle regression, the default) or `omp` (orthogonal "
+                        "matching pursuit) orders the candidate terms.",
+    "method.q": "sparse only: the hyperbolic truncation ‖α‖_q ≤ max_order, 0 < q ≤ 1; 1 (the default) is "
+                "total degree, smaller keeps fewer interactions. `q: 0.75`",
     "method.split": "Use the paper's split form x = x0 + S (Eq. 22–24) for projections. Default false.",
     "method.allow_aliasing": "Let a projection's order exceed what the grid integrates exactly (refused "
                              "otherwise; the report says so). Default false.",
@@ -172,6 +178,9 @@ VALUES = {
         "script": "Fly a JSBSim run script as JSBSim does, its events included (keys `scenario.script`, "
                   "`scenario.end_s`, `output_rate_hz`)."},
     "method.kind": {
+        "sparse": "Sparse PCE: candidate terms up to `max_order` (q-hyperbolic), ordered by LARS or OMP, the "
+                  "basis and order chosen by the corrected leave-one-out error; on any design (see "
+                  "[methods](../methods.md)).",
         "integration": "Weighted sums of the runs (Eq. 17); on a grid the PCE for bands, PDFs and Sobol' "
                        "indices is the projection.",
         "pseudo_galerkin": "Projection of the runs on the PCE (Eq. 19–21); moments from the PCE.",
@@ -265,8 +274,10 @@ def accepted_keys() -> list[Key]:
     keys = dict.fromkeys(k for kind, entry in DESIGNS.items()
                          for k in refused_keys(lambda: entry.build({"kind": kind, "?": 0}, ["normal"], 0)))
     found += [Key(f"design.{k}", "design", design.get(k)) for k in keys]
+    own = dict.fromkeys(k for entry in METHODS.values() if entry.settings
+                        for k in (entry.order_key, *(key for key, _ in entry.settings)))
     found += [Key(p, "method", dict(METHODS) if p == "method.kind" else None)
-              for p in _paths("method", schema.METHOD_KEYS)]
+              for p in _paths("method", tuple(dict.fromkeys((*schema.METHOD_KEYS, *own))))]
     found += [Key(p, "execution") for p in _paths("execution", schema.EXECUTION_KEYS)]
     found += [Key(p, "storage") for p in _paths("storage", schema.STORAGE_KEYS) + _paths("storage.tsvd",
                                                                                            schema.TSVD_KEYS)]

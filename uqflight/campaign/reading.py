@@ -100,3 +100,23 @@ def _from_aircraft(check: Checker, data: dict, simulator: dict, attrs: dict) -> 
     except (FileNotFoundError, RuntimeError) as exc:
         check.fail("simulator.aircraft", str(exc))
     return schema.parameters(check, data["parameters"], "jsbsim", aircraft)
+
+
+def campaign_mapping(campaign: Campaign) -> dict:
+    """The campaign file as a YAML mapping (read as `uqflight` reads it)."""
+    import yaml
+
+    return yaml.load(campaign.text, Loader=schema.CampaignLoader)
+
+
+def campaign_folder(campaign: Campaign) -> Path:
+    """The folder of the campaign file (where its python model and relative paths are looked up)."""
+    return Path(campaign.source).resolve().parent
+
+
+def check_campaign_text(text: str, source: str) -> None:
+    """Validate campaign text as `uqflight plan` does (CampaignError when it would be refused)."""
+    from ..simulators.validation_view import validation_view
+    from . import parse_campaign
+
+    parse_campaign(text, source, view=validation_view)

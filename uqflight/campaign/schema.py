@@ -11,7 +11,7 @@ import numpy as np
 import yaml
 
 from ..designs import DESIGN_KINDS, SAMPLED_DESIGNS, Design, design_size, is_sampled
-from ..methods import METHOD_KINDS, method_entry
+from ..methods import METHOD_KINDS, METHODS, method_entry
 from ..methods.exactness import exact_total_degree, max_projection_order
 from ..methods.validity import MAX_TERMS, method_problem
 from ..parameters import DISTRIBUTIONS, Parameter, make_parameter, seed_names
@@ -219,15 +219,17 @@ def check_method_fits_design(check: Checker, method: dict, design: Design, germs
     """Refuse, before anything runs, a method the design's points cannot carry (methods.validity).
     Without `order`, the order is 2, or the largest a grid's projection allows when that is lower."""
     sampled = is_sampled(design.kind)
-    if "order" not in method:
-        method["order"] = DEFAULT_ORDER
-        if method_entry(method["kind"]).rule == "projection" and not sampled:
+    entry = method_entry(method["kind"])
+    key = entry.order_key
+    if key not in method:
+        method[key] = DEFAULT_ORDER
+        if entry.rule == "projection" and not sampled:
             degree = exact_total_degree(design.xi, design.weights, germs, max_degree=2 * DEFAULT_ORDER)
-            method["order"] = max(0, min(DEFAULT_ORDER, max_projection_order(degree)))
-    problem = method_problem(method["kind"], method["order"], design.xi, design.weights, germs, sampled,
+            method[key] = max(0, min(DEFAULT_ORDER, max_projection_order(degree)))
+    problem = method_problem(method["kind"], method[key], design.xi, design.weights, germs, sampled,
                              allow_aliasing=method.get("allow_aliasing", False))
     if problem:
-        check.fail("method.order" if method["kind"] != "monte_carlo" else "method.kind", problem)
+        check.fail(f"method.{key}" if entry.pce is not None else "method.kind", problem)
 
 
 def simulator(check: Checker, value) -> dict:
@@ -470,6 +472,16 @@ def function_property(check: Checker, spec: dict, path: str, kind: str, aircraft
 
 
 def method(check: Checker, value) -> dict:
+    entry = METHODS.get(value.get("kind")) if isinstance(value, dict) else None
+    if entry is not None and entry.settings:  # a kind with keys of its own (sparse): exactly those
+        keys = ("kind", entry.order_key, *(key for key, _ in entry.settings))
+        method = dict(check.mapping(value, "method", keys, required=("kind",)))
+        if entry.order_key in method:
+            check.integer(method[entry.order_key], f"method.{entry.order_key}", 1)
+        problem = entry.settings_problem(method)
+        if problem:
+            check.fail(f"method.{problem[0]}", problem[1])
+        return method
     method = dict(check.mapping(value, "method", METHOD_KEYS, required=("kind",)))
     check.string(method["kind"], "method.kind", METHOD_KINDS)
     if "order" in method:
@@ -566,7 +578,8 @@ def check_size(check: Checker, data: dict, simulator: dict, parameters: list, me
     if points is not None and points > limits["max_runs"]:
         check.fail("design", f"{points:.4g} runs (points built), more than limits.max_runs = {limits['max_runs']}; "
                              "choose a smaller design or raise limits.max_runs")
-    order = method.get("order", DEFAULT_ORDER)  # without it, at most DEFAULT_ORDER (check_method_fits_design)
+    entry = METHODS.get(method.get("kind"))
+    order = method.get(entry.order_key if entry else "order", DEFAULT_ORDER)  # without it, DEFAULT_ORDER at most
     terms = math.comb(d + order, order) if order <= 10**6 else math.inf
     figures["pce_terms"] = terms
     if terms > limits["max_pce_terms"]:

@@ -28,13 +28,15 @@ class DesignKind:
     """A registered design: its builder (spec, germs, seed) -> (xi, weights, info); its size (spec,
     germs) -> the runs it builds, from the spec alone and without building anything (for the campaign's
     limits; a sparse grid's points before merging; None when the spec is malformed, so that the
-    builder's own checks speak); and `draws`: how its random points relate to independent draws
-    (analysis.proportions), or None for a quadrature grid (its weights are valid only all together)."""
+    builder's own checks speak); `draws`: how its random points relate to independent draws
+    (analysis.proportions), or None for a quadrature grid (its weights are valid only all together);
+    `sobol_from_runs`: its runs give Sobol' indices themselves (pick-freeze estimators), without a PCE."""
 
     build: Callable
     size: Callable
     draws: str | None
     example: dict  # a small `design:` mapping of this kind (help text and tests)
+    sobol_from_runs: bool = False
 
     @property
     def sampled(self) -> bool:
@@ -52,7 +54,7 @@ REGISTRY: dict[str, DesignKind] = {
     "sparse_grid": DesignKind(sparse_grid_design, sparse_grid_size, None, {"kind": "sparse_grid", "level": 2}),
     "tensor_grid": DesignKind(tensor_grid_design, tensor_grid_size, None, {"kind": "tensor_grid", "points": 4}),
     "pick_freeze": DesignKind(pick_freeze_design, pick_freeze_size, "pick_freeze",
-                              {"kind": "pick_freeze", "samples": 16}),
+                              {"kind": "pick_freeze", "samples": 16}, sobol_from_runs=True),
 }
 DESIGN_KINDS = tuple(REGISTRY)
 SAMPLED_DESIGNS = tuple(kind for kind, entry in REGISTRY.items() if entry.sampled)

@@ -12,11 +12,13 @@ class PCE:
 
     Because the basis is orthonormal, the mean is the constant coefficient and the variance
     the sum of the other coefficients squared (Eq. 53 without the β! of unnormalised Hermite).
+    ``selection``: what a selecting method (sparse) chose, for summary.json; None otherwise.
     """
 
     germs: list[str]
     indices: np.ndarray
     coefficients: np.ndarray
+    selection: dict | None = None
 
     def _is_constant(self) -> np.ndarray:
         return ~np.asarray(self.indices).any(axis=1)

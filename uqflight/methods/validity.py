@@ -6,6 +6,8 @@
   on the 15-point grid). Measured on the points (`exactness`), not taken from theory.
 * A fit (regression, least squares) needs its design matrix to have rank Z on the actual points:
   N ≥ Z is not enough (3-D Gauss–Legendre level 2 has 25 points but rank 19 of 20 at order 3).
+* A selection (sparse) needs at least 3 points; whether some basis it selects has a defined
+  leave-one-out error is known only at the fit, which refuses otherwise.
 * Grid weights are a quadrature only all together: a grid with failed or missing runs refuses the
   projections and the weighted sums; the fits are made on the runs that exist, after the rank check.
 
@@ -42,12 +44,15 @@ def method_problem(kind: str, order: int, xi, weights, germs: list[str], sampled
                 f"{missing} of {n + missing} runs are missing; use least_squares or regression on the "
                 "runs that exist, or rerun the campaign")
     if method.rule == "fit":
-        rank, _ = design_matrix_rank(xi, germs, order, None if kind == "regression" else weights)
+        rank, _ = design_matrix_rank(xi, germs, order, weights if method.weighted else None)
         if rank < terms:
             fitting = largest_fitting_order(kind, xi, weights, germs, order)
             return (f"{kind} of order {order} fits {terms} terms, but the design matrix on the {n} points has "
                     f"rank {rank}: the coefficients are not determined; the largest order with full rank is "
                     f"{fitting}")
+    if method.rule == "selection" and n < 3:
+        return (f"{kind} needs at least 3 points to choose a basis by its leave-one-out error, but there are {n}: "
+                "add points")
     if method.rule == "projection" and not sampled and not allow_aliasing:
         degree = exact_total_degree(xi, weights, germs, max_degree=2 * order)
         if degree < 2 * order:
@@ -59,8 +64,9 @@ def method_problem(kind: str, order: int, xi, weights, germs: list[str], sampled
 
 def largest_fitting_order(kind: str, xi, weights, germs: list[str], below: int) -> int:
     """The largest order < `below` whose design matrix has full rank on the points (−1 if none)."""
+    weighted = method_entry(kind).weighted
     for order in range(below - 1, -1, -1):
-        rank, terms = design_matrix_rank(xi, germs, order, None if kind == "regression" else weights)
+        rank, terms = design_matrix_rank(xi, germs, order, weights if weighted else None)
         if rank == terms:
             return order
     return -1

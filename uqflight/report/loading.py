@@ -8,10 +8,9 @@ from pathlib import Path
 
 import yaml
 
+from ..designs import REGISTRY as DESIGNS
+from ..methods import method_entry
 from ..statistics import Statistics, add_reference_errors, read_statistics
-
-METHOD_NAMES = {"integration": "Int", "pseudo_galerkin": "PG", "interpolation": "interpolation",
-                "regression": "regression", "least_squares": "least squares", "monte_carlo": "MC"}
 
 
 @dataclass
@@ -32,11 +31,11 @@ class Entry:
 
     @property
     def monte_carlo(self) -> bool:
-        return self.stats.method["kind"] == "monte_carlo"
+        return method_entry(self.stats.method["kind"]).pce is None
 
     @property
     def pick_freeze(self) -> bool:
-        return self.stats.design_kind == "pick_freeze"
+        return DESIGNS[self.stats.design_kind].sobol_from_runs
 
     @property
     def has_sobol(self) -> bool:
@@ -50,9 +49,9 @@ class Entry:
 
 def method_label(method: dict) -> str:
     """A method as in the paper's legends, e.g. "PG order 2", "MC"."""
-    kind = method["kind"]
-    name = METHOD_NAMES.get(kind, kind)
-    if kind == "monte_carlo":
+    entry = method_entry(method["kind"])
+    name = entry.label
+    if entry.pce is None:
         return name
     return f"{name} order {method['order']}" + (" split" if method.get("split") else "")
 
