@@ -43,6 +43,7 @@ from .designs import is_sampled
 from .methods import PCE, METHODS, failed_runs_note, method_entry
 from .methods.basis import orthonormal_basis
 from .methods.loo import relative_loo_error
+from .methods.pce_moments import pce_standardised_moments
 from .methods.validity import method_problem
 from .parameters.distributions import SEED_REFUSAL
 from .parameters.germs import draw_germs
@@ -317,7 +318,7 @@ def _output_statistics(store: ResultStore, name: str, method: dict, germs: list[
         rows, row_scale, band_weights = orthonormal_basis(germs, pce.indices, draws), pce.coefficients, None
     pick_freeze = pce is None and design_kind == "pick_freeze" and ok.all()
     blocks = _over_time_blocks(rows, row_scale, store.time.size, band_weights,
-                               len(store.parameter_names) if pick_freeze else 0, options, from_runs)
+                               len(store.parameter_names) if pick_freeze else 0, options, from_runs, pce)
     magnitude = np.max(np.sqrt(mean**2 + np.maximum(variance, 0.0)))  # the output's own size over its history
     rtol = JSBSIM_RESOLUTION if "aircraft_hash" in store.attrs else RESOLUTION_RTOL
     repeatability = store.resolution(name)  # the simulator's own resolution: its two valid trims' drift
@@ -394,23 +395,28 @@ def _lower_order_difference(entry, xi, weights, basis, scale, germs, order, x0, 
 
 
 def _over_time_blocks(rows, scale, n_times: int, weights, pick_freeze_dimensions: int, options: Options,
-                      from_runs: bool) -> dict:
+                      from_runs: bool, pce: PCE | None = None) -> dict:
     """Quantiles, 99 % band, skewness and kurtosis, PDFs, final-time samples (the runs' fourth central
     moments, pick-freeze indices) of Y = rows @ scale (scale None: Y = rows), rebuilding Y for
     TIME_BLOCK times at once: the memory stays that of one block whatever the number of runs or draws.
-    Every statistic here is per time, so blocks change nothing."""
+    Every statistic here is per time, so blocks change nothing. A `pce`'s skewness and kurtosis are its
+    exact ones (methods.pce_moments), not those of its draws; the KDE's std comes from the factors."""
     probabilities = (0.5 * (1 - BAND_LEVEL), 0.5 * (1 + BAND_LEVEL), *options.quantiles)
+    exact = None if pce is None else pce_standardised_moments(pce.germs, pce.indices, pce.coefficients)
+    std = None if scale is None else np.sqrt(np.maximum(weighted_moments(rows, None, scale, unbiased=True)[1], 0.0))
     parts: dict[str, list] = {key: [] for key in ("quantiles", "support", "density", "skewness", "kurtosis",
                                                   "fourth", "first", "total", "first_ci", "total_ci")}
     for start in range(0, n_times, TIME_BLOCK):
         stop = min(start + TIME_BLOCK, n_times)
         Y = rows[:, start:stop] if scale is None else rows @ scale[:, start:stop]
         parts["quantiles"].append(weighted_quantiles(Y, probabilities, weights))
-        support, density = pdf_over_time(Y, PDF_POINTS)
-        skewness, kurtosis = standardised_moments(Y, weights)
-        for key, value in (("support", support), ("density", density), ("skewness", skewness),
-                           ("kurtosis", kurtosis)):
-            parts[key].append(value)
+        support, density = pdf_over_time(Y, PDF_POINTS, std=None if std is None else std[start:stop])
+        parts["support"].append(support)
+        parts["density"].append(density)
+        if exact is None:
+            skewness, kurtosis = standardised_moments(Y, weights)
+            parts["skewness"].append(skewness)
+            parts["kurtosis"].append(kurtosis)
         if from_runs and weights is None:
             parts["fourth"].append(central_moments(Y)[2])
         if pick_freeze_dimensions:
@@ -418,10 +424,10 @@ def _over_time_blocks(rows, scale, n_times: int, weights, pick_freeze_dimensions
             for key in ("first", "total", "first_ci", "total_ci"):
                 parts[key].append(indices[key])
     quantiles = np.concatenate(parts["quantiles"], axis=1)
+    skewness, kurtosis = exact or (np.concatenate(parts["skewness"]), np.concatenate(parts["kurtosis"]))
     joined = {"band": (quantiles[0], quantiles[1]), "quantiles": list(quantiles[2:]),
               "support": np.concatenate(parts["support"]), "density": np.concatenate(parts["density"]),
-              "skewness": np.concatenate(parts["skewness"]), "kurtosis": np.concatenate(parts["kurtosis"]),
-              "final": Y[:, -1].copy()}
+              "skewness": skewness, "kurtosis": kurtosis, "final": Y[:, -1].copy()}
     if parts["fourth"]:
         joined["fourth"] = np.concatenate(parts["fourth"])
     if pick_freeze_dimensions:

@@ -185,8 +185,7 @@ def _pdf_heat_map(fig, ax, out) -> None:
     scaled = np.divide(out.pdf_density, peak, out=np.zeros_like(out.pdf_density), where=peak > 0)
     about_mean = narrow_band(out)
     support = out.pdf_support - out.mean[:, None] if about_mean else out.pdf_support
-    times = np.broadcast_to(out.time[:, None], support.shape)
-    mesh = ax.pcolormesh(times, support, scaled, shading="gouraud", cmap="magma", rasterized=True)
+    mesh = ax.pcolormesh(*_cell_edges(out.time, support), scaled, shading="flat", cmap="magma", rasterized=True)
     if about_mean:
         ax.plot(out.time, out.band99[0] - out.mean, color="cyan", lw=0.8, ls="--", label="99 % band")
         ax.plot(out.time, out.band99[1] - out.mean, color="cyan", lw=0.8, ls="--")
@@ -200,6 +199,20 @@ def _pdf_heat_map(fig, ax, out) -> None:
     ax.set_xlabel(TIME_LABEL, fontsize=9)
     ax.legend(loc="upper right", fontsize=8)
     fig.colorbar(mesh, ax=ax, label="density / peak density at that time")
+
+
+def _cell_edges(time: np.ndarray, support: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Corners (T + 1, G + 1) of the cells centred on each time's support points (T, G): flat cells
+    draw in a fifth of the time of Gouraud triangles and look the same at 1000 times × 120 points."""
+    def edges(centres, axis):
+        inner = 0.5 * (np.take(centres, range(1, centres.shape[axis]), axis)
+                       + np.take(centres, range(centres.shape[axis] - 1), axis))
+        first = 2 * np.take(centres, [0], axis) - np.take(inner, [0], axis)
+        last = 2 * np.take(centres, [-1], axis) - np.take(inner, [-1], axis)
+        return np.concatenate([first, inner, last], axis)
+
+    along_time = edges(np.broadcast_to(time[:, None], support.shape), 0)
+    return edges(along_time, 1), edges(edges(support, 1), 0)
 
 
 def time_indices(time: np.ndarray, times: list[float]) -> list[int]:
