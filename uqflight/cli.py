@@ -13,7 +13,8 @@ import typer
 
 from .arguments import check_campaign_file, check_output, check_results_file
 from .calibration.command import register as register_calibrate
-from .console import clean, echo
+from .console import echo
+from .progress import Progress
 
 from .methods import METHOD_KINDS
 from .simulators.base import FlightError
@@ -423,9 +424,9 @@ def report(
     if write_baseline:
         check_output(write_baseline, "--write-baseline")
     try:
-        with _status("report") as tell:
+        with Progress(0, label="report") as progress:
             written = write_report(results, out, reference=reference, times=selected, baseline=write_baseline,
-                                   method=overrides or None, progress=tell, partial=partial,
+                                   method=overrides or None, progress=progress, partial=partial,
                                    allow_aliasing=allow_aliasing)
     except BadInput as exc:
         echo(f"error: {exc}", err=True)
@@ -440,34 +441,6 @@ def report(
     echo(f"wrote {len(in_report)} files to {out}: open {out / 'report.html'}")
     if write_baseline:
         echo(f"wrote baseline {write_baseline}")
-
-
-class _status:
-    """A rich status line on stderr when it is a terminal (each stage of a long command), else silent."""
-
-    def __init__(self, what: str):
-        self.what, self._status = what, None
-
-    def __enter__(self):
-        import sys
-
-        if sys.stderr.isatty():
-            from rich.console import Console
-
-            self._status = Console(stderr=True).status(f"{self.what}: starting")
-            self._status.start()
-        return self.tell
-
-    def tell(self, text: str) -> None:
-        if self._status is not None:  # plain text: a label holding [brackets] is no rich markup
-            from rich.text import Text
-
-            self._status.update(Text(clean(f"{self.what}: {text}")))
-
-    def __exit__(self, *exc):
-        if self._status is not None:
-            self._status.stop()
-        return False
 
 
 @app.command()
@@ -517,7 +490,8 @@ def surrogate_export(
     check_results_file(results)
     check_output(out, "--out")
     try:
-        export(results, out, override)
+        with Progress(0, label="surrogate export") as progress:
+            export(results, out, override, progress)
     except SurrogateError as exc:
         echo(f"error: {exc}", err=True)
         raise typer.Exit(2)

@@ -149,16 +149,16 @@ def campaign_facts(store: ResultStore) -> tuple[dict, list[str], dict]:
 
 
 def read_statistics(path, method: dict | None = None, partial: bool = False,
-                    allow_aliasing: bool = False) -> tuple[Statistics, dict]:
+                    allow_aliasing: bool = False, progress=None) -> tuple[Statistics, dict]:
     """The statistics of a results file (`method` overriding the campaign's) and its root attributes;
-    BadInput, one line naming the file, when it cannot give right numbers."""
+    BadInput, one line naming the file, when it cannot give right numbers. `progress`: see analyse."""
     path = Path(path)
     if not path.is_file():
         raise BadInput(f"{path}: no such results file")
     try:
         with ResultStore.open(path) as store:
             attrs = store.attrs
-        return analyse(path, method=method, partial=partial, allow_aliasing=allow_aliasing), attrs
+        return analyse(path, method=method, partial=partial, allow_aliasing=allow_aliasing, progress=progress), attrs
     except BadInput:
         raise
     except CorruptFile as exc:
@@ -169,12 +169,13 @@ def read_statistics(path, method: dict | None = None, partial: bool = False,
 
 
 def analyse(path, reference: str | None = None, options: Options | None = None, method: dict | None = None,
-            partial: bool = False, allow_aliasing: bool = False) -> Statistics:
+            partial: bool = False, allow_aliasing: bool = False, progress=None) -> Statistics:
     """All statistics of the results file `path` (and errors against `reference`).
 
     `method` ({"kind", "order", "split"}) overrides the campaign's: the runs of one grid serve every
     method, so methods and orders are compared on the same runs. `partial` analyses a file with pending
     runs where a subset of the runs is valid; `allow_aliasing` lets a projection exceed the grid's degree.
+    `progress` (a uqflight.progress.Progress) gets a stage per file and counts its outputs and quantities.
     """
     with ResultStore.open(path) as store:
         stored_method, germs, analysis = campaign_facts(store)
@@ -207,13 +208,20 @@ def analyse(path, reference: str | None = None, options: Options | None = None, 
         stats.from_runs = method_entry(method["kind"]).runs_on_sampled and sampled
         replicates = int(json.loads(store.attrs.get("design_info", "{}")).get("replicates", 1))
         stats.replicates = replicates if stats.from_runs and ok.all() else 1
+        if progress is not None:
+            progress.stage(f"analysing {path} ({method['kind']} order {method['order']})",
+                           len(store.output_names) + len(store.quantity_names), "outputs")
         for name in store.output_names:
             out = stats.outputs[name] = _output_statistics(store, name, method, germs, design_kind, ok, options)
             if stats.replicates > 1:
                 out.replicate_moments = _replicate_moments(store, name, stats.replicates)
+            if progress is not None:
+                progress.advance()
         for name in store.quantity_names:
             stats.quantities[name] = quantity_statistics(store, stats, name, germs, ok, options,
                                                          analysis.get("exceedance", {}).get(name, []))
+            if progress is not None:
+                progress.advance()
     if reference:
         add_reference_errors(stats, analyse(reference, options=Options(
             band_samples=options.band_samples, bootstrap=0, seed=options.seed, quantiles=options.quantiles)))

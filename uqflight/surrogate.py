@@ -80,15 +80,17 @@ class Surrogate:
 
 
 def fit_surrogate(path, method: dict | None = None, partial: bool = False,
-                  allow_aliasing: bool = False) -> Surrogate:
+                  allow_aliasing: bool = False, progress=None) -> Surrogate:
     """The PCE of every output of the results file `path`, exactly as `uqflight.statistics.analyse`
     fits it (with `method` overriding the campaign's), after the same checks: pending or failed runs,
     a projection the grid cannot integrate and a rank-deficient fit are refused (statistics.BadInput).
-    SurrogateError when the method builds no PCE."""
-    from .statistics import analyse
+    SurrogateError when the method builds no PCE. `progress`: see statistics.analyse."""
+    from .statistics import Options, analyse
     from .store import ResultStore
 
-    stats = analyse(path, method=method, partial=partial, allow_aliasing=allow_aliasing)
+    # few band draws: the PCE does not depend on them, and its bands and PDFs are not exported
+    stats = analyse(path, options=Options(band_samples=200, bootstrap=0), method=method, partial=partial,
+                    allow_aliasing=allow_aliasing, progress=progress)
     pces = {name: out.pce for name, out in stats.outputs.items()}
     if any(pce is None for pce in pces.values()):
         raise SurrogateError(f"{path}: method {stats.method['kind']} on a {stats.design_kind} design builds no PCE; "
@@ -129,10 +131,13 @@ def surrogate_json(surrogate: Surrogate, results: str = "") -> dict:
     }
 
 
-def export(results, out, method: dict | None = None) -> Path:
+def export(results, out, method: dict | None = None, progress=None) -> Path:
     """Fit the PCE of `results` and write it to `out` as strict JSON; returns `out`. The folder of
-    `out` must exist; nothing is left behind when the write fails (a full disk)."""
-    data = surrogate_json(fit_surrogate(results, method), str(results))
+    `out` must exist; nothing is left behind when the write fails (a full disk). `progress` (a
+    uqflight.progress.Progress) is told the stages."""
+    data = surrogate_json(fit_surrogate(results, method, progress=progress), str(results))
+    if progress is not None:
+        progress.stage(f"writing {out}")
     text = json.dumps(data, allow_nan=False) + "\n"
     if len(text) > MAX_FILE_BYTES:
         raise SurrogateError(f"{results}: the surrogate takes {len(text) / 2**20:.0f} MiB of JSON, more than the "

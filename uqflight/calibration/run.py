@@ -48,8 +48,9 @@ class Calibration:
 def calibrate(results, data, out, outputs: list[str] | None = None, noise: list[str] = (), seed: int = 0,
               walkers: int | None = None, steps: int = 6000, method: str | None = None, order: int | None = None,
               campaign: str | None = None, predictive_draws: int = 50, truth: dict | None = None,
-              progress: bool = False) -> Calibration:
-    """Calibrate the campaign of `results` on flight `data`; see docs/calibration.md.
+              progress=None) -> Calibration:
+    """Calibrate the campaign of `results` on flight `data`; see docs/calibration.md. `progress` (a
+    uqflight.progress.Progress) is told the stages and counts the sampler's steps.
 
     Raises DataError / SurrogateError (bad input, data too large for memory: calibration.size),
     ValueError (bad settings), NotConverged.
@@ -65,6 +66,8 @@ def _calibrate(results, data, out, outputs, noise, seed, walkers, steps, method,
                predictive_draws, truth, progress) -> Calibration:
     started = clock.perf_counter()
     out = Path(out)
+    stage = progress.stage if progress else (lambda text, total=0, unit="steps": None)
+    stage(f"fitting the surrogate of {results}")
     surrogate = fit_surrogate(results, method=method, order=order, campaign_path=campaign)
     flight = read_flight_csv(data, outputs, surrogate.outputs)
     given = parse_noise(list(noise), list(flight.values))
@@ -99,8 +102,10 @@ def _calibrate(results, data, out, outputs, noise, seed, walkers, steps, method,
             raise NotConverged(chain.diagnostics, removed)
         return chain
 
+    stage(f"sampling the posterior ({walkers} walkers)", steps, "steps")
     chain = converged(sample(posterior, posterior.ndim, posterior.labels, posterior.start(), prior_draw, walkers,
                              steps, seed, progress=progress))
+    stage(f"flying {predictive_draws} posterior draws")
     sampled = clock.perf_counter()
     d = len(names)
     rng = np.random.default_rng(seed + 1)
@@ -114,8 +119,10 @@ def _calibrate(results, data, out, outputs, noise, seed, walkers, steps, method,
         extra = {o: _full_rows(flight.values[o], errors[o].T / math.sqrt(errors[o].shape[0])) for o in errors}
         posterior = LogPosterior.build(surrogate.time, surrogate.coefficients, surrogate.error_factors, germs,
                                        names, surrogate.basis, flight, given, extra_error=extra)
+        stage("sampling again with the surrogate error measured at the posterior", steps, "steps")
         chain = converged(sample(posterior, posterior.ndim, posterior.labels, posterior.start(), prior_draw,
                                  walkers, steps, seed + 1, progress=progress))
+        stage(f"flying {predictive_draws} posterior draws")
         draws, pick, sim_time, runs, failures, ok, errors = _predictive(chain, posterior, surrogate, flight, rng,
                                                                         predictive_draws)
         check = {**_surrogate_check(posterior, errors, draws[pick][ok]), "refined": True,
@@ -195,6 +202,7 @@ def _calibrate(results, data, out, outputs, noise, seed, walkers, steps, method,
     }
 
     # write into a scratch folder first, then move: an interrupted run leaves no half set of outputs
+    stage(f"writing {out}")
     out.mkdir(parents=True, exist_ok=True)
     scratch = Path(tempfile.mkdtemp(prefix=".calibrate-", dir=out))
     try:
