@@ -24,10 +24,13 @@ from __future__ import annotations
 
 import json
 import math
+import os
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
+from threadpoolctl import threadpool_limits
 
 from .analysis.density import pdf_over_time
 from .analysis.divergence import kl_divergence
@@ -51,6 +54,7 @@ from .store import CorruptFile, ResultStore, Status
 
 PDF_POINTS = 120
 TIME_BLOCK = 100  # recorded times whose runs or surrogate draws are rebuilt at once
+ANALYSIS_THREADS = min(2, os.cpu_count() or 1)  # time blocks analysed at once (each with one BLAS thread)
 BAND_LEVEL = 0.99
 DEFAULT_QUANTILES = (0.005, 0.995)
 # The relative spread a JSBSim output can resolve: the same sample flown on a reused model and on a
@@ -177,7 +181,9 @@ def analyse(path, reference: str | None = None, options: Options | None = None, 
     runs where a subset of the runs is valid; `allow_aliasing` lets a projection exceed the grid's degree.
     `progress` (a uqflight.progress.Progress) gets a stage per file and counts its outputs and quantities.
     """
-    with ResultStore.open(path) as store:
+    # one BLAS thread: the matrices are tall and thin (runs or draws × terms), where several threads are no
+    # faster, and 10-20x slower on a loaded machine; the time blocks run in threads instead
+    with ResultStore.open(path) as store, threadpool_limits(limits=1):
         stored_method, germs, analysis = campaign_facts(store)
         method = {"order": 2, **stored_method, **(method or {})}
         allow_aliasing = allow_aliasing or bool(method.get("allow_aliasing"))
@@ -412,31 +418,31 @@ def _over_time_blocks(rows, scale, n_times: int, weights, pick_freeze_dimensions
     probabilities = (0.5 * (1 - BAND_LEVEL), 0.5 * (1 + BAND_LEVEL), *options.quantiles)
     exact = None if pce is None else pce_standardised_moments(pce.germs, pce.indices, pce.coefficients)
     std = None if scale is None else np.sqrt(np.maximum(weighted_moments(rows, None, scale, unbiased=True)[1], 0.0))
-    parts: dict[str, list] = {key: [] for key in ("quantiles", "support", "density", "skewness", "kurtosis",
-                                                  "fourth", "first", "total", "first_ci", "total_ci")}
-    for start in range(0, n_times, TIME_BLOCK):
+
+    def block(start: int) -> dict:
         stop = min(start + TIME_BLOCK, n_times)
         Y = rows[:, start:stop] if scale is None else rows @ scale[:, start:stop]
-        parts["quantiles"].append(weighted_quantiles(Y, probabilities, weights))
-        support, density = pdf_over_time(Y, PDF_POINTS, std=None if std is None else std[start:stop])
-        parts["support"].append(support)
-        parts["density"].append(density)
+        found = {"quantiles": weighted_quantiles(Y, probabilities, weights), "final": Y[:, -1].copy()}
+        found["support"], found["density"] = pdf_over_time(Y, PDF_POINTS, std=None if std is None else std[start:stop])
         if exact is None:
-            skewness, kurtosis = standardised_moments(Y, weights)
-            parts["skewness"].append(skewness)
-            parts["kurtosis"].append(kurtosis)
+            found["skewness"], found["kurtosis"] = standardised_moments(Y, weights)
         if from_runs and weights is None:
-            parts["fourth"].append(central_moments(Y)[2])
+            found["fourth"] = central_moments(Y)[2]
         if pick_freeze_dimensions:
-            indices = pick_freeze_indices(Y, pick_freeze_dimensions, n_boot=options.bootstrap, seed=options.seed)
-            for key in ("first", "total", "first_ci", "total_ci"):
-                parts[key].append(indices[key])
+            found.update(pick_freeze_indices(Y, pick_freeze_dimensions, n_boot=options.bootstrap, seed=options.seed))
+        return found
+
+    # blocks in ANALYSIS_THREADS threads (numpy's selection, FFTs and BLAS release the GIL); each block's
+    # numbers are its own, joined in time order: the same bits in any thread count
+    with ThreadPoolExecutor(ANALYSIS_THREADS) as pool:
+        found = list(pool.map(block, range(0, n_times, TIME_BLOCK)))
+    parts = {key: [f[key] for f in found] for key in found[0]}
     quantiles = np.concatenate(parts["quantiles"], axis=1)
     skewness, kurtosis = exact or (np.concatenate(parts["skewness"]), np.concatenate(parts["kurtosis"]))
     joined = {"band": (quantiles[0], quantiles[1]), "quantiles": list(quantiles[2:]),
               "support": np.concatenate(parts["support"]), "density": np.concatenate(parts["density"]),
-              "skewness": skewness, "kurtosis": kurtosis, "final": Y[:, -1].copy()}
-    if parts["fourth"]:
+              "skewness": skewness, "kurtosis": kurtosis, "final": found[-1]["final"]}
+    if "fourth" in parts:
         joined["fourth"] = np.concatenate(parts["fourth"])
     if pick_freeze_dimensions:
         joined.update({key: np.concatenate(parts[key], axis=-1) for key in ("first", "total", "first_ci", "total_ci")})

@@ -70,6 +70,7 @@ def write_report(paths: list[Path], out_dir: Path | None = None, reference: Path
 def _write_into(out_dir: Path, entries: list[Entry], ref: Entry | None, times, progress: Progress) -> None:
     # the page's modules import matplotlib (half a second): loaded only when a page is drawn, so that
     # `surrogate export` and `report --method` parsing (report.loading) start fast
+    from .plots import background_rendering
     from .render import render_html, render_markdown
     from .sections import Table, build_sections, files_section
 
@@ -79,7 +80,8 @@ def _write_into(out_dir: Path, entries: list[Entry], ref: Entry | None, times, p
     written = write_summaries(entries, out_dir)
     written += write_statistics_tables(entries, out_dir)
     progress.stage("drawing the plots", _drawing_stages(entries), "sections")
-    sections = build_sections(entries, ref, times, out_dir, progress=lambda text: progress.advance(1, text))
+    with background_rendering():  # figures written in forked children while the next is built
+        sections = build_sections(entries, ref, times, out_dir, progress=lambda text: progress.advance(1, text))
     progress.advance(progress.total)
     for table in (block for section in sections for block in section.blocks if isinstance(block, Table)):
         written.append(write_csv(out_dir / table.file, table.header, table.rows))
