@@ -26,8 +26,8 @@ def test_the_same_png_bytes_in_a_child(tmp_path):
 
 def test_a_figure_that_fails_in_a_child_is_named(tmp_path):
     missing = tmp_path / "no-such-folder" / "cov.png"
-    with pytest.raises(RuntimeError, match="cannot write the plot .*no-such-folder/cov.png"):
-        with plots.background_rendering():
-            plots.plot_cov(outputs(), missing, "CoV")
+    with pytest.raises(RuntimeError, match="cannot write the plot .*no-such-folder/cov.png"), \
+            plots.background_rendering():
+        plots.plot_cov(outputs(), missing, "CoV")
     plots.plot_cov(outputs(), tmp_path / "after.png", "CoV")  # written in the process again
     assert (tmp_path / "after.png").is_file()
