@@ -27,19 +27,22 @@ class Progress:
                             TextColumn("{task.fields[rate]}"), TimeElapsedColumn(), TextColumn("ETA"),
                             TimeRemainingColumn(), console=Console(file=stream), transient=False)
             self._bar.start()
-            self._task = self._bar.add_task("", total=None, rate="")
+            self._task = None
         self._count(total, done, unit, "")
 
     def _count(self, total: int, done: int, unit: str, text: str) -> None:
         self.total, self.done, self.unit, self.text = total, done, unit, text
         self.start, self.first = time.perf_counter(), done
         self._next_log = done / total + 0.1 if total else 1.0
-        if self._bar is not None:
-            self._bar.update(self._task, description=self._description(), total=total or None, completed=done,
-                             rate="")
+        if self._bar is not None:  # a task per stage: its own count (none: "?") and elapsed time
+            if self._task is not None:
+                self._bar.remove_task(self._task)
+            self._task = self._bar.add_task(self._description(), total=total or None, completed=done, rate="")
 
     def _description(self) -> str:
-        return clean(f"{self.label}: {self.text or self.unit}" if self.label else self.text or self.unit)
+        if self.label:
+            return clean(f"{self.label}: {self.text or 'starting'}")
+        return clean(self.text or self.unit)
 
     def stage(self, text: str, total: int = 0, unit: str = "steps") -> None:
         """A new stage, counting `total` `unit` from 0 (0: a stage without a count); a log line off a terminal."""

@@ -215,7 +215,7 @@ def analyse(path, reference: str | None = None, options: Options | None = None, 
         replicates = int(json.loads(store.attrs.get("design_info", "{}")).get("replicates", 1))
         stats.replicates = replicates if stats.from_runs and ok.all() else 1
         if progress is not None:
-            progress.stage(f"analysing {path} ({method['kind']} order {method['order']})",
+            progress.stage(f"analysing {Path(path).name} ({method['kind']} order {method['order']})",
                            len(store.output_names) + len(store.quantity_names), "outputs")
         for name in store.output_names:
             out = stats.outputs[name] = _output_statistics(store, name, method, germs, design_kind, ok, options)
