@@ -9,6 +9,7 @@ from numpy.polynomial.legendre import leggauss
 
 from uqflight.analysis.moments import standardised_moments
 from uqflight.methods.basis import orthonormal_basis, total_degree_indices
+from uqflight.methods import pce_moments
 from uqflight.methods.pce_moments import pce_standardised_moments
 from uqflight.parameters.germs import draw_germs
 
@@ -61,3 +62,13 @@ def test_the_sampled_estimate_it_replaces_is_within_its_sampling_error():
     error = batches.std(axis=0, ddof=1) / np.sqrt(20)
     exact = np.array(pce_standardised_moments(germs, indices, coefficients))
     assert np.all(np.abs(sampled - exact) <= 4 * error)
+
+
+def test_blocks_of_times_change_nothing_and_a_large_basis_is_left_to_the_draws(monkeypatch):
+    germs, indices = ["normal", "uniform", "normal"], total_degree_indices(3, 2)  # 9 varying terms, 35 in Φ
+    coefficients = np.random.default_rng(0).standard_normal((len(indices), 50))
+    whole = pce_standardised_moments(germs, indices, coefficients)
+    monkeypatch.setattr(pce_moments, "MAX_TENSOR_ENTRIES", 9**2 * 35)  # blocks of 35 of the 50 times
+    assert all(np.array_equal(a, b) for a, b in zip(whole, pce_standardised_moments(germs, indices, coefficients)))
+    monkeypatch.setattr(pce_moments, "MAX_TENSOR_ENTRIES", 9**2 * 35 - 1)
+    assert pce_standardised_moments(germs, indices, coefficients) is None

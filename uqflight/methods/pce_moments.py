@@ -44,13 +44,17 @@ def pce_standardised_moments(germs: list[str], indices, coefficients) -> tuple[n
     if len(indices) ** 2 * len(square_indices) > MAX_TENSOR_ENTRIES:
         return None
     products = triple_products(germs, indices, square_indices).reshape(len(indices) ** 2, -1)
-    pairs = (centred[:, None, :] * centred[None, :, :]).reshape(len(indices) ** 2, -1)  # c_α c_β per time
-    square = products.T @ pairs  # e_κ (K, T)
     position = {tuple(row): k for k, row in enumerate(square_indices)}
-    linear = np.zeros_like(square)
-    linear[[position[tuple(row)] for row in indices]] = centred  # Z in the basis Φ
+    linear_rows = [position[tuple(row)] for row in indices]  # where Z's terms sit in the basis Φ
+    third, fourth = np.empty(centred.shape[1]), np.empty(centred.shape[1])
+    step = max(1, MAX_TENSOR_ENTRIES // max(products.shape))  # times at once: pairs and square stay bounded
+    for start in range(0, centred.shape[1], step):
+        c = centred[:, start:start + step]
+        pairs = (c[:, None, :] * c[None, :, :]).reshape(len(products), -1)  # c_α c_β per time
+        square = products.T @ pairs  # e_κ (K, times)
+        third[start:start + step] = (square[linear_rows] * c).sum(axis=0)
+        fourth[start:start + step] = (square**2).sum(axis=0)
     variance = (centred**2).sum(axis=0)
-    third, fourth = (square * linear).sum(axis=0), (square**2).sum(axis=0)
     with np.errstate(invalid="ignore", divide="ignore"):
         skewness = np.where(variance > 0, third / variance**1.5, np.nan)
         kurtosis = np.where(variance > 0, fourth / variance**2, np.nan)
