@@ -14,7 +14,8 @@ import typer
 
 from .arguments import check_campaign_file, check_output, check_results_file
 from .calibration.command import register as register_calibrate
-from .console import clean, echo
+from .console import echo
+from .progress import Progress
 
 from .methods import METHOD_KINDS
 from .simulators.base import FlightError
@@ -467,9 +468,9 @@ def report(
     if times is not None:
         _check_times(times, selected, results)
     try:
-        with _status("report") as tell:
+        with Progress(0, label="report") as progress:
             written = write_report(results, out, reference=reference, times=selected, baseline=write_baseline,
-                                   method=overrides or None, progress=tell, partial=partial,
+                                   method=overrides or None, progress=progress, partial=partial,
                                    allow_aliasing=allow_aliasing)
     except BadInput as exc:
         echo(f"error: {exc}", err=True)
@@ -504,34 +505,6 @@ def _check_times(text: str, selected: list[float], results: list[Path]) -> None:
             echo(f"error: --times {text}: {', '.join(f'{t:g}' for t in outside)} s outside the flight of {path}, "
                  f"which records {time[0]:g} to {time[-1]:g} s; choose times in that range or 'end'", err=True)
             raise typer.Exit(2)
-
-
-class _status:
-    """A rich status line on stderr when it is a terminal (each stage of a long command), else silent."""
-
-    def __init__(self, what: str):
-        self.what, self._status = what, None
-
-    def __enter__(self):
-        import sys
-
-        if sys.stderr.isatty():
-            from rich.console import Console
-
-            self._status = Console(stderr=True).status(f"{self.what}: starting")
-            self._status.start()
-        return self.tell
-
-    def tell(self, text: str) -> None:
-        if self._status is not None:  # plain text: a label holding [brackets] is no rich markup
-            from rich.text import Text
-
-            self._status.update(Text(clean(f"{self.what}: {text}")))
-
-    def __exit__(self, *exc):
-        if self._status is not None:
-            self._status.stop()
-        return False
 
 
 @app.command()
@@ -589,7 +562,8 @@ def surrogate_export(
     check_results_file(results)
     check_output(out, "--out")
     try:
-        export(results, out, override)
+        with Progress(0, label="surrogate export") as progress:
+            export(results, out, override, progress)
     except SurrogateError as exc:
         echo(f"error: {exc}", err=True)
         raise typer.Exit(2)

@@ -46,9 +46,9 @@ from threadpoolctl import threadpool_limits
 from .campaign import Campaign
 from .campaign.reading import parameters_attribute
 from .campaign.schema import WORKER_BYTES
-from .console import clean
 from .designs import Design
 from .parameters import seed_names
+from .progress import Progress
 from .store import ResultStore, Status, compact, open_for_campaign
 from .store.lock import LockHeld, ResultsLock
 from .worker import NominalFlight, WorkerSpec
@@ -676,58 +676,3 @@ def _execute_dask(tasks, spec, n_times, outputs, workers: int, scheduler: str | 
         client.close()
         if cluster is not None:
             cluster.close()
-
-
-class Progress:
-    """Runs done out of the design's (resumed ones included), the rate of this session and the ETA: a
-    rich progress bar fitted to the terminal on a terminal, a log line every ~10 % otherwise."""
-
-    def __init__(self, total: int, done: int = 0, quiet: bool = False, stream=sys.stderr):
-        self.total, self.done, self.quiet, self.stream = total, done, quiet, stream
-        self.start, self.first = time.perf_counter(), done
-        self._next_log = done / total + 0.1 if total else 1.0
-        self._bar = None
-        if stream.isatty() and not quiet and total:
-            from rich.console import Console
-            from rich.progress import (BarColumn, MofNCompleteColumn, TextColumn, TimeElapsedColumn,
-                                       TimeRemainingColumn)
-            from rich.progress import Progress as Bar
-
-            self._bar = Bar(TextColumn("runs"), BarColumn(), MofNCompleteColumn(), TextColumn("{task.fields[rate]}"),
-                            TimeElapsedColumn(), TextColumn("ETA"), TimeRemainingColumn(),
-                            console=Console(file=stream), transient=False)
-            self._bar.start()
-            self._task = self._bar.add_task("runs", total=total, completed=done, rate="")
-
-    def advance(self, n: int) -> None:
-        self.done += n
-        if self.quiet or self.total == 0:
-            return
-        elapsed = time.perf_counter() - self.start
-        rate = (self.done - self.first) / elapsed if elapsed > 0 else 0.0
-        if self._bar is not None:
-            self._bar.update(self._task, completed=self.done, rate=f"{rate:.1f} runs/s")
-            return
-        fraction = self.done / self.total
-        if fraction >= self._next_log or self.done == self.total:
-            eta = (self.total - self.done) / rate if rate > 0 else float("inf")
-            self.stream.write(f"{self.done}/{self.total} runs ({100 * fraction:.0f} %), {rate:.1f} runs/s, "
-                              f"ETA {eta:.0f} s\n")
-            self._next_log = fraction + 0.1
-
-    def note(self, text: str) -> None:
-        """A line for the reader (above the bar on a terminal); nothing when quiet."""
-        if self.quiet:
-            return
-        text = clean(text)
-        if self._bar is not None:
-            self._bar.console.print(text, markup=False, highlight=False)
-        else:
-            self.stream.write(text + "\n")
-            self.stream.flush()
-
-    def close(self) -> None:
-        if self._bar is not None:
-            self._bar.stop()
-            self._bar = None
-

@@ -24,10 +24,13 @@ from __future__ import annotations
 
 import json
 import math
+import os
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
+from threadpoolctl import threadpool_limits
 
 from .analysis.density import pdf_over_time
 from .analysis.divergence import kl_divergence
@@ -44,6 +47,7 @@ from .designs import is_sampled
 from .methods import PCE, METHODS, failed_runs_note, fit, method_entry, method_settings, normalised
 from .methods.basis import orthonormal_basis
 from .methods.loo import relative_loo_error
+from .methods.pce_moments import pce_standardised_moments
 from .methods.validity import method_problem
 from .parameters.distributions import SEED_REFUSAL
 from .parameters.germs import draw_germs
@@ -51,6 +55,7 @@ from .store import CorruptFile, ResultStore, Status
 
 PDF_POINTS = 120
 TIME_BLOCK = 100  # recorded times whose runs or surrogate draws are rebuilt at once
+ANALYSIS_THREADS = min(2, os.cpu_count() or 1)  # time blocks analysed at once (each with one BLAS thread)
 BAND_LEVEL = 0.99
 DEFAULT_QUANTILES = (0.005, 0.995)
 # The relative spread a JSBSim output can resolve: the same sample flown on a reused model and on a
@@ -151,16 +156,16 @@ def campaign_facts(store: ResultStore) -> tuple[dict, list[str], dict]:
 
 
 def read_statistics(path, method: dict | None = None, partial: bool = False,
-                    allow_aliasing: bool = False) -> tuple[Statistics, dict]:
+                    allow_aliasing: bool = False, progress=None) -> tuple[Statistics, dict]:
     """The statistics of a results file (`method` overriding the campaign's) and its root attributes;
-    BadInput, one line naming the file, when it cannot give right numbers."""
+    BadInput, one line naming the file, when it cannot give right numbers. `progress`: see analyse."""
     path = Path(path)
     if not path.is_file():
         raise BadInput(f"{path}: no such results file")
     try:
         with ResultStore.open(path) as store:
             attrs = store.attrs
-        return analyse(path, method=method, partial=partial, allow_aliasing=allow_aliasing), attrs
+        return analyse(path, method=method, partial=partial, allow_aliasing=allow_aliasing, progress=progress), attrs
     except BadInput:
         raise
     except CorruptFile as exc:
@@ -171,14 +176,17 @@ def read_statistics(path, method: dict | None = None, partial: bool = False,
 
 
 def analyse(path, reference: str | None = None, options: Options | None = None, method: dict | None = None,
-            partial: bool = False, allow_aliasing: bool = False) -> Statistics:
+            partial: bool = False, allow_aliasing: bool = False, progress=None) -> Statistics:
     """All statistics of the results file `path` (and errors against `reference`).
 
     `method` ({"kind", "order", "split"}) overrides the campaign's: the runs of one grid serve every
     method, so methods and orders are compared on the same runs. `partial` analyses a file with pending
     runs where a subset of the runs is valid; `allow_aliasing` lets a projection exceed the grid's degree.
+    `progress` (a uqflight.progress.Progress) gets a stage per file and counts its outputs and quantities.
     """
-    with ResultStore.open(path) as store:
+    # one BLAS thread: the matrices are tall and thin (runs or draws × terms), where several threads are no
+    # faster, and 10-20x slower on a loaded machine; the time blocks run in threads instead
+    with ResultStore.open(path) as store, threadpool_limits(limits=1):
         stored_method, germs, analysis = campaign_facts(store)
         method = {"order": 2, **normalised(stored_method), **normalised(method or {})}
         allow_aliasing = allow_aliasing or bool(method.get("allow_aliasing"))
@@ -214,13 +222,20 @@ def analyse(path, reference: str | None = None, options: Options | None = None, 
         stats.from_runs = method_entry(method["kind"]).runs_on_sampled and sampled
         replicates = int(design_info(store).get("replicates", 1))
         stats.replicates = replicates if stats.from_runs and ok.all() else 1
+        if progress is not None:
+            progress.stage(f"analysing {Path(path).name} ({method['kind']} order {method['order']})",
+                           len(store.output_names) + len(store.quantity_names), "outputs")
         for name in store.output_names:
             out = stats.outputs[name] = _output_statistics(store, name, method, germs, design_kind, ok, options)
             if stats.replicates > 1:
                 out.replicate_moments = _replicate_moments(store, name, stats.replicates)
+            if progress is not None:
+                progress.advance()
         for name in store.quantity_names:
             stats.quantities[name] = quantity_statistics(store, stats, name, germs, ok, options,
                                                          analysis.get("exceedance", {}).get(name, []))
+            if progress is not None:
+                progress.advance()
     if reference:
         add_reference_errors(stats, analyse(reference, options=Options(
             band_samples=options.band_samples, bootstrap=0, seed=options.seed, quantiles=options.quantiles)))
@@ -328,7 +343,7 @@ def _output_statistics(store: ResultStore, name: str, method: dict, germs: list[
         rows, row_scale, band_weights = orthonormal_basis(germs, pce.indices, draws), pce.coefficients, None
     pick_freeze = from_runs and DESIGNS[design_kind].sobol_from_runs and ok.all()
     blocks = _over_time_blocks(rows, row_scale, store.time.size, band_weights,
-                               len(store.parameter_names) if pick_freeze else 0, options, from_runs)
+                               len(store.parameter_names) if pick_freeze else 0, options, from_runs, pce)
     magnitude = np.max(np.sqrt(mean**2 + np.maximum(variance, 0.0)))  # the output's own size over its history
     rtol = JSBSIM_RESOLUTION if "aircraft_hash" in store.attrs else RESOLUTION_RTOL
     resolution = store.resolution(name)  # the simulator's own resolution: its two valid trims' drift
@@ -403,35 +418,40 @@ def _lower_order_difference(kind, xi, weights, basis, scale, germs, order, x0, p
 
 
 def _over_time_blocks(rows, scale, n_times: int, weights, pick_freeze_dimensions: int, options: Options,
-                      from_runs: bool) -> dict:
+                      from_runs: bool, pce: PCE | None = None) -> dict:
     """Quantiles, 99 % band, skewness and kurtosis, PDFs, final-time samples (the runs' fourth central
     moments, pick-freeze indices) of Y = rows @ scale (scale None: Y = rows), rebuilding Y for
     TIME_BLOCK times at once: the memory stays that of one block whatever the number of runs or draws.
-    Every statistic here is per time, so blocks change nothing."""
+    Every statistic here is per time, so blocks change nothing. A `pce`'s skewness and kurtosis are its
+    exact ones (methods.pce_moments), not those of its draws; the KDE's std comes from the factors."""
     probabilities = (0.5 * (1 - BAND_LEVEL), 0.5 * (1 + BAND_LEVEL), *options.quantiles)
-    parts: dict[str, list] = {key: [] for key in ("quantiles", "support", "density", "skewness", "kurtosis",
-                                                  "fourth", "first", "total", "first_ci", "total_ci")}
-    for start in range(0, n_times, TIME_BLOCK):
+    exact = None if pce is None else pce_standardised_moments(pce.germs, pce.indices, pce.coefficients)
+    std = None if scale is None else np.sqrt(np.maximum(weighted_moments(rows, None, scale, unbiased=True)[1], 0.0))
+
+    def block(start: int) -> dict:
         stop = min(start + TIME_BLOCK, n_times)
         Y = rows[:, start:stop] if scale is None else rows @ scale[:, start:stop]
-        parts["quantiles"].append(weighted_quantiles(Y, probabilities, weights))
-        support, density = pdf_over_time(Y, PDF_POINTS)
-        skewness, kurtosis = standardised_moments(Y, weights)
-        for key, value in (("support", support), ("density", density), ("skewness", skewness),
-                           ("kurtosis", kurtosis)):
-            parts[key].append(value)
+        found = {"quantiles": weighted_quantiles(Y, probabilities, weights), "final": Y[:, -1].copy()}
+        found["support"], found["density"] = pdf_over_time(Y, PDF_POINTS, std=None if std is None else std[start:stop])
+        if exact is None:
+            found["skewness"], found["kurtosis"] = standardised_moments(Y, weights)
         if from_runs and weights is None:
-            parts["fourth"].append(central_moments(Y)[2])
+            found["fourth"] = central_moments(Y)[2]
         if pick_freeze_dimensions:
-            indices = pick_freeze_indices(Y, pick_freeze_dimensions, n_boot=options.bootstrap, seed=options.seed)
-            for key in ("first", "total", "first_ci", "total_ci"):
-                parts[key].append(indices[key])
+            found.update(pick_freeze_indices(Y, pick_freeze_dimensions, n_boot=options.bootstrap, seed=options.seed))
+        return found
+
+    # blocks in ANALYSIS_THREADS threads (numpy's selection, FFTs and BLAS release the GIL); each block's
+    # numbers are its own, joined in time order: the same bits in any thread count
+    with ThreadPoolExecutor(ANALYSIS_THREADS) as pool:
+        found = list(pool.map(block, range(0, n_times, TIME_BLOCK)))
+    parts = {key: [f[key] for f in found] for key in found[0]}
     quantiles = np.concatenate(parts["quantiles"], axis=1)
+    skewness, kurtosis = exact or (np.concatenate(parts["skewness"]), np.concatenate(parts["kurtosis"]))
     joined = {"band": (quantiles[0], quantiles[1]), "quantiles": list(quantiles[2:]),
               "support": np.concatenate(parts["support"]), "density": np.concatenate(parts["density"]),
-              "skewness": np.concatenate(parts["skewness"]), "kurtosis": np.concatenate(parts["kurtosis"]),
-              "final": Y[:, -1].copy()}
-    if parts["fourth"]:
+              "skewness": skewness, "kurtosis": kurtosis, "final": found[-1]["final"]}
+    if "fourth" in parts:
         joined["fourth"] = np.concatenate(parts["fourth"])
     if pick_freeze_dimensions:
         joined.update({key: np.concatenate(parts[key], axis=-1) for key in ("first", "total", "first_ci", "total_ci")})

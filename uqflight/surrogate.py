@@ -83,16 +83,17 @@ class Surrogate:
 
 
 def fit_surrogate(path, method: dict | None = None, partial: bool = False, allow_aliasing: bool = False,
-                  options=None) -> Surrogate:
+                  options=None, progress=None) -> Surrogate:
     """The PCE of every output of the results file `path`, exactly as `uqflight.statistics.analyse`
     fits it (with `method` overriding the campaign's), after the same checks: pending or failed runs,
     a projection the grid cannot integrate and a rank-deficient fit are refused (statistics.BadInput).
     A method that builds no PCE of its own on this design is exported as its registry entry says
     (`exported_as`: monte_carlo, and integration on a sampled design, as least squares). The export
-    and the calibration both fit here. `options`: statistics.Options (the bands' draws)."""
+    and the calibration both fit here. `options`: statistics.Options (default 200 band draws: the PCE
+    does not depend on them, and its bands and PDFs are not exported); `progress`: see analyse."""
     from .designs import REGISTRY as DESIGNS
     from .methods import METHOD_KINDS, exported_kind, normalised
-    from .statistics import analyse
+    from .statistics import Options, analyse
     from .store import ResultStore
 
     with ResultStore.open(path) as store:
@@ -102,7 +103,8 @@ def fit_surrogate(path, method: dict | None = None, partial: bool = False, allow
     kind = override.get("kind", stored.get("kind"))
     if design_kind in DESIGNS and isinstance(kind, str) and kind in METHOD_KINDS:  # else analyse refuses
         override["kind"] = exported_kind(kind, DESIGNS[design_kind].sampled)
-    stats = analyse(path, method=override, partial=partial, allow_aliasing=allow_aliasing, options=options)
+    stats = analyse(path, method=override, partial=partial, allow_aliasing=allow_aliasing,
+                    options=options or Options(band_samples=200, bootstrap=0), progress=progress)
     pces = {name: out.pce for name, out in stats.outputs.items()}
     dependence = {k: v for k, v in stats.dependence.items() if k != "sobol_of"} if stats.dependence else None
     return Surrogate(parameters, list(next(iter(pces.values())).germs),
@@ -164,10 +166,13 @@ def surrogate_json(surrogate: Surrogate, results: str = "") -> dict:
     return data
 
 
-def export(results, out, method: dict | None = None) -> Path:
+def export(results, out, method: dict | None = None, progress=None) -> Path:
     """Fit the PCE of `results` and write it to `out` as strict JSON; returns `out`. The folder of
-    `out` must exist; nothing is left behind when the write fails (a full disk)."""
-    data = surrogate_json(fit_surrogate(results, method), str(results))
+    `out` must exist; nothing is left behind when the write fails (a full disk). `progress` (a
+    uqflight.progress.Progress) is told the stages."""
+    data = surrogate_json(fit_surrogate(results, method, progress=progress), str(results))
+    if progress is not None:
+        progress.stage(f"writing {out}")
     text = json.dumps(data, allow_nan=False) + "\n"
     if len(text) > MAX_FILE_BYTES:
         raise SurrogateError(f"{results}: the surrogate takes {len(text) / 2**20:.0f} MiB of JSON, more than the "

@@ -11,6 +11,7 @@ import typer
 
 from ..arguments import check_campaign_file, check_output, check_results_file
 from ..console import echo
+from ..progress import Progress
 
 EXIT_BAD_INPUT = 2
 EXIT_NOT_CONVERGED = 3
@@ -70,9 +71,10 @@ def calibrate_command(
 
     streams, previous = (sys.stdout, sys.stderr), signal.signal(signal.SIGINT, _interrupted)
     try:
-        result = calibrate(results, data, out, outputs=list(output) or None, noise=list(noise), seed=seed,
-                           walkers=walkers, steps=steps, method=method, order=order, campaign=campaign,
-                           predictive_draws=predictive_draws, progress=False)
+        with Progress(0, label="calibrate") as progress:
+            result = calibrate(results, data, out, outputs=list(output) or None, noise=list(noise), seed=seed,
+                               walkers=walkers, steps=steps, method=method, order=order, campaign=campaign,
+                               predictive_draws=predictive_draws, progress=progress)
     except KeyboardInterrupt:
         sys.stdout, sys.stderr = streams
         echo(f"\ninterrupted: no calibration written to {out}", err=True)

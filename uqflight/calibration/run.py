@@ -48,8 +48,9 @@ class Calibration:
 def calibrate(results, data, out, outputs: list[str] | None = None, noise: list[str] = (), seed: int = 0,
               walkers: int | None = None, steps: int = 6000, method: str | None = None, order: int | None = None,
               campaign: str | None = None, predictive_draws: int = 50, truth: dict | None = None,
-              progress: bool = False) -> Calibration:
-    """Calibrate the campaign of `results` on flight `data`; see docs/calibration.md.
+              progress=None) -> Calibration:
+    """Calibrate the campaign of `results` on flight `data`; see docs/calibration.md. `progress` (a
+    uqflight.progress.Progress) is told the stages and counts the sampler's steps.
 
     Raises DataError / SurrogateError (bad input, data too large for memory: calibration.size),
     ValueError (bad settings), NotConverged.
@@ -66,6 +67,7 @@ def _calibrate(results, data, out, outputs, noise, seed, walkers, steps, method,
     """The steps of `calibrate`: fit, sample (and refine), summarise, write."""
     started = clock.perf_counter()
     out = Path(out)
+    _stage(progress, f"fitting the surrogate of {results}")
     surrogate, flight, given, posterior = _fitted(results, data, outputs, noise, method, order, campaign)
     walkers = walkers or max(32, 2 * posterior.ndim + 2)
     if steps < 100:
@@ -111,6 +113,12 @@ def _calibrate(results, data, out, outputs, noise, seed, walkers, steps, method,
     return Calibration(out, summary, list(OUTPUT_FILES))
 
 
+def _stage(progress, text: str, total: int = 0, unit: str = "steps") -> None:
+    """A new stage of `progress` (a uqflight.progress.Progress), when there is one."""
+    if progress:
+        progress.stage(text, total, unit)
+
+
 def _fitted(results, data, outputs, noise, method, order, campaign):
     """The surrogate of `results`, the flight data, the given noise and the log-posterior."""
     surrogate = calibration_surrogate(results, method=method, order=order, campaign_path=campaign)
@@ -134,7 +142,7 @@ class Sampling:
     steps: int
     seed: int
     out: Path
-    progress: bool
+    progress: object  # a uqflight.progress.Progress, or None
     first_sampled: float = 0.0
 
     def __post_init__(self):
@@ -149,6 +157,7 @@ class Sampling:
 
     def chain(self, posterior, seed):
         """A converged chain of `posterior`, or NotConverged (with a hint for noise-free data)."""
+        _stage(self.progress, f"sampling the posterior ({self.walkers} walkers)", self.steps, "steps")
         chain = sample(posterior, posterior.ndim, posterior.labels, posterior.start(),
                        lambda rng, n: self.prior_draw(posterior, rng, n), self.walkers, self.steps, seed,
                        progress=self.progress)
@@ -175,6 +184,7 @@ class Sampling:
         surrogate, flight = self.surrogate, self.flight
         chain = self.chain(posterior, self.seed)
         self.first_sampled = clock.perf_counter()
+        _stage(self.progress, f"flying {predictive_draws} posterior draws")
         predictive = _predictive(chain, posterior, surrogate, flight, self.rng, predictive_draws)
         draws, pick, _, _, _, ok, errors = predictive
         # The surrogate's error measured where the posterior is (the real simulator at its draws): when it
@@ -187,6 +197,7 @@ class Sampling:
                                            surrogate.germs, surrogate.names, surrogate.basis, flight, self.given,
                                            extra_error=extra)
             chain = self.chain(posterior, self.seed + 1)
+            _stage(self.progress, f"flying {predictive_draws} posterior draws")
             predictive = _predictive(chain, posterior, surrogate, flight, self.rng, predictive_draws)
             draws, pick, _, _, _, ok, errors = predictive
             check = {**_surrogate_check(posterior, errors, draws[pick][ok]), "refined": True,
@@ -275,6 +286,7 @@ def _write_outputs(out, results, data, seed, surrogate, flight, posterior, chain
     """posterior.h5, calibrated.yaml, the plots and summary.json, written into a scratch folder first,
     then moved: an interrupted run leaves no half set of outputs."""
     names, specs = surrogate.names, draws.specs
+    _stage(sampling.progress, f"writing {out}")
     out.mkdir(parents=True, exist_ok=True)
     scratch = Path(tempfile.mkdtemp(prefix=".calibrate-", dir=out))
     try:

@@ -88,9 +88,9 @@ def find_mode(log_prob: Callable, start: np.ndarray, prior_draws: np.ndarray) ->
 
 
 def sample(log_prob: Callable, ndim: int, labels: list[str], start: np.ndarray, prior_draw: Callable,
-           walkers: int, steps: int, seed: int, progress: bool = False, moves=None) -> Chain:
+           walkers: int, steps: int, seed: int, progress=None, moves=None) -> Chain:
     """Run the ensemble (vectorised log_prob: (M, D) → (M,)), seeded; diagnostics in chain.diagnostics.
-    `moves`: emcee's [(move, weight)] (default MOVES)."""
+    `moves`: emcee's [(move, weight)] (default MOVES); `progress` (a uqflight.progress.Progress) counts the steps."""
     if walkers < 2 * ndim:
         raise ValueError(f"--walkers: expected at least 2 × {ndim} parameters = {2 * ndim}, got {walkers}")
     if walkers % 2:
@@ -112,7 +112,9 @@ def _sample(log_prob, ndim, labels, start, prior_draw, walkers, steps, seed, pro
         raise ValueError("cannot place the walkers where the posterior is positive around its mode")
     sampler = emcee.EnsembleSampler(walkers, ndim, log_prob, vectorize=True, moves=moves)
     sampler.random_state = np.random.RandomState(seed).get_state()
-    sampler.run_mcmc(initial, steps, progress=progress)
+    for _ in sampler.sample(initial, iterations=steps):  # what run_mcmc does, step by step
+        if progress:
+            progress.advance()
     chain = Chain(sampler.get_chain(), sampler.get_log_prob(), sampler.acceptance_fraction.copy(),
                   steps // 2, list(labels), mode)
     chain.diagnostics = diagnose(chain)

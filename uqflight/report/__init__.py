@@ -21,12 +21,11 @@ import shutil
 from pathlib import Path
 
 from ..check import write_baseline
-from .files import _write_text, write_csv, write_statistics_tables, write_summaries
+from ..progress import Progress
 from ..methods.parsing import parse_methods
+from .files import _write_text, write_csv, write_statistics_tables, write_summaries
 from .loading import Entry, load_entries
-from .render import render_html, render_markdown
 from .replace import check_replaceable, make_staging, replace_dir
-from .sections import Table, build_sections, files_section
 
 __all__ = ["check_replaceable", "default_out_dir", "parse_methods", "write_report"]
 
@@ -46,20 +45,20 @@ def write_report(paths: list[Path], out_dir: Path | None = None, reference: Path
     RESULTS-report/); returns the files written (the baseline last, when asked for).
 
     `method`: one override {"kind", "order"}, a list of them (each file analysed with each, overlaid
-    in the plots), or None (each campaign's own). `progress(text)` is told each stage. `partial`,
+    in the plots), or None (each campaign's own). `progress` (a Progress) is told each stage. `partial`,
     `allow_aliasing`: see statistics.analyse. Everything is written into a temporary folder first and
     moved into place at the end; nothing is written when a file is refused (statistics.BadInput)."""
     out_dir = Path(os.path.abspath(out_dir if out_dir is not None else default_out_dir(paths[0])))
     check_replaceable(out_dir)
-    tell = progress or (lambda text: None)
-    entries, ref = load_entries(paths, reference, method, progress=tell, partial=partial,
+    progress = progress or Progress(0, quiet=True)
+    entries, ref = load_entries(paths, reference, method, progress=progress, partial=partial,
                                 allow_aliasing=allow_aliasing)
     out_dir.parent.mkdir(parents=True, exist_ok=True)
     staging = make_staging(out_dir)
     try:
-        _write_into(staging, entries, ref, times, tell)
+        _write_into(staging, entries, ref, times, progress)
         written = sorted(out_dir / p.relative_to(staging) for p in staging.rglob("*") if p.is_file())
-        tell(f"moving the report into {out_dir}")
+        progress.stage(f"moving the report into {out_dir}")
         replace_dir(staging, out_dir)
     except BaseException:
         shutil.rmtree(staging, ignore_errors=True)
@@ -69,19 +68,35 @@ def write_report(paths: list[Path], out_dir: Path | None = None, reference: Path
     return written
 
 
-def _write_into(out_dir: Path, entries: list[Entry], ref: Entry | None, times, tell) -> None:
+def _write_into(out_dir: Path, entries: list[Entry], ref: Entry | None, times, progress: Progress) -> None:
+    # the page's modules import matplotlib (half a second): loaded only when a page is drawn, so that
+    # `surrogate export` and `report --method` parsing (report.loading) start fast
+    from .plots import background_rendering
+    from .render import render_html, render_markdown
+    from .sections import Table, build_sections, files_section
+
     for sub in ("plots", "tables"):
         (out_dir / sub).mkdir(parents=True, exist_ok=True)
-    tell("writing summaries and tables")
+    progress.stage("writing summaries and tables")
     written = write_summaries(entries, out_dir)
     written += write_statistics_tables(entries, out_dir)
-    tell("drawing the plots")
-    sections = build_sections(entries, ref, times, out_dir, progress=tell)
+    progress.stage("drawing the plots", _drawing_stages(entries), "sections")
+    with background_rendering():  # figures written in forked children while the next is built
+        sections = build_sections(entries, ref, times, out_dir, progress=lambda text: progress.advance(1, text))
+    progress.advance(progress.total)
     for table in (block for section in sections for block in section.blocks if isinstance(block, Table)):
         written.append(write_csv(out_dir / table.file, table.header, table.rows))
     written += [out_dir / "report.html", out_dir / "report.md"]
     sections.append(files_section(written, out_dir))
-    tell("writing the page")
+    progress.stage("writing the page")
     title = f"uqflight report: {entries[0].label}" + (f" and {len(entries) - 1} more" if len(entries) > 1 else "")
     _write_text(out_dir / "report.html", render_html(title, sections, out_dir))
     _write_text(out_dir / "report.md", render_markdown(title, sections))
+
+
+def _drawing_stages(entries: list[Entry]) -> int:
+    """The stages build_sections tells, plus the last one's end: the run and statistics sections, and the
+    errors, quantities and Sobol' sections when there are any."""
+    optional = (any(e.has_errors for e in entries), any(e.stats.quantities for e in entries),
+                any(e.has_sobol for e in entries))
+    return 2 + sum(optional)

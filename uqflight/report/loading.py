@@ -94,20 +94,18 @@ def load_entries(paths: list[Path], reference: Path | None, method: dict | list[
                  progress=None, partial: bool = False, allow_aliasing: bool = False) -> tuple[list[Entry], Entry | None]:
     """Every file analysed once per method (`method`: one override, several, or None for the
     campaigns' own; the reference keeps its own), with errors against the reference unless it is
-    the reference itself, and the reference. `progress(text)` is told each stage."""
+    the reference itself, and the reference. `progress` (a Progress) counts each file's outputs."""
     methods = method if isinstance(method, list) else [method]
     methods = methods or [None]
     stems: set[str] = set()
-    tell = progress or (lambda text: None)
     ref = None
     if reference:
-        tell(f"analysing the reference {reference}")
-        ref = _entry(reference, *read_statistics(reference), set())
+        ref = _entry(reference, *read_statistics(reference, progress=progress), set())
     entries = []
     for path in paths:
         for override in methods:
-            tell(f"analysing {path}" + (f" ({method_label({'order': '?', **override})})" if override else ""))
-            stats, attrs = read_statistics(path, override, partial=partial, allow_aliasing=allow_aliasing)
+            stats, attrs = read_statistics(path, override, partial=partial, allow_aliasing=allow_aliasing,
+                                           progress=progress)
             if ref is not None and not _same_file(path, reference):
                 add_reference_errors(stats, ref.stats)
             entries.append(_entry(path, stats, attrs, stems, with_method=len(methods) > 1))

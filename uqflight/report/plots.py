@@ -6,6 +6,9 @@ point) is drawn as markers instead of lines.
 """
 from __future__ import annotations
 
+import os
+import traceback
+from contextlib import contextmanager
 from pathlib import Path
 
 import matplotlib
@@ -74,13 +77,69 @@ def _panels(count: int, title: str, row_height: float = 2.9):
 
 def _save(fig, path: Path, legend_handles=None, legend_columns: int = 3) -> Path:
     """Place a shared legend under the panels (when given) and write the PNG."""
+    rect = (0, 0, 1, 1)
     if legend_handles:
         handles, labels = legend_handles
         fig.legend(handles, labels, loc="lower center", ncol=min(legend_columns, len(labels)), fontsize=8,
                    frameon=False)
-        fig.tight_layout(rect=(0, 0.04 + 0.025 * ((len(labels) - 1) // legend_columns), 1, 1))
-    else:
-        fig.tight_layout()
+        rect = (0, 0.04 + 0.025 * ((len(labels) - 1) // legend_columns), 1, 1)
+    return _write(fig, path, rect)
+
+
+_background: dict | None = None  # inside background_rendering(): "children" (pid, figure), "limit", "failed"
+
+
+@contextmanager
+def background_rendering(processes: int | None = None):
+    """Inside, each figure is laid out and written by a forked child while the caller builds the next
+    (at most `processes` children at once, default the CPU count): the same PNG bytes, in a fraction of
+    the time on several cores. Leaving waits for every child; RuntimeError names a figure that failed."""
+    global _background
+    if not hasattr(os, "fork") or _background is not None:
+        yield
+        return
+    _background = {"children": [], "limit": processes or os.cpu_count() or 1, "failed": []}
+    try:
+        yield
+    except BaseException:
+        _wait_all()
+        raise
+    failed = _wait_all()
+    if failed:
+        raise RuntimeError(f"cannot write the plot {failed[0]} (its error is printed above)")
+
+
+def _wait_all() -> list[str]:
+    """Wait for every child writing a figure; the figures that failed. Ends background rendering."""
+    global _background
+    state, _background = _background, None
+    return state["failed"] + _failures(state["children"])
+
+
+def _failures(children: list) -> list[str]:
+    """Wait for the (pid, figure) children; the figures whose child failed."""
+    return [path for pid, path in children if os.waitstatus_to_exitcode(os.waitpid(pid, 0)[1]) != 0]
+
+
+def _write(fig, path: Path, rect=(0, 0, 1, 1)) -> Path:
+    """tight_layout within `rect`, then the PNG: here, or in a forked child (background_rendering)."""
+    if _background is not None:
+        children = _background["children"]
+        while len(children) >= _background["limit"]:
+            _background["failed"] += _failures([children.pop(0)])
+        pid = os.fork()
+        if pid:
+            children.append((pid, str(path)))
+            plt.close(fig)
+            return Path(path)
+        try:  # the child: write the figure and leave at once, running no handler of the parent's
+            fig.tight_layout(rect=rect)
+            fig.savefig(path, dpi=DPI)
+        except BaseException:
+            traceback.print_exc()
+            os._exit(1)
+        os._exit(0)
+    fig.tight_layout(rect=rect)
     fig.savefig(path, dpi=DPI)
     plt.close(fig)
     return Path(path)
@@ -185,8 +244,7 @@ def _pdf_heat_map(fig, ax, out) -> None:
     scaled = np.divide(out.pdf_density, peak, out=np.zeros_like(out.pdf_density), where=peak > 0)
     about_mean = narrow_band(out)
     support = out.pdf_support - out.mean[:, None] if about_mean else out.pdf_support
-    times = np.broadcast_to(out.time[:, None], support.shape)
-    mesh = ax.pcolormesh(times, support, scaled, shading="gouraud", cmap="magma", rasterized=True)
+    mesh = ax.pcolormesh(*_cell_edges(out.time, support), scaled, shading="flat", cmap="magma", rasterized=True)
     if about_mean:
         ax.plot(out.time, out.band99[0] - out.mean, color="cyan", lw=0.8, ls="--", label="99 % band")
         ax.plot(out.time, out.band99[1] - out.mean, color="cyan", lw=0.8, ls="--")
@@ -200,6 +258,20 @@ def _pdf_heat_map(fig, ax, out) -> None:
     ax.set_xlabel(TIME_LABEL, fontsize=9)
     ax.legend(loc="upper right", fontsize=8)
     fig.colorbar(mesh, ax=ax, label="density / peak density at that time")
+
+
+def _cell_edges(time: np.ndarray, support: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Corners (T + 1, G + 1) of the cells centred on each time's support points (T, G): flat cells
+    draw in a fifth of the time of Gouraud triangles and look the same at 1000 times × 120 points."""
+    def edges(centres, axis):
+        inner = 0.5 * (np.take(centres, range(1, centres.shape[axis]), axis)
+                       + np.take(centres, range(centres.shape[axis] - 1), axis))
+        first = 2 * np.take(centres, [0], axis) - np.take(inner, [0], axis)
+        last = 2 * np.take(centres, [-1], axis) - np.take(inner, [-1], axis)
+        return np.concatenate([first, inner, last], axis)
+
+    along_time = edges(np.broadcast_to(time[:, None], support.shape), 0)
+    return edges(along_time, 1), edges(edges(support, 1), 0)
 
 
 def time_indices(time: np.ndarray, times: list[float]) -> list[int]:
@@ -503,7 +575,4 @@ def plot_design_pairs(results, path: Path, title: str) -> Path | None:
                 ax.set_xticklabels([])
             ax.grid(alpha=0.3)
     fig.suptitle(title, fontsize=11)
-    fig.tight_layout()
-    fig.savefig(path, dpi=DPI)
-    plt.close(fig)
-    return Path(path)
+    return _write(fig, path)
