@@ -390,6 +390,9 @@ def report(
                                              "is valid (Monte Carlo, QMC, least squares, regression); labelled partial."),
     allow_aliasing: bool = typer.Option(False, help="Let a projection's order exceed what the grid integrates "
                                                     "exactly (refused otherwise); the report says so."),
+    figure_format: str = typer.Option("png", "--format", metavar="png|svg|pdf",
+                                      help="Format of plots/: png; svg (the page embeds the SVGs); pdf (beside "
+                                           "PNGs of the same names, which the page embeds and links to the PDFs)."),
 ):
     """Statistics, tables, plots and a report page of one or more results files.
 
@@ -409,6 +412,8 @@ def report(
         raise typer.BadParameter(f"expected comma-separated seconds or 'end', got {times!r}", param_hint="--times")
     if order is not None and order < 0:
         raise typer.BadParameter(f"expected an integer >= 0, got {order}", param_hint="--order")
+    if figure_format not in ("png", "svg", "pdf"):
+        raise typer.BadParameter(f"expected png, svg or pdf, got {figure_format!r}", param_hint="--format")
     if order is not None and not method:
         raise typer.BadParameter("--order needs --method KIND", param_hint="--order")
     try:
@@ -426,7 +431,7 @@ def report(
         with _status("report") as tell:
             written = write_report(results, out, reference=reference, times=selected, baseline=write_baseline,
                                    method=overrides or None, progress=tell, partial=partial,
-                                   allow_aliasing=allow_aliasing)
+                                   allow_aliasing=allow_aliasing, fmt=figure_format)
     except BadInput as exc:
         echo(f"error: {exc}", err=True)
         raise typer.Exit(2)
