@@ -12,8 +12,7 @@ import pytest
 from matplotlib.image import imread
 
 from conftest import cli_in_process
-from uqflight.campaign import parse_campaign
-from uqflight.execution import run_campaign
+from test_report import run
 from uqflight.report import plots, write_report
 from uqflight.report.loading import load_entries
 from uqflight.report.render import figure_html
@@ -33,20 +32,14 @@ analysis: {{band_samples: 1000}}
 """
 
 
-def run(path: Path, **fields) -> Path:
-    campaign = parse_campaign(PHUGOID.format(**fields), str(path.with_suffix(".yaml")))
-    run_campaign(campaign, out=path, workers=1)
-    return path
-
-
 @pytest.fixture(scope="module")
 def files(tmp_path_factory) -> dict[str, Path]:
     root = tmp_path_factory.mktemp("phugoid")
     mc = "{kind: monte_carlo, samples: %d}"
-    return {"grid": run(root / "grid.h5", name="grid", design="{kind: sparse_grid, rule: gauss_hermite, level: 2}",
+    return {"grid": run(PHUGOID, root / "grid.h5", name="grid", design="{kind: sparse_grid, rule: gauss_hermite, level: 2}",
                         method="{kind: pseudo_galerkin, order: 2}", seed=1),
-            "mc": run(root / "mc.h5", name="mc", design=mc % 120, method="{kind: monte_carlo}", seed=2),
-            "ref": run(root / "ref.h5", name="ref", design=mc % 300, method="{kind: monte_carlo}", seed=3)}
+            "mc": run(PHUGOID, root / "mc.h5", name="mc", design=mc % 120, method="{kind: monte_carlo}", seed=2),
+            "ref": run(PHUGOID, root / "ref.h5", name="ref", design=mc % 300, method="{kind: monte_carlo}", seed=3)}
 
 
 @pytest.fixture(scope="module")
