@@ -28,7 +28,15 @@ app = typer.Typer(help="Uncertainty quantification campaigns on a JSBSim flight-
 surrogate_app = typer.Typer(help="The PCE surrogate of a results file: export it as JSON.", no_args_is_help=True,
                             context_settings=CONTEXT, rich_markup_mode=None)
 app.add_typer(surrogate_app, name="surrogate")
-register_calibrate(app)
+
+
+def _calibration_page(out: Path) -> Path:
+    from .report.calibration_page import write_calibration_page
+
+    return write_calibration_page(out)
+
+
+register_calibrate(app, page=_calibration_page)
 
 
 def _version(value: bool):

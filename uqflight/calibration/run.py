@@ -213,10 +213,11 @@ def _calibrate(results, data, out, outputs, noise, seed, walkers, steps, method,
         check_campaign_text(text, str(out / "calibrated.yaml"))  # loadable by `uqflight plan`, or a bug here
         (scratch / "calibrated.yaml").write_text(text, encoding="utf-8")
         truth_row = np.array([truth.get(n, np.nan) for n in names]) if truth else None
-        corner_plot(scratch / "plots/corner.png", kappa, names, truth_row)
+        properties = [specs[n]["property"] for n in names]
+        corner_plot(scratch / "plots/corner.png", kappa, names, truth_row, properties=properties)
         prior_xi = prior_draw(np.random.default_rng(seed + 2), 20000)[:, :d]
         marginals_plot(scratch / "plots/marginals.png", to_physical(surrogate.parameters, prior_xi), kappa, names,
-                       truth_row)
+                       truth_row, properties=properties)
         predictive_plot(scratch / "plots/predictive.png", flight.time, flight.values, at_data, band,
                         surrogate.units, int((~ok).sum()))
         summary["seconds"]["total"] = clock.perf_counter() - started

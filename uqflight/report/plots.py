@@ -19,13 +19,8 @@ import numpy as np  # noqa: E402
 from matplotlib.lines import Line2D  # noqa: E402
 from matplotlib.ticker import FixedLocator, FuncFormatter, LogLocator, MaxNLocator, NullFormatter  # noqa: E402
 
-LABELS = {
-    "alpha_deg": "angle of attack α [deg]",
-    "theta_deg": "pitch attitude θ [deg]",
-    "h_ft": "altitude h [ft]",
-    "q_degps": "pitch rate q [deg/s]",
-    "vtas_kt": "true airspeed V_TAS [kt]",
-}
+from ..labels import label, short_label  # noqa: E402,F401 (plots.label: the report's captions)
+
 TIME_LABEL = "time [s]"
 DPI = 110
 COLORS = plt.get_cmap("tab10").colors
@@ -114,18 +109,6 @@ def method_style(k: int, points: int = 0) -> dict:
         step = points // 10
         style["markevery"] = ((k * step) // 7 % step, step)
     return style
-
-
-def label(name: str, units: str = "") -> str:
-    """Axis label of an output: its description and unit, e.g. "pitch attitude θ [deg]"."""
-    if name in LABELS:
-        return LABELS[name]
-    return f"{name} [{units}]" if units else name
-
-
-def short_label(name: str) -> str:
-    """A panel title: the label without its unit, e.g. "pitch attitude θ"."""
-    return label(name).split(" [")[0]
 
 
 def plot_flight(time: np.ndarray, outputs: dict[str, np.ndarray], path: Path, title: str = "") -> Path:
