@@ -306,7 +306,8 @@ def plot_cov(outputs: dict, path: Path, title: str) -> Path:
 def _floor_log_axis(ax, series: list, decades: float) -> None:
     """Start a log y-axis `decades` below the largest value, so that near-zero errors at a
     deterministic instant (e.g. t = 0) do not squeeze the rest."""
-    top = max((np.nanmax(values) for values in series), default=0.0)
+    finite = [v[np.isfinite(v)] for v in (np.asarray(values, dtype=float) for values in series)]
+    top = max((v.max() for v in finite if v.size), default=0.0)  # an all-NaN CoV (zero mean): none
     if top > 0:
         ax.set_ylim(bottom=decades * top)
 
