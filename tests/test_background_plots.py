@@ -10,8 +10,9 @@ from uqflight.report import plots
 
 def outputs():
     time = np.linspace(0.0, 10.0, 201)
-    return {name: SimpleNamespace(name=name, time=time, cov=0.01 + np.abs(np.sin(k + time)))
-            for k, name in enumerate(("alpha_deg", "h_ft"))}
+    return {name: SimpleNamespace(name=name, time=time, cov=0.01 + np.abs(np.sin(k + time)),
+                                  mean=offset + np.sin(k + time), std=0.01 + np.abs(np.sin(k + time)), units="")
+            for k, (name, offset) in enumerate((("alpha_deg", 0.0), ("h_ft", 15000.0)))}
 
 
 def test_the_same_png_bytes_in_a_child(tmp_path):

@@ -32,7 +32,15 @@ app = typer.Typer(help="Uncertainty quantification campaigns on a JSBSim flight-
 surrogate_app = typer.Typer(help="The PCE surrogate of a results file: export it as JSON.", no_args_is_help=True,
                             context_settings=CONTEXT, rich_markup_mode=None)
 app.add_typer(surrogate_app, name="surrogate")
-register_calibrate(app)
+
+
+def _calibration_page(out: Path) -> Path:
+    from .report.calibration_page import write_calibration_page
+
+    return write_calibration_page(out)
+
+
+register_calibrate(app, page=_calibration_page)
 
 
 def _version(value: bool):
@@ -432,6 +440,9 @@ def report(
                                              "is valid (Monte Carlo, QMC, least squares, regression); labelled partial."),
     allow_aliasing: bool = typer.Option(False, help="Let a projection's order exceed what the grid integrates "
                                                     "exactly (refused otherwise); the report says so."),
+    figure_format: str = typer.Option("png", "--format", metavar="png|svg|pdf",
+                                      help="Format of plots/: png; svg (the page embeds the SVGs); pdf (beside "
+                                           "PNGs of the same names, which the page embeds and links to the PDFs)."),
 ):
     """Statistics, tables, plots and a report page of one or more results files.
 
@@ -452,6 +463,8 @@ def report(
         raise typer.BadParameter(f"expected comma-separated seconds or 'end', got {times!r}", param_hint="--times")
     if order is not None and order < 0:
         raise typer.BadParameter(f"expected an integer >= 0, got {order}", param_hint="--order")
+    if figure_format not in ("png", "svg", "pdf"):
+        raise typer.BadParameter(f"expected png, svg or pdf, got {figure_format!r}", param_hint="--format")
     if order is not None and not method:
         raise typer.BadParameter("--order needs --method KIND", param_hint="--order")
     try:
@@ -471,7 +484,7 @@ def report(
         with Progress(0, label="report") as progress:
             written = write_report(results, out, reference=reference, times=selected, baseline=write_baseline,
                                    method=overrides or None, progress=progress, partial=partial,
-                                   allow_aliasing=allow_aliasing)
+                                   allow_aliasing=allow_aliasing, fmt=figure_format)
     except BadInput as exc:
         echo(f"error: {exc}", err=True)
         raise typer.Exit(2)

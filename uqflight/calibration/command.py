@@ -40,10 +40,13 @@ def calibrate_command(
                                                        "file cannot be rebuilt (a python model file elsewhere)."),
     predictive_draws: int = typer.Option(50, help="Posterior draws flown with the real simulator for the "
                                                   "posterior predictive band."),
+    truth: List[str] = typer.Option([], "--truth", metavar="NAME=VALUE", help="A parameter's known true value "
+                                    "(physical units; repeatable): marked in the plots and the page, and "
+                                    "summary.json says whether the 95 % interval holds it."),
 ):
     """Bayesian calibration of the campaign's parameters on flight data (PCE surrogate + emcee).
 
-    Writes OUT/posterior.h5 (draws in standard and physical variables), OUT/summary.json (prior and posterior mean, std, 95 % interval per parameter, correlations, diagnostics; strict JSON), OUT/calibrated.yaml (the campaign with the posterior marginals) and OUT/plots/ (corner, marginals, posterior predictive from real simulator runs).
+    Writes OUT/posterior.h5 (draws in standard and physical variables), OUT/summary.json (prior and posterior mean, std, 95 % interval per parameter, correlations, diagnostics; strict JSON), OUT/calibrated.yaml (the campaign with the posterior marginals), OUT/plots/ (corner, marginals, posterior predictive from real simulator runs) and OUT/report.html (all of it on one self-contained page).
 
     Exit 0: done; 2: bad input (data, options, results file, data times outside the surrogate's); 3: the chain did not converge (nothing written; the message says what to change); 130: interrupted (Ctrl-C).
     """  # noqa: E501
@@ -67,6 +70,7 @@ def calibrate_command(
     except DataError as exc:
         echo(f"error: {exc}", err=True)
         raise typer.Exit(EXIT_BAD_INPUT)
+    known = _truth(truth, results)
     from .run import NotConverged, SurrogateError, calibrate
 
     streams, previous = (sys.stdout, sys.stderr), signal.signal(signal.SIGINT, _interrupted)
@@ -74,7 +78,7 @@ def calibrate_command(
         with Progress(0, label="calibrate") as progress:
             result = calibrate(results, data, out, outputs=list(output) or None, noise=list(noise), seed=seed,
                                walkers=walkers, steps=steps, method=method, order=order, campaign=campaign,
-                               predictive_draws=predictive_draws, progress=progress)
+                               predictive_draws=predictive_draws, truth=known, progress=progress)
     except KeyboardInterrupt:
         sys.stdout, sys.stderr = streams
         echo(f"\ninterrupted: no calibration written to {out}", err=True)
@@ -86,6 +90,9 @@ def calibrate_command(
         echo("not converged: no posterior is reported.", err=True)
         for problem in exc.diagnostics["problems"]:
             echo(f"  - {problem}", err=True)
+        if _page[0] is not None and (out / "report.html").is_file():
+            (out / "report.html").unlink()  # the page of an earlier run would look like this run's
+            exc.removed.append("report.html")
         if exc.removed:
             echo(f"  (removed the outputs of an earlier run from {out}: {', '.join(exc.removed)})", err=True)
         raise typer.Exit(EXIT_NOT_CONVERGED)
@@ -111,7 +118,26 @@ def calibrate_command(
     cover = ", ".join(f"{k} {v:.0%}" if v is not None else f"{k} -" for k, v in pred["coverage95"].items())
     echo(f"posterior predictive ({pred['draws']} simulator runs, {pred['failed']} failed): data inside the "
          f"95 % band: {cover}")
-    echo(f"wrote {', '.join(result.written)} to {out} ({summary['seconds']['total']:.1f} s)")
+    written = list(result.written)
+    if _page[0] is not None:
+        written.append(_page[0](out).name)
+    echo(f"wrote {', '.join(written)} to {out} ({summary['seconds']['total']:.1f} s)")
+
+
+def _truth(items: list[str], results: Path) -> dict[str, float] | None:
+    """--truth NAME=VALUE items as {name: value}; exit 2 for a malformed item, a repeated or unknown name."""
+    from ..store import ResultStore
+    from .likelihood import DataError, name_values
+
+    if not items:
+        return None
+    with ResultStore.open(results) as store:
+        names = list(store.parameter_names)
+    try:
+        return name_values(items, "--truth", "NAME=VALUE with a finite VALUE", names, f"the parameters of {results}")
+    except DataError as exc:
+        echo(f"error: {exc}", err=True)
+        raise typer.Exit(EXIT_BAD_INPUT)
 
 
 def _method(text: str, order: int | None) -> tuple[str, int | None]:
@@ -137,6 +163,12 @@ def _interrupted(signum, frame):
     raise KeyboardInterrupt
 
 
-def register(app: typer.Typer) -> None:
-    """Add the `calibrate` command to `app`."""
+_page = [None]  # writes OUT/report.html after a calibration (`register`'s page)
+
+
+def register(app: typer.Typer, page=None) -> None:
+    """Add the `calibrate` command to `app`; `page(out) -> Path`, when given, writes the calibration's
+    page into OUT (report.calibration_page, a layer above this one); without it, an earlier one stays."""
+    if page is not None:
+        _page[0] = page
     app.command("calibrate")(calibrate_command)

@@ -91,22 +91,29 @@ def read_flight_csv(path, outputs: list[str] | None, available: list[str]) -> Fl
 
 def parse_noise(pairs: list[str], outputs: list[str]) -> dict[str, float]:
     """`NAME=SIGMA` pairs (SIGMA > 0, in the output's unit) for outputs among `outputs`."""
-    noise = {}
+    return name_values(pairs, "--noise", "OUTPUT=SIGMA with SIGMA > 0", outputs, "the calibrated outputs", positive=True)
+
+
+def name_values(pairs: list[str], option: str, form: str, names: list[str], among: str,
+                positive: bool = False) -> dict[str, float]:
+    """`NAME=VALUE` pairs of `option` as {name: value}: VALUE finite (and > 0 when `positive`), NAME
+    one of `names` (`among` says what they are), each once; DataError otherwise."""
+    values = {}
     for pair in pairs:
-        name, sep, value = pair.partition("=")
+        name, sep, text = pair.partition("=")
         name = name.strip()
         try:
-            sigma = float(value)
+            value = float(text)
         except ValueError:
-            sigma = float("nan")
-        if not sep or not name or not (math.isfinite(sigma) and sigma > 0):
-            raise DataError(f"--noise: expected OUTPUT=SIGMA with SIGMA > 0, got {pair!r}")
-        if name not in outputs:
-            raise DataError(f"--noise {name}: not one of the calibrated outputs ({', '.join(outputs)})")
-        if name in noise:
-            raise DataError(f"--noise {name}: given twice ({noise[name]:g} and {sigma:g}); give it once")
-        noise[name] = sigma
-    return noise
+            value = float("nan")
+        if not sep or not name or not math.isfinite(value) or (positive and not value > 0):
+            raise DataError(f"{option}: expected {form}, got {pair!r}")
+        if name not in names:
+            raise DataError(f"{option} {name}: not one of {among} ({', '.join(names)})")
+        if name in values:
+            raise DataError(f"{option} {name}: given twice ({values[name]:g} and {value:g}); give it once")
+        values[name] = value
+    return values
 
 
 def interpolate_in_time(values: np.ndarray, source: np.ndarray, target: np.ndarray) -> np.ndarray:

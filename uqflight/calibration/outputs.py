@@ -9,6 +9,7 @@ import h5py
 import numpy as np
 import yaml
 
+from ..labels import label, parameter_label, short_label
 from ..statistics import json_ready as strict
 
 OUTPUT_FILES = ("posterior.h5", "summary.json", "calibrated.yaml", "plots/corner.png", "plots/marginals.png",
@@ -148,15 +149,31 @@ def _pyplot():
     return plt
 
 
-def corner_plot(path: Path, draws: np.ndarray, names: list[str], truth=None, bins: int = 40) -> None:
-    """A lower-triangle corner plot: histograms on the diagonal, 2-D histograms below."""
+def corner_plot(path: Path, draws: np.ndarray, names: list[str], truth=None, bins: int = 40,
+                properties: list[str] | None = None) -> None:
+    """Write `corner_figure` to `path`."""
+    _write(corner_figure(draws, names, truth, bins, properties), path)
+
+
+def _write(fig, path: Path) -> None:
+    fig.savefig(path, dpi=90)
+    _pyplot().close(fig)
+
+
+def corner_figure(draws: np.ndarray, names: list[str], truth=None, bins: int = 40, properties: list[str] | None = None):
+    """A lower-triangle corner plot in physical values, axes labelled with the parameters' units:
+    histograms on the diagonal, 2-D histograms below; the posterior mean dashed (+ below the
+    diagonal) and the truth (`truth`, NaN where unknown) red."""
     plt = _pyplot()
     d = draws.shape[1]
-    size = min(2.0 * d, 16.0)
+    labels = _labels(names, properties)
+    size = min(2.0 * d + 0.6, 16.0)
     fig, axes = plt.subplots(d, d, figsize=(size, size), squeeze=False)
     lows, highs = np.quantile(draws, 0.001, axis=0), np.quantile(draws, 0.999, axis=0)
     spans = np.where(highs > lows, highs - lows, 1.0)
     lows, highs = lows - 0.05 * spans, highs + 0.05 * spans
+    mean = draws.mean(axis=0)
+    known = truth is not None and np.isfinite(truth).any()
     for i in range(d):
         for j in range(d):
             ax = axes[i, j]
@@ -165,36 +182,49 @@ def corner_plot(path: Path, draws: np.ndarray, names: list[str], truth=None, bin
                 continue
             if i == j:
                 ax.hist(draws[:, i], bins=bins, range=(lows[i], highs[i]), color="C0", histtype="stepfilled", alpha=0.6)
+                ax.axvline(mean[i], color="k", ls="--", lw=1)
                 ax.set_yticks([])
-                if truth is not None:
+                if known and np.isfinite(truth[i]):
                     ax.axvline(truth[i], color="C3")
             else:
                 ax.hist2d(draws[:, j], draws[:, i], bins=bins, range=[[lows[j], highs[j]], [lows[i], highs[i]]],
                           cmap="Blues")
-                if truth is not None:
+                ax.plot(mean[j], mean[i], "+", color="k", ms=8)
+                if known and np.isfinite(truth[i]) and np.isfinite(truth[j]):
                     ax.plot(truth[j], truth[i], "s", color="C3", ms=4)
+                _ticks(ax.yaxis)
+            _ticks(ax.xaxis, rotate=True)
             if i == d - 1:
-                ax.set_xlabel(names[j], fontsize=8)
+                ax.set_xlabel(labels[j], fontsize=8)
             else:
                 ax.set_xticklabels([])
             if j == 0 and i > 0:
-                ax.set_ylabel(names[i], fontsize=8)
-            elif j > 0:
+                ax.set_ylabel(labels[i], fontsize=8)
+            elif j > 0 and i != j:
                 ax.set_yticklabels([])
             ax.tick_params(labelsize=6)
+    fig.legend(handles=_marks(known), loc="upper right", fontsize=9, frameon=False)
     fig.suptitle("posterior (physical values)")
     fig.tight_layout()
-    fig.savefig(path, dpi=90)
-    plt.close(fig)
+    return fig
 
 
-def marginals_plot(path: Path, prior: np.ndarray, posterior: np.ndarray, names: list[str], truth=None) -> None:
-    """Prior against posterior histogram of every parameter (physical values, densities)."""
+def marginals_plot(path: Path, prior: np.ndarray, posterior: np.ndarray, names: list[str], truth=None,
+                   properties: list[str] | None = None) -> None:
+    """Write `marginals_figure` to `path`."""
+    _write(marginals_figure(prior, posterior, names, truth, properties), path)
+
+
+def marginals_figure(prior: np.ndarray, posterior: np.ndarray, names: list[str], truth=None,
+                     properties: list[str] | None = None):
+    """Prior against posterior histogram of every parameter (physical values with their units,
+    densities), the posterior mean dashed and the truth (when given) red."""
     plt = _pyplot()
     d = posterior.shape[1]
     cols = min(d, 4)
     rows = math.ceil(d / cols)
-    fig, axes = plt.subplots(rows, cols, figsize=(3.2 * cols, 2.6 * rows), squeeze=False)
+    labels = _labels(names, properties)
+    fig, axes = plt.subplots(rows, cols, figsize=(3.3 * cols, 2.8 * rows), squeeze=False)
     for k in range(rows * cols):
         ax = axes.flat[k]
         if k >= d:
@@ -205,15 +235,23 @@ def marginals_plot(path: Path, prior: np.ndarray, posterior: np.ndarray, names: 
         ax.hist(prior[:, k], bins=60, range=(lo, hi), density=True, histtype="step", color="0.4", label="prior")
         ax.hist(posterior[:, k], bins=60, range=(lo, hi), density=True, histtype="stepfilled", alpha=0.6,
                 color="C0", label="posterior")
-        if truth is not None:
-            ax.axvline(truth[k], color="C3", label="truth")
-        ax.set_title(names[k], fontsize=9)
+        ax.axvline(posterior[:, k].mean(), color="k", ls="--", lw=1, label="posterior mean")
+        if truth is not None and np.isfinite(truth[k]):
+            ax.axvline(truth[k], color="C3", label="truth (--truth)")
+        ax.set_xlabel(labels[k], fontsize=8)
         ax.set_yticks([])
+        _ticks(ax.xaxis, count=4, rotate=True)
         ax.tick_params(labelsize=7)
-    axes.flat[0].legend(fontsize=7)
-    fig.tight_layout()
-    fig.savefig(path, dpi=90)
-    plt.close(fig)
+    handles, texts = [], []
+    for ax in axes.flat[:d]:
+        for handle, text in zip(*ax.get_legend_handles_labels()):
+            if text not in texts:
+                handles.append(handle)
+                texts.append(text)
+    fig.legend(handles, texts, loc="lower center", ncol=len(texts), fontsize=8, frameon=False)
+    fig.suptitle("prior and posterior of each parameter (physical values)", fontsize=11)
+    fig.tight_layout(rect=(0, 0.05, 1, 1))
+    return fig
 
 
 def predictive_plot(path: Path, time, data: dict, runs: dict, band: dict, units: dict, failed: int) -> None:
@@ -221,7 +259,7 @@ def predictive_plot(path: Path, time, data: dict, runs: dict, band: dict, units:
     (left), and the same about the runs' median (right), where the noise can be seen."""
     plt = _pyplot()
     outputs = list(data)
-    fig, axes = plt.subplots(len(outputs), 2, figsize=(13, 2.4 * len(outputs)), squeeze=False, sharex=True)
+    fig, axes = plt.subplots(len(outputs), 2, figsize=(13, 2.4 * len(outputs) + 0.6), squeeze=False, sharex=True)
     for row, name in enumerate(outputs):
         median = np.median(runs[name], axis=0) if len(runs[name]) else np.zeros_like(time)
         lower, upper = band[name]
@@ -232,8 +270,9 @@ def predictive_plot(path: Path, time, data: dict, runs: dict, band: dict, units:
                             label="95 % predictive (runs + noise)")
             ax.plot(time, (runs[name] - offset).T, color="C0", lw=0.4, alpha=0.5)
             ax.plot(time, data[name] - offset, ".", color="k", ms=1.5, label="data")
-            label = name if col == 0 else f"{name} - median run"
-            ax.set_ylabel(label + (f" [{unit}]" if unit else ""), fontsize=8)
+            text = label(name, unit) if col == 0 else \
+                f"{short_label(name)} − median run" + (f" [{unit}]" if unit else "")
+            ax.set_ylabel(text, fontsize=8)
             ax.tick_params(labelsize=7)
     axes[0, 0].legend(fontsize=7, loc="best")
     for ax in axes[-1]:
@@ -243,3 +282,32 @@ def predictive_plot(path: Path, time, data: dict, runs: dict, band: dict, units:
     fig.tight_layout()
     fig.savefig(path, dpi=90)
     plt.close(fig)
+
+
+def _ticks(axis, count: int = 3, rotate: bool = False) -> None:
+    """At most `count` plain tick labels (no offset: -22.04, not 0.04 - 22), slanted when asked,
+    so that long values such as -0.01052 do not run into each other."""
+    from matplotlib.ticker import MaxNLocator, ScalarFormatter
+
+    axis.set_major_locator(MaxNLocator(count))
+    formatter = ScalarFormatter(useOffset=False)
+    formatter.set_powerlimits((-5, 6))
+    axis.set_major_formatter(formatter)
+    if rotate:
+        for text in axis.get_ticklabels():
+            text.set_rotation(35)
+            text.set_horizontalalignment("right")
+
+
+def _marks(truth: bool):
+    """Legend handles of the posterior mean and (when given) the truth."""
+    from matplotlib.lines import Line2D
+
+    handles = [Line2D([], [], color="k", ls="--", marker="+", label="posterior mean")]
+    if truth:
+        handles.append(Line2D([], [], color="C3", marker="s", ms=4, label="truth (--truth)"))
+    return handles
+
+
+def _labels(names: list[str], properties: list[str] | None) -> list[str]:
+    return [parameter_label(n, p) for n, p in zip(names, properties)] if properties else list(names)

@@ -307,10 +307,12 @@ def _write_outputs(out, results, data, seed, surrogate, flight, posterior, chain
         check_campaign_text(text, str(out / "calibrated.yaml"))  # loadable by `uqflight plan`, or a bug here
         (scratch / "calibrated.yaml").write_text(text, encoding="utf-8")
         truth_row = np.array([truth.get(n, np.nan) for n in names]) if truth else None
-        corner_plot(scratch / "plots/corner.png", draws.kappa, names, truth_row)
+        properties = [specs[n]["property"] for n in names]
+        corner_plot(scratch / "plots/corner.png", draws.kappa, names, truth_row, properties=properties)
         prior_xi = sampling.prior_draw(posterior, np.random.default_rng(seed + 2), 20000)[:, :len(names)]
         prior_kappa = to_physical(surrogate.parameters, prior_xi, surrogate.campaign.dependence)
-        marginals_plot(scratch / "plots/marginals.png", prior_kappa, draws.kappa, names, truth_row)
+        marginals_plot(scratch / "plots/marginals.png", prior_kappa, draws.kappa, names, truth_row,
+                       properties=properties)
         predictive_plot(scratch / "plots/predictive.png", flight.time, flight.values, at_data, band,
                         surrogate.units, failed)
         summary["seconds"]["total"] = clock.perf_counter() - started

@@ -6,7 +6,7 @@ Layout of the report directory:
     summaries/<stem>.json      every file's, when several are given
     tables/*.csv               statistics over time per file and output, statistics and Sobol' indices
                                at selected times, errors against the reference, PCE vs Monte Carlo
-    plots/*.png                the figures
+    plots/*.png                the figures (*.svg with --format svg; *.pdf beside the PNGs with pdf)
     report.html                all of it on one page, plots embedded: it can be mailed
     report.md                  the same, linking plots/
 
@@ -25,6 +25,7 @@ from ..progress import Progress
 from ..methods.parsing import parse_methods
 from .files import _write_text, write_csv, write_statistics_tables, write_summaries
 from .loading import Entry, load_entries
+from .plots import FORMATS, exporting
 from .replace import check_replaceable, make_staging, replace_dir
 
 __all__ = ["check_replaceable", "default_out_dir", "parse_methods", "write_report"]
@@ -40,15 +41,18 @@ def default_out_dir(results: Path) -> Path:
 
 def write_report(paths: list[Path], out_dir: Path | None = None, reference: Path | None = None,
                  times=DEFAULT_TIMES, baseline: Path | None = None, method: dict | list[dict] | None = None,
-                 progress=None, partial: bool = False, allow_aliasing: bool = False) -> list[Path]:
+                 progress=None, partial: bool = False, allow_aliasing: bool = False, fmt: str = "png") -> list[Path]:
     """Write the whole report of `paths` into `out_dir` (default: next to the first file,
     RESULTS-report/); returns the files written (the baseline last, when asked for).
 
     `method`: one override {"kind", "order"}, a list of them (each file analysed with each, overlaid
     in the plots), or None (each campaign's own). `progress` (a Progress) is told each stage. `partial`,
-    `allow_aliasing`: see statistics.analyse. Everything is written into a temporary folder first and
+    `allow_aliasing`: see statistics.analyse. `fmt`: the figures' format (plots.FORMATS; see
+    plots.exporting). Everything is written into a temporary folder first and
     moved into place at the end; nothing is written when a file is refused (statistics.BadInput)."""
     out_dir = Path(os.path.abspath(out_dir if out_dir is not None else default_out_dir(paths[0])))
+    if fmt not in FORMATS:
+        raise ValueError(f"figure format: expected one of {', '.join(FORMATS)}, got {fmt!r}")
     check_replaceable(out_dir)
     progress = progress or Progress(0, quiet=True)
     entries, ref = load_entries(paths, reference, method, progress=progress, partial=partial,
@@ -56,7 +60,8 @@ def write_report(paths: list[Path], out_dir: Path | None = None, reference: Path
     out_dir.parent.mkdir(parents=True, exist_ok=True)
     staging = make_staging(out_dir)
     try:
-        _write_into(staging, entries, ref, times, progress)
+        with exporting(fmt):
+            _write_into(staging, entries, ref, times, progress)
         written = sorted(out_dir / p.relative_to(staging) for p in staging.rglob("*") if p.is_file())
         progress.stage(f"moving the report into {out_dir}")
         replace_dir(staging, out_dir)
@@ -91,7 +96,7 @@ def _write_into(out_dir: Path, entries: list[Entry], ref: Entry | None, times, p
     progress.stage("writing the page")
     title = f"uqflight report: {entries[0].label}" + (f" and {len(entries) - 1} more" if len(entries) > 1 else "")
     _write_text(out_dir / "report.html", render_html(title, sections, out_dir))
-    _write_text(out_dir / "report.md", render_markdown(title, sections))
+    _write_text(out_dir / "report.md", render_markdown(title, sections, out_dir))
 
 
 def _drawing_stages(entries: list[Entry]) -> int:

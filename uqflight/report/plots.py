@@ -15,36 +15,123 @@ import matplotlib
 
 matplotlib.use("Agg")
 matplotlib.rcParams["axes.formatter.useoffset"] = False  # 15000.5 ft, not 0.5 + 1.5e4
+matplotlib.rcParams["svg.fonttype"] = "none"  # SVG text stays text: editable, searchable, smaller
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 from matplotlib.lines import Line2D  # noqa: E402
+from matplotlib.ticker import FixedLocator, FuncFormatter, LogLocator, MaxNLocator, NullFormatter  # noqa: E402
 
-LABELS = {
-    "alpha_deg": "angle of attack α [deg]",
-    "theta_deg": "pitch attitude θ [deg]",
-    "h_ft": "altitude h [ft]",
-    "q_degps": "pitch rate q [deg/s]",
-    "vtas_kt": "true airspeed V_TAS [kt]",
-}
+from ..labels import label, short_label  # noqa: E402,F401 (plots.label: the report's captions)
+
 TIME_LABEL = "time [s]"
 DPI = 110
 COLORS = plt.get_cmap("tab10").colors
 MARKERS = "osD^vPX*<>"
+LINESTYLES = ("-", "--", "-.", ":")
 NARROW_BAND = 0.2  # a band narrower than this share of the mean's excursion is also drawn about the mean
 COV_DECADES = 1e-4  # the CoV plot shows four decades below the largest value
-ERROR_DECADES = 1e-6  # error plots show six decades below the largest error
+LOW_QUANTILE = 0.02  # error and decay axes start below the lowest line's 2 % quantile (`informative_limits`)
+OFFSET_DATUM = 10.0  # min|mean| above this many times the mean's excursion: an offset datum (h, V), no CoV
+DECAY_ONSET = 1e-3  # without a known pulse start, coefficient decay is drawn from where degree >= 1 reaches
+#                     this share of its largest value
+FORMATS = ("png", "svg", "pdf")
+_format = ["png"]  # the export format of the figures (`exporting`)
 
 
-def label(name: str, units: str = "") -> str:
-    """Axis label of an output: its description and unit, e.g. "pitch attitude θ [deg]"."""
-    if name in LABELS:
-        return LABELS[name]
-    return f"{name} [{units}]" if units else name
+@contextmanager
+def exporting(fmt: str):
+    """Write the figures drawn inside as `fmt`: png; svg (vector; the page embeds it); pdf (vector,
+    beside a PNG of the same name that the page shows)."""
+    if fmt not in FORMATS:
+        raise ValueError(f"unknown figure format {fmt!r}: expected one of {', '.join(FORMATS)}")
+    previous, _format[0] = _format[0], fmt
+    try:
+        yield
+    finally:
+        _format[0] = previous
 
 
-def short_label(name: str) -> str:
-    """A panel title: the label without its unit, e.g. "pitch attitude θ"."""
-    return label(name).split(" [")[0]
+def write_figure(fig, path: Path, dpi: int = DPI, rect=None) -> Path:
+    """Lay `fig` out (tight_layout within `rect`, when given), save it as `path` in the export format and
+    close it: here, or in a forked child under background_rendering. Returns the file the page shows
+    (the SVG for svg, the PNG for png and pdf: a pdf is written beside it)."""
+    path, fmt = Path(path), _format[0]
+    shown = path.with_suffix(".svg" if fmt == "svg" else ".png")
+
+    def save():
+        if rect is not None:
+            fig.tight_layout(rect=rect)
+        fig.savefig(shown, dpi=dpi)
+        if fmt == "pdf":
+            fig.savefig(path.with_suffix(".pdf"))
+
+    if _background is not None:
+        children = _background["children"]
+        while len(children) >= _background["limit"]:
+            _background["failed"] += _failures([children.pop(0)])
+        pid = os.fork()
+        if pid:
+            children.append((pid, str(shown)))
+            plt.close(fig)
+            return shown
+        try:  # the child: write the figure and leave at once, running no handler of the parent's
+            save()
+        except BaseException:
+            traceback.print_exc()
+            os._exit(1)
+        os._exit(0)
+    save()
+    plt.close(fig)
+    return shown
+
+
+SUPERSCRIPTS = str.maketrans("-0123456789", "⁻⁰¹²³⁴⁵⁶⁷⁸⁹")
+
+
+def tick_text(value: float, _position=None) -> str:
+    """A log axis's tick label in plain text: 0.002, 60, 2×10⁻⁵, 10⁸ (no mathtext, no minor labels)."""
+    if not value > 0:
+        return ""
+    exponent = int(np.floor(np.log10(value) + 1e-9))
+    if -3 <= exponent <= 4:
+        return f"{value:.6g}"
+    mantissa = value / 10.0 ** exponent
+    head = "" if abs(mantissa - 1) < 1e-6 else f"{mantissa:.3g}×"
+    return f"{head}10{str(exponent).translate(SUPERSCRIPTS)}"
+
+
+def log_axis(axis, at=None) -> None:
+    """Readable log ticks on `axis` (ax.xaxis or ax.yaxis), for its current limits: labelled major
+    ticks at 1-9 × 10^k within one decade, 1, 2, 5 × 10^k within 2.5 decades, else decades; minor
+    ticks unlabelled. `at`: label these values instead (e.g. the run counts, when few)."""
+    low, high = sorted(axis.get_view_interval())
+    decades = np.log10(high / low) if low > 0 else np.inf
+    subs = np.arange(1.0, 10.0) if decades < 1 else (1.0, 2.0, 5.0) if decades < 2.5 else (1.0,)
+    axis.set_major_locator(FixedLocator(sorted(at)) if at is not None else LogLocator(subs=subs, numticks=10))
+    axis.set_major_formatter(FuncFormatter(tick_text))
+    axis.set_minor_formatter(NullFormatter())
+
+
+RUN_TICKS = 6  # up to this many distinct run counts are the runs axis's ticks
+
+
+def runs_axis(ax, runs) -> None:
+    """A log runs axis labelled at the run counts themselves when there are few of them."""
+    ax.set_xscale("log")
+    distinct = sorted(set(int(n) for n in runs))
+    log_axis(ax.xaxis, distinct if len(distinct) <= RUN_TICKS else None)
+
+
+def method_style(k: int, points: int = 0) -> dict:
+    """Line style of the k-th file or method: colour, marker and dash pattern all differ, so that
+    lines stay apart in grey print and where they coincide; `points`: the line's length, for
+    markers every tenth of it (staggered per method)."""
+    style = {"color": COLORS[k % len(COLORS)], "marker": MARKERS[k % len(MARKERS)], "ms": 5, "mfc": "none",
+             "ls": LINESTYLES[k % len(LINESTYLES)]}
+    if points > 12:
+        step = points // 10
+        style["markevery"] = ((k * step) // 7 % step, step)
+    return style
 
 
 def plot_flight(time: np.ndarray, outputs: dict[str, np.ndarray], path: Path, title: str = "") -> Path:
@@ -59,7 +146,7 @@ def plot_flight(time: np.ndarray, outputs: dict[str, np.ndarray], path: Path, ti
     if title:
         fig.suptitle(title)
     fig.tight_layout()
-    fig.savefig(path, dpi=110)
+    fig.savefig(path, dpi=DPI)  # the user's file name and format (`simulate --plot`)
     plt.close(fig)
     return Path(path)
 
@@ -122,27 +209,8 @@ def _failures(children: list) -> list[str]:
 
 
 def _write(fig, path: Path, rect=(0, 0, 1, 1)) -> Path:
-    """tight_layout within `rect`, then the PNG: here, or in a forked child (background_rendering)."""
-    if _background is not None:
-        children = _background["children"]
-        while len(children) >= _background["limit"]:
-            _background["failed"] += _failures([children.pop(0)])
-        pid = os.fork()
-        if pid:
-            children.append((pid, str(path)))
-            plt.close(fig)
-            return Path(path)
-        try:  # the child: write the figure and leave at once, running no handler of the parent's
-            fig.tight_layout(rect=rect)
-            fig.savefig(path, dpi=DPI)
-        except BaseException:
-            traceback.print_exc()
-            os._exit(1)
-        os._exit(0)
-    fig.tight_layout(rect=rect)
-    fig.savefig(path, dpi=DPI)
-    plt.close(fig)
-    return Path(path)
+    """tight_layout within `rect`, then `write_figure` (both in the child under background_rendering)."""
+    return write_figure(fig, path, rect=rect)
 
 
 def _style(ax, out, ylabel: str | None = None) -> None:
@@ -238,21 +306,23 @@ def plot_pdf_over_time(out, path: Path, title: str, slice_times: list[float]) ->
 
 
 def _pdf_heat_map(fig, ax, out) -> None:
-    """Each time's density scaled to its peak, over its own support; drawn as deviation from the mean
-    when the band is too narrow to see against the mean's excursion over time."""
+    """Each time's density scaled to its peak, over its own support, white where it is low; drawn as
+    deviation from the mean when the band is too narrow to see against the mean's excursion over time."""
     peak = out.pdf_density.max(axis=1, keepdims=True)
     scaled = np.divide(out.pdf_density, peak, out=np.zeros_like(out.pdf_density), where=peak > 0)
     about_mean = narrow_band(out)
     support = out.pdf_support - out.mean[:, None] if about_mean else out.pdf_support
-    mesh = ax.pcolormesh(*_cell_edges(out.time, support), scaled, shading="flat", cmap="magma", rasterized=True)
+    mesh = ax.pcolormesh(*_cell_edges(out.time, support), scaled, shading="flat", cmap="Blues", vmin=0.0, vmax=1.0,
+                         rasterized=True)
+    line = {"color": COLORS[3], "lw": 0.9}
     if about_mean:
-        ax.plot(out.time, out.band99[0] - out.mean, color="cyan", lw=0.8, ls="--", label="99 % band")
-        ax.plot(out.time, out.band99[1] - out.mean, color="cyan", lw=0.8, ls="--")
+        ax.plot(out.time, out.band99[0] - out.mean, ls="--", label="99 % band", **line)
+        ax.plot(out.time, out.band99[1] - out.mean, ls="--", **line)
         unit = f" [{out.units}]" if out.units else ""
         ax.set_ylabel(f"{short_label(out.name)} − mean(t){unit}", fontsize=9)
         ax.set_title("density about the mean over time, each time scaled to its peak", fontsize=10)
     else:
-        ax.plot(out.time, out.mean, color="cyan", lw=0.9, label="mean")
+        ax.plot(out.time, out.mean, label="mean", **line)
         ax.set_ylabel(label(out.name, out.units), fontsize=9)
         ax.set_title("density over time, each time scaled to its peak", fontsize=10)
     ax.set_xlabel(TIME_LABEL, fontsize=9)
@@ -280,86 +350,118 @@ def time_indices(time: np.ndarray, times: list[float]) -> list[int]:
 
 
 def plot_cov(outputs: dict, path: Path, title: str) -> Path:
-    """The modified coefficient of variation std(t) / max|mean| of all outputs in one plot (Fig. 8)."""
-    fig, ax = plt.subplots(figsize=(9, 4.8))
-    for color, (name, out) in zip(COLORS, outputs.items()):
-        _line(ax, out.time, 100 * out.cov, color=color, lw=1.3, label=short_label(name))
-    ax.set_yscale("log")
-    _floor_log_axis(ax, [100 * out.cov for out in outputs.values()], COV_DECADES)
-    ax.set_xlabel(TIME_LABEL, fontsize=9)
-    ax.set_ylabel("std(t) / max |mean| [%] (log scale)", fontsize=9)
-    ax.grid(alpha=0.3, which="both")
-    ax.legend(fontsize=8, loc="center left", bbox_to_anchor=(1.01, 0.5))
-    ax.set_title(title, fontsize=12)
+    """The modified coefficient of variation std(t) / max|mean| (Fig. 8) of the outputs without an
+    offset datum (left), and the std in its own unit of those with one (`offset_datum`, right)."""
+    groups = [(False, [n for n, o in outputs.items() if not offset_datum(o)]),
+              (True, [n for n, o in outputs.items() if offset_datum(o)])]
+    groups = [(datum, names) for datum, names in groups if names]
+    fig, axes = plt.subplots(1, len(groups), figsize=(6.6 * len(groups) + 1.6, 4.8), squeeze=False)
+    for ax, (datum, names) in zip(axes[0], groups):
+        series = []
+        for k, name in enumerate(names):
+            out = outputs[name]
+            values = out.std if datum else 100 * out.cov
+            text = f"{short_label(name)} [{out.units}]" if datum and out.units else short_label(name)
+            ax.plot(out.time, values, lw=1.3, label=text, **method_style(k, out.time.size))
+            series.append(values)
+        ax.set_yscale("log")
+        _floor_log_axis(ax, series, COV_DECADES)
+        log_axis(ax.yaxis)
+        ax.set_xlabel(TIME_LABEL, fontsize=9)
+        ax.set_ylabel("std(t) in the output's unit (log scale)" if datum else "std(t) / max |mean| [%] (log scale)",
+                      fontsize=9)
+        ax.set_title(f"std: offset datum (min|mean| > {OFFSET_DATUM:g} × its excursion)" if datum
+                     else "modified coefficient of variation", fontsize=10)
+        ax.grid(alpha=0.3, which="both")
+        ax.legend(fontsize=8, loc="best")
+    fig.suptitle(title, fontsize=12)
     return _save(fig, path)
 
 
 def _floor_log_axis(ax, series: list, decades: float) -> None:
     """Start a log y-axis `decades` below the largest value, so that near-zero errors at a
     deterministic instant (e.g. t = 0) do not squeeze the rest."""
-    top = max((np.max(values) for values in series), default=0.0)
+    finite = [v[np.isfinite(v)] for v in (np.asarray(values, dtype=float) for values in series)]
+    top = max((v.max() for v in finite if v.size), default=0.0)  # an all-NaN CoV (zero mean): none
     if top > 0:
         ax.set_ylim(bottom=decades * top)
 
 
 def plot_errors(curves: list[tuple[str, dict]], key: str, path: Path, title: str) -> Path:
     """ε_m or ε_v (`key` "eps_m"/"eps_v", Eq. 49) over time, one panel per output, one line per
-    file (`curves`: (label, outputs)); log y-axis, exact zeros left out."""
+    file (`curves`: (label, outputs)) in its own colour, marker and dash; log y-axis over the decades
+    the lines occupy, exact zeros left out."""
     names = list(dict.fromkeys(name for _, outputs in curves for name, out in outputs.items() if out.errors))
     symbol = {"eps_m": "ε_m (error of the mean)", "eps_v": "ε_v (error of the variance)"}[key]
     fig, axes = _panels(len(names), title)
     floors = any(out.errors.get(f"{key}_floor") is not None for _, outputs in curves
                  for out in outputs.values() if out.errors)
     for ax, name in zip(axes, names):
-        errors, drawn_floor = [], False
-        for color, (_, outputs) in zip(COLORS, curves):
+        series, drawn_floor = [], False
+        for k, (_, outputs) in enumerate(curves):
             out = outputs.get(name)
             if out is not None and out.errors:
-                errors.append(out.errors[key])
-                _line(ax, out.time, np.where(errors[-1] > 0, errors[-1], np.nan), color=color, lw=1.1)
+                errors = np.asarray(out.errors[key], dtype=float)
+                series.append(errors)
+                ax.plot(out.time, np.where(errors > 0, errors, np.nan), lw=1.1, **method_style(k, out.time.size))
                 floor = out.errors.get(f"{key}_floor")
                 if floor is not None and not drawn_floor:
                     floor = np.broadcast_to(np.asarray(floor, dtype=float), out.time.shape)
-                    ax.plot(out.time, np.where(floor > 0, floor, np.nan), color="gray", lw=1.0, ls="--")
+                    ax.plot(out.time, np.where(floor > 0, floor, np.nan), color="gray", lw=1.0, ls=(0, (5, 3)))
+                    series.append(floor)
                     drawn_floor = True
                 shown = out
         ax.set_yscale("log")
-        _floor_log_axis(ax, errors, ERROR_DECADES)
+        _set_log_limits(ax, series)
         _style(ax, shown, ylabel=f"{symbol} [-]")
     handles, labels = _file_legend(curves)
     if floors:
-        handles, labels = handles + [Line2D([], [], color="gray", ls="--")], labels + ["reference floor"]
+        handles, labels = handles + [Line2D([], [], color="gray", ls=(0, (5, 3)))], labels + ["reference floor"]
     return _save(fig, path, (handles, labels), legend_columns=2)
 
 
-def _file_legend(entries: list[tuple[str, dict]], **style) -> tuple[list, list[str]]:
-    """Legend handles and labels for one line per file, coloured in file order."""
+def _file_legend(entries: list[tuple[str, dict]]) -> tuple[list, list[str]]:
+    """Legend handles and labels for one line per file, in file order (`method_style`)."""
     labels = [file_label for file_label, _ in entries]
-    return [Line2D([], [], color=color, **style) for color, _ in zip(COLORS, labels)], labels
+    return [Line2D([], [], **method_style(k)) for k in range(len(labels))], labels
 
 
 def plot_kld_vs_runs(points: list[tuple[str, int, dict]], path: Path, title: str) -> Path:
     """KLD at the final time against the number of runs (Fig. 20), one panel per output and one line
-    per method (hollow markers, so that coinciding methods stay visible); `points` are
-    (method label, runs, {output: KLD})."""
+    per method (hollow markers, so that coinciding methods stay visible), and the reference's KLD
+    floor (the KLD its own sampling noise gives, `analysis.floors.kld_floor`; the largest over the
+    methods) dashed: a KLD below it is noise. `points`: (method label, runs, {output: (KLD, floor or None)})."""
     names = list(dict.fromkeys(name for _, _, values in points for name in values))
     methods = list(dict.fromkeys(method for method, _, _ in points))
-    style = {"ms": 7, "mfc": "none", "mew": 1.5}
     fig, axes = _panels(len(names), title, row_height=2.7)
+    floors = False
     for ax, name in zip(axes, names):
-        for color, marker, method in zip(COLORS, MARKERS, methods):
-            found = sorted((n, values[name]) for m, n, values in points if m == method and name in values)
+        series = []
+        for k, method in enumerate(methods):
+            found = sorted((n, values[name][0]) for m, n, values in points if m == method and name in values)
             if found:
-                ax.plot(*zip(*found), marker=marker, color=color, **style)
-        ax.set_xscale("log")
+                ax.plot(*zip(*found), mew=1.5, **{**method_style(k), "ms": 7})
+                series.append([v for _, v in found])
+        floor = [values[name][1] for _, _, values in points if name in values and values[name][1] is not None
+                 and np.isfinite(values[name][1])]
+        if floor:
+            ax.axhline(max(floor), color="gray", ls=(0, (5, 3)), lw=1.0)
+            series.append([max(floor)])
+            floors = True
+        runs_axis(ax, [n for _, n, values in points if name in values])
         ax.set_yscale("log")
+        _set_log_limits(ax, series)
         ax.set_title(short_label(name), fontsize=10)
         ax.set_xlabel("runs (simulator calls)", fontsize=8)
         ax.set_ylabel("KLD at the final time [nat]", fontsize=8)
         ax.tick_params(labelsize=8)
         ax.grid(alpha=0.3, which="both")
-    handles = [Line2D([], [], color=c, marker=m, **style) for c, m, _ in zip(COLORS, MARKERS, methods)]
-    return _save(fig, path, (handles, methods), legend_columns=3)
+    handles = [Line2D([], [], mew=1.5, **{**method_style(k), "ms": 7}) for k in range(len(methods))]
+    labels = list(methods)
+    if floors:
+        handles.append(Line2D([], [], color="gray", ls=(0, (5, 3))))
+        labels.append("reference KLD floor (below it: sampling noise)")
+    return _save(fig, path, (handles, labels), legend_columns=3)
 
 
 def plot_sobol(outputs: dict, path: Path, title: str) -> Path:
@@ -410,24 +512,30 @@ def _sobol_bars(ax, out) -> None:
 
 
 def plot_band_comparison(entries: list[tuple[str, dict]], path: Path, title: str) -> Path:
-    """Mean (solid) and 99 % band (dashed) of every output for several files overlaid (Figs. 4-5);
-    an output with a narrow band gets a second panel about the first file's mean."""
-    first = entries[0][1]
-    panels = _band_panels(first)
-    fig, axes = _panels(len(panels), title)
-    for ax, (name, about_mean) in zip(axes, panels):
-        for k, (color, (_, outputs)) in enumerate(zip(COLORS, entries)):
+    """Each file's mean (left) and 99 % band edges (right, lower and upper alike) minus the first
+    file's, over the first file's times (others interpolated), one row per output: the first file is
+    the zero line, and files that agree lie on it instead of hiding each other (Figs. 4-5 as differences)."""
+    first_label, first = entries[0]
+    names = list(first)
+    fig, axes = plt.subplots(len(names), 2, figsize=(12.4, 2.5 * len(names) + 1.2), squeeze=False)
+    for row, name in zip(axes, names):
+        base = first[name]
+        for k, (_, outputs) in enumerate(entries):
             out = outputs.get(name)
             if out is None:
                 continue
-            # earlier files drawn wider, so that coinciding methods stay visible under later ones
-            widen = 1.0 + 0.9 * (len(entries) - 1 - k)
-            offset = np.interp(out.time, first[name].time, first[name].mean) if about_mean else 0.0
-            _line(ax, out.time, out.mean - offset, color=color, lw=1.3 * widen)
-            for bound in out.band99:
-                _line(ax, out.time, bound - offset, color=color, lw=0.9 * widen, ls="--")
-        _style_band_panel(ax, first[name], about_mean)
-    return _save(fig, path, _file_legend(entries), legend_columns=2)
+            style = method_style(k, base.time.size)
+            row[0].plot(base.time, _on_times(out, out.mean, base) - base.mean, lw=1.2, **style)
+            for bound, base_bound in zip(out.band99, base.band99):
+                row[1].plot(base.time, _on_times(out, bound, base) - base_bound, lw=1.0, **style)
+        unit = f" [{base.units}]" if base.units else ""
+        for ax, what in zip(row, ("mean", "99 % band edges")):
+            _style(ax, base, ylabel=f"difference{unit}")
+            ax.set_title(f"{short_label(name)}: {what} − the first file's", fontsize=10)
+    fig.suptitle(title, fontsize=12)
+    handles, labels = _file_legend(entries)
+    labels[0] = f"{labels[0]} (first: the zero line)"
+    return _save(fig, path, (handles, labels), legend_columns=2)
 
 
 def plot_final_pdfs(entries: list[tuple[str, dict]], path: Path, title: str) -> Path:
@@ -435,9 +543,10 @@ def plot_final_pdfs(entries: list[tuple[str, dict]], path: Path, title: str) -> 
     first = entries[0][1]
     fig, axes = _panels(len(first), title, row_height=2.7)
     for ax, (name, out) in zip(axes, first.items()):
-        for color, (_, outputs) in zip(COLORS, entries):
+        for k, (_, outputs) in enumerate(entries):
             if name in outputs:
-                ax.plot(outputs[name].pdf_support[-1], outputs[name].pdf_density[-1], color=color, lw=1.3)
+                support = outputs[name].pdf_support[-1]
+                ax.plot(support, outputs[name].pdf_density[-1], lw=1.3, **method_style(k, support.size))
         ax.set_title(f"{short_label(name)} at t = {out.time[-1]:g} s", fontsize=10)
         ax.set_xlabel(label(name, out.units), fontsize=8)
         ax.set_ylabel("probability density", fontsize=8)
@@ -483,57 +592,70 @@ def plot_convergence(points: list[tuple[str, int, dict]], path: Path, title: str
     eps_m floor, eps_v floor)}); the reference's floor dashed when known."""
     names = list(dict.fromkeys(name for _, _, values in points for name in values))
     methods = list(dict.fromkeys(method for method, _, _ in points))
-    style = {"ms": 6, "mfc": "none", "mew": 1.4}
     fig, axes = plt.subplots(len(names), 2, figsize=(11, 2.6 * len(names) + 0.9), squeeze=False)
     floors = False
     for row, name in zip(axes, names):
         for column, (ax, symbol) in enumerate(zip(row, ("max ε_m [-]", "max ε_v [-]"))):
-            for color, marker, method in zip(COLORS, MARKERS, methods):
+            series = []
+            for k, method in enumerate(methods):
                 found = sorted((n, values[name][column]) for m, n, values in points
                                if m == method and name in values and values[name][column] > 0)
                 if found:
-                    ax.plot(*zip(*found), marker=marker, color=color, **style)
+                    ax.plot(*zip(*found), mew=1.4, **method_style(k))
+                    series.append([v for _, v in found])
             floor = [values[name][column + 2] for _, _, values in points
                      if name in values and values[name][column + 2] is not None]
             if floor:
-                ax.axhline(max(floor), color="gray", ls="--", lw=1.0)
+                ax.axhline(max(floor), color="gray", ls=(0, (5, 3)), lw=1.0)
+                series.append([max(floor)])
                 floors = True
-            ax.set_xscale("log")
+            runs_axis(ax, [n for _, n, values in points if name in values])
             ax.set_yscale("log")
-            low, high = ax.get_ylim()
-            if low > 0 and high / low < 10:  # at least a decade, so that log ticks stay readable
-                middle = np.sqrt(low * high)
-                ax.set_ylim(middle / np.sqrt(10), middle * np.sqrt(10))
+            limits = informative_limits(series)
+            if limits is not None:
+                low, high = limits
+                if high / low < 10:  # at least a decade, so that log ticks stay readable
+                    middle = np.sqrt(low * high)
+                    low, high = middle / np.sqrt(10), middle * np.sqrt(10)
+                ax.set_ylim(low, high)
+            log_axis(ax.yaxis)
             ax.set_title(f"{short_label(name)}: {symbol.split(' [')[0]}", fontsize=10)
             ax.set_xlabel("runs (simulator calls)", fontsize=8)
             ax.set_ylabel(symbol, fontsize=8)
             ax.tick_params(labelsize=8)
             ax.grid(alpha=0.3, which="both")
     fig.suptitle(title, fontsize=12)
-    handles = [Line2D([], [], color=c, marker=m, **style) for c, m, _ in zip(COLORS, MARKERS, methods)]
+    handles = [Line2D([], [], mew=1.4, **method_style(k)) for k in range(len(methods))]
     labels = list(methods)
     if floors:
-        handles.append(Line2D([], [], color="gray", ls="--"))
+        handles.append(Line2D([], [], color="gray", ls=(0, (5, 3))))
         labels.append("reference floor")
     return _save(fig, path, (handles, labels), legend_columns=3)
 
 
-def plot_coefficient_decay(outputs: dict, path: Path, title: str) -> Path:
-    """Root-sum-square of the PCE coefficients of each total degree over time, log y, one panel per
-    output (`OutputStatistics.coefficient_decay`: {degree: array over time})."""
+def plot_coefficient_decay(outputs: dict, path: Path, title: str, start_s: float | None = None) -> Path:
+    """Root-sum-square of the PCE coefficients of each total degree from 1 on (degree 0 is the mean)
+    over time, log y, one panel per output (`OutputStatistics.coefficient_decay`: {degree: array over
+    time}); from the excitation's start `start_s` on (before it every run flies the same trim), or,
+    unknown, from where degree >= 1 first reaches DECAY_ONSET of its largest value."""
     names = [n for n, o in outputs.items() if getattr(o, "coefficient_decay", None)]
     fig, axes = _panels(max(len(names), 1), title)
     degrees: list = []
     for ax, name in zip(axes, names):
         out = outputs[name]
-        for degree, values in sorted(out.coefficient_decay.items(), key=lambda kv: int(kv[0])):
+        shown = sorted(((int(d), np.asarray(v, dtype=float)) for d, v in out.coefficient_decay.items() if int(d) >= 1))
+        keep = _decay_times(out.time, [v for _, v in shown], start_s)
+        series = []
+        for degree, values in shown:
             if degree not in degrees:
                 degrees.append(degree)
-            values = np.asarray(values, dtype=float)
-            _line(ax, out.time, np.where(values > 0, values, np.nan), color=COLORS[degrees.index(degree) % 10], lw=1.1)
+            values = np.where(values[keep] > 0, values[keep], np.nan)
+            series.append(values)
+            ax.plot(out.time[keep], values, lw=1.1, **method_style(degrees.index(degree), int(keep.sum())))
         ax.set_yscale("log")
+        _set_log_limits(ax, series)
         _style(ax, out, ylabel=f"RSS of coefficients [{out.units}]" if out.units else "RSS of coefficients")
-    handles = [Line2D([], [], color=COLORS[k % 10]) for k in range(len(degrees))]
+    handles = [Line2D([], [], **method_style(k)) for k in range(len(degrees))]
     return _save(fig, path, (handles, [f"degree {d}" for d in degrees]), legend_columns=6)
 
 
@@ -541,38 +663,150 @@ MAX_PAIRS = 8  # parameters drawn in the design scatter (the first ones)
 
 
 def plot_design_pairs(results, path: Path, title: str) -> Path | None:
-    """The design points on every pair of inputs (lower triangle), in standard variables ξ (paper
-    Fig. 9), marker size by |weight| for a grid; failed runs as red crosses. None for one input."""
+    """The design points on every pair of inputs (lower triangle) in physical values κ (paper Fig. 9,
+    which is in ξ); marker area by |weight| for a grid, negative weights orange, failed runs as red
+    crosses, each in the legend with its count. A design whose pairs all coincide in ξ (a symmetric
+    grid) is drawn once in ξ, with each input's κ at the grid's ξ levels in a table. None for one input."""
     from ..store import ResultStore
 
     with ResultStore.open(results) as store:
-        xi, weights, status, names = store.xi, store.weights, store.status, store.parameter_names
+        xi, kappa, weights = store.xi, store.kappa, store.weights
+        status, names = store.status, store.parameter_names
     d = min(xi.shape[1], MAX_PAIRS)
     if d < 2:
         return None
+    pairs = [(i, j) for i in range(1, d) for j in range(i)]
     failed = status > 0
-    sizes = 8.0 if np.allclose(weights, weights[0]) else 6 + 40 * np.abs(weights) / np.abs(weights).max()
-    fig, axes = plt.subplots(d - 1, d - 1, figsize=(1.7 * (d - 1) + 1.2, 1.7 * (d - 1) + 1.0), squeeze=False)
-    alpha = 0.8 if xi.shape[0] <= 500 else 0.25
+    signed = not np.allclose(weights, weights[0])
+    key = _pair_key(xi, weights, failed, *pairs[0])
+    if len(pairs) > 1 and all(_pair_key(xi, weights, failed, i, j) == key for i, j in pairs[1:]):
+        fig, (ax, table) = plt.subplots(1, 2, figsize=(11, 4.8), gridspec_kw={"width_ratios": [1, 1.3]})
+        handles = _design_points(ax, xi[:, 0], xi[:, 1], weights, failed, signed, xi.shape[0])
+        ax.set_xlabel("ξ of any input", fontsize=9)
+        ax.set_ylabel("ξ of any other input", fontsize=9)
+        ax.set_title(f"all {len(pairs)} pairs of the {d} inputs coincide: drawn once", fontsize=10)
+        ax.grid(alpha=0.3)
+        _kappa_table(table, xi, kappa, names[:d])
+        fig.legend(*handles, loc="lower center", ncol=3, fontsize=8, frameon=False)
+        fig.suptitle(title, fontsize=11)
+        fig.tight_layout(rect=(0, 0.06, 1, 1))
+        return write_figure(fig, path)
+    side = max(1.7 * (d - 1) + 1.2, 7.0)
+    fig, axes = plt.subplots(d - 1, d - 1, figsize=(side, side - 0.2), squeeze=False)
     for i in range(1, d):
         for j in range(d - 1):
             ax = axes[i - 1, j]
             if j >= i:
                 ax.set_visible(False)
                 continue
-            ax.scatter(xi[~failed, j], xi[~failed, i], s=sizes if np.ndim(sizes) == 0 else sizes[~failed],
-                       color=COLORS[0], alpha=alpha, lw=0)
-            if failed.any():
-                ax.scatter(xi[failed, j], xi[failed, i], s=18, color="red", marker="x", lw=1)
+            handles = _design_points(ax, kappa[:, j], kappa[:, i], weights, failed, signed, xi.shape[0])
             ax.tick_params(labelsize=6)
+            ax.xaxis.set_major_locator(MaxNLocator(3))
+            ax.yaxis.set_major_locator(MaxNLocator(3))
             if j == 0:
-                ax.set_ylabel(f"ξ {names[i]}", fontsize=8)
+                ax.set_ylabel(names[i], fontsize=8)
             else:
                 ax.set_yticklabels([])
             if i == d - 1:
-                ax.set_xlabel(f"ξ {names[j]}", fontsize=8)
+                ax.set_xlabel(names[j], fontsize=8)
             else:
                 ax.set_xticklabels([])
             ax.grid(alpha=0.3)
-    fig.suptitle(title, fontsize=11)
-    return _write(fig, path)
+    fig.legend(*handles, loc="upper right", fontsize=8, frameon=False)
+    fig.suptitle(f"{title}\nphysical values κ", fontsize=11)
+    fig.tight_layout()
+    return write_figure(fig, path)
+
+
+def offset_datum(out) -> bool:
+    """Whether an output over time sits on an offset datum (an altitude of 15,000 ft, an airspeed of
+    200 kt): min|mean| more than OFFSET_DATUM times the mean's excursion max − min. Its std / max|mean|
+    is then the std over a constant that says where zero is, not how uncertain the output is.
+    A scalar output keeps its CoV."""
+    mean = np.asarray(out.mean, dtype=float)
+    if mean.size < 2 or not np.isfinite(mean).all():
+        return False
+    return bool(np.min(np.abs(mean)) > OFFSET_DATUM * (mean.max() - mean.min()))
+
+
+def informative_limits(series: list) -> tuple[float, float] | None:
+    """Log-axis limits that show every line and no empty decades: from half the lowest line's 2 %
+    quantile (so that a dip to zero at one instant does not stretch the axis) to 1.5 × the largest
+    value, at most 12 decades. None when no value is positive."""
+    positive = [v[np.isfinite(v) & (v > 0)] for v in (np.atleast_1d(np.asarray(s, dtype=float)) for s in series)]
+    positive = [v for v in positive if v.size]
+    if not positive:
+        return None
+    top = max(v.max() for v in positive)
+    low = min(np.quantile(v, LOW_QUANTILE) for v in positive)
+    return max(low / 2, top * 1e-12), top * 1.5
+
+
+def _set_log_limits(ax, series: list) -> None:
+    limits = informative_limits(series)
+    if limits is not None:
+        ax.set_ylim(*limits)
+    log_axis(ax.yaxis)
+
+
+def _on_times(out, values, base) -> np.ndarray:
+    """`values` of `out` at the times of `base` (linear interpolation; a scalar output as it is)."""
+    values = np.asarray(values, dtype=float)
+    if out.time.size == 1 or np.array_equal(out.time, base.time):
+        return values
+    return np.interp(base.time, out.time, values)
+
+
+def _decay_times(time: np.ndarray, series: list, start_s: float | None) -> np.ndarray:
+    """The times the decay plot shows: from `start_s` on, or from the onset of the variation."""
+    if time.size == 1:
+        return np.ones(1, dtype=bool)
+    if start_s is not None:
+        keep = time >= start_s
+        return keep if keep.any() else np.ones_like(time, dtype=bool)
+    total = np.nanmax(series, axis=0) if series else np.zeros_like(time)
+    peak = np.nanmax(total) if np.isfinite(total).any() else 0.0
+    onset = np.flatnonzero(total >= DECAY_ONSET * peak) if peak > 0 else np.zeros(1, dtype=int)
+    return time >= time[onset[0]]
+
+
+def _pair_key(xi, weights, failed, i, j) -> list:
+    """The points of the pair (ξ_j, ξ_i) as a sorted list of (x, y, weight, failed): equal keys, equal panels."""
+    return sorted(zip(np.round(xi[:, j], 9), np.round(xi[:, i], 9), np.round(weights, 12), failed))
+
+
+def _design_points(ax, x, y, weights, failed, signed: bool, count: int) -> tuple[list, list[str]]:
+    """Scatter the runs: area by |weight| for a grid (`signed`), negative weights in orange, failed
+    runs as red crosses; returns the legend's (handles, labels) with their counts."""
+    sizes = 6 + 40 * np.abs(weights) / np.abs(weights).max() if signed else np.full(len(x), 8.0)
+    alpha = 0.8 if count <= 500 else 0.25
+    negative = (weights < 0) & ~failed
+    positive = ~negative & ~failed
+    ax.scatter(x[positive], y[positive], s=sizes[positive], color=COLORS[0], alpha=alpha, lw=0)
+    ax.scatter(x[negative], y[negative], s=sizes[negative], color=COLORS[1], alpha=alpha, lw=0)
+    ax.scatter(x[failed], y[failed], s=18, color="red", marker="x", lw=1)
+    run = "run (area ∝ |weight|)" if signed else "run"
+    handles = [Line2D([], [], ls="", marker="o", color=COLORS[0]), Line2D([], [], ls="", marker="x", color="red")]
+    labels = [f"{run}: {int(positive.sum())}", f"failed run: {int(failed.sum())}"]
+    if signed:
+        handles.insert(1, Line2D([], [], ls="", marker="o", color=COLORS[1]))
+        labels.insert(1, f"negative weight: {int(negative.sum())}")
+    return handles, labels
+
+
+def _kappa_table(ax, xi, kappa, names) -> None:
+    """Each input's physical value κ at the grid's ξ levels, as a table on `ax`."""
+    levels = np.unique(np.round(xi[:, 0], 9))
+    rows = []
+    for p, name in enumerate(names):
+        cells = []
+        for level in levels:
+            at = np.flatnonzero(np.isclose(xi[:, p], level, atol=1e-9))
+            cells.append(f"{kappa[at[0], p]:.4g}" if at.size else "")
+        rows.append([name, *cells])
+    ax.axis("off")
+    ax.set_title("physical value κ of each input at each ξ level", fontsize=10)
+    table = ax.table(cellText=rows, colLabels=["input", *(f"ξ = {v:.3g}" for v in levels)], loc="center")
+    table.auto_set_font_size(False)
+    table.set_fontsize(7 if len(levels) > 5 else 8)
+    table.scale(1.0, 1.3)

@@ -59,9 +59,7 @@ def _block_title(block) -> str:
 
 def _html_block(anchor: str, n: int, block, out_dir: Path) -> str:
     if isinstance(block, Figure):
-        data = base64.b64encode((out_dir / block.file).read_bytes()).decode("ascii")
-        return (f'<figure id="{anchor}-{n}"><img src="data:image/png;base64,{data}" alt="{html.escape(block.file)}">'
-                f"<figcaption>{html.escape(block.caption)} ({html.escape(block.file)})</figcaption></figure>")
+        return figure_html(f"{anchor}-{n}", block, out_dir)
     header, groups = page_view(block)
     head = "".join(f"<th>{html.escape(h)}</th>" for h in header)
     rows = "".join((f'<tr><th colspan="{len(header)}" style="text-align:left">{html.escape(group)}</th></tr>'
@@ -72,8 +70,22 @@ def _html_block(anchor: str, n: int, block, out_dir: Path) -> str:
             f"<table><tr>{head}</tr>{rows}</table>")
 
 
-def render_markdown(title: str, sections: list[Section]) -> str:
-    """The same page in Markdown, linking the PNGs in plots/. Every name, reason and caption is
+MIME = {".png": "image/png", ".svg": "image/svg+xml"}
+
+
+def figure_html(anchor: str, block: Figure, out_dir: Path) -> str:
+    """A figure embedded as a data URI (PNG or SVG), its caption, and a link to its PDF when one was
+    written beside it (`report --format pdf`)."""
+    path = out_dir / block.file
+    data = base64.b64encode(path.read_bytes()).decode("ascii")
+    pdf = Path(block.file).with_suffix(".pdf")
+    link = f' <a href="{html.escape(pdf.as_posix())}">PDF</a>' if (out_dir / pdf).is_file() else ""
+    return (f'<figure id="{anchor}"><img src="data:{MIME[path.suffix]};base64,{data}" alt="{html.escape(block.file)}">'
+            f"<figcaption>{html.escape(block.caption)} ({html.escape(block.file)}){link}</figcaption></figure>")
+
+
+def render_markdown(title: str, sections: list[Section], out_dir: Path | None = None) -> str:
+    """The same page in Markdown, linking the figures in plots/ (and their PDFs in out_dir, if any). Every name, reason and caption is
     escaped (`md`); the campaign text sits in a fence longer than any run of backticks in it."""
     lines = [f"# {md(title)}"]
     lead = [s for s in sections if s.lead]
@@ -91,6 +103,9 @@ def render_markdown(title: str, sections: list[Section]) -> str:
         for block in s.blocks:
             if isinstance(block, Figure):
                 lines += ["", f"![{md(block.caption)}]({block.file})", "", f"*{md(block.caption)}* ({md(block.file)})"]
+                pdf = Path(block.file).with_suffix(".pdf")
+                if out_dir is not None and (out_dir / pdf).is_file():
+                    lines[-1] += f" [PDF]({pdf.as_posix()})"
             else:
                 header, groups = page_view(block)
                 lines += ["", f"### {md(block.caption)}", "", f"({md(block.file)})", "",

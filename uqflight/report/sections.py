@@ -160,7 +160,8 @@ def run_section(entries: list[Entry], out_dir: Path) -> Section:
                                        f"{e.stats.runs} points ({_file_stem(e)})")
         if path is not None:
             blocks.append(Figure(_rel(path, out_dir), f"The design points of {_file_stem(e)} projected on each pair "
-                                 "of inputs, in standard variables ξ (paper Fig. 9); failed runs as red crosses."))
+                                 "of inputs in physical values (paper Fig. 9); a symmetric grid once, in ξ, with "
+                                 "the inputs' values at its levels; negative weights orange, failed runs red crosses."))
     texts = "\n\n".join(f"# {e.path or e.stats.path}\n{str(e.attrs.get('campaign', '')).strip()}"
                           for e in _files(entries))
     return Section("What was run", "run", texts, blocks, preformatted=True)
@@ -235,9 +236,10 @@ def statistics_section(entries: list[Entry], ref: Entry | None, times: list[floa
                              f"Mean and 99 % band of each output over time of {entry.label} (paper Figs. 6-7)"
                              + ("; the reference dashed." if overlay else ".")))
         blocks.append(Figure(_rel(plots.plot_cov(entry.outputs, plot_dir / f"cov_{entry.stem}.png",
-                                                 f"Modified coefficient of variation: {entry.label}"), out_dir),
-                             f"Modified coefficient of variation std(t) / max|mean| of every output of {entry.label} "
-                             "(paper Fig. 8)."))
+                                                 f"Spread over time: {entry.label}"), out_dir),
+                             f"Modified coefficient of variation std(t) / max|mean| of the outputs of {entry.label} "
+                             "(paper Fig. 8); outputs on an offset datum (min|mean| more than "
+                             f"{plots.OFFSET_DATUM:g} × the mean's excursion, e.g. an altitude) as std in their unit."))
         for name, out in entry.outputs.items():
             path = plots.plot_pdf_over_time(out, plot_dir / f"pdf_{entry.stem}_{file_name(name)}.png",
                                             f"PDF of {plots.short_label(name)}: {entry.label}", times)
@@ -247,9 +249,9 @@ def statistics_section(entries: list[Entry], ref: Entry | None, times: list[floa
         labelled = [(e.label, e.outputs) for e in entries] + ([(f"reference {ref.label}", ref.outputs)]
                                                              if ref is not None else [])
         path = plots.plot_band_comparison(labelled, plot_dir / "bands_compared.png",
-                                          "Every file and method: mean (solid) and 99 % band (dashed)")
-        blocks.append(Figure(_rel(path, out_dir), "Mean and 99 % band of every file and method overlaid"
-                             + (", the reference last." if ref is not None else ".")))
+                                          "Every file and method against the first: mean and 99 % band edges")
+        blocks.append(Figure(_rel(path, out_dir), "Mean and 99 % band edges of every file and method minus the "
+                             "first's, over time" + (", the reference last." if ref is not None else ".")))
     extra = _extra_statistics(entries)
     rows = []
     for entry in entries:
@@ -332,12 +334,14 @@ def accuracy_section(entries: list[Entry], out_dir: Path) -> Section:
         blocks.append(Figure(_rel(path, out_dir), "max over time of ε_m and ε_v against the number of runs, one line "
                              "per method and design, log-log; the reference's floor dashed when known."))
         points = [(f"{method_label(e.stats.method)} ({e.stats.design_kind})", e.stats.runs,
-                   {name: out.errors["kld_final"] for name, out in e.outputs.items() if out.errors}) for e in compared]
+                   {name: (out.errors["kld_final"], out.errors.get("kld_floor")) for name, out in e.outputs.items()
+                    if out.errors}) for e in compared]
         path = plots.plot_kld_vs_runs(points, out_dir / "plots" / "kld_vs_runs.png",
                                       "Kullback-Leibler divergence from the reference at the final time (Eq. 50)")
         blocks.append(Figure(_rel(path, out_dir), "KLD of each output's final-time PDF from the reference's "
                                                   "against the number of runs, one line per method and design "
-                                                  "(paper Fig. 20)."))
+                                                  "(paper Fig. 20); the reference's KLD floor dashed: a KLD "
+                                                  "below it is the reference's sampling noise."))
     rows = []
     for e in compared:
         for name, out in e.outputs.items():
@@ -432,10 +436,13 @@ def decay_section(entries: list[Entry], out_dir: Path) -> Section:
     """The PCE coefficients' root-sum-square per total degree over time (convergence of the expansion)."""
     blocks = []
     for e in entries:
+        excitation = (campaign_settings(str(e.attrs.get("campaign", ""))).get("simulator") or {}).get("excitation")
+        start = excitation.get("start_s") if isinstance(excitation, dict) else None
         path = plots.plot_coefficient_decay(e.outputs, out_dir / "plots" / f"coefficient_decay_{e.stem}.png",
-                                            f"PCE coefficients by total degree: {e.label}")
+                                            f"PCE coefficients by total degree: {e.label}", start_s=start)
         blocks.append(Figure(_rel(path, out_dir), f"Root-sum-square of the PCE coefficients of each total degree "
-                             f"over time, {e.label}: a fast decay says the order suffices."))
+                             f"from 1 on over time, {e.label}, from the excitation's start on: a fast decay "
+                             "says the order suffices."))
     return Section("Convergence of the expansion", "decay", "Coefficients of degree p small against those of "
                    "degree p-1 mean the expansion has converged at that time.", blocks)
 
@@ -444,12 +451,12 @@ def monte_carlo_section(entries: list[Entry], out_dir: Path) -> Section:
     """Several Monte Carlo files (the reference too) overlaid, e.g. normal against uniform inputs (Figs. 4-5)."""
     labelled = [(f"{e.label} (inputs {e.inputs})", e.outputs) for e in entries]
     bands = plots.plot_band_comparison(labelled, out_dir / "plots" / "mc_bands.png",
-                                       "Monte Carlo files: mean (solid) and 99 % band (dashed)")
+                                       "Monte Carlo files against the first: mean and 99 % band edges")
     pdfs = plots.plot_final_pdfs(labelled, out_dir / "plots" / "mc_pdf_final.png",
                                  "Monte Carlo files: PDF at the final time")
     return Section("Monte Carlo files compared", "monte-carlo",
                    "The Monte Carlo files side by side, e.g. normal against uniform inputs (paper Figs. 4-5).",
-                   [Figure(_rel(bands, out_dir), "Mean and 99 % band of each Monte Carlo file."),
+                   [Figure(_rel(bands, out_dir), "Mean and 99 % band edges of each Monte Carlo file minus the first's."),
                     Figure(_rel(pdfs, out_dir), "PDF of each output at the final time for each Monte Carlo file.")])
 
 

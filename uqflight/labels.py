@@ -1,0 +1,51 @@
+"""How figures name outputs and parameters: a description with its unit, each unit said once."""
+from __future__ import annotations
+
+OUTPUT_LABELS = {
+    "alpha_deg": "angle of attack α [deg]",
+    "theta_deg": "pitch attitude θ [deg]",
+    "h_ft": "altitude h [ft]",
+    "q_degps": "pitch rate q [deg/s]",
+    "vtas_kt": "true airspeed V_TAS [kt]",
+}
+# The BACM's uncertain coefficients (aircraft/bacm/bacm.xml): CLalpha multiplies alpha in rad, Cmq the
+# pitch rate in rad made dimensionless by c/2V; the others are plain coefficients. A patch's scale
+# (aero/uq/scale/NAME) is a factor.
+PARAMETER_UNITS = {"aero/uq/CL0": "-", "aero/uq/CLalpha": "1/rad", "aero/uq/CD0": "-", "aero/uq/k1": "-",
+                   "aero/uq/k2": "-", "aero/uq/Cm0": "-", "aero/uq/Cmq": "1/rad"}
+# JSBSim's property names end in their unit: velocities/vt-fps, inertia/weight-lbs, ...
+PROPERTY_SUFFIXES = {"ft": "ft", "deg": "deg", "rad": "rad", "lbs": "lbs", "kts": "kt", "fps": "ft/s",
+                     "sqft": "ft²", "slug_ft2": "slug·ft²", "rad_sec": "rad/s", "deg_sec": "deg/s", "psf": "psf",
+                     "mps": "m/s", "m": "m", "kg": "kg", "sec": "s", "hz": "Hz"}
+
+
+def label(name: str, units: str = "") -> str:
+    """Axis label of an output: its description and unit, e.g. "pitch attitude θ [deg]"."""
+    if name in OUTPUT_LABELS:
+        return OUTPUT_LABELS[name]
+    return f"{name} [{units}]" if units else name
+
+
+def short_label(name: str) -> str:
+    """A panel title: the label without its unit, e.g. "pitch attitude θ"."""
+    return label(name).split(" [")[0]
+
+
+def parameter_unit(prop: str) -> str:
+    """The unit of a parameter's property: the BACM coefficients' known units, "-" for a patch's
+    scale factor, the unit a JSBSim name ends in (`-ft`, `_deg`, `-lbs` ...), else "" (unknown)."""
+    if prop in PARAMETER_UNITS:
+        return PARAMETER_UNITS[prop]
+    if prop.startswith("aero/uq/scale/"):
+        return "-"
+    tail = prop.rsplit("/", 1)[-1].lower()
+    for k, char in enumerate(tail):  # the longest suffix after a - or _ that names a unit
+        if char in "-_" and tail[k + 1:] in PROPERTY_SUFFIXES:
+            return PROPERTY_SUFFIXES[tail[k + 1:]]
+    return ""
+
+
+def parameter_label(name: str, prop: str) -> str:
+    """A parameter's axis label with its unit when known, e.g. "CLalpha [1/rad]"."""
+    unit = parameter_unit(prop)
+    return f"{name} [{unit}]" if unit else name
