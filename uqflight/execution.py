@@ -47,10 +47,11 @@ from .campaign import Campaign
 from .campaign.reading import parameters_attribute
 from .campaign.schema import WORKER_BYTES
 from .console import clean
-from .designs import Design
+from .designs import Design, is_adaptive
 from .parameters import seed_names, to_physical
 from .store import ResultStore, Status, compact, open_for_campaign
 from .store.lock import LockHeld, ResultsLock
+from .refinement import run_rounds
 from .worker import WorkerSpec
 
 DEFAULT_TIMEOUT_FLOOR_S = 60.0   # default timeout: max(this, TIMEOUT_FLIGHTS x one nominal flight)
@@ -138,7 +139,8 @@ def prepare_store(campaign: Campaign, design: Design, out: Path, force: bool, pr
         out, campaign_text=campaign.text, force=force, restart=restart, xi=design.xi, kappa=kappa, weights=design.weights,
         parameter_names=[p.name for p in campaign.parameters], outputs=outputs, time=time_grid,
         raw=campaign.storage["raw"], tsvd=campaign.storage.get("tsvd"), attrs=attrs, units=units,
-        batch_rows=campaign.execution["chunk"], repeatability=repeatability, quantities=list(campaign.quantities))
+        batch_rows=campaign.execution["chunk"], repeatability=repeatability, quantities=list(campaign.quantities),
+        capacity=campaign.runs if is_adaptive(design.kind) else None)
 
 
 def nominal_kappa(campaign: Campaign) -> np.ndarray:
@@ -267,8 +269,11 @@ def run_campaign(campaign: Campaign, out: Path | None = None, workers: int | Non
                     raise DiskFull(errno.ENOSPC, disk_full_message(out, 0)) from exc
                 raise
             try:
-                summary = _run_pending(store, campaign, pool, spec, chunk, workers, executor, scheduler,
-                                       timeout, out, progress)
+                def fly():
+                    return _run_pending(store, campaign, pool, spec, chunk, workers, executor, scheduler,
+                                        timeout, out, progress)
+
+                summary = run_rounds(store, campaign, fly) if is_adaptive(design.kind) else fly()
                 complete = store.pending().size == 0
             finally:
                 try:

@@ -12,7 +12,7 @@ from typing import Callable
 
 import yaml
 
-from ..designs import SAMPLED_DESIGNS, Design, build_design
+from ..designs import SAMPLED_DESIGNS, Design, build_design, design_size, is_adaptive
 from ..parameters import Parameter, seed_names
 from ..quantities.spec import check_quantities
 from ..simulators.jsbsim import NAMED_OUTPUTS
@@ -103,6 +103,10 @@ def parse_campaign(text: str, source: str = "<campaign>", probe: PropertyProbe |
         if sep and (field_path.startswith("design") or field_path == "seed"):
             raise CampaignError(source, field_path, rest) from exc
         raise CampaignError(source, "design", message) from exc
+    if is_adaptive(design.kind):  # its grid is made from the results: the method is checked on analysis
+        campaign.method.setdefault("order", schema.DEFAULT_ORDER)
+        campaign.runs = int(design_size(campaign.design_spec, campaign.germs))
+        return campaign
     schema.check_method_fits_design(check, campaign.method, design, campaign.germs)
     campaign.runs = len(design.weights)
     return campaign

@@ -6,6 +6,8 @@ Kinds (keys in braces):
 - sparse_grid {level, rule, nested, growth}: Smolyak combination technique on 1-D rules.
 - tensor_grid {rule, points}: full tensor product.
 - pick_freeze {samples}: Saltelli's [A; B; AB_1; …; AB_d] for Sobol' index estimators.
+- adaptive_sparse_grid {rule, budget, tolerance}: Gerstner–Griebel's dimension-adaptive grid, built
+  round by round from the results (`adaptive`; the runner refines it).
 """
 from __future__ import annotations
 
@@ -15,6 +17,7 @@ from typing import Callable
 import numpy as np
 
 from ..parameters.germs import check_germs
+from .adaptive import adaptive_design, adaptive_size
 from .montecarlo import (halton_design, latin_hypercube_design, monte_carlo_design, samples_size, sobol_design,
                          sobol_size)
 from .pickfreeze import pick_freeze_design, pick_freeze_size
@@ -29,12 +32,15 @@ class DesignKind:
     germs) -> the runs it builds, from the spec alone and without building anything (for the campaign's
     limits; a sparse grid's points before merging; None when the spec is malformed, so that the
     builder's own checks speak); and whether its points are random draws (`sampled`: moments are sample
-    averages, valid on any subset of runs) or a quadrature grid (its weights are valid only all together)."""
+    averages, valid on any subset of runs) or a quadrature grid (its weights are valid only all together).
+    `adaptive`: the builder gives the first round only; the runner adds the others from the results
+    (designs.adaptive), up to `size` runs."""
 
     build: Callable
     size: Callable
     sampled: bool
     example: dict  # a small `design:` mapping of this kind (help text and tests)
+    adaptive: bool = False
 
 
 REGISTRY: dict[str, DesignKind] = {
@@ -46,9 +52,17 @@ REGISTRY: dict[str, DesignKind] = {
     "sparse_grid": DesignKind(sparse_grid_design, sparse_grid_size, False, {"kind": "sparse_grid", "level": 2}),
     "tensor_grid": DesignKind(tensor_grid_design, tensor_grid_size, False, {"kind": "tensor_grid", "points": 4}),
     "pick_freeze": DesignKind(pick_freeze_design, pick_freeze_size, True, {"kind": "pick_freeze", "samples": 16}),
+    "adaptive_sparse_grid": DesignKind(adaptive_design, adaptive_size, False,
+                                       {"kind": "adaptive_sparse_grid", "budget": 50, "tolerance": 1e-4},
+                                       adaptive=True),
 }
 DESIGN_KINDS = tuple(REGISTRY)
 SAMPLED_DESIGNS = tuple(kind for kind, entry in REGISTRY.items() if entry.sampled)
+
+
+def is_adaptive(kind: str) -> bool:
+    """Whether the design kind grows round by round from the results (see DesignKind)."""
+    return REGISTRY[kind].adaptive
 
 
 def is_sampled(kind: str) -> bool:
