@@ -40,6 +40,7 @@ from .analysis.resolution import RESOLUTION_RTOL, resolved_variance
 from .analysis.sobol import pick_freeze_indices
 from .designs import REGISTRY as DESIGNS
 from .designs import is_sampled
+from .designs.adaptive import index_set_summary
 from .methods import PCE, METHODS, failed_runs_note, method_entry
 from .methods.basis import orthonormal_basis
 from .methods.loo import relative_loo_error
@@ -127,6 +128,7 @@ class Statistics:
     replicates: int = 1  # independent randomised-QMC replicates of the design
     seeds: list[str] = field(default_factory=list)  # parameters that are random streams' seeds
     quantities: dict[str, QuantityStatistics] = field(default_factory=dict)
+    index_set: dict | None = None  # an adaptive grid's refinement (designs.adaptive.index_set_summary)
 
 
 @dataclass
@@ -194,6 +196,8 @@ def analyse(path, reference: str | None = None, options: Options | None = None, 
                            store.parameter_names, int(status.size), int(ok.sum()), int(np.sum(status > 0)),
                            pending, {}, partial=pending > 0)
         _check_runs(store, stats, sampled, partial)
+        state = store.index_set()
+        stats.index_set = None if state is None else index_set_summary(state, store.parameter_names)
         problem = method_problem(method["kind"], method["order"], store.xi[ok], store.weights[ok], germs, sampled,
                                  missing=int(status.size - ok.sum()), allow_aliasing=allow_aliasing)
         seeds = json.loads(store.attrs.get("seeds", "[]"))
@@ -629,4 +633,5 @@ def summary_json(stats: Statistics) -> dict:
         "failure_probability": stats.failure_probability, "partial": stats.partial, "notes": stats.notes,
         "failures": stats.failures, "parameters": stats.parameter_names, "reference": stats.reference,
         "outputs": outputs,
-        "quantities": {name: _quantity_json(quantity, stats.seeds) for name, quantity in stats.quantities.items()}})
+        "quantities": {name: _quantity_json(quantity, stats.seeds) for name, quantity in stats.quantities.items()},
+        **({"index_set": stats.index_set} if stats.index_set else {})})

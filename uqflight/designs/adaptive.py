@@ -40,6 +40,7 @@ class Grid:
     def __init__(self, rules: list[str]):
         self.rules = list(rules)
         self.ids, self.values, self.differences = [], [], []
+        self._tensors = {}
         for rule in self.rules:
             top = rule_catalog.max_level(rule, "exponential") or MAX_LEVELS
             sizes = rule_catalog.level_sizes(rule, "exponential", min(top, MAX_LEVELS))
@@ -63,6 +64,11 @@ class Grid:
 
     def tensor(self, index) -> tuple[np.ndarray, np.ndarray]:
         """Node ids (n, d) of the tensor grid of `index` (last dimension fastest) and Δ_index's weights (n,)."""
+        if index not in self._tensors:
+            self._tensors[index] = self._tensor(index)
+        return self._tensors[index]
+
+    def _tensor(self, index) -> tuple[np.ndarray, np.ndarray]:
         grids = np.meshgrid(*[self.ids[k][level] for k, level in enumerate(index)], indexing="ij")
         ids = np.stack([grid.ravel() for grid in grids], axis=1)
         weights = reduce(np.multiply.outer, [self.differences[k][level] for k, level in enumerate(index)])
@@ -102,6 +108,7 @@ class Points:
     ids: np.ndarray
     xi: np.ndarray
     row: dict = field(default_factory=dict)
+    differences: dict = field(default_factory=dict)  # index -> Δ_index's weights on the rows (N,)
 
 
 def grid_points(grid: Grid, state: IndexSet) -> Points:
@@ -127,10 +134,12 @@ def _rows(points: Points, ids: np.ndarray) -> np.ndarray:
 
 def difference_weights(grid: Grid, points: Points, index) -> np.ndarray:
     """Δ_index's weights on the rows (N,)."""
-    ids, weights = grid.tensor(index)
-    out = np.zeros(len(points.ids))
-    np.add.at(out, _rows(points, ids), weights)
-    return out
+    if index not in points.differences:
+        ids, weights = grid.tensor(index)
+        out = np.zeros(len(points.ids))
+        np.add.at(out, _rows(points, ids), weights)
+        points.differences[index] = out
+    return points.differences[index]
 
 
 def combination_weights(grid: Grid, points: Points, indices) -> np.ndarray:
@@ -257,3 +266,15 @@ def adaptive_design(spec: dict, germs: list[str], seed: int):
     info = {"rule": rule_catalog.rule_names(grid.rules), "budget": budget, "tolerance": tolerance,
             "rounds": "refined from the results, up to the budget"}
     return points.xi, np.ones(1), info
+
+
+def index_set_summary(state: IndexSet, parameter_names: list[str]) -> dict:
+    """The refinement for people and summary.json: rounds, why it stopped, η, the highest 1-D level
+    reached per parameter, and every index with its state, round and last indicator (None before its
+    points ran)."""
+    levels = np.array(state.indices, dtype=int).reshape(-1, len(parameter_names))
+    return {"rounds": state.rounds, "stopped": state.stopped or None,
+            "eta": None if np.isnan(state.eta) else state.eta,
+            "max_level": dict(zip(parameter_names, levels.max(axis=0).tolist())),
+            "indices": levels.tolist(), "old": list(state.old), "round": list(state.added),
+            "indicator": [None if np.isnan(value) else value for value in state.indicator]}
