@@ -1,6 +1,7 @@
 """Dimension-adaptive sparse grids (designs.adaptive, refinement): the combination rule against closed
 forms, the refinement on an anisotropic closed form against the isotropic grid, the rounds in one
 results file, and a SIGKILLed campaign resumed to the same bits."""
+import csv
 import math
 import os
 import signal
@@ -16,6 +17,7 @@ from uqflight.designs import build_design, design_size
 from uqflight.designs import rules as rule_catalog
 from uqflight.designs.adaptive import Grid, IndexSet, combination_weights, grid_points, refine
 from uqflight.execution import run_campaign
+from uqflight.report import write_report
 from uqflight.simulators import models
 from uqflight.statistics import analyse, summary_json
 from uqflight.store import ResultStore
@@ -122,7 +124,7 @@ parameters:
 {parameters}
 design: {{kind: adaptive_sparse_grid, rule: genz_keister, budget: {budget}, tolerance: 1.0e-7}}
 method: {{kind: integration, order: 1}}
-execution: {{workers: 2, chunk: 4}}
+execution: {{workers: 1, chunk: 8}}
 """
 
 
@@ -131,30 +133,38 @@ def adaptive_text(budget: int, d: int = 3) -> str:
     return ADAPTIVE.format(budget=budget, parameters=parameters)
 
 
-def test_rounds_grow_one_results_file_and_stop_at_the_budget(tmp_path):
-    campaign = parse_campaign(adaptive_text(budget=30), str(tmp_path / "a.yaml"))
-    assert campaign.runs == design_size(campaign.design_spec, campaign.germs) == 30  # limits.max_runs' figure
+def test_rounds_grow_one_results_file_whose_statistics_are_the_combination_quadrature(tmp_path):
+    campaign = parse_campaign(adaptive_text(budget=200), str(tmp_path / "a.yaml"))
+    assert campaign.runs == design_size(campaign.design_spec, campaign.germs) == 200  # limits.max_runs' figure
     run_campaign(campaign, out=tmp_path / "a.h5")
     with ResultStore.open(tmp_path / "a.h5") as store:
         state, n, weights = store.index_set(), store.status.size, store.weights
-    assert state.stopped == "budget" and state.rounds >= 2 and n <= 30
+    assert state.stopped == "tolerance" and state.rounds >= 2 and n <= 200
     assert weights.sum() == pytest.approx(1.0, abs=1e-13)
-    summary = summary_json(analyse(tmp_path / "a.h5"))
-    recorded = summary["index_set"]
-    assert recorded["stopped"] == "budget" and recorded["rounds"] == state.rounds
-    assert recorded["max_level"]["x1"] == max(index[0] for index in state.indices)
-    assert recorded["indices"] == [list(index) for index in state.indices]
-    rerun = run_campaign(parse_campaign(adaptive_text(budget=30), str(tmp_path / "a.yaml")), out=tmp_path / "a.h5")
-    assert rerun.ran == 0  # a finished adaptive campaign resumes to nothing
-
-
-def test_the_adaptive_grids_statistics_are_its_combination_quadrature(tmp_path):
-    campaign = parse_campaign(adaptive_text(budget=200), str(tmp_path / "b.yaml"))
-    run_campaign(campaign, out=tmp_path / "b.h5")
-    stats = analyse(tmp_path / "b.h5")
+    stats = analyse(tmp_path / "a.h5")
     mean, variance = anisotropic_moments(3)
     out = stats.outputs["y"]  # stopped at tolerance 1e-7 of the indicators: 1e-6 holds with margin
     assert out.mean[0] == pytest.approx(mean, rel=1e-6) and out.variance[0] == pytest.approx(variance, rel=1e-6)
+    recorded = summary_json(stats)["index_set"]
+    assert recorded["stopped"] == "tolerance" and recorded["rounds"] == state.rounds
+    assert recorded["max_level"]["x1"] == max(index[0] for index in state.indices)
+    assert recorded["indices"] == [list(index) for index in state.indices]
+    rerun = run_campaign(parse_campaign(adaptive_text(budget=200), str(tmp_path / "a.yaml")), out=tmp_path / "a.h5")
+    assert rerun.ran == 0  # a finished adaptive campaign resumes to nothing
+    write_report([tmp_path / "a.h5"], tmp_path / "report")
+    html = (tmp_path / "report" / "report.html").read_text()
+    assert "Adaptive grid: the refined inputs" in html and (tmp_path / "report/plots/index_set_a.png").is_file()
+    with open(tmp_path / "report/tables/index_set.csv") as table:
+        first = next(csv.DictReader(table))
+    assert first["input"] == "x1"  # the dominant input is the most refined
+
+
+def test_the_refinement_stops_before_the_budget():
+    grid, state = Grid(["genz_keister"] * 3), IndexSet.initial(3)
+    while not state.stopped:
+        points = grid_points(grid, state)
+        state = refine(grid, state, points, [model(points.xi)[:, None]], budget=30, tolerance=0.0)
+    assert state.stopped == "budget" and len(grid_points(grid, state).ids) <= 30 and state.rounds >= 2
 
 
 @pytest.mark.slow

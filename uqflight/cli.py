@@ -180,7 +180,7 @@ def _load(path: Path):
 @app.command()
 def plan(campaign: Path = typer.Argument(..., metavar="CAMPAIGN", help="Campaign YAML file.")):
     """Validate a campaign and print its design, the number of runs and an estimated time."""
-    from .designs import describe
+    from .designs import describe, is_adaptive
 
     spec = _load(campaign)
     design = spec.design()
@@ -191,8 +191,8 @@ def plan(campaign: Path = typer.Argument(..., metavar="CAMPAIGN", help="Campaign
              f"interval [{p.lower:.6g}, {p.upper:.6g}]")
     echo(describe(design))
     echo(f"method: {spec.method['kind']} (order {spec.method['order']})")
-    runs = len(design.xi)
-    echo(f"runs: {runs}")
+    runs = spec.runs or len(design.xi)  # an adaptive grid's budget: its rounds are made from the results
+    echo(f"runs: {runs}" + (" at most (design.budget)" if is_adaptive(design.kind) else ""))
     echo(f"results: {Path(spec.storage['path']).resolve()} (storage.path, from the working directory; "
          "--out to choose)")
     seconds = _seconds_per_run(spec)
