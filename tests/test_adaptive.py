@@ -20,7 +20,7 @@ from uqflight.execution import run_campaign
 from uqflight.report import write_report
 from uqflight.simulators import models
 from uqflight.statistics import analyse, summary_json
-from uqflight.store import ResultStore
+from uqflight.store import CorruptFile, ResultStore
 
 from conftest import UQFLIGHT, assert_same_results
 
@@ -157,6 +157,10 @@ def test_rounds_grow_one_results_file_whose_statistics_are_the_combination_quadr
     with open(tmp_path / "report/tables/index_set.csv") as table:
         first = next(csv.DictReader(table))
     assert first["input"] == "x1"  # the dominant input is the most refined
+    with h5py.File(tmp_path / "a.h5", "r+") as f:  # a damaged index set is refused, not read
+        del f["design/old"]
+    with pytest.raises(CorruptFile, match="/design/old is missing"):
+        ResultStore.open(tmp_path / "a.h5")
 
 
 def test_the_refinement_stops_before_the_budget():

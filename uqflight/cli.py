@@ -346,6 +346,10 @@ def _describe_results(results, store, Status) -> None:
     echo(f"file: {results}")
     echo(f"campaign: {attrs.get('campaign_name', '?')} (sha256 {store.campaign_hash[:12]})")
     echo(f"design: {attrs.get('design_kind', '?')} {attrs.get('design_info', '')}")
+    state = store.index_set()  # an adaptive grid's refinement (/design)
+    if state is not None:
+        echo(f"index set: {len(state.indices)} multi-indices, {state.rounds} rounds, "
+             f"{'stopped by ' + state.stopped if state.stopped else 'refining (resume to go on)'}")
     echo(f"parameters: {', '.join(store.parameter_names)}")
     echo(f"outputs: {', '.join(store.output_names)} ({store.time.size} times, "
          f"{store.time[0]:g} to {store.time[-1]:g} s)")
