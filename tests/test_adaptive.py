@@ -207,3 +207,11 @@ def test_a_sigkilled_adaptive_campaign_resumes_to_the_same_bits(tmp_path):
 def test_bad_adaptive_specs_name_the_key(spec, message):
     with pytest.raises(ValueError, match=message):
         build_design({"kind": "adaptive_sparse_grid", **spec}, ["normal"], seed=0)
+
+
+def test_an_adaptive_grid_refuses_monte_carlo_before_anything_runs(tmp_path):
+    from uqflight.campaign import CampaignError
+
+    with pytest.raises(CampaignError, match="method.kind: monte_carlo needs a sampled design"):
+        parse_campaign(adaptive_text(budget=30).replace("kind: integration, order: 1", "kind: monte_carlo"),
+                       str(tmp_path / "m.yaml"))
