@@ -49,9 +49,9 @@ from .campaign.schema import WORKER_BYTES
 from .console import clean
 from .designs import Design, is_adaptive
 from .parameters import seed_names, to_physical
+from .refinement import run_rounds
 from .store import ResultStore, Status, compact, open_for_campaign
 from .store.lock import LockHeld, ResultsLock
-from .refinement import run_rounds
 from .worker import WorkerSpec
 
 DEFAULT_TIMEOUT_FLOOR_S = 60.0   # default timeout: max(this, TIMEOUT_FLIGHTS x one nominal flight)
