@@ -215,3 +215,24 @@ def test_an_adaptive_grid_refuses_monte_carlo_before_anything_runs(tmp_path):
     with pytest.raises(CampaignError, match="method.kind: monte_carlo needs a sampled design"):
         parse_campaign(adaptive_text(budget=30).replace("kind: integration, order: 1", "kind: monte_carlo"),
                        str(tmp_path / "m.yaml"))
+
+
+@pytest.mark.slow
+def test_on_bacm_the_adaptive_grid_refines_k2_most(tmp_path):
+    """campaigns/bacm-adaptive.yaml as shipped (300 runs at most, real JSBSim). k2 carries most of h's and
+    V_TAS's variance and is only C⁰ there (the engine tables' kinks): it is refined most; CLalpha (q) and
+    CL0 (α, θ) follow, the inputs that carry the other outputs' variance."""
+    from uqflight.campaign import load_campaign
+    from uqflight.simulators.jsbsim_probe import jsbsim_probe
+
+    from conftest import ROOT
+
+    campaign = load_campaign(ROOT / "campaigns" / "bacm-adaptive.yaml", probe=jsbsim_probe)
+    run_campaign(campaign, out=tmp_path / "bacm.h5")
+    with ResultStore.open(tmp_path / "bacm.h5") as store:
+        state, names, n = store.index_set(), store.parameter_names, store.status.size
+    levels = np.array(state.indices)
+    refined = dict(zip(names, np.count_nonzero(levels[np.array(state.old)] > 0, axis=0)))
+    ranked = sorted(refined, key=refined.get, reverse=True)
+    assert n <= 300 and state.stopped in ("budget", "tolerance")
+    assert ranked[0] == "k2" and set(ranked[:3]) == {"k2", "CLalpha", "CL0"}, refined

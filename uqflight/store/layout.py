@@ -10,6 +10,8 @@ from __future__ import annotations
 import h5py
 import numpy as np
 
+from ..designs.adaptive import STOP_REASONS
+
 KINDS = {"float": "f", "integer": "iu"}
 # Beyond any campaign (limits.max_runs defaults to 10^6), and beyond what a reader can hold in memory:
 # a damaged or hostile file declaring such sizes is refused before anything is read.
@@ -169,3 +171,5 @@ def _index_set_problems(f: h5py.File, d, problems: list[str]) -> None:
         problems.append("/design/index_set must hold at least one multi-index of levels >= 0")
     if not {"rounds", "stopped", "eta"} <= set(f["design"].attrs):
         problems.append("/design lacks one of its attributes rounds, stopped, eta")
+    elif f["design"].attrs["stopped"] not in ("", *STOP_REASONS):
+        problems.append(f"/design's attribute stopped must be empty or one of {', '.join(STOP_REASONS)}")
