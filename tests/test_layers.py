@@ -19,7 +19,7 @@ LAYERS = [
     ("uqflight.methods",),
     ("uqflight.store", "uqflight.worker"),
     ("uqflight.campaign", "uqflight.statistics"),
-    ("uqflight.execution", "uqflight.check", "uqflight.surrogate", "uqflight.calibration"),
+    ("uqflight.execution", "uqflight.refinement", "uqflight.check", "uqflight.surrogate", "uqflight.calibration"),
     ("uqflight.report",),
     ("uqflight.cli",),
 ]

@@ -214,7 +214,7 @@ def _load(path: Path):
 @app.command()
 def plan(campaign_file: Path = typer.Argument(..., metavar="CAMPAIGN", help="Campaign YAML file.")):
     """Validate a campaign and print its design, the number of runs and an estimated time."""
-    from .designs import describe
+    from .designs import describe, is_adaptive
 
     campaign = _load(campaign_file)
     design = campaign.design()
@@ -229,8 +229,8 @@ def plan(campaign_file: Path = typer.Argument(..., metavar="CAMPAIGN", help="Cam
     echo(describe(design))
     kind = campaign.method["kind"]
     echo(f"method: {kind}" + (f" (order {campaign.method['order']})" if _has_order(kind, design.kind) else ""))
-    runs = len(design.xi)
-    echo(f"runs: {runs}")
+    runs = campaign.runs or len(design.xi)  # an adaptive grid's budget: its rounds are made from the results
+    echo(f"runs: {runs}" + (" at most (design.budget)" if is_adaptive(design.kind) else ""))
     echo(f"results: {Path(campaign.storage['path']).resolve()} (storage.path, from the working directory; "
          "--out to choose)")
     seconds = _seconds_per_run(campaign)
@@ -393,6 +393,10 @@ def _describe_results(results, store, Status) -> None:
     echo(f"file: {results}")
     echo(f"campaign: {attrs.get('campaign_name', '?')} (sha256 {store.campaign_hash[:12]})")
     echo(f"design: {attrs.get('design_kind', '?')} {attrs.get('design_info', '')}")
+    state = store.index_set()  # an adaptive grid's refinement (/design)
+    if state is not None:
+        echo(f"index set: {len(state.indices)} multi-indices, {state.rounds} rounds, "
+             f"{'stopped by ' + state.stopped if state.stopped else 'refining (resume to go on)'}")
     echo(f"parameters: {', '.join(store.parameter_names)}")
     echo(f"outputs: {', '.join(store.output_names)} ({store.time.size} times, "
          f"{store.time[0]:g} to {store.time[-1]:g} s)")

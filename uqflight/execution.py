@@ -46,9 +46,10 @@ from threadpoolctl import threadpool_limits
 from .campaign import Campaign
 from .campaign.reading import parameters_attribute
 from .campaign.schema import WORKER_BYTES
-from .designs import Design
+from .designs import Design, is_adaptive
 from .parameters import seed_names
 from .progress import Progress
+from .refinement import run_rounds
 from .store import ResultStore, Status, compact, open_for_campaign
 from .store.lock import LockHeld, ResultsLock
 from .worker import NominalFlight, WorkerSpec
@@ -140,7 +141,7 @@ def prepare_store(campaign: Campaign, design: Design, out: Path, force: bool, no
         parameter_names=[p.name for p in campaign.parameters], outputs=nominal.outputs, time=nominal.time,
         raw=campaign.storage["raw"], tsvd=campaign.storage.get("tsvd"), attrs=attrs, units=nominal.units,
         batch_rows=campaign.execution["chunk"], resolution=nominal.resolution,
-        quantities=list(campaign.quantities))
+        quantities=list(campaign.quantities), capacity=campaign.runs if is_adaptive(design.kind) else None)
 
 
 def simulate(campaign: Campaign, kappa: np.ndarray, outputs: list[str]):
@@ -296,8 +297,11 @@ def run_campaign(campaign: Campaign, out: Path | None = None, workers: int | Non
                     raise DiskFull(errno.ENOSPC, disk_full_message(out, 0)) from exc
                 raise
             try:
-                summary = _run_pending(store, campaign, pool, spec, chunk, workers, executor, scheduler,
-                                       timeout, out, progress)
+                def fly():
+                    return _run_pending(store, campaign, pool, spec, chunk, workers, executor, scheduler,
+                                        timeout, out, progress)
+
+                summary = run_rounds(store, campaign, fly) if is_adaptive(design.kind) else fly()
                 complete = store.pending().size == 0
             finally:
                 try:

@@ -44,6 +44,7 @@ from .analysis.resolution import RESOLUTION_RTOL, resolved_variance
 from .analysis.sobol import pick_freeze_indices
 from .designs import REGISTRY as DESIGNS
 from .designs import is_sampled
+from .designs.adaptive import index_set_summary
 from .methods import PCE, METHODS, failed_runs_note, fit, method_entry, method_settings, normalised
 from .methods.basis import orthonormal_basis
 from .methods.loo import relative_loo_error
@@ -135,6 +136,7 @@ class Statistics:
     seeds: list[str] = field(default_factory=list)  # parameters that are random streams' seeds
     dependence: dict | None = None  # the inputs' Gaussian copula (parameters.dependence.summary), None: independent
     quantities: dict[str, QuantityStatistics] = field(default_factory=dict)
+    index_set: dict | None = None  # an adaptive grid's refinement (designs.adaptive.index_set_summary)
 
 
 @dataclass
@@ -205,6 +207,8 @@ def analyse(path, reference: str | None = None, options: Options | None = None, 
                            store.parameter_names, int(status.size), int(ok.sum()), int(np.sum(status > 0)),
                            pending, {}, partial=pending > 0)
         _check_runs(store, stats, sampled, partial)
+        state = store.index_set()
+        stats.index_set = None if state is None else index_set_summary(state, store.parameter_names)
         problem = method_problem(method["kind"], method["order"], store.xi[ok], store.weights[ok], germs, sampled,
                                  missing=int(status.size - ok.sum()), allow_aliasing=allow_aliasing)
         seeds = json.loads(store.attrs.get("seeds", "[]"))
@@ -664,4 +668,5 @@ def summary_json(stats: Statistics) -> dict:
         "failures": stats.failures, "parameters": stats.parameter_names, "reference": stats.reference,
         **({"dependence": stats.dependence} if stats.dependence else {}),
         "outputs": outputs,
-        "quantities": {name: _quantity_json(quantity, stats.seeds) for name, quantity in stats.quantities.items()}})
+        "quantities": {name: _quantity_json(quantity, stats.seeds) for name, quantity in stats.quantities.items()},
+        **({"index_set": stats.index_set} if stats.index_set else {})})

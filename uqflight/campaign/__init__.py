@@ -13,7 +13,8 @@ from typing import Callable
 import numpy as np
 import yaml
 
-from ..designs import SAMPLED_DESIGNS, Design, build_design
+from ..designs import SAMPLED_DESIGNS, Design, build_design, design_size, is_adaptive
+from ..methods import method_entry
 from ..parameters import Parameter, germs_of, seed_names, to_physical
 from ..parameters.dependence import GaussianCopula
 from ..quantities.spec import check_quantities
@@ -112,6 +113,13 @@ def parse_campaign(text: str, source: str = "<campaign>", view: ValidationView |
         if sep and (field_path.startswith("design") or field_path == "seed"):
             raise CampaignError(source, field_path, rest) from exc
         raise CampaignError(source, "design", message) from exc
+    if is_adaptive(design.kind):  # its grid is made from the results: its points are checked on analysis
+        campaign.method.setdefault("order", schema.DEFAULT_ORDER)
+        if method_entry(campaign.method["kind"]).sampled_only:
+            check.fail("method.kind", f"{campaign.method['kind']} needs a sampled design; an adaptive grid needs "
+                                      "its weights: use integration, pseudo_galerkin or interpolation")
+        campaign.runs = int(design_size(campaign.design_spec, campaign.germs))
+        return campaign
     schema.check_method_fits_design(check, campaign.method, design, campaign.germs)
     campaign.runs = len(design.weights)
     return campaign

@@ -91,6 +91,11 @@ KEYS = {
     "design.scramble": "Scramble the QMC points with the seed. Default true. `scramble: false`",
     "design.replicates": "`sobol`: R independent scrambles of `samples` points (randomised QMC), giving every "
                          "statistic's standard error. Default 1. `replicates: 16`",
+    "design.budget": "adaptive_sparse_grid only, required: the most runs; the refinement stops before a round "
+                     "would pass it (stopped: budget). `budget: 300`",
+    "design.tolerance": "adaptive_sparse_grid only, required: stop when the sum of the active indices' "
+                        "indicators (change of mean and variance, normalised like ε_m and ε_v) is at most "
+                        "this (stopped: tolerance). `tolerance: 1e-5`",
     "design.level": "Sparse-grid level, 0-1000. `level: 2`",
     "design.rule": "The 1-D rule (below) for every dimension, or a mapping germ -> rule "
                    "(`rule: {normal: gauss_hermite, uniform: clenshaw_curtis}`). Default: each germ's Gauss rule "

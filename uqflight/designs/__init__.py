@@ -6,6 +6,8 @@ Kinds (keys in braces):
 - sparse_grid {level, rule, nested, growth}: Smolyak combination technique on 1-D rules.
 - tensor_grid {rule, points}: full tensor product.
 - pick_freeze {samples}: Saltelli's [A; B; AB_1; …; AB_d] for Sobol' index estimators.
+- adaptive_sparse_grid {rule, budget, tolerance}: Gerstner–Griebel's dimension-adaptive grid, built
+  round by round from the results (`adaptive`; the runner refines it).
 """
 from __future__ import annotations
 
@@ -15,6 +17,7 @@ from typing import Callable
 import numpy as np
 
 from ..parameters.germs import check_germs
+from .adaptive import adaptive_design, adaptive_size
 from .montecarlo import (halton_design, latin_hypercube_design, monte_carlo_design, samples_size, sobol_design,
                          sobol_size)
 from .pickfreeze import pick_freeze_design, pick_freeze_size
@@ -30,13 +33,16 @@ class DesignKind:
     limits; a sparse grid's points before merging; None when the spec is malformed, so that the
     builder's own checks speak); `draws`: how its random points relate to independent draws
     (analysis.proportions), or None for a quadrature grid (its weights are valid only all together);
-    `sobol_from_runs`: its runs give Sobol' indices themselves (pick-freeze estimators), without a PCE."""
+    `sobol_from_runs`: its runs give Sobol' indices themselves (pick-freeze estimators), without a PCE;
+    `adaptive`: the builder gives the first round only; the runner adds the others from the results
+    (designs.adaptive), up to `size` runs."""
 
     build: Callable
     size: Callable
     draws: str | None
     example: dict  # a small `design:` mapping of this kind (help text and tests)
     sobol_from_runs: bool = False
+    adaptive: bool = False
 
     @property
     def sampled(self) -> bool:
@@ -55,9 +61,17 @@ REGISTRY: dict[str, DesignKind] = {
     "tensor_grid": DesignKind(tensor_grid_design, tensor_grid_size, None, {"kind": "tensor_grid", "points": 4}),
     "pick_freeze": DesignKind(pick_freeze_design, pick_freeze_size, "pick_freeze",
                               {"kind": "pick_freeze", "samples": 16}, sobol_from_runs=True),
+    "adaptive_sparse_grid": DesignKind(adaptive_design, adaptive_size, None,
+                                       {"kind": "adaptive_sparse_grid", "budget": 50, "tolerance": 1e-4},
+                                       adaptive=True),
 }
 DESIGN_KINDS = tuple(REGISTRY)
 SAMPLED_DESIGNS = tuple(kind for kind, entry in REGISTRY.items() if entry.sampled)
+
+
+def is_adaptive(kind: str) -> bool:
+    """Whether the design kind grows round by round from the results (see DesignKind)."""
+    return REGISTRY[kind].adaptive
 
 
 def is_sampled(kind: str) -> bool:

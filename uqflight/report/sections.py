@@ -71,6 +71,11 @@ def build_sections(entries: list[Entry], ref: Entry | None, times: list[float], 
 
         tell("drawing the quantities of interest")
         sections.append(quantities_section(entries, out_dir))
+    if any(getattr(e.stats, "index_set", None) for e in entries):
+        from .index_set import index_set_section
+
+        tell("drawing the adaptive grid's index set")
+        sections.append(index_set_section(entries, out_dir))
     if any(e.stats.seeds for e in entries):
         from .variance_split import variance_split_section
 

@@ -46,3 +46,14 @@ def phugoid(p: dict) -> dict:
         "q_degps": -1.6 * np.exp(-1.2 * t) * np.cos(1.6 * t) + 0.05 * b * np.cos(omega * t),
         "vtas_kt": 200.0 + 1.7 * (1 + 0.03 * b) * phugoid_wave,
     }
+
+
+ANISOTROPIC_A, ANISOTROPIC_B, ANISOTROPIC_C = 1.2, 0.02, 0.01
+
+
+def anisotropic(p: dict) -> dict:
+    """y = exp(A x1) + B Σ_{k≥2} sin(x_k) + C x1 x2 over the parameters in order, each ~ N(0, 1): one
+    dominant input among the others (A = 1.2, B = 0.02, C = 0.01). E[y] = exp(A²/2);
+    Var[y] = exp(2A²) − exp(A²) + (d − 1) B² (1 − e⁻²)/2 + C²."""
+    x = np.array(list(p.values()), dtype=float)
+    return {"y": np.exp(ANISOTROPIC_A * x[0]) + ANISOTROPIC_B * np.sin(x[1:]).sum() + ANISOTROPIC_C * x[0] * x[1]}

@@ -10,6 +10,8 @@ from __future__ import annotations
 import h5py
 import numpy as np
 
+from ..designs.adaptive import STOP_REASONS
+
 KINDS = {"float": "f", "integer": "iu"}
 # Beyond any campaign (limits.max_runs defaults to 10^6), and beyond what a reader can hold in memory:
 # a damaged or hostile file declaring such sizes is refused before anything is read.
@@ -113,6 +115,8 @@ def layout_problems(f: h5py.File) -> list[str]:
             data = _dataset(f, f"resolution/{key}", "float", (n_times,), problems)
             if data is not None and not (np.isfinite(data[()]).all() and (data[()] >= 0).all()):
                 problems.append(f"/resolution/{key} must hold finite values ≥ 0")
+    if "design" in f:
+        _index_set_problems(f, None if xi is None else xi.shape[1], problems)
     if isinstance(compressed, h5py.Group):
         _tsvd_problems(f, compressed, n, n_times, problems)
         if isinstance(raw, h5py.Group) and set(raw) != set(compressed):
@@ -155,3 +159,17 @@ def _tsvd_problems(f: h5py.File, group: h5py.Group, n: int, n_times, problems: l
                 problems.append(f"/{path}/columns must name distinct runs in [0, {n})")
         if index is not None and np.any((index[()] < -1) | (index[()] >= n)):
             problems.append(f"/{path}/buffer_index must name runs in [0, {n}) (or -1)")
+
+
+def _index_set_problems(f: h5py.File, d, problems: list[str]) -> None:
+    """An adaptive grid's /design (store.rounds): its datasets of one length K, its attributes."""
+    index_set = _dataset(f, "design/index_set", "integer", (None, d), problems)
+    k = None if index_set is None else index_set.shape[0]
+    for key, kind in (("old", "integer"), ("round", "integer"), ("indicator", "float")):
+        _dataset(f, f"design/{key}", kind, (k,), problems)
+    if index_set is not None and (k == 0 or np.any(index_set[()] < 0)):
+        problems.append("/design/index_set must hold at least one multi-index of levels >= 0")
+    if not {"rounds", "stopped", "eta"} <= set(f["design"].attrs):
+        problems.append("/design lacks one of its attributes rounds, stopped, eta")
+    elif f["design"].attrs["stopped"] not in ("", *STOP_REASONS):
+        problems.append(f"/design's attribute stopped must be empty or one of {', '.join(STOP_REASONS)}")

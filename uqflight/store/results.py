@@ -53,6 +53,7 @@ from ..simulators.base import Status
 from ..tsvd import IncrementalSVD, iter_column_blocks
 from .compressed import append_rows, apply_staged, buffer_rows, chunk_rows, commit, ingest, write_state
 from .layout import is_time_grid, layout_problems
+from .rounds import read_index_set, write_index_set
 
 
 def _key(name: str) -> str:
@@ -128,7 +129,7 @@ class ResultStore:
     def create(cls, path, *, campaign_text: str, xi, kappa, weights, parameter_names, outputs, time,
                raw: bool = True, tsvd: dict | None = None, attrs: dict | None = None,
                units: dict | None = None, batch_rows: int | None = None,
-               resolution: dict | None = None, quantities=()) -> ResultStore:
+               resolution: dict | None = None, quantities=(), capacity: int | None = None) -> ResultStore:
         """A new file (refused if `path` exists) holding the design, with every run pending.
 
         `tsvd` = {"tol": ..., "batch": ...} turns on compression (batch defaults to the paper's 1000
@@ -137,6 +138,7 @@ class ResultStore:
         rows (at least 64 KiB, at most ~1 MiB), so that a batch fills whole HDF5 chunks instead of
         rewriting part-filled ones. `resolution` maps output name → (T,) the simulator's own resolution.
         `quantities`: the names of the campaign's quantities of interest, one value per run each.
+        `capacity`: the runs the design may grow to (an adaptive grid's budget, `set_design`); None: fixed.
         """
         xi, kappa = np.atleast_2d(xi).astype(float), np.atleast_2d(kappa).astype(float)
         weights, time = np.asarray(weights, dtype=float), np.asarray(time, dtype=float)
@@ -156,19 +158,22 @@ class ResultStore:
                                                 float(tsvd["tol"]))
             batch = int(tsvd.get("batch", 1000))
 
+        grow = {} if capacity is None else {"maxshape": (None,)}  # resizable along the runs
+        rows_hint = n if capacity is None else max(n, capacity)
         f = h5py.File(path, "w-")
         f.attrs.update({"campaign": campaign_text, "campaign_hash": text_hash(campaign_text),
                         "created": datetime.now(timezone.utc).isoformat(timespec="seconds")})
         f.attrs.update({k: json.dumps(v) if isinstance(v, dict) else v for k, v in (attrs or {}).items()})
         samples = f.create_group("samples")
-        samples.create_dataset("xi", data=xi, **CHECKED).attrs["dimensions"] = ["sample", "parameter"]
-        samples.create_dataset("kappa", data=kappa, **CHECKED).attrs.update(
+        design = {} if capacity is None else {"maxshape": (None, d)}
+        samples.create_dataset("xi", data=xi, **CHECKED, **design).attrs["dimensions"] = ["sample", "parameter"]
+        samples.create_dataset("kappa", data=kappa, **CHECKED, **design).attrs.update(
             {"names": parameter_names, "dimensions": ["sample", "parameter"]})
-        samples.create_dataset("weight", data=weights, **CHECKED)
+        samples.create_dataset("weight", data=weights, **CHECKED, **grow)
         samples.create_dataset("status", shape=(n,), dtype="i1", fillvalue=Status.PENDING,
-                               **CHECKED).attrs["codes"] = json.dumps({s.name.lower(): s.value for s in Status})
+                               **CHECKED, **grow).attrs["codes"] = json.dumps({s.name.lower(): s.value for s in Status})
         samples.create_dataset("reason", shape=(n,), dtype=h5py.string_dtype("utf-8", REASON_BYTES),
-                               chunks=(min(n, REASON_ROWS),), fletcher32=True)
+                               chunks=(min(rows_hint, REASON_ROWS),), fletcher32=True, **grow)
         f.create_dataset("time", data=time, **CHECKED).attrs["units"] = "s"
         if resolution:
             group = f.create_group("resolution", track_order=True)
@@ -179,17 +184,19 @@ class ResultStore:
                 group.create_dataset(_key(name), data=np.asarray(resolution[name], dtype=float), **CHECKED)
         if raw:
             group = f.create_group("outputs", track_order=True)
-            rows = min(chunk_rows(time.size, n), max(batch_rows or n, -(-MIN_CHUNK_BYTES // (8 * time.size))))
+            rows = min(chunk_rows(time.size, rows_hint),
+                       max(batch_rows or rows_hint, -(-MIN_CHUNK_BYTES // (8 * time.size))))
             for name in outputs:
                 ds = group.create_dataset(_key(name), shape=(n, time.size), dtype="f8", fillvalue=np.nan,
-                                          chunks=(rows, time.size), fletcher32=True)
+                                          chunks=(rows, time.size), fletcher32=True,
+                                          **({} if capacity is None else {"maxshape": (None, time.size)}))
                 ds.attrs.update({"units": units.get(name, ""), "dimensions": ["sample", "time"]})
         if quantities:
             group = f.create_group("quantities", track_order=True)
             group.attrs["description"] = "one number per run (the campaign's quantities:), NaN where undefined"
             for name in quantities:
                 group.create_dataset(_key(name), shape=(n,), dtype="f8", fillvalue=np.nan,
-                                     chunks=(min(n, QUANTITY_ROWS),), fletcher32=True)
+                                     chunks=(min(rows_hint, QUANTITY_ROWS),), fletcher32=True, **grow)
         if tsvd is not None:
             group = f.create_group("tsvd", track_order=True)
             group.attrs.update({"tol": empty.tol, "batch": batch,
@@ -346,6 +353,44 @@ class ResultStore:
     def pending(self) -> np.ndarray:
         """Indices of the runs not written yet, ascending."""
         return np.flatnonzero(self.status == Status.PENDING)
+
+    # -- a growing design (adaptive grids) --------------------------------------------------
+    def set_design(self, xi, kappa, weights) -> None:
+        """Make the design these N rows (a file made with `capacity`): rows beyond the file's are added,
+        pending; the pending rows' xi and kappa are (re)written and every weight is replaced. The rows
+        already run must keep their points (ValueError otherwise). Idempotent, so that a writer killed
+        half-way through is mended by calling it again."""
+        xi, kappa = np.atleast_2d(xi).astype(float), np.atleast_2d(kappa).astype(float)
+        weights = np.asarray(weights, dtype=float)
+        status, samples = self.status, self._file["samples"]
+        n = len(weights)
+        if n < status.size or xi.shape != kappa.shape or len(xi) != n:
+            raise ValueError(f"a design can only grow: {n} rows for a file of {status.size}")
+        done = np.flatnonzero(status != Status.PENDING)
+        if not np.array_equal(samples["xi"][()][done], xi[done]):
+            raise ValueError("the runs already made would move: the design is not the file's")
+        if n > status.size:
+            if samples["status"].maxshape[0] is not None:
+                raise ValueError("this results file holds a fixed design; it cannot grow")
+            groups = [samples] + [self._file[key] for key in ("outputs", "quantities") if key in self._file]
+            for group in groups:
+                for data in group.values():
+                    data.resize(n, axis=0)
+        pending = np.flatnonzero(np.r_[status, np.full(n - status.size, Status.PENDING)] == Status.PENDING)
+        if pending.size:
+            samples["xi"][pending[0]:] = xi[pending[0]:]  # the pending rows follow the run ones (set_design's order)
+            samples["kappa"][pending[0]:] = kappa[pending[0]:]
+        samples["weight"][...] = weights
+        self._flush(sync=True)
+
+    def index_set(self):
+        """The adaptive grid's state (`designs.adaptive.IndexSet`) written by `write_index_set`, or None."""
+        return read_index_set(self._file)
+
+    def write_index_set(self, state) -> None:
+        """Record an adaptive grid's state in /design (replaced whole, see `rounds`)."""
+        write_index_set(self._file, state)
+        self._flush(sync=True)
 
     # -- writing ----------------------------------------------------------------------------
     def write_batch(self, indices, status, reasons, outputs: dict) -> None:

@@ -1,0 +1,54 @@
+"""An adaptive grid's state in its results file: the group /design.
+
+    /design/index_set (K, d) int      the multi-indices (1-D levels from 0), in the order they were added
+    /design/old (K,) int8             1: refined (its forward neighbours were considered), 0: active
+    /design/round (K,) int            the refinement round that added it (0: the centre)
+    /design/indicator (K,) float      its error indicator when last computed (NaN: not yet)
+    attributes: rounds, stopped ("" while refining; "budget", "tolerance", "levels" or "failed"),
+                eta (Σ of the active indicators when last computed)
+
+The group is replaced whole: written as /design_next, marked complete, then moved in place; a reader
+prefers a complete /design_next (a writer killed before the move), so a kill leaves the old or the new
+state, never a mix.
+"""
+from __future__ import annotations
+
+import h5py
+import numpy as np
+
+from ..designs.adaptive import IndexSet
+
+GROUP, STAGED = "design", "design_next"
+
+
+def read_index_set(f: h5py.File) -> IndexSet | None:
+    """The state recorded in `f`, or None when the file holds none."""
+    staged = f.get(STAGED)
+    group = staged if staged is not None and staged.attrs.get("complete", False) else f.get(GROUP)
+    if group is None:
+        return None
+    indices = [tuple(int(level) for level in row) for row in group["index_set"][()]]
+    return IndexSet(indices, [bool(v) for v in group["old"][()]], [int(v) for v in group["round"][()]],
+                    [float(v) for v in group["indicator"][()]], int(group.attrs["rounds"]),
+                    str(group.attrs["stopped"]), float(group.attrs["eta"]))
+
+
+def write_index_set(f: h5py.File, state: IndexSet) -> None:
+    """Replace the recorded state by `state` (see the module docstring)."""
+    if STAGED in f:
+        del f[STAGED]
+    staged = f.create_group(STAGED)
+    d = len(state.indices[0])
+    staged.create_dataset("index_set", data=np.array(state.indices, dtype=np.int64).reshape(-1, d))
+    staged.create_dataset("old", data=np.array(state.old, dtype=np.int8))
+    staged.create_dataset("round", data=np.array(state.added, dtype=np.int64))
+    staged.create_dataset("indicator", data=np.array(state.indicator, dtype=float))
+    staged.attrs.update({"rounds": state.rounds, "stopped": state.stopped, "eta": state.eta,
+                         "description": "adaptive sparse grid: multi-indices (1-D levels from 0), refined (old) "
+                                        "or active, the round that added each and its error indicator"})
+    staged.attrs["complete"] = True
+    f.flush()
+    if GROUP in f:
+        del f[GROUP]
+    f.move(STAGED, GROUP)
+    del f[GROUP].attrs["complete"]
