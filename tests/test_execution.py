@@ -35,6 +35,7 @@ def jsbsim_campaign(samples=12, duration=5):
 
 
 
+@pytest.mark.slow  # a long real-process check; the slow suite runs it in CI
 def test_results_do_not_depend_on_workers_or_executor(tmp_path):
     campaign = jsbsim_campaign()
     one = run_campaign(campaign, out=tmp_path / "one.h5", workers=1)

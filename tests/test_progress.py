@@ -36,6 +36,7 @@ def logged(stderr: str, label: str) -> list[str]:
     return [line for line in stderr.splitlines() if line.startswith(f"{label}: ")]
 
 
+@pytest.mark.slow  # a long real-process check; the slow suite runs it in CI
 def test_report_and_export_log_their_stages_with_percentages(results, tmp_path):
     report = cli("report", results, "--out", tmp_path / "report")
     assert report.returncode == 0, report.stderr

@@ -57,6 +57,7 @@ def alive(pid):
     return stat.rsplit(")", 1)[1].split()[0] != "Z"
 
 
+@pytest.mark.slow  # a long real-process check; the slow suite runs it in CI
 def test_samples_that_kill_their_worker_are_failed_runs_with_any_number_of_workers(tmp_path):
     results = {}
     for workers in (1, 2):
@@ -125,6 +126,7 @@ def wait_for(predicate, seconds=60.0):
     return False
 
 
+@pytest.mark.slow  # a long real-process check; the slow suite runs it in CI
 def test_one_writer_per_file_and_sigterm_stops_cleanly(tmp_path):
     # 100 s of work: the SIGTERM ends it after a few, however slowly the other commands start on a loaded machine
     yaml = write_campaign(tmp_path, "slow", samples=2000, chunk=4, workers=2)
@@ -187,6 +189,7 @@ def test_a_results_path_that_cannot_be_written_is_refused(tmp_path, where):
         run_campaign(campaign("slow", samples=1), out=tmp_path / where)
 
 
+@pytest.mark.slow  # a long real-process check; the slow suite runs it in CI
 def test_no_orphan_workers_after_the_runner_is_killed(tmp_path):
     # 100 s of work: the SIGTERM ends it after a few, however slowly the other commands start on a loaded machine
     yaml = write_campaign(tmp_path, "slow", samples=2000, chunk=4, workers=2)
@@ -225,6 +228,7 @@ def small_disk(tmp_path):
         yield mount
 
 
+@pytest.mark.slow  # a long real-process check; the slow suite runs it in CI
 def test_a_full_disk_stops_cleanly_and_the_resume_equals_an_uninterrupted_run(tmp_path, small_disk):
     yaml = write_campaign(tmp_path, "long_histories", samples=300, chunk=10, workers=2)
     out = small_disk / "r.h5"
