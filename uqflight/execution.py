@@ -88,11 +88,16 @@ class RunSummary:
     seconds: float
     failures: Counter = field(default_factory=Counter)
     timeout_s: float = float("nan")
+    nominal_failure: str | None = None  # why the nominal flight (ξ = 0) failed, when it did
 
     def describe(self) -> str:
         rate = self.ran / self.seconds if self.seconds > 0 else float("nan")
         lines = [f"{self.path}: {self.total} runs, {self.ran} run now ({rate:.1f}/s), "
                  f"{self.skipped} already done, {sum(self.failures.values())} failed"]
+        if self.nominal_failure:
+            lines.append(f"  warning: the nominal flight (every parameter at its law's centre) failed: "
+                         f"{self.nominal_failure}; runs near it fail the same way: check the campaign's flight with "
+                         "`uqflight simulate` and its --set")
         lines += [f"  failed ({n}): {reason}" for reason, n in self.failures.most_common(10)]
         return "\n".join(lines)
 
@@ -321,6 +326,7 @@ def run_campaign(campaign: Campaign, out: Path | None = None, workers: int | Non
         lock.release()
     summary.seconds = time.perf_counter() - started
     summary.timeout_s = timeout
+    summary.nominal_failure = nominal.failure
     return summary
 
 

@@ -26,7 +26,7 @@ import numpy as np
 from .quantities import quantity_key
 from .quantities.recorder import QuantityRecorder
 from .simulators import FlightError, make_simulator
-from .simulators.base import NominalFailed, nominal_failed
+from .simulators.base import NominalFailed
 from .simulators.bundle import localized
 
 
@@ -111,13 +111,15 @@ def run_chunk(spec: WorkerSpec, indices: np.ndarray, kappa: np.ndarray, n_times:
 class NominalFlight:
     """What the runner needs to create the results file and derive the default per-run time limit,
     measured in a worker: the recorded times, the output names and units, the seconds one flight at the
-    nominal took, and the simulator's resolution there ({output: (T,)}, or None)."""
+    nominal took, the simulator's resolution there ({output: (T,)}, or None), and why that flight
+    failed (None when it flew)."""
 
     time: np.ndarray
     outputs: list[str]
     units: dict[str, str]
     seconds: float
     resolution: dict[str, np.ndarray] | None
+    failure: str | None = None
 
 
 def nominal_flight(spec: WorkerSpec, kappa: np.ndarray, measure_resolution: bool = True) -> NominalFlight:
@@ -129,13 +131,15 @@ def nominal_flight(spec: WorkerSpec, kappa: np.ndarray, measure_resolution: bool
     started = time.perf_counter()
     try:  # with the quantities: a linearisation costs more than the flight (5 s for bacm's two turboprops)
         flown = simulator.evaluate(kappa, observers)
-    except FlightError as exc:  # every run would start from a campaign whose centre does not fly
-        raise nominal_failed(spec.parameter_names, kappa, exc, "fly them with `uqflight simulate`, its --set and "
-                                                              "the campaign's flight") from exc
+    except FlightError as exc:  # still the cost of a flight; the campaign goes on, its runs say why they fail
+        flown, failure = None, str(exc)
+    else:
+        failure = None
     seconds = time.perf_counter() - started
     resolution = getattr(simulator, "resolution", None)
     return NominalFlight(np.asarray(time_grid, dtype=float), list(outputs), dict(getattr(simulator, "units", {}) or {}),
-                         seconds, resolution(kappa, flown) if measure_resolution and resolution else None)
+                         seconds, resolution(kappa, flown) if measure_resolution and resolution and flown is not None
+                         else None, failure)
 
 
 def _die_with_parent(parent: int) -> None:

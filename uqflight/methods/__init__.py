@@ -169,9 +169,13 @@ def fit(kind: str, xi, weights, Y, germs, order: int = 2, x0=None, *, scale=None
 
 
 def exported_kind(kind: str, sampled: bool) -> str:
-    """The kind whose PCE a surrogate of method `kind` carries (its entry's `exported_as`)."""
+    """The kind whose PCE a surrogate of method `kind` carries (its entry's `exported_as`); a kind that
+    needs a sampled design stays itself on a grid, for the analysis to refuse (never another method
+    in its place)."""
     entry = method_entry(kind)
-    return kind if entry.exported_as is None else entry.exported_as[0 if sampled else 1]
+    if entry.exported_as is None or (entry.sampled_only and not sampled):
+        return kind
+    return entry.exported_as[0 if sampled else 1]
 
 
 def method_settings(method: dict) -> dict:

@@ -23,16 +23,14 @@ COLOR_MAP = "viridis"
 
 def save_fixed(fig, path: Path, legend=None, legend_columns: int = 4, right: float = 0.2) -> Path:
     """Lay the panels out with fixed margins in inches (matplotlib's tight layout would draw the figure
-    once more to measure it) and write the PNG; `legend` (handles, labels) goes under the panels."""
+    once more to measure it) and write it in the report's format (plots.write_figure); `legend` (handles, labels) goes under the panels."""
     width, height = fig.get_size_inches()
     bottom = 0.55 + (0.25 * -(-len(legend[1]) // legend_columns) if legend else 0.0)
     fig.subplots_adjust(left=0.95 / width, right=1 - right / width, top=1 - 0.75 / height, bottom=bottom / height,
                         hspace=0.62, wspace=0.3)
     if legend:
         fig.legend(*legend, loc="lower center", ncol=legend_columns, fontsize=8, frameon=False)
-    fig.savefig(path, dpi=plots.DPI)
-    plots.plt.close(fig)
-    return Path(path)
+    return plots.write_figure(fig, path)
 
 
 def run_subset(status: np.ndarray, count: int, seed: int) -> np.ndarray:

@@ -46,15 +46,15 @@ class NominalFailed(RuntimeError):
     message names it, gives its values and says what to do; `run` stops there (exit 2)."""
 
 
-def nominal_failed(names, kappa, exc: Exception, see_why: str = "call simulator.function with them") -> NominalFailed:
-    """The NominalFailed that says sample `kappa` of the parameters `names` failed with `exc`; `see_why`:
-    how the user reproduces it."""
+def nominal_failed(names, kappa, exc: Exception) -> NominalFailed:
+    """The NominalFailed that says sample `kappa` of the parameters `names` failed with `exc`."""
     values = ", ".join(f"{name} = {float(value):.10g}" for name, value in zip(names, kappa))
     return NominalFailed(
         f"the nominal sample failed ({values}: the centre of every parameter's law, ξ = 0), which uqflight "
         f"runs first to learn the outputs, the time grid and the cost of a run: {type(exc).__name__}: {exc}. "
-        f"Make the simulator succeed at these values ({see_why} to see why), or move the parameters' "
-        "intervals (lower and upper, or nominal with interval_pct) so that their centre is an input it accepts")
+        "Make the simulator succeed at these values (call simulator.function with them to see why), or move "
+        "the parameters' intervals (lower and upper, or nominal with interval_pct) so that their centre is an "
+        "input it accepts")
 
 
 class Simulator(Protocol):
