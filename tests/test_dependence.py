@@ -322,7 +322,7 @@ dependence: {kind: gaussian_copula, parameters: [a, d], correlation: [[1, 0.3], 
 
     from uqflight.campaign.schema import CampaignLoader
 
-    written = calibrated_campaign(yaml.load(text, Loader=CampaignLoader), {}, post, prior, scores, names, None, "test")
+    written = calibrated_campaign(yaml.load(text, Loader=CampaignLoader), {}, post, prior, scores, names, "test")
     again = parse_campaign(written)
     assert again.dependence.names == ("a", "b", "c")  # the old block replaced; d is independent of all
     np.testing.assert_allclose(again.dependence.correlation, np.corrcoef(scores[:, :3], rowvar=False), atol=1e-12)

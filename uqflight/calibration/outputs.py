@@ -76,7 +76,7 @@ def write_posterior(path: Path, names, properties, xi, kappa, noise_names, sigma
 
 
 def calibrated_campaign(mapping: dict, specs: dict, posterior: dict, prior: dict, scores: np.ndarray,
-                        names: list[str], function_path: str | None, source: str) -> str:
+                        names: list[str], source: str) -> str:
     """The campaign text with the posterior marginals as its parameters (normal, mean ± 3σ) and their
     posterior dependence as a Gaussian copula (`dependence:`).
 
@@ -91,8 +91,6 @@ def calibrated_campaign(mapping: dict, specs: dict, posterior: dict, prior: dict
     storage = dict(mapping.get("storage") or {})
     storage["path"] = f"results/{name}-calibrated.h5"
     mapping["storage"] = storage
-    if function_path is not None:
-        mapping["simulator"] = {**mapping["simulator"], "function": function_path}
     parameters = {}
     kept = []
     for pname in names:

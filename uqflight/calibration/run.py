@@ -19,7 +19,7 @@ from .outputs import (OUTPUT_FILES, calibrated_campaign, corner_plot, informed, 
                       predictive_plot, write_json, write_posterior)
 from .sampler import sample
 from .size import PREDICTIVE_NOISE_DRAWS, check_size
-from .surrogate import (SurrogateError, calibration_surrogate, campaign_folder, campaign_mapping, check_campaign_text,
+from .surrogate import (SurrogateError, calibration_surrogate, check_campaign_text, portable_mapping,
                         parameter_specs, prior_summaries, simulate, to_physical, to_standard)
 
 TIME_HANDLING = ("PCE coefficients (and the surrogate's error variance) interpolated linearly in time "
@@ -296,14 +296,9 @@ def _write_outputs(out, results, data, seed, surrogate, flight, posterior, chain
         write_posterior(scratch / "posterior.h5", names, [specs[n]["property"] for n in names], draws.xi, draws.kappa,
                         list(flight.values), draws.sigma, draws.log_prob, chain.samples, posterior.labels, chain.burn,
                         attrs)
-        function_path = None
-        sim = surrogate.campaign.simulator
-        if sim["kind"] == "python" and ".py:" in sim["function"]:
-            file, _, attr = sim["function"].rpartition(":")
-            function_path = f"{(campaign_folder(surrogate.campaign) / file).resolve()}:{attr}"
         scores = normal_scores(surrogate.parameters, draws.kappa, draws.post, draws.prior)
-        text = calibrated_campaign(campaign_mapping(surrogate.campaign), specs, draws.post, draws.prior,
-                                   scores, names, function_path, f"{results}, {data}")
+        text = calibrated_campaign(portable_mapping(surrogate.campaign), specs, draws.post, draws.prior,
+                                   scores, names, f"{results}, {data}")
         check_campaign_text(text, str(out / "calibrated.yaml"))  # loadable by `uqflight plan`, or a bug here
         (scratch / "calibrated.yaml").write_text(text, encoding="utf-8")
         truth_row = np.array([truth.get(n, np.nan) for n in names]) if truth else None

@@ -16,7 +16,7 @@ from pathlib import Path
 import numpy as np
 
 from ..campaign import Campaign, CampaignError, load_campaign
-from ..campaign.reading import campaign_folder, campaign_mapping, check_campaign_text, results_campaign
+from ..campaign.reading import campaign_folder, check_campaign_text, portable_mapping, results_campaign
 from ..designs import is_sampled
 from ..execution import simulate
 from ..methods import METHOD_KINDS, normalised
@@ -33,7 +33,7 @@ from ..surrogate import SurrogateError, fit_surrogate
 from .likelihood import error_factors_of
 
 __all__ = ["CalibrationSurrogate", "CampaignError", "SurrogateError", "calibration_surrogate", "campaign_folder",
-           "campaign_mapping", "check_campaign_text", "load_campaign_file", "parameter_specs", "prior_summaries",
+           "check_campaign_text", "portable_mapping", "load_campaign_file", "parameter_specs", "prior_summaries",
            "simulate", "to_physical", "to_standard"]
 
 

@@ -109,6 +109,15 @@ def campaign_mapping(campaign: Campaign) -> dict:
     return yaml.load(campaign.text, Loader=schema.CampaignLoader)
 
 
+def portable_mapping(campaign: Campaign) -> dict:
+    """`campaign_mapping` with the files its simulator names relative to the campaign's folder (a model
+    file, an aircraft folder, a script) made absolute: the same campaign when written elsewhere."""
+    mapping = campaign_mapping(campaign)
+    mapping["simulator"] = simulator_entry(mapping["simulator"]).relocated(mapping["simulator"],
+                                                                          campaign_folder(campaign))
+    return mapping
+
+
 def campaign_folder(campaign: Campaign) -> Path:
     """The folder of the campaign file (where its python model and relative paths are looked up)."""
     return Path(campaign.source).resolve().parent

@@ -139,12 +139,15 @@ def provenance(config: dict, base: Path | None = None, properties=()) -> dict:
 def relocated(config: dict, folder: Path) -> dict:
     """An aircraft given as a folder relative to `folder` made absolute (a project or JSBSim aircraft
     keeps its name), and the scenario's files as its kind says."""
-    from ..aircraft import locate
+    from ..aircraft import AircraftNotFound, locate
 
     sim = dict(config)
     if "aircraft" in sim:
-        location = locate(sim["aircraft"], Path(folder))
-        if location.origin == "path":
+        try:
+            location = locate(sim["aircraft"], Path(folder))
+        except AircraftNotFound:  # not there (any more): as written, for the campaign's checks to name it
+            location = None
+        if location is not None and location.origin == "path":
             sim["aircraft"] = str(location.folder)
     return SCENARIOS[scenario_kind(sim)].relocated(sim, Path(folder))
 
