@@ -321,3 +321,18 @@ execution: {workers: 1}
     assert not check["outputs"]["x"]["exceeds"]
     lower, upper = summary["parameters"]["a"]["posterior"]["ci95"]
     assert lower <= 1.75 <= upper
+
+
+def test_the_memory_limit_is_the_campaigns_own(tmp_path):
+    # 32 walkers x 5,000,000 steps keep a 3.8 GB chain: under the default 8 GB, over this campaign's 1 GB
+    (tmp_path / "model.py").write_text(MODEL)
+    text = CAMPAIGN.replace("design: {kind: latin_hypercube, samples: 40}",
+                            "design: {kind: latin_hypercube, samples: 12}\nlimits: {max_memory_gb: 1}")
+    (tmp_path / "campaign.yaml").write_text(text)
+    path = tmp_path / "small.h5"
+    run_campaign(parse_campaign(text, str(tmp_path / "campaign.yaml")), out=path, workers=1)
+    good = tmp_path / "good.csv"
+    write_csv(good, TIME, synthetic(3))
+    run = CliRunner().invoke(app(), ["calibrate", str(path), "--data", str(good), "--out", str(tmp_path / "o"),
+                                     "--steps", "5000000"])
+    assert run.exit_code == 2 and "the 1 GB memory limit (limits.max_memory_gb)" in run.output, run.output

@@ -51,7 +51,7 @@ def calibrate_command(
     Exit 0: done; 2: bad input (data, options, results file, data times outside the surrogate's); 3: the chain did not converge (nothing written; the message says what to change); 130: interrupted (Ctrl-C).
     """  # noqa: E501
     from .likelihood import DataError
-    from .size import check_size
+    from .size import campaign_memory_limit, check_size
 
     check_results_file(results)
     if campaign is not None:
@@ -66,7 +66,7 @@ def calibrate_command(
         echo(f"error: --predictive-draws: expected an integer >= 1, got {predictive_draws}", err=True)
         raise typer.Exit(EXIT_BAD_INPUT)
     try:  # before the sampler's and the surrogate's modules are even imported: a refusal is immediate
-        check_size(data, list(output) or None, walkers, steps, predictive_draws)
+        check_size(data, list(output) or None, walkers, steps, predictive_draws, campaign_memory_limit(results))
     except DataError as exc:
         echo(f"error: {exc}", err=True)
         raise typer.Exit(EXIT_BAD_INPUT)

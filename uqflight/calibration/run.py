@@ -18,7 +18,7 @@ from .likelihood import DataError, LogPosterior, interpolate_in_time, parse_nois
 from .outputs import (OUTPUT_FILES, calibrated_campaign, corner_plot, informed, marginal, marginals_plot,
                       predictive_plot, write_json, write_posterior)
 from .sampler import sample
-from .size import PREDICTIVE_NOISE_DRAWS, check_size
+from .size import PREDICTIVE_NOISE_DRAWS, campaign_memory_limit, check_size
 from .surrogate import (SurrogateError, calibration_surrogate, check_campaign_text, portable_mapping,
                         parameter_specs, prior_summaries, simulate, to_physical, to_standard)
 
@@ -56,7 +56,7 @@ def calibrate(results, data, out, outputs: list[str] | None = None, noise: list[
     ValueError (bad settings), NotConverged.
     One BLAS thread: the matrices are small (a few hundred rows), where several threads on a shared
     machine make the SVDs 10-100x slower."""
-    check_size(data, outputs, walkers, steps, predictive_draws)  # before any work
+    check_size(data, outputs, walkers, steps, predictive_draws, campaign_memory_limit(results))  # before any work
     with threadpool_limits(limits=1):
         return _calibrate(results, data, out, outputs, noise, seed, walkers, steps, method, order, campaign,
                           predictive_draws, truth, progress)

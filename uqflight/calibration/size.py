@@ -24,6 +24,20 @@ def row_bytes(predictive_draws: int, walkers: int, noise_draws: int = PREDICTIVE
     return 8.0 * (predictive_draws * (2 * noise_draws + 3) + 4 * walkers)
 
 
+def campaign_memory_limit(results) -> float:
+    """The results file's campaign `limits.max_memory_gb`, read without running any of its code; the
+    default when the file cannot be read (then its own checks speak)."""
+    from ..campaign.reading import results_campaign
+    from ..store import ResultStore
+
+    try:
+        with ResultStore.open(results) as store:
+            attrs = dict(store.attrs)
+        return float(results_campaign(attrs, str(results)).limits["max_memory_gb"])
+    except (OSError, ValueError, KeyError):
+        return DEFAULT_LIMITS["max_memory_gb"]
+
+
 def check_size(data, outputs: list[str] | None, walkers: int | None, steps: int, predictive_draws: int,
                max_memory_gb: float = DEFAULT_LIMITS["max_memory_gb"]) -> None:
     """DataError when the calibration of `data` would need more than `max_memory_gb`; reads the
