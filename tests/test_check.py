@@ -59,3 +59,45 @@ def test_a_baseline_without_quantities_is_compared_on_its_outputs(quantity_files
     assert compare(stats, older, 1e-6, 1e-9).compared < compare(stats, data, 1e-6, 1e-9).compared
     assert not compare(stats, older, 1e-6, 1e-9).drifts
     assert baseline_json(stats, "")["quantities"].keys() == data["quantities"].keys()
+
+
+# -- baselines that are no baselines, and tolerances that let anything through
+def baseline_text(mean):
+    return ('{"kind": "uqflight-baseline", "version": 1, "outputs": {"y": {"time": [0, 1], "mean": %s, '
+            '"variance": [1, 1], "band99": {"lower": [0, 0], "upper": [1, 1]}, "sobol_first": {}, '
+            '"sobol_total": {}}}}' % mean)
+
+
+@pytest.mark.parametrize("mean", ["[Infinity, 1]", "[-Infinity, 1]", "[1e999, 1]"])
+def test_check_refuses_infinite_baseline_values(tmp_path, mean):
+    from uqflight.check import BadInput, load_baseline
+
+    path = tmp_path / "b.json"
+    path.write_text(baseline_text(mean))
+    with pytest.raises(BadInput, match="infinite|Infinity"):
+        load_baseline(path)
+
+
+def test_check_accepts_nan_and_null_baseline_values(tmp_path):
+    from uqflight.check import load_baseline
+
+    path = tmp_path / "b.json"
+    path.write_text(baseline_text("[NaN, null]"))
+    assert load_baseline(path)["outputs"]["y"]["mean"][1] is None
+
+
+def test_check_refuses_deeply_nested_json(tmp_path):
+    from uqflight.check import BadInput, load_baseline
+
+    path = tmp_path / "b.json"
+    path.write_text("[" * 100000 + "]" * 100000)
+    with pytest.raises(BadInput, match="nested too deeply"):
+        load_baseline(path)
+
+
+@pytest.mark.parametrize("rtol, atol", [(1e-6, float("inf")), (float("nan"), 1e-9), (float("inf"), 0.0)])
+def test_check_refuses_non_finite_tolerances(rtol, atol):
+    from uqflight.check import BadInput, compare
+
+    with pytest.raises(BadInput, match="expected a finite number >= 0"):
+        compare(None, {"outputs": {}}, rtol, atol)
