@@ -273,9 +273,10 @@ def _note_runs(store: ResultStore, stats: Statistics, sampled: bool, allow_alias
     done = status != Status.PENDING
     failed = status[done] > 0
     if sampled:
-        found = sampled_proportion(status > 0, done, DESIGNS[stats.design_kind].draws, design_info(store))
+        found = sampled_proportion(status > 0, done, DESIGNS[stats.design_kind].draws, design_info(store),
+                                   event="failed")
         stats.failure_probability = {**{k: found[k] for k in ("estimate", "lower", "upper", "n_effective")},
-                                     "method": found["sentence"].replace("runs", "runs failed", 1)}
+                                     "method": found["sentence"]}
     else:
         stats.failure_probability = grid_failure_probability(failed, store.weights[done])
     if stats.failed:

@@ -30,10 +30,10 @@ def exceedance_from_runs(values: np.ndarray, defined: np.ndarray, thresholds: li
     found = []
     for item in thresholds:
         (bound, threshold), = item.items()
-        beyond = _beyond(np.where(defined, values, np.nan), bound, threshold)
-        p = sampled_proportion(beyond, defined, draws, info or {}, CONFIDENCE)
-        note = p["sentence"].replace("runs", f"runs {bound} {threshold:g}", 1)
-        if int((beyond & defined).sum()) < RARE_COUNT:
+        beyond = _beyond(values, bound, threshold) & defined
+        p = sampled_proportion(beyond, defined, draws, info or {}, CONFIDENCE, event=f"{bound} {threshold:g}")
+        note = p["sentence"]
+        if int(beyond.sum()) < RARE_COUNT:
             note += (f"; fewer than {RARE_COUNT} runs exceed: a rare-event extrapolation from the runs, "
                      "run more to resolve it")
         found.append({bound: threshold, "probability": p["estimate"], "lower": p["lower"], "upper": p["upper"],

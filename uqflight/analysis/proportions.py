@@ -23,17 +23,17 @@ from .failures import wilson_interval
 DRAWS = ("independent", "pick_freeze", "stratified", "net")
 
 
-def sampled_proportion(hits, counted, draws: str, info: dict, confidence: float = 0.95) -> dict:
+def sampled_proportion(hits, counted, draws: str, info: dict, confidence: float = 0.95, event: str = "") -> dict:
     """{"estimate", "lower", "upper", "n_effective", "method", "sentence"} of the runs `counted` (bool
     (N,), in design order) where `hits` (bool (N,)) holds. lower/upper are None without an interval;
-    `method`: "wilson", "replicates" or "points"; `sentence` says how, for a note. `info`: the design's
-    recorded info (n_base, replicates, scramble)."""
+    `method`: "wilson", "replicates" or "points"; `sentence` says how, for a note, counting the runs
+    `event` names ("failed", "above 5"). `info`: the design's recorded info (n_base, replicates, scramble)."""
     hits, counted = np.asarray(hits, dtype=bool), np.asarray(counted, dtype=bool)
     if draws not in DRAWS:
         raise ValueError(f"draws must be one of {', '.join(DRAWS)}, got {draws!r}")
     replicates = int(info.get("replicates", 1))
     if draws == "net" and replicates > 1:
-        return _replicated(hits, counted, replicates, confidence)
+        return _replicated(hits, counted, replicates, confidence, event)
     if draws == "pick_freeze":
         counted = counted & (np.arange(hits.size) < 2 * int(info["n_base"]))
     k, n = int((hits & counted).sum()), int(counted.sum())
@@ -41,7 +41,7 @@ def sampled_proportion(hits, counted, draws: str, info: dict, confidence: float 
         return {"estimate": None, "lower": None, "upper": None, "n_effective": 0.0, "method": None,
                 "sentence": "no run counts: the probability is undefined"}
     estimate = k / n
-    counts = f"{k} of {n} runs"
+    counts = _counts(k, n, event)
     if draws == "net" and not info.get("scramble", True):
         return {"estimate": estimate, "lower": None, "upper": None, "n_effective": float(n), "method": "points",
                 "sentence": f"{counts}; no interval: unscrambled QMC points are fixed, not random (scramble them, "
@@ -63,24 +63,29 @@ def sampled_proportion(hits, counted, draws: str, info: dict, confidence: float 
             "method": "wilson", "sentence": sentence}
 
 
-def _replicated(hits, counted, replicates: int, confidence: float) -> dict:
+def _counts(k: int, n: int, event: str) -> str:
+    return f"{k} of {n} runs {event}" if event else f"{k} of {n} runs"
+
+
+def _replicated(hits, counted, replicates: int, confidence: float, event: str) -> dict:
     """Randomised QMC: the mean of the replicates' proportions, Student-t over their spread."""
     size = hits.size // replicates
     shares = [hits[r * size:(r + 1) * size][counted[r * size:(r + 1) * size]].mean()
               for r in range(replicates) if counted[r * size:(r + 1) * size].any()]
     k, n = int((hits & counted).sum()), int(counted.sum())
+    counts = _counts(k, n, event)
     if len(shares) < 2:
         return {"estimate": k / n if n else None, "lower": None, "upper": None, "n_effective": float(n),
-                "method": None, "sentence": f"{k} of {n} runs; no interval: fewer than 2 replicates have runs"}
+                "method": None, "sentence": f"{counts}; no interval: fewer than 2 replicates have runs"}
     shares = np.asarray(shares)
     r = shares.size
     estimate = float(shares.mean())
     half = float(stats.t.ppf(0.5 * (1 + confidence), r - 1) * shares.std(ddof=1) / np.sqrt(r))
     if half == 0.0:
         return {"estimate": estimate, "lower": None, "upper": None, "n_effective": float(n), "method": "replicates",
-                "sentence": f"{k} of {n} runs; no interval: every one of the {r} replicates gives {estimate:g}, "
+                "sentence": f"{counts}; no interval: every one of the {r} replicates gives {estimate:g}, "
                             f"so their spread says nothing finer than 1/{size}; run more samples per replicate"}
     return {"estimate": estimate, "lower": max(estimate - half, 0.0), "upper": min(estimate + half, 1.0),
             "n_effective": float(n), "method": "replicates",
-            "sentence": f"{k} of {n} runs; mean of {r} replicates' proportions, {100 * confidence:g} % Student-t "
+            "sentence": f"{counts}; mean of {r} replicates' proportions, {100 * confidence:g} % Student-t "
                         "interval of their spread"}

@@ -1,5 +1,5 @@
 """The memory a calibration needs, estimated before any work from the data file's rows and the
-options, and refused beyond the memory limit of `plan` and `run` (limits.max_memory_gb's default).
+options, and refused beyond the campaign's memory limit (limits.max_memory_gb, as `plan` and `run`).
 
 Per data row and calibrated output, the arrays that grow with the data: the posterior-predictive
 band (predictive draws x noise draws, and the copy its quantiles sort), the simulator runs and the
@@ -39,7 +39,7 @@ def campaign_memory_limit(results) -> float:
 
 
 def check_size(data, outputs: list[str] | None, walkers: int | None, steps: int, predictive_draws: int,
-               max_memory_gb: float = DEFAULT_LIMITS["max_memory_gb"]) -> None:
+               max_memory_gb: float) -> None:
     """DataError when the calibration of `data` would need more than `max_memory_gb`; reads the
     header and counts lines, nothing more."""
     path = Path(data)
