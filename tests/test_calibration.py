@@ -236,6 +236,39 @@ def test_surrogate_error_widens_the_posterior():
         assert mean == pytest.approx(0.5 * information / (1 + information), rel=1e-3)
 
 
+def test_log_likelihood_is_the_dense_gaussian_density():
+    # two outputs on a 2-D quadratic basis, one with a given noise and a 2-direction surrogate error,
+    # one with its noise inferred and none: the stacked quadratic-form evaluation equals scipy's
+    # multivariate normal log-density with the full covariance σ²I + F Fᵀ. Data about 15000 (an
+    # altitude) so that the expansion about the prior centre is what keeps the digits; 1e-9 relative
+    # leaves room for the rounding of |y − f|² formed from a Gram matrix (measured 1e-13).
+    from scipy import stats
+
+    from uqflight.methods.basis import Basis, total_degree_indices
+
+    rng = np.random.default_rng(3)
+    indices = total_degree_indices(2, 2)
+    basis = Basis(["normal", "uniform"], indices)
+    times = np.linspace(0.0, 1.0, 40)
+    coefficients = {"h": rng.standard_normal((len(indices), 40)), "q": rng.standard_normal((len(indices), 40))}
+    coefficients["h"][0] += 15000.0
+    factors = {"h": 0.2 * rng.standard_normal((40, 2)), "q": np.zeros((40, 0))}
+    truth = np.array([[0.4, -0.3]])
+    values = {name: (basis(truth) @ c)[0] + 0.1 * rng.standard_normal(40) for name, c in coefficients.items()}
+    data = FlightData("x", times, values)
+    posterior = LogPosterior.build(times, coefficients, factors, ["normal", "uniform"], ["a", "b"], basis,
+                                   data, {"h": 0.1})
+    theta = np.column_stack([rng.normal(0.3, 0.2, 5), rng.uniform(-0.9, 0.9, 5), np.log(rng.uniform(0.05, 0.2, 5))])
+    expected = []
+    for row in theta:
+        f = {name: (basis(row[None, :2]) @ c)[0] for name, c in coefficients.items()}
+        cov_h = 0.1**2 * np.eye(40) + factors["h"] @ factors["h"].T
+        cov_q = np.exp(row[2]) ** 2 * np.eye(40)
+        expected.append(stats.multivariate_normal(f["h"], cov_h).logpdf(values["h"])
+                        + stats.multivariate_normal(f["q"], cov_q).logpdf(values["q"]))
+    assert posterior.log_likelihood(theta) == pytest.approx(np.array(expected), rel=1e-9)
+
+
 def test_split_rhat_detects_disagreeing_chains():
     rng = np.random.default_rng(0)
     same = rng.standard_normal((1000, 8, 1))

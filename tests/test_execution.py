@@ -183,3 +183,43 @@ def test_chunks_cover_the_design_and_taper_at_its_end(total, chunk):
     chunks = pending_chunks(np.arange(total), chunk, total)
     assert np.array_equal(np.concatenate(chunks), np.arange(total))
     assert [c.tolist() for c in pending_chunks(np.array([total - 1]), chunk, total)] == [chunks[-1].tolist()]
+
+
+CRASHING_MODEL = '''
+import os, signal
+import numpy as np
+T = np.linspace(0.0, 1.0, 11)
+
+def f(p):
+    if p["a"] > 5.0:  # the process itself dies, as a crashing native simulator would
+        os.kill(os.getpid(), signal.SIGKILL)
+    return {"time": T, "y": p["a"] * T, "z": p["b"] - T}
+'''
+
+
+def test_simulate_split_over_processes_equals_one_process_and_survives_a_dying_one(tmp_path):
+    # calibrate's predictive runs: the same numbers in 1 or 3 forked processes; a process killed by its
+    # simulator fails its own runs with the reason, the others' runs stand
+    from uqflight.execution import simulate
+
+    (tmp_path / "model.py").write_text(CRASHING_MODEL)
+    campaign = parse_campaign('''
+name: split
+seed: 1
+simulator: {kind: python, function: "model.py:f"}
+parameters:
+  a: {distribution: uniform, lower: 0, upper: 10}
+  b: {distribution: normal, nominal: 1.0, interval_pct: 30}
+design: {kind: monte_carlo, samples: 4}
+''', str(tmp_path / "c.yaml"))
+    kappa = np.column_stack([np.linspace(0.5, 4.5, 9), np.linspace(0.9, 1.1, 9)])
+    time, one, failures = simulate(campaign, kappa, ["y", "z"])
+    assert not failures
+    split_time, split, split_failures = simulate(campaign, kappa, ["y", "z"], processes=3)
+    assert not split_failures and np.array_equal(split_time, time)
+    for name in ("y", "z"):
+        assert np.array_equal(split[name], one[name])
+    kappa[7, 0] = 8.0  # in the last of three chunks (rows 6-8)
+    _, crashed, failures = simulate(campaign, kappa, ["y", "z"], processes=3)
+    assert failures == ["the process flying this run died (signal 9)"] * 3
+    assert np.isnan(crashed["y"][6:]).all() and np.array_equal(crashed["y"][:6], one["y"][:6])

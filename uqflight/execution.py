@@ -47,6 +47,7 @@ from .campaign import Campaign
 from .campaign.reading import parameters_attribute
 from .campaign.schema import WORKER_BYTES
 from .designs import Design, is_adaptive
+from .forking import FORKS, Child, ChildFailed
 from .parameters import seed_names
 from .progress import Progress
 from .refinement import run_rounds
@@ -149,22 +150,52 @@ def prepare_store(campaign: Campaign, design: Design, out: Path, force: bool, no
         quantities=list(campaign.quantities), capacity=campaign.runs if is_adaptive(design.kind) else None)
 
 
-def simulate(campaign: Campaign, kappa: np.ndarray, outputs: list[str]):
-    """Fly (or call) the campaign's simulator at every row of kappa (M, d) in this process, as a worker of
-    `uqflight run` does (e.g. the calibration's posterior-predictive runs).
+def simulate(campaign: Campaign, kappa: np.ndarray, outputs: list[str], processes: int = 1):
+    """Fly (or call) the campaign's simulator at every row of kappa (M, d), as a worker of `uqflight run`
+    does (e.g. the calibration's posterior-predictive runs): in this process, or split over `processes`
+    forked children (where the system forks). Each run starts from a fresh simulator state, so the
+    numbers do not depend on the split.
 
     Returns (time (T,), {output: (M, T)} with NaN rows for failed runs, [failure reasons]).
     """
+    kappa = np.asarray(kappa, dtype=float)
+    chunks = np.array_split(np.arange(len(kappa)), max(1, min(processes, len(kappa))))
+    if len(chunks) == 1 or not FORKS:
+        return _simulate_rows(campaign, kappa, outputs)
+    children = [Child(lambda rows=rows: _simulate_rows(campaign, kappa[rows], outputs)) for rows in chunks]
+    found = []
+    for child in children:
+        try:
+            found.append(child.wait())
+        except ChildFailed as exc:
+            found.append(f"the process flying this run {exc}")
+    time = next((f[0] for f in found if not isinstance(f, str)), None)
+    if time is None:  # every child died: the time grid from the simulator here
+        time = _simulate_rows(campaign, kappa[:0], outputs)[0]
+    values = {name: np.full((len(kappa), len(time)), np.nan) for name in outputs}
+    failures = []
+    for rows, f in zip(chunks, found):
+        if isinstance(f, str):  # a child that died: its runs failed, with how
+            failures += [f] * len(rows)
+            continue
+        failures += f[2]
+        for name in outputs:
+            values[name][rows] = f[1][name]
+    return time, values, failures
+
+
+def _simulate_rows(campaign: Campaign, kappa: np.ndarray, outputs: list[str]):
+    """`simulate` of every row in this process."""
     from .simulators import make_simulator
     from .simulators.base import FlightError
 
     names = [p.name for p in campaign.parameters]
     properties = [p.property for p in campaign.parameters]
     simulator = make_simulator(campaign.simulator, names, properties, Path(campaign.source).resolve().parent)
-    time, _ = simulator.layout(np.asarray(kappa)[0])
+    time, _ = simulator.layout(kappa[0] if len(kappa) else nominal_kappa(campaign))
     values = {name: np.full((len(kappa), len(time)), np.nan) for name in outputs}
     failures = []
-    for row, k in enumerate(np.asarray(kappa, dtype=float)):
+    for row, k in enumerate(kappa):
         simulator.restart()  # each run as from a fresh worker: independent of the order of the draws
         try:
             result = simulator.evaluate(k)

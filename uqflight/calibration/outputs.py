@@ -9,6 +9,7 @@ import h5py
 import numpy as np
 import yaml
 
+from ..forking import FORKS, Child, ChildFailed
 from ..labels import label, parameter_label, short_label
 from ..statistics import json_ready as strict
 
@@ -138,6 +139,24 @@ def calibrated_campaign(mapping: dict, specs: dict, posterior: dict, prior: dict
 
 
 # -- plots --------------------------------------------------------------------------------------------
+def draw_all(plots: list) -> None:
+    """Call every plot function, each in a forked child at once where the system forks (they are
+    independent); RuntimeError when one fails (its traceback is printed)."""
+    if not FORKS:
+        for plot in plots:
+            plot()
+        return
+    children = [Child(plot) for plot in plots]
+    failed = []
+    for child in children:
+        try:
+            child.wait()
+        except ChildFailed as exc:
+            failed.append(str(exc))
+    if failed:
+        raise RuntimeError(f"cannot write a calibration plot: its process {failed[0]} (the error is printed above)")
+
+
 def _pyplot():
     import matplotlib
 
@@ -166,27 +185,31 @@ def corner_figure(draws: np.ndarray, names: list[str], truth=None, bins: int = 4
     d = draws.shape[1]
     labels = _labels(names, properties)
     size = min(2.0 * d + 0.6, 16.0)
-    fig, axes = plt.subplots(d, d, figsize=(size, size), squeeze=False)
+    fig = plt.figure(figsize=(size, size))
+    # fixed margins in inches (tick labels, names, title) instead of a layout pass over d² panels
+    grid = fig.add_gridspec(d, d, left=0.8 / size, right=1 - 0.15 / size, bottom=0.9 / size, top=1 - 0.5 / size,
+                            wspace=0.1, hspace=0.1)
     lows, highs = np.quantile(draws, 0.001, axis=0), np.quantile(draws, 0.999, axis=0)
     spans = np.where(highs > lows, highs - lows, 1.0)
     lows, highs = lows - 0.05 * spans, highs + 0.05 * spans
     mean = draws.mean(axis=0)
     known = truth is not None and np.isfinite(truth).any()
     for i in range(d):
-        for j in range(d):
-            ax = axes[i, j]
-            if j > i:
-                ax.axis("off")
-                continue
+        for j in range(i + 1):
+            ax = fig.add_subplot(grid[i, j])
             if i == j:
-                ax.hist(draws[:, i], bins=bins, range=(lows[i], highs[i]), color="C0", histtype="stepfilled", alpha=0.6)
+                counts, edges = np.histogram(draws[:, i], bins=bins, range=(lows[i], highs[i]))
+                ax.stairs(counts, edges, color="C0", fill=True, alpha=0.6)
+                ax.set_xlim(lows[i], highs[i])
                 ax.axvline(mean[i], color="k", ls="--", lw=1)
                 ax.set_yticks([])
                 if known and np.isfinite(truth[i]):
                     ax.axvline(truth[i], color="C3")
             else:
-                ax.hist2d(draws[:, j], draws[:, i], bins=bins, range=[[lows[j], highs[j]], [lows[i], highs[i]]],
-                          cmap="Blues")
+                counts, _, _ = np.histogram2d(draws[:, j], draws[:, i], bins=bins,
+                                              range=[[lows[j], highs[j]], [lows[i], highs[i]]])
+                ax.imshow(counts.T, origin="lower", extent=(lows[j], highs[j], lows[i], highs[i]), aspect="auto",
+                          cmap="Blues", interpolation="nearest")
                 ax.plot(mean[j], mean[i], "+", color="k", ms=8)
                 if known and np.isfinite(truth[i]) and np.isfinite(truth[j]):
                     ax.plot(truth[j], truth[i], "s", color="C3", ms=4)
@@ -203,7 +226,6 @@ def corner_figure(draws: np.ndarray, names: list[str], truth=None, bins: int = 4
             ax.tick_params(labelsize=6)
     fig.legend(handles=_marks(known), loc="upper right", fontsize=9, frameon=False)
     fig.suptitle("posterior (physical values)")
-    fig.tight_layout()
     return fig
 
 

@@ -3,6 +3,7 @@ from __future__ import annotations
 
 import json
 import math
+import os
 import shutil
 import tempfile
 import time as clock
@@ -15,7 +16,7 @@ from threadpoolctl import threadpool_limits
 from ..parameters.germs import GERMS
 
 from .likelihood import DataError, LogPosterior, interpolate_in_time, parse_noise, read_flight_csv
-from .outputs import (OUTPUT_FILES, calibrated_campaign, corner_plot, informed, marginal, marginals_plot,
+from .outputs import (OUTPUT_FILES, calibrated_campaign, corner_plot, draw_all, informed, marginal, marginals_plot,
                       predictive_plot, write_json, write_posterior)
 from .sampler import sample
 from .size import PREDICTIVE_NOISE_DRAWS, campaign_memory_limit, check_size
@@ -303,13 +304,14 @@ def _write_outputs(out, results, data, seed, surrogate, flight, posterior, chain
         (scratch / "calibrated.yaml").write_text(text, encoding="utf-8")
         truth_row = np.array([truth.get(n, np.nan) for n in names]) if truth else None
         properties = [specs[n]["property"] for n in names]
-        corner_plot(scratch / "plots/corner.png", draws.kappa, names, truth_row, properties=properties)
         prior_xi = sampling.prior_draw(posterior, np.random.default_rng(seed + 2), 20000)[:, :len(names)]
         prior_kappa = to_physical(surrogate.parameters, prior_xi, surrogate.campaign.dependence)
-        marginals_plot(scratch / "plots/marginals.png", prior_kappa, draws.kappa, names, truth_row,
-                       properties=properties)
-        predictive_plot(scratch / "plots/predictive.png", flight.time, flight.values, at_data, band,
-                        surrogate.units, failed)
+        plots = scratch / "plots"
+        draw_all([lambda: corner_plot(plots / "corner.png", draws.kappa, names, truth_row, properties=properties),
+                  lambda: marginals_plot(plots / "marginals.png", prior_kappa, draws.kappa, names, truth_row,
+                                         properties=properties),
+                  lambda: predictive_plot(plots / "predictive.png", flight.time, flight.values, at_data, band,
+                                          surrogate.units, failed)])
         summary["seconds"]["total"] = clock.perf_counter() - started
         write_json(scratch / "summary.json", summary)
         (out / "plots").mkdir(exist_ok=True)
@@ -340,7 +342,8 @@ def _predictive(chain, posterior, surrogate, flight, rng, count):
     pick = rng.choice(len(draws), size=min(count, len(draws)), replace=False)
     xi = draws[pick, :len(surrogate.names)]
     kappa = to_physical(surrogate.parameters, xi, surrogate.campaign.dependence)
-    sim_time, runs, failures = simulate(surrogate.campaign, kappa, list(flight.values))
+    processes = min(surrogate.campaign.execution["workers"], os.cpu_count() or 1)  # the campaign's, on this machine
+    sim_time, runs, failures = simulate(surrogate.campaign, kappa, list(flight.values), processes)
     ok = np.all([np.all(np.isfinite(runs[o]), axis=1) for o in runs], axis=0)
     errors = {}
     basis = surrogate.basis(xi[ok])

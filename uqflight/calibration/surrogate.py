@@ -20,7 +20,7 @@ from ..campaign.reading import campaign_folder, check_campaign_text, portable_ma
 from ..designs import is_sampled
 from ..execution import simulate
 from ..methods import METHOD_KINDS, normalised
-from ..methods.basis import orthonormal_basis
+from ..methods.basis import Basis, orthonormal_basis
 from ..methods.loo import loo_residuals, relative_loo_error
 from ..parameters import Parameter
 from ..parameters import to_physical as _to_physical
@@ -80,7 +80,9 @@ class CalibrationSurrogate:
 
     def basis(self, xi: np.ndarray) -> np.ndarray:
         """Ψ_α(ξ) at the rows of xi (M, d): (M, Z)."""
-        return orthonormal_basis(self.germs, self.indices, xi)
+        if getattr(self, "_basis", None) is None:
+            self._basis = Basis(self.germs, self.indices)
+        return self._basis(xi)
 
     def prior_mean_variance(self, output: str) -> tuple[np.ndarray, np.ndarray]:
         """Mean and variance over time of the surrogate under the prior (orthonormal basis)."""

@@ -7,7 +7,6 @@ point) is drawn as markers instead of lines.
 from __future__ import annotations
 
 import os
-import traceback
 from contextlib import contextmanager
 from pathlib import Path
 
@@ -21,6 +20,7 @@ import numpy as np  # noqa: E402
 from matplotlib.lines import Line2D  # noqa: E402
 from matplotlib.ticker import FixedLocator, FuncFormatter, LogLocator, MaxNLocator, NullFormatter  # noqa: E402
 
+from ..forking import FORKS, Child, ChildFailed  # noqa: E402
 from ..labels import label, short_label  # noqa: E402,F401 (plots.label: the report's captions)
 
 TIME_LABEL = "time [s]"
@@ -69,17 +69,9 @@ def write_figure(fig, path: Path, dpi: int = DPI, rect=None) -> Path:
         children = _background["children"]
         while len(children) >= _background["limit"]:
             _background["failed"] += _failures([children.pop(0)])
-        pid = os.fork()
-        if pid:
-            children.append((pid, str(shown)))
-            plt.close(fig)
-            return shown
-        try:  # the child: write the figure and leave at once, running no handler of the parent's
-            save()
-        except BaseException:
-            traceback.print_exc()
-            os._exit(1)
-        os._exit(0)
+        children.append((Child(save), str(shown)))
+        plt.close(fig)
+        return shown
     save()
     plt.close(fig)
     return shown
@@ -182,7 +174,7 @@ def background_rendering(processes: int | None = None):
     (at most `processes` children at once, default the CPU count): the same PNG bytes, in a fraction of
     the time on several cores. Leaving waits for every child; RuntimeError names a figure that failed."""
     global _background
-    if not hasattr(os, "fork") or _background is not None:
+    if not FORKS or _background is not None:
         yield
         return
     _background = {"children": [], "limit": processes or os.cpu_count() or 1, "failed": []}
@@ -204,8 +196,14 @@ def _wait_all() -> list[str]:
 
 
 def _failures(children: list) -> list[str]:
-    """Wait for the (pid, figure) children; the figures whose child failed."""
-    return [path for pid, path in children if os.waitstatus_to_exitcode(os.waitpid(pid, 0)[1]) != 0]
+    """Wait for the (child, figure) pairs; the figures whose child failed."""
+    failed = []
+    for child, path in children:
+        try:
+            child.wait()
+        except ChildFailed:
+            failed.append(path)
+    return failed
 
 
 def _write(fig, path: Path, rect=(0, 0, 1, 1)) -> Path:

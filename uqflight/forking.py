@@ -1,0 +1,48 @@
+"""Work done in a forked child while the parent goes on (figures written in the background, runs split
+over processes). The child inherits the parent's memory, so nothing is pickled on the way in; its
+result comes back pickled through a pipe. It runs no handler of the parent's and leaves with
+os._exit; a child that fails or dies is reported as such when waited for."""
+from __future__ import annotations
+
+import os
+import pickle
+import traceback
+from typing import Callable
+
+FORKS = hasattr(os, "fork")  # where the system cannot fork, callers do the work themselves
+
+
+class ChildFailed(RuntimeError):
+    """A child that raised (its traceback printed to stderr) or died; the message says which."""
+
+
+class Child:
+    """A forked child doing `work()`; `wait()` gives its result."""
+
+    def __init__(self, work: Callable[[], object]):
+        read, write = os.pipe()
+        self.pid = os.fork()
+        if self.pid == 0:  # the child
+            os.close(read)
+            code = 0
+            try:
+                payload = pickle.dumps(work(), protocol=pickle.HIGHEST_PROTOCOL)
+                with os.fdopen(write, "wb") as pipe:
+                    pipe.write(payload)
+            except BaseException:
+                traceback.print_exc()
+                code = 1
+            os._exit(code)
+        os.close(write)
+        self._read = read
+
+    def wait(self):
+        """The child's result; ChildFailed when it raised or died."""
+        with os.fdopen(self._read, "rb") as pipe:  # read first: a large result would block the child
+            payload = pipe.read()
+        status = os.waitstatus_to_exitcode(os.waitpid(self.pid, 0)[1])
+        if status < 0:
+            raise ChildFailed(f"died (signal {-status})")
+        if status != 0 or not payload:
+            raise ChildFailed(f"failed (exit {status})")
+        return pickle.loads(payload)
