@@ -16,7 +16,7 @@ How the points were drawn (`DesignKind.draws`, with the design's recorded info):
 from __future__ import annotations
 
 import numpy as np
-from scipy import stats
+from scipy import special
 
 from .failures import wilson_interval
 
@@ -80,7 +80,7 @@ def _replicated(hits, counted, replicates: int, confidence: float, event: str) -
     shares = np.asarray(shares)
     r = shares.size
     estimate = float(shares.mean())
-    half = float(stats.t.ppf(0.5 * (1 + confidence), r - 1) * shares.std(ddof=1) / np.sqrt(r))
+    half = float(special.stdtrit(r - 1, 0.5 * (1 + confidence)) * shares.std(ddof=1) / np.sqrt(r))  # Student t quantile
     if half == 0.0:
         return {"estimate": estimate, "lower": None, "upper": None, "n_effective": float(n), "method": "replicates",
                 "sentence": f"{counts}; no interval: every one of the {r} replicates gives {estimate:g}, "

@@ -151,17 +151,42 @@ def _panels(count: int, title: str, row_height: float = 2.9):
     for ax in axes.flat[count:]:
         ax.set_visible(False)
     fig.suptitle(title, fontsize=12)
+    fig.panel_grid = (rows, columns)  # laid out by _save with fixed margins, not a layout pass
     return fig, list(axes.flat[:count])
+
+
+# margins of a panel grid, in inches: tick labels and the axis label on the left of each panel; its title
+# above and its tick labels and time label below; the figure's title on top
+PANEL_MARGINS = {"left": 0.9, "right": 0.25, "column_gap": 1.0, "top": 0.6, "row_gap": 0.85, "bottom": 0.6,
+                 "legend_row": 0.22}
+
+
+def _fix_panel_layout(fig, legend_rows: int) -> None:
+    """Place the panels of a `_panels` figure with PANEL_MARGINS (and room for `legend_rows` of legend
+    below): what tight_layout would find for these fonts, without measuring every text."""
+    rows, columns = fig.panel_grid
+    width, height = fig.get_size_inches()
+    m = PANEL_MARGINS
+    bottom = m["bottom"] + m["legend_row"] * legend_rows
+    panel_width = (width - m["left"] - m["right"] - (columns - 1) * m["column_gap"]) / columns
+    panel_height = (height - m["top"] - bottom - (rows - 1) * m["row_gap"]) / rows
+    fig.subplots_adjust(left=m["left"] / width, right=1 - m["right"] / width, top=1 - m["top"] / height,
+                        bottom=bottom / height, wspace=m["column_gap"] / panel_width,
+                        hspace=m["row_gap"] / panel_height)
 
 
 def _save(fig, path: Path, legend_handles=None, legend_columns: int = 3) -> Path:
     """Place a shared legend under the panels (when given) and write the PNG."""
-    rect = (0, 0, 1, 1)
+    rect, legend_rows = (0, 0, 1, 1), 0
     if legend_handles:
         handles, labels = legend_handles
         fig.legend(handles, labels, loc="lower center", ncol=min(legend_columns, len(labels)), fontsize=8,
                    frameon=False)
-        rect = (0, 0.04 + 0.025 * ((len(labels) - 1) // legend_columns), 1, 1)
+        legend_rows = 1 + (len(labels) - 1) // legend_columns
+        rect = (0, 0.04 + 0.025 * (legend_rows - 1), 1, 1)
+    if hasattr(fig, "panel_grid"):
+        _fix_panel_layout(fig, legend_rows)
+        return write_figure(fig, path)
     return _write(fig, path, rect)
 
 
@@ -289,8 +314,10 @@ def plot_pdf_over_time(out, path: Path, title: str, slice_times: list[float]) ->
         ax.set_ylabel("probability density", fontsize=9)
         ax.grid(alpha=0.3)
         fig.suptitle(title, fontsize=12)
+        fig.panel_grid = (1, 1)
         return _save(fig, path)
     fig, (top, bottom) = plt.subplots(2, 1, figsize=(9, 8.2), gridspec_kw={"height_ratios": [3, 2]})
+    fig.panel_grid = (2, 1)
     _pdf_heat_map(fig, top, out)
     for color, index in zip(COLORS, time_indices(out.time, slice_times)):
         bottom.plot(out.pdf_support[index], out.pdf_density[index], color=color, label=f"t = {out.time[index]:g} s")
@@ -712,7 +739,9 @@ def plot_design_pairs(results, path: Path, title: str) -> Path | None:
             ax.grid(alpha=0.3)
     fig.legend(*handles, loc="upper right", fontsize=8, frameon=False)
     fig.suptitle(f"{title}\nphysical values κ", fontsize=11)
-    fig.tight_layout()
+    # fixed margins in inches: names and 6-pt tick labels outside the grid, none between its panels
+    fig.subplots_adjust(left=0.75 / side, right=1 - 0.2 / side, bottom=0.6 / side, top=1 - 0.85 / side,
+                        wspace=0.12, hspace=0.12)
     return write_figure(fig, path)
 
 
