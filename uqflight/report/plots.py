@@ -203,6 +203,7 @@ def background_rendering(processes: int | None = None):
         yield
         return
     _background = {"children": [], "limit": processes or os.cpu_count() or 1, "failed": []}
+    _warm_text_caches()
     try:
         yield
     except BaseException:
@@ -211,6 +212,17 @@ def background_rendering(processes: int | None = None):
     failed = _wait_all()
     if failed:
         raise RuntimeError(f"cannot write the plot {failed[0]} (its error is printed above)")
+
+
+def _warm_text_caches() -> None:
+    """Draw a small figure with the report's fonts and digits once here, so that every forked child
+    inherits the loaded fonts and their glyph and metric caches instead of building them again."""
+    fig, ax = plt.subplots(figsize=(2, 1))
+    for size in (6, 7, 8, 9, 10, 11, 12):
+        ax.text(0, 0, "0123456789.−-×⁰¹²³⁴⁵⁶⁷⁸⁹ time [s] deg ft kt", fontsize=size)
+    ax.set_title("warm", fontsize=10)
+    fig.canvas.draw()
+    plt.close(fig)
 
 
 def _wait_all() -> list[str]:
