@@ -157,7 +157,7 @@ def _panels(count: int, title: str, row_height: float = 2.9):
 
 # margins of a panel grid, in inches: tick labels and the axis label on the left of each panel; its title
 # above and its tick labels and time label below; the figure's title on top
-PANEL_MARGINS = {"left": 0.9, "right": 0.25, "column_gap": 1.0, "top": 0.6, "row_gap": 0.85, "bottom": 0.6,
+PANEL_MARGINS = {"left": 0.9, "right": 0.25, "column_gap": 1.0, "top": 0.72, "row_gap": 0.85, "bottom": 0.6,
                  "legend_row": 0.22}
 
 
