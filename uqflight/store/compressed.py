@@ -1,5 +1,6 @@
 """The compressed (tSVD) storage form: per output, the incremental thin-SVD factors of the ok runs and a
-buffer of ok runs not folded in yet, /tsvd/<name>/{U, s, V, columns, buffer, buffer_index}.
+buffer of ok runs not folded in yet, /tsvd/<name>/{U, s, V, columns, buffer, buffer_index} (/tsvd attributes:
+the truncation tolerance tol and the fold size batch).
 
 The buffer takes the runs as they come; the runs are folded into the factors in design order, `batch`
 columns at a time, only over the contiguous completed prefix (and the last partial batch once no run is

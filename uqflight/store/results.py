@@ -24,14 +24,13 @@ Crash safety: every batch writes its data and the failed runs' reasons first, fl
 writes the status,
 flushes and fsyncs again (one flush would let HDF5 write its cached chunks in its own order, and a
 kill or full disk could then leave a status without its data), so a killed process loses at most
-the batch in flight and `pending()` tells exactly what to rerun. The factors
-and the buffer of an output are replaced together: written into `/tsvd/<name>/next`, marked complete,
-flushed, then moved in place; reopening with mode "a" finishes or discards such a half-done step.
+the batch in flight and `pending()` tells exactly what to rerun. The tSVD form replaces an output's
+factors and buffer together, staged in `/tsvd/<name>/next`; reopening with mode "a" finishes or
+discards such a half-done step (`compressed`).
 
-Determinism: runs complete in any order, but the tSVD ingests the ok runs in design order, `batch`
-columns at a time, folding only the contiguous completed prefix (and the last partial batch once no
-run is pending), so the factors do not depend on the number of workers or on interruptions. Every
-fold runs with one BLAS thread (threadpoolctl), whoever calls it, so a resume gives the same bits.
+Determinism: runs complete in any order; the raw rows land in their design rows, and the tSVD folds
+the ok runs in design order with one BLAS thread (`compressed`), so the file depends neither on the
+number of workers nor on interruptions: a resume gives the same bits.
 
 Integrity: every dataset is chunked with HDF5's fletcher32 checksum, so a flipped byte is reported
 on reading (`CorruptFile`) instead of read back as a valid value; status codes outside `Status`
