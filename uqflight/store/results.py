@@ -134,7 +134,7 @@ class ResultStore:
             raise ValueError("the recorded times must be finite and strictly increasing")
         if not raw and tsvd is None:
             raise ValueError("nothing would be stored: turn on raw storage or tsvd compression")
-        tsvd = None if tsvd is None else TsvdStorage.settings(tsvd)  # a bad tolerance is refused before the file
+        settings = None if tsvd is None else TsvdStorage.settings(tsvd)  # a bad tolerance: refused before the file
 
         grow = {} if capacity is None else {"maxshape": (None,)}  # resizable along the runs
         rows_hint = n if capacity is None else max(n, capacity)
@@ -170,7 +170,7 @@ class ResultStore:
                 group.create_dataset(key_of(name), shape=(n,), dtype="f8", fillvalue=np.nan,
                                      chunks=(min(rows_hint, QUANTITY_ROWS),), fletcher32=True, **grow)
         if tsvd is not None:
-            TsvdStorage.create(f, outputs, units, time.size, *tsvd)
+            TsvdStorage.create(f, outputs, units, time.size, *settings)
         f.flush()
         return cls(f)
 
