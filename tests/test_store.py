@@ -3,6 +3,7 @@
 Run as a script (`python test_store.py PATH SEED`), this file is the writer that the SIGKILL test kills.
 """
 import hashlib
+import inspect
 import json
 import os
 import signal
@@ -20,6 +21,8 @@ import uqflight.store.results
 from uqflight.analysis.moments import weighted_moments
 from uqflight.statistics import output_basis
 from uqflight.store import ResultStore, Status, open_for_campaign
+from uqflight.store.results import STORAGES
+from uqflight.store.storage import OutputStorage
 
 N, T = 240, 400
 XI, TIME = np.random.default_rng(7).standard_normal((N, 2)), np.linspace(0.0, 20.0, T)
@@ -198,6 +201,57 @@ def test_a_partial_compressed_file_reads_its_buffered_runs(tmp_path):
         np.testing.assert_allclose((V * s) @ U.T, outputs["alpha_deg"][ok], rtol=1e-9)
 
 
+def test_every_storage_form_implements_every_interface_method():
+    """Each form is one entry of results.STORAGES, under its layout group (raw first: it is read when
+    kept), and defines every method of OutputStorage itself, with the interface's parameters."""
+    assert set(OutputStorage.__subclasses__()) == set(STORAGES)
+    assert [form.GROUP for form in STORAGES] == ["outputs", "tsvd"]
+    interface = sorted(OutputStorage.__abstractmethods__)
+    assert {"write", "settle", "matrix", "blocks", "factors", "lost_runs", "problems", "description"} <= set(interface)
+    for form in STORAGES:
+        assert not form.__abstractmethods__, form
+        for name in interface:
+            assert name in vars(form), f"{form.__name__} does not define {name}"
+            ours, theirs = vars(form)[name], vars(OutputStorage)[name]
+            if isinstance(theirs, property):
+                assert isinstance(ours, property), f"{form.__name__}.{name} is not a property"
+                ours, theirs = ours.fget, theirs.fget
+            assert list(inspect.signature(ours).parameters) == list(inspect.signature(theirs).parameters), name
+
+
+def test_raw_and_tsvd_forms_hold_the_same_runs(tmp_path):
+    """The two forms of one raw + tSVD file, fed the same runs out of order, half of them and then all:
+    the same matrix (NaN rows where not run or failed), the same runs in design order block by block,
+    nothing lost, no problem. The tSVD rebuild is within K·tol·σ₁ of the raw data in the 2-norm, so in
+    every entry: each of the K ≤ N/batch updates drops singular values below tol·σ₁ (σ₁ of the data)."""
+    batches = shuffled_batches(seed=8)
+    with ResultStore.create(tmp_path / "both.h5", campaign_text=CAMPAIGN, **create_args()) as store:
+        raw, tsvd = store._storages
+        for written in (batches[:len(batches) // 2], batches[len(batches) // 2:]):
+            write_runs(store, written)
+            status = store.status
+            ok = np.flatnonzero(status == Status.OK)
+            rows = np.r_[N - 1:-1:-1, 5, 5]  # any order, repeats allowed
+            for name in OUTPUTS:
+                exact = raw.matrix(name, rows, status)
+                bound = (N / 8) * 1e-10 * np.linalg.norm(exact[np.isfinite(exact[:, 0])], 2)
+                rebuilt = tsvd.matrix(name, rows, status)
+                np.testing.assert_array_equal(np.isnan(rebuilt), np.isnan(exact))
+                assert np.nanmax(np.abs(rebuilt - exact)) <= bound
+                for form in (raw, tsvd):
+                    indices, histories = zip(*form.blocks(name, status, 50))
+                    np.testing.assert_array_equal(np.concatenate(indices), ok)
+                    assert np.abs(np.vstack(histories) - raw.matrix(name, ok, status)).max() <= bound
+                U, s, V, columns = tsvd.factors(name, status)
+                np.testing.assert_array_equal(np.sort(columns), ok)
+                assert raw.factors(name, status) is None
+            for form in (raw, tsvd):
+                assert form.problems(status, 64) == [] and not form.lost_runs(status, 64).any()
+                assert form.output_names == OUTPUTS and form.units == {"alpha_deg": "deg", "h_ft": "ft"}
+        assert (raw.tolerance, tsvd.tolerance) == (0.0, 1e-10)
+        assert (raw.description, tsvd.description) == ("raw", "tsvd tol 1e-10, batch 8, ranks alpha_deg 4, h_ft 3")
+
+
 def kill_writer_midway(path, batches_before_kill, delay) -> None:
     """Run this file as the writer of `path` and SIGKILL it `delay` seconds after it has written that many
     batches (a batch takes a few milliseconds: the delay moves the kill across the steps of the next ones).
@@ -348,8 +402,7 @@ def test_a_crash_between_two_steps_is_mended_on_reopening(tmp_path, reference, m
     path = tmp_path / "crashed.h5"
     with ResultStore.create(path, campaign_text=CAMPAIGN, **create_args()) as store:
         write_runs(store, [np.arange(0, 6)])
-        # the writer calls append_rows from the layout module, and the staging steps inside compressed
-        module = uqflight.store.results if step == "append_rows" else uqflight.store.compressed
+        module = uqflight.store.compressed  # the tSVD form's buffering and staging steps
         monkeypatch.setattr(module, step, crash(getattr(module, step)))
         with pytest.raises(Crash):
             write_runs(store, [np.arange(6, 20)])  # enough runs to fold a batch of 8 columns

@@ -1,5 +1,5 @@
-"""The HDF5 results file: its layout (`results`), compressed tSVD storage (`compressed`) and the resume
-policy (`resume`)."""
+"""The HDF5 results file: its layout (`results`), the outputs' storage forms behind one interface
+(`storage`: raw histories in `raw`, tSVD factors in `compressed`) and the resume policy (`resume`)."""
 from ..simulators.base import Status
 from .resume import compact, open_for_campaign
 from .lock import LockHeld, ResultsLock

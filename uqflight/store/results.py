@@ -16,18 +16,21 @@ Layout (docs/results-file.md; N runs, d parameters, T recorded times):
     root attributes: campaign (YAML text), campaign_hash (its sha256), created, and the caller's
     (versions, aircraft_hash, ...)
 
+Storage forms: the outputs are kept raw (`raw`), compressed (`compressed`), or both, each behind one
+interface (`storage.OutputStorage`); every batch is written to each form the file holds, and read from
+the first (raw when kept: it is exact).
+
 Crash safety: every batch writes its data and the failed runs' reasons first, flushes and fsyncs, then
 writes the status,
 flushes and fsyncs again (one flush would let HDF5 write its cached chunks in its own order, and a
 kill or full disk could then leave a status without its data), so a killed process loses at most
-the batch in flight and `pending()` tells exactly what to rerun. The factors
-and the buffer of an output are replaced together: written into `/tsvd/<name>/next`, marked complete,
-flushed, then moved in place; reopening with mode "a" finishes or discards such a half-done step.
+the batch in flight and `pending()` tells exactly what to rerun. The tSVD form replaces an output's
+factors and buffer together, staged in `/tsvd/<name>/next`; reopening with mode "a" finishes or
+discards such a half-done step (`compressed`).
 
-Determinism: runs complete in any order, but the tSVD ingests the ok runs in design order, `batch`
-columns at a time, folding only the contiguous completed prefix (and the last partial batch once no
-run is pending), so the factors do not depend on the number of workers or on interruptions. Every
-fold runs with one BLAS thread (threadpoolctl), whoever calls it, so a resume gives the same bits.
+Determinism: runs complete in any order; the raw rows land in their design rows, and the tSVD folds
+the ok runs in design order with one BLAS thread (`compressed`), so the file depends neither on the
+number of workers nor on interruptions: a resume gives the same bits.
 
 Integrity: every dataset is chunked with HDF5's fletcher32 checksum, so a flipped byte is reported
 on reading (`CorruptFile`) instead of read back as a valid value; status codes outside `Status`
@@ -46,23 +49,16 @@ from datetime import datetime, timezone
 import h5py
 import numpy as np
 
-from threadpoolctl import threadpool_limits
-
 from ..quantities import is_quantity_key
 from ..simulators.base import Status
-from ..tsvd import IncrementalSVD, iter_column_blocks
-from .compressed import append_rows, apply_staged, buffer_rows, chunk_rows, commit, ingest, write_state
+from .chunks import chunk_blocks, grow_rows
+from .compressed import TsvdStorage
 from .layout import is_time_grid, layout_problems
+from .raw import RawStorage
 from .rounds import read_index_set, write_index_set
+from .storage import OutputStorage, key_of, name_of
 
-
-def _key(name: str) -> str:
-    """HDF5 name of an output: JSBSim property outputs contain "/", which HDF5 reads as groups."""
-    return name.replace("/", "|")
-
-
-def _name(key: str) -> str:
-    return key.replace("|", "/")
+STORAGES = (RawStorage, TsvdStorage)  # the storage forms, in the order they are read from
 
 
 def text_hash(text: str) -> str:
@@ -70,7 +66,6 @@ def text_hash(text: str) -> str:
     return hashlib.sha256(text.encode("utf-8")).hexdigest()
 
 
-MIN_CHUNK_BYTES = 64 * 1024  # raw chunks hold whole batches, but no fewer bytes than this (tiny runs)
 REASON_BYTES = 256  # a failure's reason is stored in at most this many UTF-8 bytes, longer ones cut with "…"
 REASON_ROWS = 256  # reasons per HDF5 chunk (64 KiB); only chunks holding a failed run are ever written
 QUANTITY_ROWS = 8192  # quantity values per HDF5 chunk (64 KiB)
@@ -102,27 +97,13 @@ def _no_reasons(data: h5py.Dataset, n: int):
     return [""] * n if h5py.check_string_dtype(data.dtype).length is None else np.zeros(n, dtype=data.dtype)
 
 
-def _chunk_blocks(data: h5py.Dataset, block: int, fill) -> Iterator[tuple[int, int, np.ndarray | None]]:
-    """(start, stop, rows) over `data` in blocks of whole chunks; a block that fails its checksum (a chunk
-    a kill tore) is overwritten with `fill`, chunk by chunk, and comes as (start, stop, None)."""
-    rows = data.chunks[0] if data.chunks else block
-    step = max(rows, block - block % rows)
-    for start in range(0, data.shape[0], step):
-        stop = min(start + step, data.shape[0])
-        try:
-            values = data[start:stop]
-        except OSError:
-            for first in range(start, stop, rows):
-                data[first:min(first + rows, stop)] = fill
-            values = None
-        yield start, stop, values
-
-
 class ResultStore:
     """One campaign's results file. Build it with `create`, `open` or `open_for_campaign`."""
 
     def __init__(self, file: h5py.File):
         self._file = file
+        self._storages: list[OutputStorage] = [form(file) for form in STORAGES
+                                               if isinstance(file.get(form.GROUP), h5py.Group)]
         self.repaired = 0  # ok runs found without their data on opening to resume, made pending again
 
     @classmethod
@@ -153,10 +134,7 @@ class ResultStore:
             raise ValueError("the recorded times must be finite and strictly increasing")
         if not raw and tsvd is None:
             raise ValueError("nothing would be stored: turn on raw storage or tsvd compression")
-        if tsvd is not None:
-            empty = IncrementalSVD.from_factors(np.zeros((time.size, 0)), np.zeros(0), np.zeros((0, 0)),
-                                                float(tsvd["tol"]))
-            batch = int(tsvd.get("batch", 1000))
+        settings = None if tsvd is None else TsvdStorage.settings(tsvd)  # a bad tolerance: refused before the file
 
         grow = {} if capacity is None else {"maxshape": (None,)}  # resizable along the runs
         rows_hint = n if capacity is None else max(n, capacity)
@@ -181,31 +159,18 @@ class ResultStore:
                                           "both pass the checks drift apart (max so far): a spread below this is "
                                           "not resolved by the simulator")
             for name in outputs:
-                group.create_dataset(_key(name), data=np.asarray(resolution[name], dtype=float), **CHECKED)
+                group.create_dataset(key_of(name), data=np.asarray(resolution[name], dtype=float), **CHECKED)
         if raw:
-            group = f.create_group("outputs", track_order=True)
-            rows = min(chunk_rows(time.size, rows_hint),
-                       max(batch_rows or rows_hint, -(-MIN_CHUNK_BYTES // (8 * time.size))))
-            for name in outputs:
-                ds = group.create_dataset(_key(name), shape=(n, time.size), dtype="f8", fillvalue=np.nan,
-                                          chunks=(rows, time.size), fletcher32=True,
-                                          **({} if capacity is None else {"maxshape": (None, time.size)}))
-                ds.attrs.update({"units": units.get(name, ""), "dimensions": ["sample", "time"]})
+            RawStorage.create(f, outputs, units, n, time.size, batch_rows=batch_rows, rows_hint=rows_hint,
+                              growable=capacity is not None)
         if quantities:
             group = f.create_group("quantities", track_order=True)
             group.attrs["description"] = "one number per run (the campaign's quantities:), NaN where undefined"
             for name in quantities:
-                group.create_dataset(_key(name), shape=(n,), dtype="f8", fillvalue=np.nan,
+                group.create_dataset(key_of(name), shape=(n,), dtype="f8", fillvalue=np.nan,
                                      chunks=(min(rows_hint, QUANTITY_ROWS),), fletcher32=True, **grow)
         if tsvd is not None:
-            group = f.create_group("tsvd", track_order=True)
-            group.attrs.update({"tol": empty.tol, "batch": batch,
-                                "description": "column c of A (run columns[c]) ≈ U diag(s) V[c]; the buffer "
-                                               "rows (runs buffer_index) are not folded in yet"})
-            for name in outputs:
-                out = group.create_group(_key(name))
-                out.attrs["units"] = units.get(name, "")
-                write_state(out, empty, np.zeros(0, np.int64), np.zeros((0, time.size)), np.zeros(0, np.int64))
+            TsvdStorage.create(f, outputs, units, time.size, *settings)
         f.flush()
         return cls(f)
 
@@ -223,10 +188,9 @@ class ResultStore:
             raise ValueError(f"{path} is not a uqflight results file (no /samples/status)")
         store = cls(f)
         try:
-            if mode == "a" and isinstance(f.get("tsvd"), h5py.Group):  # finish or drop a step a killed
-                for group in f["tsvd"].values():                      # writer left half done, first
-                    if isinstance(group, h5py.Group):
-                        apply_staged(group)
+            if mode == "a":  # finish or drop a step a killed writer left half done, first
+                for storage in store._storages:
+                    storage.mend()
             problems = layout_problems(f)
             status = None if problems else store.status
         except OSError as exc:
@@ -249,10 +213,8 @@ class ResultStore:
                 f.close()
                 raise CorruptFile(f"{path}: {read_error(exc)}") from exc
             status = store.status
-        if mode == "a" and "tsvd" in f:
-            for key in f["tsvd"]:
-                store._fold_ready(_name(key), status)
-            f.flush()
+            for storage in store._storages:
+                storage.settle(status)
         return store
 
     def close(self) -> None:
@@ -295,28 +257,27 @@ class ResultStore:
 
     @property
     def output_names(self) -> list[str]:
-        return [_name(key) for key in self._file["outputs" if self._raw else "tsvd"]]
+        return self._read.output_names
 
     @property
     def units(self) -> dict[str, str]:
-        group = self._file["outputs" if self._raw else "tsvd"]
-        return {_name(key): str(group[key].attrs.get("units", "")) for key in group}
+        return self._read.units
 
     @property
     def quantity_names(self) -> list[str]:
         """The campaign's quantities of interest ([] for a file without them)."""
         group = self._file.get("quantities")
-        return [] if group is None else [_name(key) for key in group]
+        return [] if group is None else [name_of(key) for key in group]
 
     def quantity(self, name: str) -> np.ndarray:
         """(N,) the values of quantity `name`, NaN where undefined, not run or failed."""
-        return self._file["quantities"][_key(name)][()]
+        return self._file["quantities"][key_of(name)][()]
 
     def resolution(self, name: str) -> np.ndarray | None:
         """(T,) the simulator's own resolution of output `name` (level flight: its two trims' drift), None when the
         file holds none (a Python simulator, a file from before it was recorded)."""
         group = self._file.get("resolution")
-        return None if group is None or _key(name) not in group else group[_key(name)][()]
+        return None if group is None or key_of(name) not in group else group[key_of(name)][()]
 
     @property
     def campaign_text(self) -> str:
@@ -334,21 +295,17 @@ class ResultStore:
     @property
     def storage_description(self) -> str:
         """How the outputs are kept, e.g. "raw; tsvd tol 1e-08, batch 1000, ranks alpha_deg 11"."""
-        parts = ["raw"] if self._raw else []
-        if "tsvd" in self._file:
-            group = self._file["tsvd"]
-            ranks = ", ".join(f"{_name(key)} {group[key]['s'].size}" for key in group)
-            parts.append(f"tsvd tol {group.attrs['tol']:g}, batch {group.attrs['batch']}, ranks {ranks}")
-        return "; ".join(parts)
+        return "; ".join(storage.description for storage in self._storages)
 
     @property
     def tsvd_tolerance(self) -> float:
         """The relative truncation tolerance of the tSVD factors (0 without compression)."""
-        return float(self._file["tsvd"].attrs["tol"]) if "tsvd" in self._file else 0.0
+        return max(storage.tolerance for storage in self._storages)
 
     @property
-    def _raw(self) -> bool:
-        return "outputs" in self._file
+    def _read(self) -> OutputStorage:
+        """The storage form the outputs are read from."""
+        return self._storages[0]
 
     def pending(self) -> np.ndarray:
         """Indices of the runs not written yet, ascending."""
@@ -372,10 +329,11 @@ class ResultStore:
         if n > status.size:
             if samples["status"].maxshape[0] is not None:
                 raise ValueError("this results file holds a fixed design; it cannot grow")
-            groups = [samples] + [self._file[key] for key in ("outputs", "quantities") if key in self._file]
-            for group in groups:
-                for data in group.values():
-                    data.resize(n, axis=0)
+            grow_rows(samples, n)
+            for storage in self._storages:
+                storage.grow(n)
+            if "quantities" in self._file:
+                grow_rows(self._file["quantities"], n)
         pending = np.flatnonzero(np.r_[status, np.full(n - status.size, Status.PENDING)] == Status.PENDING)
         if pending.size:
             samples["xi"][pending[0]:] = xi[pending[0]:]  # the pending rows follow the run ones (set_design's order)
@@ -403,26 +361,21 @@ class ResultStore:
         design-order prefix is folded into the tSVD factors.
         """
         outputs, quantities = self._split_quantities(indices, status, outputs)
-        idx, status, reasons, values = self._checked_batch(indices, status, reasons, outputs)
+        idx, status, reasons, values, all_status = self._checked_batch(indices, status, reasons, outputs)
         ok = status == Status.OK
         if not ok.all():  # ok runs keep the fill value "": a campaign without failures writes no reason
             self._write_reasons(idx[~ok], reasons[~ok])
         for name, column in quantities.items():
-            self._file["quantities"][_key(name)][idx] = np.where(ok, column, np.nan)
+            self._file["quantities"][key_of(name)][idx] = np.where(ok, column, np.nan)
         for name, rows in values.items():
-            if self._raw:
-                self._file["outputs"][_key(name)][idx] = np.where(ok[:, None], rows, np.nan)
-            if "tsvd" in self._file:  # a run the factors already hold (rerun after its raw rows were lost) stays out
-                group = self._file["tsvd"][_key(name)]
-                new = ok & ~np.isin(idx, self._held_runs(group))
-                append_rows(group, rows[new], idx[new])
+            for storage in self._storages:
+                storage.write(name, idx, ok, rows)
         self._flush(sync=True)
         self._file["samples/status"][idx] = status
         self._flush(sync=True)
-        if "tsvd" in self._file:
-            all_status = self.status
-            for name in values:
-                self._fold_ready(name, all_status)
+        all_status[idx] = status
+        for storage in self._storages:
+            storage.settle(all_status)
 
     def _split_quantities(self, indices, status, outputs: dict) -> tuple[dict, dict]:
         """(outputs, quantities sorted as _checked_batch sorts the runs), the quantities checked
@@ -457,26 +410,14 @@ class ResultStore:
         overwritten: ok runs of a torn output chunk, failed runs of a torn reason chunk, whose rerun
         gives their reason again). Reasons written for runs that are pending are cleared."""
         status = self.status
-        lost = np.zeros(status.size, dtype=bool)
-        if self._raw:
-            for key in self._file["outputs"]:
-                for start, stop, values in _chunk_blocks(self._file["outputs"][key], block, np.nan):
-                    ok = status[start:stop] == Status.OK
-                    lost[start:stop] |= ok if values is None else ok & ~np.isfinite(values).all(axis=1)
-        elif "tsvd" in self._file:  # ok runs neither in the factors nor in the buffer (their order in the
-            for key in self._file["tsvd"]:  # factors then follows the rerun: equal data, other rounding)
-                group = self._file["tsvd"][key]
-                _, index, _ = buffer_rows(group, status)
-                held = np.zeros(status.size, dtype=bool)
-                held[np.union1d(group["columns"][()], index).astype(np.int64)] = True
-                lost |= (status == Status.OK) & ~held
+        lost = self._read.lost_runs(status, block)
         for key in self._file.get("quantities", {}):  # NaN is a valid value here: only torn chunks are lost
-            for start, stop, values in _chunk_blocks(self._file["quantities"][key], block, np.nan):
+            for start, stop, values in chunk_blocks(self._file["quantities"][key], block, np.nan):
                 if values is None:
                     lost[start:stop] |= status[start:stop] == Status.OK
         reasons = self._file["samples/reason"]
         stale = np.zeros(status.size, dtype=bool)
-        for start, stop, values in _chunk_blocks(reasons, block, _no_reasons(reasons, 1)[0]):
+        for start, stop, values in chunk_blocks(reasons, block, _no_reasons(reasons, 1)[0]):
             if values is None:
                 lost[start:stop] |= status[start:stop] > Status.OK
             else:
@@ -495,55 +436,18 @@ class ResultStore:
         data[idx] = [str(r) for r in reasons] if length is None else \
             np.array([fit_reason(str(r), length) for r in reasons], dtype=data.dtype)
 
-    def _held_runs(self, group) -> np.ndarray:
-        """The runs an output's tSVD factors or buffer hold."""
-        n = group["buffer_index"].shape[0]
-        return np.union1d(group["columns"][()], group["buffer_index"][:n])
-
     def batch_bytes(self, n: int) -> int:
         """An upper estimate of the bytes the next batch of `n` runs may add to the file: its rows
         (a new chunk per output at worst), and for tSVD a staged copy of the factors and buffer."""
-        n_times, total = self._file["time"].shape[0], self._file["samples/status"].shape[0]
-        estimate = 64 * 1024 + n * 1024
-        if self._raw:
-            for ds in self._file["outputs"].values():
-                rows = ds.chunks[0] if ds.chunks else n
-                estimate += 8 * n_times * (n + 2 * rows)
-        if "tsvd" in self._file:
-            for group in self._file["tsvd"].values():
-                size = sum(group[key].size * group[key].dtype.itemsize for key in ("U", "s", "V", "buffer"))
-                estimate += 2 * (size + 8 * n_times * (n + self._batch)) + 8 * total
-        return int(estimate)
+        return int(64 * 1024 + n * 1024 + sum(storage.batch_bytes(n) for storage in self._storages))
 
     def verify(self, block: int = 1000) -> list[str]:
         """Problems of the stored runs (empty when sound): ok runs whose raw histories are not
         finite, buffered tSVD runs missing. Reads every checksummed chunk once."""
-        problems, status = [], self.status
-        if self._raw:
-            for name in self.output_names:
-                data = self._file["outputs"][_key(name)]
-                for start in range(0, status.size, block):
-                    ok = status[start:start + block] == Status.OK
-                    rows = data[start:start + block]
-                    bad = start + np.flatnonzero(ok & ~np.isfinite(rows).all(axis=1))
-                    if bad.size:
-                        problems.append(f"output {name}: {bad.size} ok runs without data (e.g. run {bad[0]})")
-                        break
-        elif "tsvd" in self._file:
-            ok = np.flatnonzero(status == Status.OK)
-            for name in self.output_names:
-                group = self._file["tsvd"][_key(name)]
-                _, index, _ = buffer_rows(group, status)
-                for key in ("U", "s", "V", "buffer"):  # read once: their checksums are verified
-                    group[key][()]
-                held = np.union1d(group["columns"][()], index)
-                missing = np.setdiff1d(ok, held)
-                if missing.size:
-                    problems.append(f"output {name}: {missing.size} ok runs missing (e.g. run {missing[0]})")
-        return problems
+        return self._read.problems(self.status, block)
 
     def _checked_batch(self, indices, status, reasons, outputs):
-        """The batch sorted by index, after checking it against the file."""
+        """The batch sorted by index, after checking it against the file, and the file's status before it."""
         idx = np.asarray(indices, dtype=np.int64).ravel()
         order = np.argsort(idx)
         idx, status = idx[order], np.asarray(status, dtype=np.int8).ravel()[order]
@@ -569,75 +473,21 @@ class ResultStore:
             bad = idx[ok & ~np.isfinite(rows).all(axis=1)]
             if bad.size:
                 raise ValueError(f"output {name} of runs {bad} is not finite but their status is ok")
-        return idx, status, reasons, values
-
-    def _fold_ready(self, name: str, status: np.ndarray) -> None:
-        """Fold the buffered ok runs of the completed design-order prefix into the factors, `batch` at
-        a time (all of them once nothing is pending); drop buffer rows a killed writer left behind."""
-        group = self._file["tsvd"][_key(name)]
-        positions, index, stale = buffer_rows(group, status)
-        pending = np.flatnonzero(status == Status.PENDING)
-        if pending.size:
-            ready = np.searchsorted(index, pending[0])
-            ready -= ready % self._batch
-        else:
-            ready = index.size
-        if ready == 0 and not stale:
-            return
-        rows = group["buffer"][()][positions]
-        svd, columns = self._stored_factors(group)
-        with threadpool_limits(limits=1):
-            ingest(svd, rows[:ready], self._batch)
-        commit(group, svd, np.concatenate([columns, index[:ready]]), rows[ready:], index[ready:])
+        return idx, status, reasons, values, stored
 
     # -- reading ----------------------------------------------------------------------------
     def output_matrix(self, name: str, rows=None) -> np.ndarray:
         """The histories of `rows` (default: all runs) as (n, T), NaN where not run or failed;
         from the raw data when stored, else rebuilt from the tSVD factors."""
-        n_samples = self._file["samples/status"].shape[0]
-        rows = np.arange(n_samples) if rows is None else np.asarray(rows, dtype=np.int64)
-        if self._raw:
-            unique, inverse = np.unique(rows, return_inverse=True)
-            return self._file["outputs"][_key(name)][unique][inverse]
-        U, s, V, columns = self.output_factors(name)
-        column_of = np.full(n_samples, -1)
-        column_of[columns] = np.arange(columns.size)
-        column = column_of[rows]
-        matrix = np.full((rows.size, U.shape[0]), np.nan)
-        matrix[column >= 0] = (V[column[column >= 0]] * s) @ U.T
-        return matrix
+        status = self.status
+        rows = np.arange(status.size) if rows is None else np.asarray(rows, dtype=np.int64)
+        return self._read.matrix(name, rows, status)
 
     def iter_output_blocks(self, name: str, block: int = 1000) -> Iterator[tuple[np.ndarray, np.ndarray]]:
         """(indices, histories (n, T)) of the ok runs in design order, at most `block` runs at a time."""
-        if self._raw:
-            status, data = self.status, self._file["outputs"][_key(name)]
-            for start in range(0, status.size, block):
-                ok = np.flatnonzero(status[start:start + block] == Status.OK)
-                if ok.size:
-                    yield start + ok, data[start:start + block][ok]
-        else:
-            U, s, V, columns = self.output_factors(name)
-            for start, histories in zip(range(0, columns.size, block), iter_column_blocks(U, s, V, block)):
-                yield columns[start:start + block], histories
+        return self._read.blocks(name, self.status, block)
 
     def output_factors(self, name: str) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray] | None:
         """(U, s, V, columns) of a compressed output, V row c being run columns[c]; None when the raw
         histories are stored. Runs still in the buffer are folded in (in memory, not in the file)."""
-        if self._raw:
-            return None
-        group = self._file["tsvd"][_key(name)]
-        positions, index, _ = buffer_rows(group, self.status)
-        svd, columns = self._stored_factors(group)
-        with threadpool_limits(limits=1):
-            ingest(svd, group["buffer"][()][positions], self._batch)
-        return svd.U, svd.s, svd.V, np.concatenate([columns, index])
-
-    def _stored_factors(self, group: h5py.Group) -> tuple[IncrementalSVD, np.ndarray]:
-        """The factors as written in the file (without the buffer), and the run of each V row."""
-        svd = IncrementalSVD.from_factors(group["U"][()], group["s"][()], group["V"][()],
-                                          self._file["tsvd"].attrs["tol"])
-        return svd, group["columns"][()]
-
-    @property
-    def _batch(self) -> int:
-        return int(self._file["tsvd"].attrs["batch"])
+        return self._read.factors(name, self.status)
