@@ -11,6 +11,7 @@ from pathlib import Path
 
 import h5py
 import numpy as np
+import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
 DATA = Path(__file__).parent / "data"
@@ -44,8 +45,6 @@ def cli_in_process(*args, cwd=None) -> subprocess.CompletedProcess:
 def mounted_tmpfs(folder, size: str):
     """A tmpfs of `size` (e.g. "8m") mounted at FOLDER/disk for the block: a disk that fills on demand.
     The test is skipped where it cannot be mounted (it needs root)."""
-    import pytest
-
     mount = Path(folder) / "disk"
     mount.mkdir()
     done = subprocess.run(["mount", "-t", "tmpfs", "-o", f"size={size}", "tmpfs", str(mount)],
@@ -121,3 +120,30 @@ def run_python_campaign(folder: Path, text: str, name: str = "c"):
     out = Path(folder) / f"{name}.h5"
     run_campaign(load_campaign(source), out=out, workers=1)
     return out
+
+
+DECAY_TWO_INPUTS = """
+name: decay-people
+seed: 3
+simulator: {kind: python, function: "uqflight.simulators.models:exp_decay"}
+parameters:
+  a: {distribution: normal, lower: 0.5, upper: 1.5}
+  b: {distribution: uniform, lower: 1.0, upper: 2.0, nominal: 1.4}
+design: {kind: sparse_grid, level: 3}
+method: {kind: pseudo_galerkin, order: 2}
+analysis: {band_samples: 500, bootstrap: 0}
+"""
+
+
+@pytest.fixture(scope="session")
+def decay_results(tmp_path_factory) -> Path:
+    """The DECAY_TWO_INPUTS campaign flown once per session into its own folder (decay.yaml, decay.h5):
+    tests read it and write elsewhere (a test that writes beside it copies it first)."""
+    from uqflight.campaign import parse_campaign
+    from uqflight.execution import run_campaign
+
+    root = tmp_path_factory.mktemp("decay")
+    (root / "decay.yaml").write_text(DECAY_TWO_INPUTS)
+    path = root / "decay.h5"
+    run_campaign(parse_campaign(DECAY_TWO_INPUTS, str(root / "decay.yaml")), out=path, workers=1)
+    return path

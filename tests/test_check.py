@@ -101,3 +101,12 @@ def test_check_refuses_non_finite_tolerances(rtol, atol):
 
     with pytest.raises(BadInput, match="expected a finite number >= 0"):
         compare(None, {"outputs": {}}, rtol, atol)
+
+
+def test_check_against_another_campaigns_baseline_exits_2(decay_results, tmp_path):
+    baseline = write_baseline(analyse(decay_results), "", tmp_path / "baseline.json")
+    data = json.loads(baseline.read_text())
+    data["campaign_hash"] = "0" * 64
+    baseline.write_text(json.dumps(data))
+    checked = cli_in_process("check", decay_results, "--baseline", baseline)
+    assert checked.returncode == 2 and "comes from another campaign" in checked.stderr

@@ -6,7 +6,7 @@ import subprocess
 import h5py
 import numpy as np
 import pytest
-from conftest import DATA, UQFLIGHT, assert_same_results
+from conftest import DATA, DECAY_TWO_INPUTS, UQFLIGHT, assert_same_results, cli_in_process
 
 from uqflight.campaign import parse_campaign
 from uqflight.simulators.validation_view import validation_view
@@ -32,7 +32,6 @@ execution: {{workers: 1, chunk: 4}}
 
 def jsbsim_campaign(samples=12, duration=5):
     return parse_campaign(JSBSIM_CAMPAIGN.format(samples=samples, duration=duration), "small.yaml", validation_view)
-
 
 
 @pytest.mark.slow  # a long real-process check; the slow suite runs it in CI
@@ -183,3 +182,21 @@ def test_chunks_cover_the_design_and_taper_at_its_end(total, chunk):
     chunks = pending_chunks(np.arange(total), chunk, total)
     assert np.array_equal(np.concatenate(chunks), np.arange(total))
     assert [c.tolist() for c in pending_chunks(np.array([total - 1]), chunk, total)] == [chunks[-1].tolist()]
+
+
+@pytest.mark.slow
+def test_restart_starts_a_same_campaign_file_over_and_force_keeps_its_meaning(tmp_path):
+    campaign = tmp_path / "decay.yaml"
+    campaign.write_text(DECAY_TWO_INPUTS)
+    out = tmp_path / "d.h5"
+    assert cli_in_process("run", campaign, "--out", out).returncode == 0
+    with h5py.File(out, "a") as f:
+        f.attrs["marker"] = "the first run's file"
+    again = cli_in_process("run", campaign, "--out", out, "--force")  # a file of this campaign: resumed, nothing to do
+    assert again.returncode == 0 and " 0 run now" in again.stdout
+    with h5py.File(out, "r") as f:
+        assert "marker" in f.attrs
+    restarted = cli_in_process("run", campaign, "--out", out, "--restart")
+    assert restarted.returncode == 0 and " 0 already done" in restarted.stdout
+    with h5py.File(out, "r") as f:
+        assert "marker" not in f.attrs  # a new file

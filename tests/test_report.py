@@ -2,6 +2,7 @@
 import csv
 import json
 import re
+import shutil
 import subprocess
 from pathlib import Path
 
@@ -78,7 +79,6 @@ def files(tmp_path_factory) -> dict[str, Path]:
         "ishigami_pf": run(ISHIGAMI, root / "ishigami_pf.h5", name="pick-freeze", method="{kind: monte_carlo}",
                            design="{kind: pick_freeze, samples: 100}"),
     }
-
 
 
 def read_csv(path: Path) -> list[dict]:
@@ -318,3 +318,43 @@ def test_an_empty_folder_or_an_earlier_report_may_be_replaced(tmp_path):
         (earlier / name).write_text("x")
     for folder in (empty, earlier, tmp_path / "absent"):
         check_replaceable(folder)
+
+
+def test_report_writes_next_to_the_results_file_by_default(decay_results, tmp_path):
+    results = Path(shutil.copy(decay_results, tmp_path / "decay.h5"))  # the report is written beside it
+    result = cli_in_process("report", results)
+    assert result.returncode == 0, result.stderr
+    out = results.with_name("decay-report")
+    files = [p for p in out.rglob("*") if p.is_file()]
+    assert result.stdout.strip() == f"wrote {len(files)} files to {out}: open {out / 'report.html'}"
+    assert (out / "summary.json").is_file() and (out / "tables" / "parameters.csv").is_file()
+    parameters = list(csv.DictReader(open(out / "tables" / "parameters.csv")))
+    assert [(r["parameter"], r["distribution"], float(r["nominal"])) for r in parameters] == \
+        [("a", "normal", 1.0), ("b", "uniform", 1.4)]
+    page = (out / "report.html").read_text()
+    assert "What was run" in page and "design_decay.png" in page and "name: decay-people" in page
+    assert not [p for p in results.parent.iterdir() if p.name.startswith(".decay-report")]
+
+
+@pytest.mark.slow
+def test_several_methods_over_the_same_runs(decay_results, tmp_path):
+    out = tmp_path / "methods"
+    result = cli_in_process("report", decay_results, "--method", "pseudo_galerkin:2", "--method", "least_squares:1",
+                 "--method", "regression", "--order", "2", "--out", out)
+    assert result.returncode == 0, result.stderr
+    labels = [row["label"] for row in csv.DictReader(open(out / "tables" / "files.csv"))]
+    assert [label.split(": ")[1].split(",")[0] for label in labels] == \
+        ["PG order 2", "least squares order 1", "regression order 2"]
+    plots = {p.name for p in (out / "plots").iterdir()}
+    assert {"sobol_compared.png", "bands_compared.png", "mean_band_decay_least_squares1.png"} <= plots
+    summaries = {p.name: json.loads(p.read_text()) for p in (out / "summaries").iterdir()}
+    least = summaries["decay_least_squares1.json"]
+    assert least["method"]["kind"] == "least_squares" and least["method"]["order"] == 1
+    exact = analyse(decay_results, method={"kind": "least_squares", "order": 1}).outputs["x"].mean
+    np.testing.assert_allclose(least["outputs"]["x"]["mean"], exact, rtol=1e-12)
+    for bad, message in ((["--method", "galerkin:2"], "expected KIND[:ORDER]"),
+                         (["--method", "least_squares:two"], "integer ORDER"),
+                         (["--order", "2"], "--order needs --method")):
+        refused = cli_in_process("report", decay_results, *bad, "--out", tmp_path / "bad")
+        assert refused.returncode == 2 and message in refused.stderr and "Traceback" not in refused.stderr, bad
+        assert not (tmp_path / "bad").exists()
