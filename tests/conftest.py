@@ -147,3 +147,24 @@ def decay_results(tmp_path_factory) -> Path:
     path = root / "decay.h5"
     run_campaign(parse_campaign(DECAY_TWO_INPUTS, str(root / "decay.yaml")), out=path, workers=1)
     return path
+
+
+def hostile_campaign_text(function, samples=40, chunk=8, workers=1, extra="", name="hostile"):
+    """A Monte Carlo campaign over x ~ U(-2, 2) of a model of data/hostile_model.py that misbehaves on
+    purpose (crashing, hanging, slow, long_histories)."""
+    return f"""
+name: {name}
+seed: 5
+simulator: {{kind: python, function: "{DATA / 'hostile_model.py'}:{function}"}}
+parameters:
+  x: {{distribution: uniform, lower: -2, upper: 2}}
+design: {{kind: monte_carlo, samples: {samples}}}
+execution: {{workers: {workers}, chunk: {chunk}{extra}}}
+"""
+
+
+def hostile_campaign(function, **kwargs):
+    """hostile_campaign_text parsed (as if from data/hostile.yaml)."""
+    from uqflight.campaign import parse_campaign
+
+    return parse_campaign(hostile_campaign_text(function, **kwargs), str(DATA / "hostile.yaml"))

@@ -5,7 +5,7 @@ import shutil
 import h5py
 import numpy as np
 import pytest
-from conftest import DATA, cli_in_process, run_python_campaign
+from conftest import DATA, cli_in_process, hostile_campaign, run_python_campaign
 
 from uqflight.campaign import parse_campaign
 from uqflight.execution import run_campaign
@@ -233,3 +233,31 @@ def load_ok(text, folder) -> bool:
 
     (folder / "sound.json").write_text(text)
     return load(folder / "sound.json").evaluate(xi=[[0.3, -0.2]])["y"].shape == (1, 5)
+
+
+def test_a_flipped_byte_is_reported(tmp_path):
+    out = tmp_path / "r.h5"
+    run_campaign(hostile_campaign("slow", samples=4), out=out)
+    with h5py.File(out, "r") as f:
+        offset = f["outputs/y"].id.get_chunk_info(0).byte_offset
+    with open(out, "r+b") as fh:
+        fh.seek(offset + 3)
+        byte = fh.read(1)
+        fh.seek(offset + 3)
+        fh.write(bytes([byte[0] ^ 0x10]))
+    info = cli_in_process("info", out)
+    assert info.returncode == 2
+    assert "data corrupted: a checksum (fletcher32) does not match" in info.stderr
+
+
+
+def test_an_unknown_status_code_is_an_error(tmp_path):
+    out = tmp_path / "r.h5"
+    run_campaign(hostile_campaign("slow", samples=2), out=out)
+    with h5py.File(out, "a") as f:
+        f["samples/status"][1] = 9
+    with pytest.raises(CorruptFile, match=r"unknown status codes \[9\]"):
+        ResultStore.open(out)
+    info = cli_in_process("info", out)
+    assert info.returncode == 2 and "unknown status codes [9]" in info.stderr
+

@@ -6,7 +6,7 @@ import subprocess
 import h5py
 import numpy as np
 import pytest
-from conftest import DATA, DECAY_TWO_INPUTS, UQFLIGHT, assert_same_results, cli_in_process
+from conftest import DATA, DECAY_TWO_INPUTS, UQFLIGHT, assert_same_results, cli_in_process, hostile_campaign
 
 from uqflight.campaign import parse_campaign
 from uqflight.simulators.validation_view import validation_view
@@ -200,3 +200,28 @@ def test_restart_starts_a_same_campaign_file_over_and_force_keeps_its_meaning(tm
     assert restarted.returncode == 0 and " 0 already done" in restarted.stdout
     with h5py.File(out, "r") as f:
         assert "marker" not in f.attrs  # a new file
+
+
+def test_an_idle_worker_gets_its_next_chunk_before_the_runner_writes(tmp_path):
+    """The pool hands a finished chunk to its caller (who writes it to HDF5) only once the worker
+    that flew it has its next chunk: workers never wait for the writer."""
+    from uqflight.execution import Task, WorkerPool, nominal_kappa, worker_spec
+    from uqflight.parameters import to_physical
+
+    spec = hostile_campaign("slow", samples=6, chunk=2)
+    kappa = to_physical(spec.parameters, spec.design().xi)
+    tasks = [Task(np.arange(i, i + 2), kappa[i:i + 2]) for i in (0, 2, 4)]
+    pool = WorkerPool(worker_spec(spec), 1, 60.0)
+    try:
+        nominal = pool.nominal_flight(nominal_kappa(spec))
+        time_grid, outputs = nominal.time, nominal.outputs
+        results = pool.run(tasks, len(time_grid), outputs)
+        first = next(results)
+        assert first[0].tolist() == [0, 1] and pool.slots[0].task is tasks[1]
+        assert [r[0].tolist() for r in results] == [[2, 3], [4, 5]]
+    finally:
+        pool.close()
+    long_runs = hostile_campaign("long_histories", samples=6, chunk=2)  # 40 kB per run
+    with h5py.File(run_campaign(long_runs, out=tmp_path / "r.h5").path) as f:  # the runner's chunk = HDF5's
+        assert f["outputs/y"].chunks[0] == 2
+
