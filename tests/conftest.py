@@ -168,3 +168,23 @@ def hostile_campaign(function, **kwargs):
     from uqflight.campaign import parse_campaign
 
     return parse_campaign(hostile_campaign_text(function, **kwargs), str(DATA / "hostile.yaml"))
+
+
+CLOSED_FORMS = DATA / "trust_models.py"
+NORMAL_2D = ("  x1: {distribution: normal, lower: -3, upper: 3}\n"
+             "  x2: {distribution: normal, lower: -3, upper: 3}\n")
+UNIFORM_X = "  x: {distribution: uniform, lower: -1, upper: 1}\n"
+NORMAL_X = "  x: {distribution: normal, lower: -3, upper: 3}\n"
+
+
+def closed_form_campaign(name, function, parameters, design, method="", extra=""):
+    """The text of a campaign of a closed-form model of data/trust_models.py (`parameters`: YAML lines such
+    as NORMAL_2D; `method`, `extra`: whole lines)."""
+    return (f"name: {name}\nseed: 5\nsimulator: {{kind: python, function: \"{CLOSED_FORMS}:{function}\"}}\n"
+            f"parameters:\n{parameters}design: {design}\n{method}{extra}"
+            "analysis: {band_samples: 2000, bootstrap: 0}\n")
+
+
+def strict_json(data: dict) -> dict:
+    """`data` through a strict JSON writer and reader, as summary.json is written and read."""
+    return json.loads(json.dumps(data, allow_nan=False))

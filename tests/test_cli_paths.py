@@ -11,14 +11,13 @@ import time
 from pathlib import Path
 
 import pytest
-from conftest import (UQFLIGHT, cli_in_process, hostile_campaign, mounted_tmpfs, run_python_campaign,
-                      scheduler_address)
-from test_trust import NORMAL_2D, campaign
+from conftest import (NORMAL_2D, UQFLIGHT, cli_in_process, closed_form_campaign, hostile_campaign, mounted_tmpfs,
+                      run_python_campaign, scheduler_address)
 
 from uqflight.execution import run_campaign
 
 BIN = Path(sys.executable).parent
-TEXT = campaign("sq", "sum_of_squares", NORMAL_2D, "{kind: tensor_grid, points: 3}",
+TEXT = closed_form_campaign("sq", "sum_of_squares", NORMAL_2D, "{kind: tensor_grid, points: 3}",
                 "method: {kind: pseudo_galerkin, order: 2}\n")
 
 
@@ -152,4 +151,3 @@ def test_a_results_path_that_cannot_be_written_is_refused(tmp_path, where):
     with pytest.raises(ValueError, match=r"cannot write the results file .*r?\.h5 \((File exists|No such file)"
                                          r".*\); choose another path with --out or storage.path"):
         run_campaign(hostile_campaign("slow", samples=1), out=tmp_path / where)
-

@@ -6,8 +6,7 @@ import io
 import numpy as np
 import pytest
 import yaml
-from conftest import DECAY_TWO_INPUTS, cli, cli_in_process, run_python_campaign
-from test_trust import NORMAL_2D, campaign
+from conftest import DECAY_TWO_INPUTS, NORMAL_2D, cli, cli_in_process, closed_form_campaign, run_python_campaign
 
 import uqflight
 from uqflight.calibration.command import _method
@@ -15,9 +14,9 @@ from uqflight.campaign import parse_campaign
 from uqflight.cli import _check_times
 from uqflight.report.loading import flight_facts
 
-GRID = campaign("sq", "sum_of_squares", NORMAL_2D, "{kind: tensor_grid, points: 3}",
+GRID = closed_form_campaign("sq", "sum_of_squares", NORMAL_2D, "{kind: tensor_grid, points: 3}",
                 "method: {kind: pseudo_galerkin, order: 2}\n")  # 9 runs, times 0, 0.25, ..., 1 s
-SAMPLED = campaign("mc", "sum_of_squares", NORMAL_2D, "{kind: monte_carlo, samples: 8}", "method: {kind: monte_carlo}\n")
+SAMPLED = closed_form_campaign("mc", "sum_of_squares", NORMAL_2D, "{kind: monte_carlo, samples: 8}", "method: {kind: monte_carlo}\n")
 
 
 @pytest.fixture(scope="module")

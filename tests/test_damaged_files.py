@@ -199,12 +199,12 @@ SURROGATE_DAMAGES = {  # name: (edit of the parsed JSON, what the message says)
 @pytest.fixture(scope="module")
 def surrogate_text(tmp_path_factory):
     """The order-2 PCE of y = 15000 + t (x1² + x2²) (5 times) on a 4x4 grid, exported."""
-    from test_trust import NORMAL_2D, campaign
+    from conftest import NORMAL_2D, closed_form_campaign
 
     from uqflight.surrogate import export
 
     folder = tmp_path_factory.mktemp("surrogate")
-    results = run_python_campaign(folder, campaign("sq", "sum_of_squares", NORMAL_2D, "{kind: tensor_grid, points: 4}",
+    results = run_python_campaign(folder, closed_form_campaign("sq", "sum_of_squares", NORMAL_2D, "{kind: tensor_grid, points: 4}",
                                                    "method: {kind: pseudo_galerkin, order: 2}\n"))
     return export(results, folder / "pce.json").read_text()
 
@@ -250,7 +250,6 @@ def test_a_flipped_byte_is_reported(tmp_path):
     assert "data corrupted: a checksum (fletcher32) does not match" in info.stderr
 
 
-
 def test_an_unknown_status_code_is_an_error(tmp_path):
     out = tmp_path / "r.h5"
     run_campaign(hostile_campaign("slow", samples=2), out=out)
@@ -260,4 +259,3 @@ def test_an_unknown_status_code_is_an_error(tmp_path):
         ResultStore.open(out)
     info = cli_in_process("info", out)
     assert info.returncode == 2 and "unknown status codes [9]" in info.stderr
-

@@ -9,9 +9,8 @@ import time
 
 import numpy as np
 import pytest
-from conftest import UQFLIGHT, cli_in_process, run_python_campaign
+from conftest import NORMAL_2D, UQFLIGHT, cli_in_process, closed_form_campaign, run_python_campaign
 from test_damaged_files import surrogate_text  # noqa: F401 - the exported order-2 PCE, a fixture
-from test_trust import NORMAL_2D, campaign
 
 from uqflight.calibration.likelihood import DataError, parse_noise, read_flight_csv
 from uqflight.surrogate import MAX_FILE_BYTES, SurrogateError, load
@@ -85,7 +84,7 @@ def test_a_surrogate_file_above_the_cap_is_refused_before_it_is_read(tmp_path):
 def results(tmp_path_factory):
     """y(t) = 15000 + t (x1² + x2²) at 5 times in [0, 1] on a 4x4 grid."""
     folder = tmp_path_factory.mktemp("calibrate")
-    return run_python_campaign(folder, campaign("sq", "sum_of_squares", NORMAL_2D, "{kind: tensor_grid, points: 4}",
+    return run_python_campaign(folder, closed_form_campaign("sq", "sum_of_squares", NORMAL_2D, "{kind: tensor_grid, points: 4}",
                                                 "method: {kind: pseudo_galerkin, order: 2}\n"))
 
 
