@@ -34,6 +34,25 @@ def jsbsim_campaign(samples=12, duration=5):
     return parse_campaign(JSBSIM_CAMPAIGN.format(samples=samples, duration=duration), "small.yaml", validation_view)
 
 
+def python_campaign(samples):
+    """A Monte Carlo campaign of a closed-form model: what the file checks below see without flying."""
+    return parse_campaign(f"""
+name: small-python
+seed: 7
+simulator: {{kind: python, function: "uqflight.simulators.models:linear"}}
+parameters:
+  x1: {{distribution: uniform, lower: -1, upper: 1}}
+design: {{kind: monte_carlo, samples: {samples}}}
+execution: {{workers: 1, chunk: 4}}
+""", "small.yaml")
+
+
+# the results-file checks do not depend on the simulator: the default suite runs them on a closed-form
+# model, the slow suite on JSBSim too
+KINDS = pytest.mark.parametrize("make_campaign", [
+    pytest.param(python_campaign, id="python"), pytest.param(jsbsim_campaign, id="jsbsim", marks=pytest.mark.slow)])
+
+
 @pytest.mark.slow  # a long real-process check; the slow suite runs it in CI
 def test_results_do_not_depend_on_workers_or_executor(tmp_path):
     campaign = jsbsim_campaign()
@@ -82,9 +101,10 @@ execution: {workers: 2, chunk: 8}
     assert sum(summary.failures.values()) == int((~ok).sum())
 
 
-def test_a_file_of_another_campaign_is_refused_unless_forced(tmp_path):
-    run_campaign(jsbsim_campaign(samples=2), out=tmp_path / "r.h5")
-    other = jsbsim_campaign(samples=3)
+@KINDS
+def test_a_file_of_another_campaign_is_refused_unless_forced(tmp_path, make_campaign):
+    run_campaign(make_campaign(samples=2), out=tmp_path / "r.h5")
+    other = make_campaign(samples=3)
     with pytest.raises(FileExistsError, match="another campaign"):
         run_campaign(other, out=tmp_path / "r.h5")
     assert run_campaign(other, out=tmp_path / "r.h5", force=True).ran == 3
@@ -134,27 +154,29 @@ def test_tsvd_storage_and_property_outputs(tmp_path):
             np.testing.assert_array_equal(compressed.resolution(name), raw.resolution(name))
 
 
-def test_an_unreadable_results_file_is_refused_unless_forced(tmp_path):
-    run_campaign(jsbsim_campaign(samples=2), out=tmp_path / "whole.h5")
+@KINDS
+def test_an_unreadable_results_file_is_refused_unless_forced(tmp_path, make_campaign):
+    run_campaign(make_campaign(samples=2), out=tmp_path / "whole.h5")
     broken = tmp_path / "r.h5"  # as if killed while the file was being created: HDF5, unreadable
     broken.write_bytes((tmp_path / "whole.h5").read_bytes()[:2048])
     with pytest.raises(FileExistsError, match="damaged HDF5 file"):
-        run_campaign(jsbsim_campaign(samples=2), out=broken)
-    assert run_campaign(jsbsim_campaign(samples=2), out=broken, force=True).ran == 2
+        run_campaign(make_campaign(samples=2), out=broken)
+    assert run_campaign(make_campaign(samples=2), out=broken, force=True).ran == 2
 
 
-def test_force_never_replaces_what_is_not_a_results_file(tmp_path):
+@KINDS
+def test_force_never_replaces_what_is_not_a_results_file(tmp_path, make_campaign):
     text = tmp_path / "notes.h5"
     text.write_text("my notes")
     with pytest.raises(FileExistsError, match="not a uqflight results file.*rm "):
-        run_campaign(jsbsim_campaign(samples=2), out=text, force=True)
+        run_campaign(make_campaign(samples=2), out=text, force=True)
     assert text.read_text() == "my notes"
     with pytest.raises(FileExistsError, match="is a directory"):
-        run_campaign(jsbsim_campaign(samples=2), out=tmp_path, force=True)
+        run_campaign(make_campaign(samples=2), out=tmp_path, force=True)
     with h5py.File(tmp_path / "other.h5", "w") as f:
         f["x"] = [1, 2, 3]
     with pytest.raises(FileExistsError, match="HDF5 file but not a uqflight results file"):
-        run_campaign(jsbsim_campaign(samples=2), out=tmp_path / "other.h5", force=True)
+        run_campaign(make_campaign(samples=2), out=tmp_path / "other.h5", force=True)
 
 
 def test_resuming_with_changed_aircraft_files_is_refused_unless_forced(tmp_path):
