@@ -204,7 +204,8 @@ def test_a_full_disk_stops_cleanly_and_the_resume_equals_an_uninterrupted_run(tm
     assert_same_results(out, tmp_path / "whole.h5")
 
 
-@pytest.mark.parametrize("inherited", ["default", "ignored"])
+# "ignored" runs the whole "default" path after the CLI restores Python's handler: "default" is for the slow suite
+@pytest.mark.parametrize("inherited", [pytest.param("default", marks=pytest.mark.slow), "ignored"])
 def test_sigint_to_the_runner_alone_stops_it_cleanly(tmp_path, inherited):
     """Also when the runner starts with SIGINT ignored, as a script's `uqflight run ... &` does (a test
     harness left it so once: the interrupted run then waited on its workers for ever)."""
