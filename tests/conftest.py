@@ -188,3 +188,17 @@ def closed_form_campaign(name, function, parameters, design, method="", extra=""
 def strict_json(data: dict) -> dict:
     """`data` through a strict JSON writer and reader, as summary.json is written and read."""
     return json.loads(json.dumps(data, allow_nan=False))
+
+
+@pytest.fixture(scope="session")
+def flown(tmp_path_factory):
+    """fly(TEXT, NAME): the results file of a python campaign's TEXT, flown once per session (and xdist
+    worker) into a folder of its own, for the tests of several modules that only read it."""
+    files = {}
+
+    def fly(text: str, name: str = "c") -> Path:
+        if text not in files:
+            files[text] = run_python_campaign(tmp_path_factory.mktemp(name), text, name)
+        return files[text]
+
+    return fly

@@ -39,6 +39,7 @@ def indices(stats, output="y"):
             [float(out.sobol_total[p][0]) for p in ("x1", "x2", "x3")])
 
 
+@pytest.mark.slow  # 3000 runs and an order-10 fit: test_analysis.py fits the same PCE in process
 def test_ishigami_sobol_indices_from_a_pce(tmp_path):
     # Regression of order 10 on 3000 Latin-hypercube points: the truncation error of the degree-10
     # expansion of sin and x^4 sin is below 1e-2 on the indices (checked against the closed form).

@@ -18,9 +18,8 @@ CONDITIONAL_MEAN = 1.0 - (4 / 3 - C**2 + C**3 / 3) / 4 / (1 - P_FAIL)
 
 
 @pytest.fixture(scope="module")
-def runs(tmp_path_factory):
-    folder = tmp_path_factory.mktemp("failed")
-    return {name: run_python_campaign(folder, corner_campaign(name, design), name)
+def runs(flown):
+    return {name: flown(corner_campaign(name, design), name)  # the Monte Carlo file: test_failure_probability.py's too
             for name, design in (("mc", "{kind: monte_carlo, samples: 1000}"),
                                  ("tensor", "{kind: tensor_grid, points: 6}"))}
 

@@ -15,9 +15,8 @@ from uqflight.statistics import analyse, summary_json
 
 
 @pytest.fixture(scope="module")
-def runs(tmp_path_factory):
-    folder = tmp_path_factory.mktemp("corner")
-    return {name: run_python_campaign(folder, corner_campaign(name, design), name)
+def runs(flown):
+    return {name: flown(corner_campaign(name, design), name)  # the Monte Carlo file: test_failed_runs.py's too
             for name, design in (("sparse", "{kind: sparse_grid, level: 5}"),
                                  ("tensor", "{kind: tensor_grid, points: 10}"),
                                  ("mc", "{kind: monte_carlo, samples: 1000}"))}

@@ -102,19 +102,19 @@ def test_kld_floor_matches_the_kld_of_two_independent_samples_of_one_law():
     assert fresh / 2 < floor < 2 * fresh
 
 
-def exact_grid_errors_against(tmp_path, reference_design: str, tag: str):
+def exact_grid_errors_against(tmp_path, flown, reference_design: str, tag: str):
     """(errors of an exact PG grid on sum_of_squares against a reference of that design, the reference's
     runs): what is left of the errors is the reference's own noise."""
     reference = run_python_campaign(tmp_path, closed_form_campaign(tag, "sum_of_squares", NORMAL_2D, reference_design), tag)
-    grid = run_python_campaign(tmp_path, closed_form_campaign("pg", "sum_of_squares", NORMAL_2D, "{kind: tensor_grid, points: 4}",
-                                                  "method: {kind: pseudo_galerkin, order: 2}\n"), "pg")
+    grid = flown(closed_form_campaign("pg", "sum_of_squares", NORMAL_2D, "{kind: tensor_grid, points: 4}",
+                                      "method: {kind: pseudo_galerkin, order: 2}\n"), "pg")
     errors = analyse(grid, reference=str(reference)).outputs["y"].errors
     with h5py.File(reference) as f:
         return errors, f["outputs/y"][()]
 
 
-def test_errors_carry_the_reference_noise_floor(tmp_path):
-    errors, Y = exact_grid_errors_against(tmp_path, "{kind: monte_carlo, samples: 400}", "ref")
+def test_errors_carry_the_reference_noise_floor(tmp_path, flown):
+    errors, Y = exact_grid_errors_against(tmp_path, flown, "{kind: monte_carlo, samples: 400}", "ref")
     # σ/√N of the reference's mean and the distribution-free standard error of its variance,
     # √((μ4 − (N−3)/(N−1) σ⁴)/N), in Eq. 49's normalisation, recomputed here from the runs
     n, variance = len(Y), Y.var(axis=0, ddof=1)
@@ -126,8 +126,8 @@ def test_errors_carry_the_reference_noise_floor(tmp_path):
     assert np.max(errors["eps_m"]) < 3 * np.max(errors["eps_m_floor"])  # the grid is exact: only noise is left
 
 
-def test_a_randomised_qmc_reference_takes_its_floor_from_the_replicates(tmp_path):
-    errors, runs = exact_grid_errors_against(tmp_path, "{kind: sobol, samples: 64, replicates: 8}", "rqmc")
+def test_a_randomised_qmc_reference_takes_its_floor_from_the_replicates(tmp_path, flown):
+    errors, runs = exact_grid_errors_against(tmp_path, flown, "{kind: sobol, samples: 64, replicates: 8}", "rqmc")
     Y = runs.reshape(8, 64, -1)
     means = Y.mean(axis=1)
     np.testing.assert_allclose(errors["eps_m_floor"], means.std(axis=0, ddof=1) / np.sqrt(8) / means.mean(axis=0).max(),
