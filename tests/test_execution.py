@@ -206,7 +206,6 @@ def test_chunks_cover_the_design_and_taper_at_its_end(total, chunk):
     assert [c.tolist() for c in pending_chunks(np.array([total - 1]), chunk, total)] == [chunks[-1].tolist()]
 
 
-@pytest.mark.slow
 def test_restart_starts_a_same_campaign_file_over_and_force_keeps_its_meaning(tmp_path):
     campaign = tmp_path / "decay.yaml"
     campaign.write_text(DECAY_TWO_INPUTS)

@@ -11,7 +11,6 @@ from uqflight.statistics import analyse
 from uqflight.surrogate import fit_surrogate, load
 
 
-@pytest.mark.slow
 def test_surrogate_export_round_trip(decay_results, tmp_path):
     out = tmp_path / "pce.json"
     result = cli_in_process("surrogate", "export", decay_results, "--out", out)
