@@ -245,7 +245,8 @@ def test_an_empty_folder_or_an_earlier_report_may_be_replaced(tmp_path):
 
 
 def test_report_writes_next_to_the_results_file_by_default(decay_results, tmp_path):
-    results = Path(shutil.copy(decay_results, tmp_path / "decay.h5"))  # the report is written beside it
+    shutil.copy(decay_results.with_suffix(".yaml"), tmp_path)  # the campaign and its file, copied: the report
+    results = Path(shutil.copy(decay_results, tmp_path / "decay.h5"))  # is written beside them
     result = cli_in_process("report", results)
     assert result.returncode == 0, result.stderr
     out = results.with_name("decay-report")
