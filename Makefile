@@ -21,7 +21,7 @@ demo: $(STAMP)
 	@echo "report: $(CURDIR)/results/$(DEMO)-report/report.html"
 
 test: $(STAMP)
-	$(BIN)/pytest -q -n 2
+	$(BIN)/pytest -q -n 2 -m "not slow"
 
 test-slow: $(STAMP)
 	$(BIN)/pytest -q -n 2 -m slow

@@ -11,6 +11,7 @@ from pathlib import Path
 
 import h5py
 import numpy as np
+import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
 DATA = Path(__file__).parent / "data"
@@ -44,8 +45,6 @@ def cli_in_process(*args, cwd=None) -> subprocess.CompletedProcess:
 def mounted_tmpfs(folder, size: str):
     """A tmpfs of `size` (e.g. "8m") mounted at FOLDER/disk for the block: a disk that fills on demand.
     The test is skipped where it cannot be mounted (it needs root)."""
-    import pytest
-
     mount = Path(folder) / "disk"
     mount.mkdir()
     done = subprocess.run(["mount", "-t", "tmpfs", "-o", f"size={size}", "tmpfs", str(mount)],
@@ -121,3 +120,85 @@ def run_python_campaign(folder: Path, text: str, name: str = "c"):
     out = Path(folder) / f"{name}.h5"
     run_campaign(load_campaign(source), out=out, workers=1)
     return out
+
+
+DECAY_TWO_INPUTS = """
+name: decay-people
+seed: 3
+simulator: {kind: python, function: "uqflight.simulators.models:exp_decay"}
+parameters:
+  a: {distribution: normal, lower: 0.5, upper: 1.5}
+  b: {distribution: uniform, lower: 1.0, upper: 2.0, nominal: 1.4}
+design: {kind: sparse_grid, level: 3}
+method: {kind: pseudo_galerkin, order: 2}
+analysis: {band_samples: 500, bootstrap: 0}
+"""
+
+
+@pytest.fixture(scope="session")
+def decay_results(tmp_path_factory) -> Path:
+    """The DECAY_TWO_INPUTS campaign flown once per session into its own folder (decay.yaml, decay.h5):
+    tests read it and write elsewhere (a test that writes beside it copies it first)."""
+    from uqflight.campaign import parse_campaign
+    from uqflight.execution import run_campaign
+
+    root = tmp_path_factory.mktemp("decay")
+    (root / "decay.yaml").write_text(DECAY_TWO_INPUTS)
+    path = root / "decay.h5"
+    run_campaign(parse_campaign(DECAY_TWO_INPUTS, str(root / "decay.yaml")), out=path, workers=1)
+    return path
+
+
+def hostile_campaign_text(function, samples=40, chunk=8, workers=1, extra="", name="hostile"):
+    """A Monte Carlo campaign over x ~ U(-2, 2) of a model of data/hostile_model.py that misbehaves on
+    purpose (crashing, hanging, slow, long_histories)."""
+    return f"""
+name: {name}
+seed: 5
+simulator: {{kind: python, function: "{DATA / 'hostile_model.py'}:{function}"}}
+parameters:
+  x: {{distribution: uniform, lower: -2, upper: 2}}
+design: {{kind: monte_carlo, samples: {samples}}}
+execution: {{workers: {workers}, chunk: {chunk}{extra}}}
+"""
+
+
+def hostile_campaign(function, **kwargs):
+    """hostile_campaign_text parsed (as if from data/hostile.yaml)."""
+    from uqflight.campaign import parse_campaign
+
+    return parse_campaign(hostile_campaign_text(function, **kwargs), str(DATA / "hostile.yaml"))
+
+
+CLOSED_FORMS = DATA / "trust_models.py"
+NORMAL_2D = ("  x1: {distribution: normal, lower: -3, upper: 3}\n"
+             "  x2: {distribution: normal, lower: -3, upper: 3}\n")
+UNIFORM_X = "  x: {distribution: uniform, lower: -1, upper: 1}\n"
+NORMAL_X = "  x: {distribution: normal, lower: -3, upper: 3}\n"
+
+
+def closed_form_campaign(name, function, parameters, design, method="", extra=""):
+    """The text of a campaign of a closed-form model of data/trust_models.py (`parameters`: YAML lines such
+    as NORMAL_2D; `method`, `extra`: whole lines)."""
+    return (f"name: {name}\nseed: 5\nsimulator: {{kind: python, function: \"{CLOSED_FORMS}:{function}\"}}\n"
+            f"parameters:\n{parameters}design: {design}\n{method}{extra}"
+            "analysis: {band_samples: 2000, bootstrap: 0}\n")
+
+
+def strict_json(data: dict) -> dict:
+    """`data` through a strict JSON writer and reader, as summary.json is written and read."""
+    return json.loads(json.dumps(data, allow_nan=False))
+
+
+@pytest.fixture(scope="session")
+def flown(tmp_path_factory):
+    """fly(TEXT, NAME): the results file of a python campaign's TEXT, flown once per session (and xdist
+    worker) into a folder of its own, for the tests of several modules that only read it."""
+    files = {}
+
+    def fly(text: str, name: str = "c") -> Path:
+        if text not in files:
+            files[text] = run_python_campaign(tmp_path_factory.mktemp(name), text, name)
+        return files[text]
+
+    return fly

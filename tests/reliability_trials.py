@@ -23,7 +23,7 @@ from pathlib import Path
 sys.path.insert(0, str(Path(__file__).parent))
 import test_store  # noqa: E402
 from test_execution import JSBSIM_CAMPAIGN  # noqa: E402
-from test_reliability import UQFLIGHT, assert_same_results, campaign_text  # noqa: E402
+from conftest import UQFLIGHT, assert_same_results, hostile_campaign_text as campaign_text  # noqa: E402
 
 from uqflight.campaign import parse_campaign  # noqa: E402
 from uqflight.execution import run_campaign  # noqa: E402

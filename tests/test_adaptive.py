@@ -151,16 +151,21 @@ def test_rounds_grow_one_results_file_whose_statistics_are_the_combination_quadr
     assert recorded["indices"] == [list(index) for index in state.indices]
     rerun = run_campaign(parse_campaign(adaptive_text(budget=200), str(tmp_path / "a.yaml")), out=tmp_path / "a.h5")
     assert rerun.ran == 0  # a finished adaptive campaign resumes to nothing
+    with h5py.File(tmp_path / "a.h5", "r+") as f:  # a damaged index set is refused, not read
+        del f["design/old"]
+    with pytest.raises(CorruptFile, match="/design/old is missing"):
+        ResultStore.open(tmp_path / "a.h5")
+
+
+@pytest.mark.slow  # a whole report (the default suite checks the index set it draws, above)
+def test_the_report_shows_the_refined_inputs_most_refined_first(tmp_path):
+    run_campaign(parse_campaign(adaptive_text(budget=200), str(tmp_path / "a.yaml")), out=tmp_path / "a.h5")
     write_report([tmp_path / "a.h5"], tmp_path / "report")
     html = (tmp_path / "report" / "report.html").read_text()
     assert "Adaptive grid: the refined inputs" in html and (tmp_path / "report/plots/index_set_a.png").is_file()
     with open(tmp_path / "report/tables/index_set.csv") as table:
         first = next(csv.DictReader(table))
     assert first["input"] == "x1"  # the dominant input is the most refined
-    with h5py.File(tmp_path / "a.h5", "r+") as f:  # a damaged index set is refused, not read
-        del f["design/old"]
-    with pytest.raises(CorruptFile, match="/design/old is missing"):
-        ResultStore.open(tmp_path / "a.h5")
 
 
 def test_the_refinement_stops_before_the_budget():

@@ -4,17 +4,26 @@ Model: y(t) = a + b t + 1e-4 c t² and z(t) = a − b t on t in [0, 2] (21 times
 normal, so with known noise the posterior of (a, b) is Gaussian in closed form (the c term moves y by
 at most 4e-4, a hundredth of the noise: c stays at its uniform prior). The PCE of order 2 contains
 the model exactly, so the surrogate error is rounding noise.
+
+On a one-output campaign: calibration data too large for memory, a byte-order mark, a repeated --noise
+are refused up front with one message, and Ctrl-C during sampling exits 130 with one line.
 """
 import json
 import math
+import os
+import signal
+import subprocess
+import time
 
 import numpy as np
 import pytest
 import typer
+from conftest import NORMAL_2D, UQFLIGHT, cli_in_process, closed_form_campaign, run_python_campaign
 from typer.testing import CliRunner
 
 from uqflight.calibration.command import register
-from uqflight.calibration.likelihood import FlightData, LogPosterior, interpolate_in_time, DataError
+from uqflight.calibration.likelihood import (DataError, FlightData, LogPosterior, interpolate_in_time, parse_noise,
+                                             read_flight_csv)
 from uqflight.calibration.sampler import sample, split_rhat
 from uqflight.calibration.surrogate import calibration_surrogate, load_campaign_file
 from uqflight.campaign import parse_campaign
@@ -369,3 +378,66 @@ def test_the_memory_limit_is_the_campaigns_own(tmp_path):
     run = CliRunner().invoke(app(), ["calibrate", str(path), "--data", str(good), "--out", str(tmp_path / "o"),
                                      "--steps", "5000000"])
     assert run.exit_code == 2 and "the 1 GB memory limit (limits.max_memory_gb)" in run.output, run.output
+
+
+# -- calibration data and a campaign of one output: hostile inputs refused up front, Ctrl-C
+@pytest.fixture(scope="module")
+def one_output(tmp_path_factory):
+    """y(t) = 15000 + t (x1² + x2²) at 5 times in [0, 1] on a 4x4 grid."""
+    folder = tmp_path_factory.mktemp("calibrate")
+    return run_python_campaign(folder, closed_form_campaign("sq", "sum_of_squares", NORMAL_2D, "{kind: tensor_grid, points: 4}",
+                                                "method: {kind: pseudo_galerkin, order: 2}\n"))
+
+
+
+def test_a_million_row_csv_is_refused_before_it_is_parsed(one_output, tmp_path):
+    data = tmp_path / "big.csv"
+    data.write_text("time_s,y\n" + "0.5,15000.5\n" * (10**6 - 1) + "not,a number\n")  # parsed: refused otherwise
+    out = tmp_path / "out"
+    result = cli_in_process("calibrate", one_output, "--data", data, "--out", out)
+    assert result.returncode == 2, result.stderr
+    # 1 output x (50 predictive draws x (2 x 40 noise draws + 3) + 4 x 32 walkers) x 8 bytes = 34.2 kB a row
+    assert f"error: {data}: more than 233619 rows of data: calibrating 1 output(s) with 32 walkers and 50 " \
+           "predictive draws takes about 34 kB a row, more than the 8 GB memory limit" in result.stderr
+    assert len(result.stderr.strip().splitlines()) == 1 and not out.exists()
+
+
+
+def test_a_byte_order_mark_is_no_part_of_the_header(tmp_path):
+    path = tmp_path / "bom.csv"
+    path.write_bytes("\ufefftime_s,y\n0,1.5\n0.5,2.5\n".encode("utf-8"))
+    flight = read_flight_csv(path, None, ["y"])
+    np.testing.assert_array_equal(flight.time, [0.0, 0.5])
+    np.testing.assert_array_equal(flight.values["y"], [1.5, 2.5])
+
+
+
+def test_a_noise_given_twice_is_refused(one_output, tmp_path):
+    with pytest.raises(DataError, match=r"--noise y: given twice \(0\.01 and 5\); give it once"):
+        parse_noise(["y=0.01", "y=5"], ["y"])
+    data = tmp_path / "flight.csv"
+    data.write_text("time_s,y\n0,15000\n0.5,15001\n1,15002\n")
+    result = cli_in_process("calibrate", one_output, "--data", data, "--out", tmp_path / "out",
+                            "--noise", "y=0.01", "--noise", "y=5")
+    assert result.returncode == 2 and result.stderr == "error: --noise y: given twice (0.01 and 5); give it once\n"
+
+
+
+@pytest.mark.slow
+def test_ctrl_c_in_calibrate_exits_130_with_one_line(one_output, tmp_path):
+    data = tmp_path / "flight.csv"
+    data.write_text("time_s,y\n0,15000\n0.25,15000.6\n0.5,15001.1\n0.75,15001.4\n1,15002.1\n")
+    process = subprocess.Popen([UQFLIGHT, "calibrate", one_output, "--data", data, "--out", tmp_path / "out",
+                                "--steps", "10000000"], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    cpu = 0.0
+    while cpu < 6.0 and process.poll() is None:  # start-up and the fit take 2-3 s of CPU: then it samples
+        time.sleep(0.2)
+        fields = open(f"/proc/{process.pid}/stat").read().rsplit(")", 1)[1].split()
+        cpu = (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
+    process.send_signal(signal.SIGINT)
+    stdout, stderr = process.communicate(timeout=60)
+    assert process.returncode == 130, stderr[-3000:]
+    # off a terminal the progress is log lines ("calibrate: ..."); beside them, one line says it all
+    others = [line for line in stderr.splitlines() if not line.startswith("calibrate: ")]
+    assert stdout == "" and others == ["", f"interrupted: no calibration written to {tmp_path / 'out'}"], stderr
+

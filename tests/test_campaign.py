@@ -1,5 +1,6 @@
 """Campaign validation: every bad file gets one clear message (file, field, what was expected),
-`uqflight plan` and `uqflight run` exit with code 2 and no traceback, and nothing is written."""
+`uqflight plan` and `uqflight run` exit with code 2 and no traceback, and nothing is written; YAML that breaks
+Python's parser limits is one message too."""
 from pathlib import Path
 
 import pytest
@@ -182,3 +183,24 @@ design: {kind: monte_carlo, samples: 4}
 def test_exponents_without_a_dot_are_numbers():
     text = (DATA / "good_python_ishigami.yaml").read_text() + "storage: {raw: false, tsvd: {tol: 1e-8}}\n"
     assert parse_campaign(text, "x.yaml").storage["tsvd"]["tol"] == 1e-8
+
+
+HOSTILE_YAML = {  # name: (the value of `seed:`, what the one line says)
+    "nested 200,000 deep": ("[" * 200_000 + "]" * 200_000, "nested deeper than 64 levels"),
+    "an integer of 4,400 digits": ("9" * 4400, "an integer of 4400 characters; no field takes more than 100"),
+    "a month 13": ("2001-13-45", "cannot read this value (month must be in 1..12)"),
+    "a float tag on a word": ("!!float abc", "cannot read this value (could not convert string to float"),
+    "a set tag on a list": ("!!set [1]", "expected a mapping node, but found sequence"),
+}
+
+
+@pytest.mark.parametrize("name", HOSTILE_YAML)
+def test_hostile_campaign_yaml_is_one_message_with_exit_2(tmp_path, name):
+    value, message = HOSTILE_YAML[name]
+    path = tmp_path / "hostile.yaml"
+    path.write_text(f"name: hostile\nseed: {value}\n")
+    result = cli_in_process("plan", path)
+    assert result.returncode == 2, result.stderr[-2000:]
+    assert result.stderr.startswith(f"error: {path}: YAML error at line 2") and message in result.stderr
+    assert len(result.stderr.strip().splitlines()) == 1 and "Traceback" not in result.stderr
+

@@ -11,11 +11,13 @@ import time
 from pathlib import Path
 
 import pytest
-from conftest import UQFLIGHT, cli_in_process, mounted_tmpfs, run_python_campaign, scheduler_address
-from test_trust import NORMAL_2D, campaign
+from conftest import (NORMAL_2D, UQFLIGHT, cli_in_process, closed_form_campaign, hostile_campaign, mounted_tmpfs,
+                      run_python_campaign, scheduler_address)
+
+from uqflight.execution import run_campaign
 
 BIN = Path(sys.executable).parent
-TEXT = campaign("sq", "sum_of_squares", NORMAL_2D, "{kind: tensor_grid, points: 3}",
+TEXT = closed_form_campaign("sq", "sum_of_squares", NORMAL_2D, "{kind: tensor_grid, points: 3}",
                 "method: {kind: pseudo_galerkin, order: 2}\n")
 
 
@@ -140,3 +142,12 @@ def test_surrogate_export_on_a_full_disk_leaves_no_partial_file(results, full_di
     result = cli_in_process("surrogate", "export", results, "--out", full_disk / "p.json")
     assert result.returncode == 2 and "No space left on device" in result.stderr, result.stderr
     assert sorted(p.name for p in full_disk.iterdir()) == ["filler"]
+
+
+@pytest.mark.parametrize("where", ["a file/r.h5", "/proc/uqflight-test.h5"])
+def test_a_results_path_that_cannot_be_written_is_refused(tmp_path, where):
+    """A file where a folder should be; a filesystem that takes no new files (procfs)."""
+    (tmp_path / "a file").write_text("not a folder")
+    with pytest.raises(ValueError, match=r"cannot write the results file .*r?\.h5 \((File exists|No such file)"
+                                         r".*\); choose another path with --out or storage.path"):
+        run_campaign(hostile_campaign("slow", samples=1), out=tmp_path / where)

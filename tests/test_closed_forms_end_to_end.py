@@ -39,6 +39,7 @@ def indices(stats, output="y"):
             [float(out.sobol_total[p][0]) for p in ("x1", "x2", "x3")])
 
 
+@pytest.mark.slow  # 3000 runs and an order-10 fit: test_analysis.py fits the same PCE in process
 def test_ishigami_sobol_indices_from_a_pce(tmp_path):
     # Regression of order 10 on 3000 Latin-hypercube points: the truncation error of the degree-10
     # expansion of sin and x^4 sin is below 1e-2 on the indices (checked against the closed form).
@@ -50,6 +51,7 @@ def test_ishigami_sobol_indices_from_a_pce(tmp_path):
     assert stats.outputs["y"].mean[0] == pytest.approx(3.5, abs=2e-2)  # E[y] = a/2
 
 
+@pytest.mark.slow  # 20 480 runs: test_analysis.py checks pick-freeze on Ishigami in process, test_seeds.py flies one
 def test_ishigami_sobol_indices_from_pick_freeze_monte_carlo(tmp_path):
     # n = 4096 base samples: the estimators' standard error is ~0.01-0.02; 0.05 is about 3 of them.
     stats = results(tmp_path, ISHIGAMI.format(name="pf", design="{kind: pick_freeze, samples: 4096}",

@@ -3,18 +3,20 @@ inside the flight, one KIND[:ORDER] for every --method, the campaign table's res
 import csv
 import io
 
+import numpy as np
 import pytest
 import yaml
-from conftest import cli_in_process, run_python_campaign
-from test_trust import NORMAL_2D, campaign
+from conftest import DECAY_TWO_INPUTS, NORMAL_2D, cli, cli_in_process, closed_form_campaign, run_python_campaign
 
+import uqflight
 from uqflight.calibration.command import _method
+from uqflight.campaign import parse_campaign
 from uqflight.cli import _check_times
 from uqflight.report.loading import flight_facts
 
-GRID = campaign("sq", "sum_of_squares", NORMAL_2D, "{kind: tensor_grid, points: 3}",
+GRID = closed_form_campaign("sq", "sum_of_squares", NORMAL_2D, "{kind: tensor_grid, points: 3}",
                 "method: {kind: pseudo_galerkin, order: 2}\n")  # 9 runs, times 0, 0.25, ..., 1 s
-SAMPLED = campaign("mc", "sum_of_squares", NORMAL_2D, "{kind: monte_carlo, samples: 8}", "method: {kind: monte_carlo}\n")
+SAMPLED = closed_form_campaign("mc", "sum_of_squares", NORMAL_2D, "{kind: monte_carlo, samples: 8}", "method: {kind: monte_carlo}\n")
 
 
 @pytest.fixture(scope="module")
@@ -86,3 +88,34 @@ def test_the_campaign_table_shows_the_flight_and_excitation_flown():
     cut = {"kind": "jsbsim", "scenario": {"kind": "script", "script": "c172_cruise_8K", "end_s": 2}}
     assert flight_facts(cut)["flight"] == "script c172_cruise_8K, cut at 2 s"
     assert flight_facts({"kind": "python", "function": "m.py:f"}) == {}
+
+
+def test_version_and_short_help():
+    result = cli("--version")
+    assert result.returncode == 0 and result.stdout.strip() == f"uqflight {uqflight.__version__}"
+    short, long = cli_in_process("-h"), cli_in_process("--help")
+    assert short.returncode == 0 and short.stdout == long.stdout and "-h, --help" in short.stdout
+    for command in ("report", "design", "simulate", "calibrate", "aircraft"):
+        assert cli_in_process(command, "-h").returncode == 0
+    assert "surrogate" in short.stdout and "design" in short.stdout
+
+
+def test_design_csv(tmp_path):
+    campaign = tmp_path / "decay.yaml"
+    campaign.write_text(DECAY_TWO_INPUTS)
+    out = tmp_path / "design.csv"
+    result = cli_in_process("design", campaign, "--csv", out)
+    assert result.returncode == 0, result.stderr
+    rows = list(csv.DictReader(open(out)))
+    design = parse_campaign(DECAY_TWO_INPUTS, str(campaign)).design()
+    assert result.stdout.strip() == (f"wrote {out}: {len(design.xi)} points of a sparse_grid design in 2 "
+                                     "parameters (a, b)")
+    assert list(rows[0]) == ["run", "xi_a", "xi_b", "a", "b", "weight"] and len(rows) == len(design.xi)
+    xi = np.array([[float(r["xi_a"]), float(r["xi_b"])] for r in rows])
+    np.testing.assert_array_equal(xi, design.xi)
+    np.testing.assert_array_equal([float(r["weight"]) for r in rows], design.weights)
+    kappa = np.array([[float(r["a"]), float(r["b"])] for r in rows])
+    np.testing.assert_allclose(kappa[:, 0], 1.0 + xi[:, 0] / 6, rtol=1e-14)  # normal: ±3σ on [0.5, 1.5]
+    np.testing.assert_allclose(kappa[:, 1], 1.5 + 0.5 * xi[:, 1], rtol=1e-14)  # uniform on [1, 2]
+    missing = cli_in_process("design", tmp_path / "missing.yaml", "--csv", out)
+    assert missing.returncode == 2 and "Traceback" not in missing.stderr

@@ -1,17 +1,20 @@
 """Damaged and foreign results files: every reader refuses them with one line naming the file and what
-is wrong (exit 2), never a traceback, never a report. Real HDF5 files from a real campaign, then cut."""
+is wrong (exit 2), never a traceback, never a report. Real HDF5 files from a real campaign, then cut.
+Damaged, lying or oversized surrogate files are refused naming the key."""
+import json
 import shutil
 
 import h5py
 import numpy as np
 import pytest
-from conftest import DATA, cli_in_process, run_python_campaign
+from conftest import DATA, cli_in_process, hostile_campaign, run_python_campaign
 
 from uqflight.campaign import parse_campaign
 from uqflight.execution import run_campaign
 from uqflight.report.loading import load_entries
 from uqflight.statistics import BadInput, read_statistics
 from uqflight.store import CorruptFile, ResultStore
+from uqflight.surrogate import MAX_FILE_BYTES, SurrogateError, load
 
 N, T = 12, 5000
 CAMPAIGN = f"""
@@ -199,12 +202,12 @@ SURROGATE_DAMAGES = {  # name: (edit of the parsed JSON, what the message says)
 @pytest.fixture(scope="module")
 def surrogate_text(tmp_path_factory):
     """The order-2 PCE of y = 15000 + t (x1² + x2²) (5 times) on a 4x4 grid, exported."""
-    from test_trust import NORMAL_2D, campaign
+    from conftest import NORMAL_2D, closed_form_campaign
 
     from uqflight.surrogate import export
 
     folder = tmp_path_factory.mktemp("surrogate")
-    results = run_python_campaign(folder, campaign("sq", "sum_of_squares", NORMAL_2D, "{kind: tensor_grid, points: 4}",
+    results = run_python_campaign(folder, closed_form_campaign("sq", "sum_of_squares", NORMAL_2D, "{kind: tensor_grid, points: 4}",
                                                    "method: {kind: pseudo_galerkin, order: 2}\n"))
     return export(results, folder / "pce.json").read_text()
 
@@ -233,3 +236,76 @@ def load_ok(text, folder) -> bool:
 
     (folder / "sound.json").write_text(text)
     return load(folder / "sound.json").evaluate(xi=[[0.3, -0.2]])["y"].shape == (1, 5)
+
+
+def test_a_flipped_byte_is_reported(tmp_path):
+    out = tmp_path / "r.h5"
+    run_campaign(hostile_campaign("slow", samples=4), out=out)
+    with h5py.File(out, "r") as f:
+        offset = f["outputs/y"].id.get_chunk_info(0).byte_offset
+    with open(out, "r+b") as fh:
+        fh.seek(offset + 3)
+        byte = fh.read(1)
+        fh.seek(offset + 3)
+        fh.write(bytes([byte[0] ^ 0x10]))
+    info = cli_in_process("info", out)
+    assert info.returncode == 2
+    assert "data corrupted: a checksum (fletcher32) does not match" in info.stderr
+
+
+def test_an_unknown_status_code_is_an_error(tmp_path):
+    out = tmp_path / "r.h5"
+    run_campaign(hostile_campaign("slow", samples=2), out=out)
+    with h5py.File(out, "a") as f:
+        f["samples/status"][1] = 9
+    with pytest.raises(CorruptFile, match=r"unknown status codes \[9\]"):
+        ResultStore.open(out)
+    info = cli_in_process("info", out)
+    assert info.returncode == 2 and "unknown status codes [9]" in info.stderr
+
+
+HOSTILE_SURROGATES = {  # name: (edit of the file's text or parsed JSON, the key and what is wrong)
+    "an order of 1e400": (lambda t: t.replace('"order": 2', '"order": 1e400'),
+                          r"order: expected an integer in \[0, 1000\], got inf"),
+    "a huge multi-index": (lambda s: s["multi_indices"].__setitem__(1, [10**30, 0]),
+                           r"multi_indices: expected rows of 2 integers in \[0, 1000\]"),
+    "a fractional multi-index": (lambda s: s["multi_indices"].__setitem__(1, [0.9, 0]),
+                                 r"multi_indices: .* with 0\.9"),
+    "a repeated multi-index": (lambda s: s["multi_indices"].__setitem__(2, s["multi_indices"][1]),
+                               r"multi_indices: row 2 repeats row 1"),
+    "a coefficient as a string": (lambda s: s["outputs"]["y"]["coefficients"][0].__setitem__(0, "1.5"),
+                                  r"outputs\.y\.coefficients: expected 6 x 5 finite numbers, .* with '1\.5'"),
+    "a time as a string": (lambda s: s["time"].__setitem__(0, "0.0"), r"time: .* with '0\.0'"),
+    "a bound as a string": (lambda s: s["parameters"][0].update(lower="-3"),
+                            r"parameters\[0\]\.lower: expected a finite number, got '-3'"),
+    "a uniform germ for a normal law": (lambda s: s.update(germs=["uniform", "normal"]),
+                                        r"parameters\[0\] \(x1\): a normal law is driven by a normal germ, "
+                                        r"but germs\[0\] is uniform"),
+    "decreasing times": (lambda s: s.update(time=s["time"][::-1]), "time: expected a list of strictly increasing"),
+    "a boolean coefficient": (lambda s: s["outputs"]["y"]["coefficients"][1].__setitem__(1, True),
+                              r"outputs\.y\.coefficients: .* with True"),
+}
+
+
+@pytest.mark.parametrize("name", HOSTILE_SURROGATES)
+def test_hostile_surrogate_files_are_refused_naming_the_key(surrogate_text, tmp_path, name):
+    edit, message = HOSTILE_SURROGATES[name]
+    path = tmp_path / "pce.json"
+    if name == "an order of 1e400":  # not JSON that json.dumps writes: edit the text
+        path.write_text(edit(surrogate_text))
+    else:
+        data = json.loads(surrogate_text)
+        edit(data)
+        path.write_text(json.dumps(data))
+    with pytest.raises(SurrogateError, match=rf"pce\.json: malformed surrogate \(ValueError: {message}"):
+        load(path)
+
+
+
+def test_a_surrogate_file_above_the_cap_is_refused_before_it_is_read(tmp_path):
+    path = tmp_path / "big.json"
+    with open(path, "wb") as fh:  # sparse: nothing is written, and parsing it would fail otherwise
+        fh.truncate(MAX_FILE_BYTES + 1)
+    with pytest.raises(SurrogateError, match=r"big\.json: cannot read the surrogate \(64 MiB, more than the 64 MiB"):
+        load(path)
+

@@ -1,6 +1,8 @@
-"""uqflight.methods.exactness: polynomial exactness and design-matrix rank measured on the points."""
+"""uqflight.methods.exactness: polynomial exactness and design-matrix rank measured on the points, and
+`plan` and `report` refusing a projection or a fit the points cannot carry."""
 import numpy as np
 import pytest
+from conftest import NORMAL_2D, cli_in_process, closed_form_campaign, run_python_campaign
 
 from uqflight.designs import build_design
 from uqflight.methods.exactness import (
@@ -10,6 +12,7 @@ from uqflight.methods.exactness import (
     quadrature_errors,
 )
 from uqflight.methods.basis import orthonormal_basis, total_degree_indices
+from uqflight.statistics import analyse
 
 
 @pytest.mark.parametrize("points", [1, 2, 3, 5, 8])
@@ -90,3 +93,33 @@ def test_rank_of_full_and_deficient_designs():
     weights[:4] = 0.0
     assert design_matrix_rank(tensor.xi, germs, 4, weights)[0] == 5
     assert design_matrix_rank(np.zeros((0, 2)), germs, 1) == (0, 3)
+
+
+def test_plan_refuses_a_projection_the_grid_cannot_integrate(tmp_path):
+    text = closed_form_campaign("alias", "sum_of_squares", NORMAL_2D, "{kind: sparse_grid, level: 1}",
+                    "method: {kind: pseudo_galerkin, order: 2}\n")
+    (tmp_path / "a.yaml").write_text(text)
+    plan = cli_in_process("plan", tmp_path / "a.yaml")
+    assert plan.returncode == 2
+    assert "method.order" in plan.stderr and "exact to degree 3" in plan.stderr
+    assert "largest order it can project is 1" in plan.stderr
+    (tmp_path / "b.yaml").write_text(text.replace("order: 2}", "order: 2, allow_aliasing: true}"))
+    assert cli_in_process("plan", tmp_path / "b.yaml").returncode == 0
+
+
+def test_report_refuses_an_aliased_order_unless_allowed(tmp_path):
+    results = run_python_campaign(tmp_path, closed_form_campaign("l1", "sum_of_squares", NORMAL_2D,
+                                                     "{kind: sparse_grid, level: 1}"))
+    refused = cli_in_process("report", results, "--method", "pseudo_galerkin", "--order", "4", "--out", tmp_path / "r")
+    assert refused.returncode == 2 and "exact to degree 3" in refused.stderr
+    allowed = analyse(results, method={"kind": "pseudo_galerkin", "order": 4}, allow_aliasing=True)
+    assert any("aliasing allowed" in note for note in allowed.notes)
+
+
+def test_plan_refuses_a_rank_deficient_least_squares_fit(tmp_path):
+    uniform = "".join(f"  x{i}: {{distribution: uniform, lower: -1, upper: 1}}\n" for i in (1, 2, 3))
+    (tmp_path / "r.yaml").write_text(closed_form_campaign("rank", "sum_of_squares", uniform,
+                                              "{kind: sparse_grid, level: 2, rule: gauss_legendre}",
+                                              "method: {kind: least_squares, order: 3}\n"))
+    plan = cli_in_process("plan", tmp_path / "r.yaml")
+    assert plan.returncode == 2 and "rank 19" in plan.stderr and "method.order" in plan.stderr

@@ -6,7 +6,7 @@ import subprocess
 import h5py
 import numpy as np
 import pytest
-from conftest import DATA, UQFLIGHT, assert_same_results
+from conftest import DATA, DECAY_TWO_INPUTS, UQFLIGHT, assert_same_results, cli_in_process, hostile_campaign
 
 from uqflight.campaign import parse_campaign
 from uqflight.simulators.validation_view import validation_view
@@ -33,6 +33,24 @@ execution: {{workers: 1, chunk: 4}}
 def jsbsim_campaign(samples=12, duration=5):
     return parse_campaign(JSBSIM_CAMPAIGN.format(samples=samples, duration=duration), "small.yaml", validation_view)
 
+
+def python_campaign(samples):
+    """A Monte Carlo campaign of a closed-form model: what the file checks below see without flying."""
+    return parse_campaign(f"""
+name: small-python
+seed: 7
+simulator: {{kind: python, function: "uqflight.simulators.models:linear"}}
+parameters:
+  x1: {{distribution: uniform, lower: -1, upper: 1}}
+design: {{kind: monte_carlo, samples: {samples}}}
+execution: {{workers: 1, chunk: 4}}
+""", "small.yaml")
+
+
+# the results-file checks do not depend on the simulator: the default suite runs them on a closed-form
+# model, the slow suite on JSBSim too
+KINDS = pytest.mark.parametrize("make_campaign", [
+    pytest.param(python_campaign, id="python"), pytest.param(jsbsim_campaign, id="jsbsim", marks=pytest.mark.slow)])
 
 
 @pytest.mark.slow  # a long real-process check; the slow suite runs it in CI
@@ -83,9 +101,10 @@ execution: {workers: 2, chunk: 8}
     assert sum(summary.failures.values()) == int((~ok).sum())
 
 
-def test_a_file_of_another_campaign_is_refused_unless_forced(tmp_path):
-    run_campaign(jsbsim_campaign(samples=2), out=tmp_path / "r.h5")
-    other = jsbsim_campaign(samples=3)
+@KINDS
+def test_a_file_of_another_campaign_is_refused_unless_forced(tmp_path, make_campaign):
+    run_campaign(make_campaign(samples=2), out=tmp_path / "r.h5")
+    other = make_campaign(samples=3)
     with pytest.raises(FileExistsError, match="another campaign"):
         run_campaign(other, out=tmp_path / "r.h5")
     assert run_campaign(other, out=tmp_path / "r.h5", force=True).ran == 3
@@ -135,27 +154,29 @@ def test_tsvd_storage_and_property_outputs(tmp_path):
             np.testing.assert_array_equal(compressed.resolution(name), raw.resolution(name))
 
 
-def test_an_unreadable_results_file_is_refused_unless_forced(tmp_path):
-    run_campaign(jsbsim_campaign(samples=2), out=tmp_path / "whole.h5")
+@KINDS
+def test_an_unreadable_results_file_is_refused_unless_forced(tmp_path, make_campaign):
+    run_campaign(make_campaign(samples=2), out=tmp_path / "whole.h5")
     broken = tmp_path / "r.h5"  # as if killed while the file was being created: HDF5, unreadable
     broken.write_bytes((tmp_path / "whole.h5").read_bytes()[:2048])
     with pytest.raises(FileExistsError, match="damaged HDF5 file"):
-        run_campaign(jsbsim_campaign(samples=2), out=broken)
-    assert run_campaign(jsbsim_campaign(samples=2), out=broken, force=True).ran == 2
+        run_campaign(make_campaign(samples=2), out=broken)
+    assert run_campaign(make_campaign(samples=2), out=broken, force=True).ran == 2
 
 
-def test_force_never_replaces_what_is_not_a_results_file(tmp_path):
+@KINDS
+def test_force_never_replaces_what_is_not_a_results_file(tmp_path, make_campaign):
     text = tmp_path / "notes.h5"
     text.write_text("my notes")
     with pytest.raises(FileExistsError, match="not a uqflight results file.*rm "):
-        run_campaign(jsbsim_campaign(samples=2), out=text, force=True)
+        run_campaign(make_campaign(samples=2), out=text, force=True)
     assert text.read_text() == "my notes"
     with pytest.raises(FileExistsError, match="is a directory"):
-        run_campaign(jsbsim_campaign(samples=2), out=tmp_path, force=True)
+        run_campaign(make_campaign(samples=2), out=tmp_path, force=True)
     with h5py.File(tmp_path / "other.h5", "w") as f:
         f["x"] = [1, 2, 3]
     with pytest.raises(FileExistsError, match="HDF5 file but not a uqflight results file"):
-        run_campaign(jsbsim_campaign(samples=2), out=tmp_path / "other.h5", force=True)
+        run_campaign(make_campaign(samples=2), out=tmp_path / "other.h5", force=True)
 
 
 def test_resuming_with_changed_aircraft_files_is_refused_unless_forced(tmp_path):
@@ -223,3 +244,45 @@ design: {kind: monte_carlo, samples: 4}
     _, crashed, failures = simulate(campaign, kappa, ["y", "z"], processes=3)
     assert failures == ["the process flying this run died (signal 9)"] * 3
     assert np.isnan(crashed["y"][6:]).all() and np.array_equal(crashed["y"][:6], one["y"][:6])
+
+
+def test_restart_starts_a_same_campaign_file_over_and_force_keeps_its_meaning(tmp_path):
+    campaign = tmp_path / "decay.yaml"
+    campaign.write_text(DECAY_TWO_INPUTS)
+    out = tmp_path / "d.h5"
+    assert cli_in_process("run", campaign, "--out", out).returncode == 0
+    with h5py.File(out, "a") as f:
+        f.attrs["marker"] = "the first run's file"
+    again = cli_in_process("run", campaign, "--out", out, "--force")  # a file of this campaign: resumed, nothing to do
+    assert again.returncode == 0 and " 0 run now" in again.stdout
+    with h5py.File(out, "r") as f:
+        assert "marker" in f.attrs
+    restarted = cli_in_process("run", campaign, "--out", out, "--restart")
+    assert restarted.returncode == 0 and " 0 already done" in restarted.stdout
+    with h5py.File(out, "r") as f:
+        assert "marker" not in f.attrs  # a new file
+
+
+def test_an_idle_worker_gets_its_next_chunk_before_the_runner_writes(tmp_path):
+    """The pool hands a finished chunk to its caller (who writes it to HDF5) only once the worker
+    that flew it has its next chunk: workers never wait for the writer."""
+    from uqflight.execution import Task, WorkerPool, nominal_kappa, worker_spec
+    from uqflight.parameters import to_physical
+
+    spec = hostile_campaign("slow", samples=6, chunk=2)
+    kappa = to_physical(spec.parameters, spec.design().xi)
+    tasks = [Task(np.arange(i, i + 2), kappa[i:i + 2]) for i in (0, 2, 4)]
+    pool = WorkerPool(worker_spec(spec), 1, 60.0)
+    try:
+        nominal = pool.nominal_flight(nominal_kappa(spec))
+        time_grid, outputs = nominal.time, nominal.outputs
+        results = pool.run(tasks, len(time_grid), outputs)
+        first = next(results)
+        assert first[0].tolist() == [0, 1] and pool.slots[0].task is tasks[1]
+        assert [r[0].tolist() for r in results] == [[2, 3], [4, 5]]
+    finally:
+        pool.close()
+    long_runs = hostile_campaign("long_histories", samples=6, chunk=2)  # 40 kB per run
+    with h5py.File(run_campaign(long_runs, out=tmp_path / "r.h5").path) as f:  # the runner's chunk = HDF5's
+        assert f["outputs/y"].chunks[0] == 2
+

@@ -4,12 +4,13 @@ model y = 1 + x1 + x2 fails where x1 + x2 > C, on 13 % of U(-1, 1)² (tests/data
 import math
 
 import h5py
+import numpy as np
 import pytest
-from conftest import cli_in_process, run_python_campaign
+from conftest import NORMAL_2D, cli_in_process, closed_form_campaign, run_python_campaign
 from data.failure_models import C, P_FAIL, corner_campaign
 
 from uqflight.methods import FAILED_RUNS, METHODS
-from uqflight.statistics import analyse
+from uqflight.statistics import BadInput, analyse
 
 # E[x1 + x2 | success] = −E[(x1 + x2) 1_fail] / 0.87, with x1 + x2 = u of density (2 − |u|)/4 on [−2, 2]:
 # E[u 1_fail] = ∫_C^2 u (2 − u)/4 du = (4/3 − C² + C³/3)/4.
@@ -17,9 +18,8 @@ CONDITIONAL_MEAN = 1.0 - (4 / 3 - C**2 + C**3 / 3) / 4 / (1 - P_FAIL)
 
 
 @pytest.fixture(scope="module")
-def runs(tmp_path_factory):
-    folder = tmp_path_factory.mktemp("failed")
-    return {name: run_python_campaign(folder, corner_campaign(name, design), name)
+def runs(flown):
+    return {name: flown(corner_campaign(name, design), name)  # the Monte Carlo file: test_failure_probability.py's too
             for name, design in (("mc", "{kind: monte_carlo, samples: 1000}"),
                                  ("tensor", "{kind: tensor_grid, points: 6}"))}
 
@@ -73,3 +73,28 @@ def test_the_reports_notes_box_says_the_statistics_are_conditional(runs, tmp_pat
     page = (tmp_path / "r" / "report.md").read_text()
     notes = page[page.index('<a id="notes"></a>'):page.index('<a id="run"></a>')]
     assert "statistics conditional on success: " in notes, notes
+
+
+@pytest.fixture(scope="module")
+def grid(tmp_path_factory):
+    """A complete 4 × 4 Gauss–Hermite grid of the quadratic, one corner failed."""
+    folder = tmp_path_factory.mktemp("grid")
+    return run_python_campaign(folder, closed_form_campaign("grid", "quadratic_failing_corner", NORMAL_2D,
+                                                "{kind: tensor_grid, points: 4}",
+                                                "method: {kind: pseudo_galerkin, order: 1}\n"))
+
+
+def test_a_grid_with_a_failed_run_refuses_projections_and_fits_the_rest_exactly(grid, tmp_path):
+    with pytest.raises(BadInput, match="1 of 16 runs are missing; use least_squares or regression"):
+        analyse(grid)
+    refused = cli_in_process("report", grid, "--out", tmp_path / "r")
+    assert refused.returncode == 2 and "pseudo_galerkin" in refused.stderr and not (tmp_path / "r").exists()
+    stats = analyse(grid, method={"kind": "least_squares", "order": 2})
+    out = stats.outputs["y"]
+    # y = 1 + x1 + x1 x2 + x2² is in the order-2 basis, which the 15 remaining points still resolve
+    assert out.mean[0] == pytest.approx(2.0, abs=1e-10) and out.variance[0] == pytest.approx(4.0, abs=1e-9)
+    assert out.loo_error[0] == pytest.approx(0.0, abs=1e-20)
+    # a tensor grid: the quadrature of the failure indicator, no interval (test_failure_probability.py)
+    assert stats.failure_probability["estimate"] > 0 and np.isnan(stats.failure_probability["lower"])
+    with pytest.raises(BadInput, match="rank"):
+        analyse(grid, method={"kind": "regression", "order": 4})

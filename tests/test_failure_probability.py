@@ -6,7 +6,7 @@ import math
 import h5py
 import numpy as np
 import pytest
-from conftest import cli_in_process, read_summary, run_python_campaign
+from conftest import UNIFORM_X, cli_in_process, closed_form_campaign, read_summary, run_python_campaign
 from data.failure_models import C, P_FAIL, corner_campaign
 
 from uqflight.analysis.failures import grid_failure_probability, kish_effective_runs
@@ -15,9 +15,8 @@ from uqflight.statistics import analyse, summary_json
 
 
 @pytest.fixture(scope="module")
-def runs(tmp_path_factory):
-    folder = tmp_path_factory.mktemp("corner")
-    return {name: run_python_campaign(folder, corner_campaign(name, design), name)
+def runs(flown):
+    return {name: flown(corner_campaign(name, design), name)  # the Monte Carlo file: test_failed_runs.py's too
             for name, design in (("sparse", "{kind: sparse_grid, level: 5}"),
                                  ("tensor", "{kind: tensor_grid, points: 10}"),
                                  ("mc", "{kind: monte_carlo, samples: 1000}"))}
@@ -115,3 +114,17 @@ def test_grid_inputs_are_checked():
         grid_failure_probability(np.array([True, False]), np.array([1.0, -1.0]))
     with pytest.raises(ValueError, match="expected \\(3,\\)"):
         grid_failure_probability(np.array([True, False, False]), np.ones(4))
+
+
+def test_the_failure_probability_interval_contains_the_true_fraction(tmp_path):
+    results = run_python_campaign(tmp_path, closed_form_campaign("fail", "fails_above", UNIFORM_X,
+                                                     "{kind: monte_carlo, samples: 400}"))
+    stats = analyse(results)
+    p = stats.failure_probability
+    assert p["lower"] <= 0.2 <= p["upper"] and "Wilson" in p["method"]
+    assert stats.failed == len(stats.failures) and stats.completed + stats.failed == 400
+    assert all(f["parameters"]["x"] > 0.6 and f["reason"] for f in stats.failures)
+    assert any("conditional on success" in note for note in stats.notes)
+    summary = summary_json(stats)
+    assert summary["failed"] == stats.failed and summary["failure_probability"]["estimate"] == pytest.approx(
+        stats.failed / 400)

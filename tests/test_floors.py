@@ -1,9 +1,13 @@
-"""uqflight.analysis.floors: the Monte Carlo reference's own noise in Eq. 49's normalisation, and the KLD's."""
+"""uqflight.analysis.floors: the Monte Carlo reference's own noise in Eq. 49's normalisation, and the KLD's;
+the errors of an exact grid against a Monte Carlo or randomised-QMC reference carry that floor."""
+import h5py
 import numpy as np
 import pytest
+from conftest import NORMAL_2D, closed_form_campaign, run_python_campaign
 
 from uqflight.analysis import kl_divergence
 from uqflight.analysis.floors import central_moments, floors_from_moments, kld_floor, reference_floors
+from uqflight.statistics import analyse
 
 
 def test_floors_from_exact_normal_moments_are_the_closed_form():
@@ -96,3 +100,39 @@ def test_kld_floor_matches_the_kld_of_two_independent_samples_of_one_law():
     floor = kld_floor(rng.standard_normal(2000))
     fresh = np.mean([kl_divergence(rng.standard_normal(1000), rng.standard_normal(1000)) for _ in range(10)])
     assert fresh / 2 < floor < 2 * fresh
+
+
+def exact_grid_errors_against(tmp_path, flown, reference_design: str, tag: str):
+    """(errors of an exact PG grid on sum_of_squares against a reference of that design, the reference's
+    runs): what is left of the errors is the reference's own noise."""
+    reference = run_python_campaign(tmp_path, closed_form_campaign(tag, "sum_of_squares", NORMAL_2D, reference_design), tag)
+    grid = flown(closed_form_campaign("pg", "sum_of_squares", NORMAL_2D, "{kind: tensor_grid, points: 4}",
+                                      "method: {kind: pseudo_galerkin, order: 2}\n"), "pg")
+    errors = analyse(grid, reference=str(reference)).outputs["y"].errors
+    with h5py.File(reference) as f:
+        return errors, f["outputs/y"][()]
+
+
+def test_errors_carry_the_reference_noise_floor(tmp_path, flown):
+    errors, Y = exact_grid_errors_against(tmp_path, flown, "{kind: monte_carlo, samples: 400}", "ref")
+    # σ/√N of the reference's mean and the distribution-free standard error of its variance,
+    # √((μ4 − (N−3)/(N−1) σ⁴)/N), in Eq. 49's normalisation, recomputed here from the runs
+    n, variance = len(Y), Y.var(axis=0, ddof=1)
+    fourth = ((Y - Y.mean(axis=0)) ** 4).mean(axis=0)
+    np.testing.assert_allclose(errors["eps_m_floor"], np.sqrt(variance / n) / Y.mean(axis=0).max(), rtol=1e-12)
+    se_variance = np.sqrt((fourth - (n - 3) / (n - 1) * variance**2) / n)
+    np.testing.assert_allclose(errors["eps_v_floor"][1:], se_variance[1:] / variance.max(), rtol=1e-9)
+    assert errors["kld_floor"] > 0 and "400 monte_carlo runs" in errors["floor_note"]
+    assert np.max(errors["eps_m"]) < 3 * np.max(errors["eps_m_floor"])  # the grid is exact: only noise is left
+
+
+def test_a_randomised_qmc_reference_takes_its_floor_from_the_replicates(tmp_path, flown):
+    errors, runs = exact_grid_errors_against(tmp_path, flown, "{kind: sobol, samples: 64, replicates: 8}", "rqmc")
+    Y = runs.reshape(8, 64, -1)
+    means = Y.mean(axis=1)
+    np.testing.assert_allclose(errors["eps_m_floor"], means.std(axis=0, ddof=1) / np.sqrt(8) / means.mean(axis=0).max(),
+                               rtol=1e-9)
+    assert "8 replicates" in errors["floor_note"]
+    # scrambled Sobol' points resolve this smooth mean better than as many random draws would (σ/√512,
+    # σ = 2 at t = 1); measured 0.32 of it, and 8 replicates estimate the spread to ~25 %: below 0.6
+    assert np.max(errors["eps_m_floor"]) < 0.6 * np.sqrt(4 / 512) / 15001

@@ -1,8 +1,7 @@
 """Campaign limits: designs, memory, disk, PCE terms and campaign files too large are refused before
 anything is built or run, naming the limit and how to raise it; names that are not safe are refused."""
 import pytest
-from conftest import cli_in_process
-from test_reliability import campaign
+from conftest import cli_in_process, hostile_campaign
 
 from uqflight.campaign import parse_campaign
 from uqflight.execution import run_campaign
@@ -86,7 +85,7 @@ def test_more_worker_processes_than_memory_allows_are_refused():
 def test_workers_asked_on_the_command_line_are_refused_beyond_memory_and_capped_at_the_chunks(tmp_path):
     from uqflight.execution import local_workers
 
-    spec = campaign("slow", samples=15, chunk=16)  # chunks of 4 at the design's end: 0, 4, 8, 12
+    spec = hostile_campaign("slow", samples=15, chunk=16)  # chunks of 4 at the design's end: 0, 4, 8, 12
     assert spec.runs == 15 and local_workers(spec, 50, 16) == 4 and local_workers(spec, 3, 16) == 3
     with pytest.raises(ValueError, match=r"100000 workers would need about 6e\+03 GB of memory \(60 MB each\), "
                                          r"more than limits.max_memory_gb = 8"):

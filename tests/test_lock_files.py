@@ -8,8 +8,9 @@ import sys
 import time
 
 import pytest
-from conftest import cli, cli_in_process
+from conftest import cli, cli_in_process, hostile_campaign
 
+from uqflight.execution import run_campaign
 from uqflight.store import LockHeld, ResultsLock, ResultStore
 from uqflight.store.lock import start_time, read_holder
 
@@ -118,3 +119,29 @@ def test_the_lock_written_is_whole_and_removed_on_release(tmp_path):
         assert holder["pid"] == os.getpid() and holder["started"] == start_time(os.getpid())
         assert sorted(p.name for p in tmp_path.iterdir()) == ["r.h5.lock"]  # no temporary file left
     assert not list(tmp_path.iterdir())
+
+
+def test_a_stale_lock_is_taken_over(tmp_path):
+    dead = subprocess.Popen([sys.executable, "-c", "pass"])
+    dead.wait()
+    lock = tmp_path / "s.h5.lock"
+    lock.write_text(json.dumps({"pid": dead.pid, "host": os.uname().nodename, "started": None,
+                                "since": "2026-01-01 00:00:00", "command": "uqflight run"}))
+    assert run_campaign(hostile_campaign("slow", samples=2), out=tmp_path / "s.h5").ran == 2
+    assert not lock.exists()
+
+
+
+@pytest.mark.parametrize("content", ["", "[1]", '"text"', '{"pid": "x"}', '{"pid": 99999999999999999999}',
+                                     "[" * 100000, "x" * 100000])
+def test_a_lock_that_is_not_ours_is_refused_and_kept_however_old(tmp_path, content):
+    """Empty, foreign or damaged lock files: refused with the file named, never a traceback, never removed
+    (issue 22: only a lock of ours whose holder is provably gone is taken over)."""
+    lock, out = tmp_path / "s.h5.lock", tmp_path / "s.h5"
+    lock.write_text(content)
+    for age in (0, 3600):
+        os.utime(lock, (time.time() - age, time.time() - age))
+        with pytest.raises(LockHeld, match=r"s\.h5\.lock exists and is not a uqflight lock .*move .*s\.h5\.lock away"):
+            ResultsLock(out).acquire()
+        assert lock.read_text() == content
+

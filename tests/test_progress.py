@@ -1,10 +1,13 @@
 """Off a terminal, `report`, `surrogate export` and `calibrate` log their stages and percentages on
 stderr (uqflight.progress, the mechanism `run` uses): real processes, stderr a pipe."""
+import io
 import re
 
 import numpy as np
 import pytest
 from conftest import cli, run_python_campaign
+
+from uqflight.execution import Progress
 
 MODEL = """
 import numpy as np
@@ -61,3 +64,15 @@ def test_calibrate_logs_the_sampler_steps(results, tmp_path):
     lines = logged(run.stderr, "calibrate")
     assert any(line.startswith("calibrate: sampling the posterior") and "(100 %)" in line for line in lines)
     assert lines[0].startswith("calibrate: fitting the surrogate")
+
+
+def test_the_progress_counts_resumed_runs_and_fits_the_terminal(monkeypatch):
+    monkeypatch.setenv("COLUMNS", "60")  # a terminal of 60 columns
+    buffer = io.StringIO()
+    buffer.isatty = lambda: True
+    progress = Progress(100, done=40, stream=buffer)
+    progress.advance(10)
+    progress.close()
+    screen = buffer.getvalue()
+    assert "50/100" in screen and "runs/s" in screen
+    assert max(len(line) for line in re.sub(r"\x1b\[[0-9;?]*[A-Za-z]", "", screen).splitlines()) <= 60

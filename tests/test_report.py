@@ -1,7 +1,8 @@
-"""`uqflight report` and `uqflight check` on real results files of closed-form and JSBSim campaigns."""
+"""`uqflight report` on real results files of closed-form and JSBSim campaigns (`check`: test_check.py)."""
 import csv
 import json
 import re
+import shutil
 import subprocess
 from pathlib import Path
 
@@ -11,10 +12,11 @@ import pytest
 
 from conftest import UQFLIGHT, cli, cli_in_process, read_summary
 from uqflight.campaign import parse_campaign
+from uqflight.check import write_baseline
 from uqflight.simulators.validation_view import validation_view
 from uqflight.execution import run_campaign
 from uqflight.report import write_report
-from uqflight.statistics import analyse
+from uqflight.statistics import analyse, read_statistics
 
 
 DECAY = """
@@ -61,12 +63,18 @@ def run(template: str, path: Path, view=None, **fields) -> Path:
 
 
 @pytest.fixture(scope="module")
-def files(tmp_path_factory) -> dict[str, Path]:
+def pg(tmp_path_factory) -> Path:
+    """The pseudo-Galerkin decay campaign: one output x at 51 times, one parameter a (test_check.py's too)."""
+    return run(DECAY, tmp_path_factory.mktemp("pg") / "pg.h5", name="pg", distribution="normal",
+               design="{kind: sparse_grid, rule: gauss_hermite, level: 3}", method="{kind: pseudo_galerkin, order: 2}")
+
+
+@pytest.fixture(scope="module")
+def files(pg, tmp_path_factory) -> dict[str, Path]:
     root = tmp_path_factory.mktemp("results")
     grid = "{kind: sparse_grid, rule: gauss_hermite, level: %d}"
     return {
-        "pg": run(DECAY, root / "pg.h5", name="pg", distribution="normal", design=grid % 3,
-                  method="{kind: pseudo_galerkin, order: 2}"),
+        "pg": pg,
         "int": run(DECAY, root / "int.h5", name="int", distribution="normal", design=grid % 2,
                    method="{kind: integration, order: 1}"),
         "mc": run(DECAY, root / "mc.h5", name="mc", distribution="normal", design="{kind: monte_carlo, samples: 1000}",
@@ -78,7 +86,6 @@ def files(tmp_path_factory) -> dict[str, Path]:
         "ishigami_pf": run(ISHIGAMI, root / "ishigami_pf.h5", name="pick-freeze", method="{kind: monte_carlo}",
                            design="{kind: pick_freeze, samples: 100}"),
     }
-
 
 
 def read_csv(path: Path) -> list[dict]:
@@ -161,93 +168,6 @@ def test_report_of_a_jsbsim_campaign_and_its_check(tmp_path):
     assert checked.stdout.startswith("no drift: ")
 
 
-@pytest.fixture(scope="module")
-def baseline(files, tmp_path_factory) -> Path:
-    path = tmp_path_factory.mktemp("baseline") / "baseline.json"
-    write_report([files["pg"]], path.parent / "report", baseline=path)
-    return path
-
-
-def test_check_passes_on_the_exact_baseline(files, baseline):
-    result = cli_in_process("check", files["pg"], "--baseline", baseline)
-    assert result.returncode == 0, result.stdout + result.stderr
-    n = 51 * 6  # mean, variance, two band bounds, first and total index of a
-    assert result.stdout.strip() == f"no drift: {n} values within rtol=1e-06/atol=1e-09"
-
-
-def test_check_reports_a_moved_mean_with_exit_1(files, baseline, tmp_path):
-    data = json.loads(baseline.read_text())
-    data["outputs"]["x"]["mean"][20] += 1e-3
-    moved = tmp_path / "moved.json"
-    moved.write_text(json.dumps(data))
-    result = cli_in_process("check", files["pg"], "--baseline", moved)
-    assert result.returncode == 1, result.stdout + result.stderr
-    assert result.stdout.startswith("drift: 1 of 306 values outside rtol=1e-06, atol=1e-09")
-    row = next(line.split() for line in result.stdout.splitlines() if line.startswith("x "))
-    assert row[:3] == ["x", "mean", "2"]
-    assert float(row[4]) == pytest.approx(data["outputs"]["x"]["mean"][20])
-    assert cli_in_process("check", files["pg"], "--baseline", moved, "--atol", "0.01").returncode == 0
-
-
-def edited(data: dict, edit) -> str:
-    """The baseline `data` as JSON text after `edit(copy)` changed a copy."""
-    copy = json.loads(json.dumps(data))
-    edit(copy)
-    return json.dumps(copy)
-
-
-def drop_last_time(data: dict) -> None:
-    entry = data["outputs"]["x"]
-    for key in ("time", "mean", "variance"):
-        entry[key].pop()
-    for key in ("band99", "sobol_first", "sobol_total"):
-        for values in entry[key].values():
-            values.pop()
-
-
-def bad_baselines(data: dict) -> dict[str, tuple[str, str]]:
-    """Name: (file text, expected message fragment)."""
-    x = "outputs.x"
-
-    def shift_time(d):
-        d["outputs"]["x"]["time"] = [t + 1 for t in d["outputs"]["x"]["time"]]
-
-    def add_parameter(d):
-        d["outputs"]["x"]["sobol_first"]["b"] = d["outputs"]["x"]["time"]
-
-    return {
-        "bad json": ('{"kind": "uqflight-baseline", "outputs": {', "not a JSON baseline"),
-        "not a baseline": ('{"outputs": {}}', "not a uqflight baseline"),
-        "missing key": (edited(data, lambda d: d["outputs"]["x"].pop("variance")), f"{x}.variance: missing"),
-        "wrong length": (edited(data, lambda d: d["outputs"]["x"]["mean"].append(1.0)),
-                         f"{x}.mean: expected 51 values (one per time), got 52"),
-        "not numbers": (edited(data, lambda d: d["outputs"]["x"]["band99"].update(lower="low")),
-                        f"{x}.band99.lower: expected a list of numbers"),
-        "shorter time grid": (edited(data, drop_last_time), "the baseline's time grid (50 times, 0 to 4.9 s) differs"),
-        "shifted time grid": (edited(data, shift_time), "the baseline's time grid (51 times, 1 to 6 s) differs"),
-        "other outputs": (edited(data, lambda d: d.update(outputs={"y": d["outputs"]["x"]})),
-                          "the baseline is for outputs y; the results have x"),
-        "other parameters": (edited(data, add_parameter),
-                             "the baseline has statistics sobol_first[b] that the results lack"),
-    }
-
-
-def test_check_refuses_bad_input_with_exit_2_and_one_line(files, baseline, tmp_path):
-    cases = bad_baselines(json.loads(baseline.read_text()))
-    for name, (text, message) in cases.items():
-        path = tmp_path / f"{name.replace(' ', '_')}.json"
-        path.write_text(text)
-        result = cli_in_process("check", files["pg"], "--baseline", path)
-        assert result.returncode == 2, (name, result.stdout, result.stderr)
-        assert message in result.stderr, (name, result.stderr)
-        assert "Traceback" not in result.stderr and len(result.stderr.strip().splitlines()) == 1, (name, result.stderr)
-    for args, message in (((files["pg"], "--baseline", tmp_path / "missing.json"), "cannot read the baseline"),
-                          ((tmp_path / "missing.h5", "--baseline", baseline), "no such results file"),
-                          ((baseline, "--baseline", baseline), "baseline.json is not a results file (a results file is HDF5")):
-        result = cli_in_process("check", *args)
-        assert result.returncode == 2 and message in result.stderr and "Traceback" not in result.stderr, result.stderr
-
-
 def test_report_refuses_an_unreadable_results_file(tmp_path):
     result = cli_in_process("report", tmp_path / "missing.h5", "--out", tmp_path / "report")
     assert result.returncode == 2
@@ -280,7 +200,7 @@ def test_method_override_reports_another_method_on_the_same_runs(files, tmp_path
 
 @pytest.mark.parametrize("occupant", ["a folder with a user's file", "a file", "a report folder with a user's file",
                                       "a symlink to a report"])
-def test_report_never_replaces_what_is_not_an_earlier_report(files, tmp_path, occupant):
+def test_report_never_replaces_what_is_not_an_earlier_report(pg, tmp_path, occupant):
     out = tmp_path / "out"
     if occupant == "a file":
         out.write_text("precious")
@@ -294,17 +214,21 @@ def test_report_never_replaces_what_is_not_an_earlier_report(files, tmp_path, oc
         kept = out / ("thesis.txt" if occupant == "a folder with a user's file" else "plots/notes.txt")
         kept.write_text("precious")
     before = sorted(str(p) for p in tmp_path.rglob("*"))
-    result = cli_in_process("report", files["pg"], "--out", out)
+    result = cli_in_process("report", pg, "--out", out)
     assert result.returncode == 2
     assert f"{out} exists and is not a uqflight report" in result.stderr and "choose another --out" in result.stderr
     assert sorted(str(p) for p in tmp_path.rglob("*")) == before
 
 
-def test_a_relative_out_counts_the_files_written(files, tmp_path):
-    result = cli_in_process("report", files["pg"], "--out", "rel", cwd=tmp_path)
+def test_a_relative_out_counts_the_files_written_and_the_baseline_is_the_files_statistics(pg, tmp_path):
+    result = cli_in_process("report", pg, "--out", "rel", "--write-baseline", "b.json", cwd=tmp_path)
     assert result.returncode == 0, result.stderr
     written = sum(1 for p in (tmp_path / "rel").rglob("*") if p.is_file())
     assert written > 10 and f"wrote {written} files to rel: open rel/report.html" in result.stdout
+    assert "wrote baseline b.json" in result.stdout
+    stats, attrs = read_statistics(pg)  # what test_check.py's baseline is
+    expected = write_baseline(stats, attrs["campaign_hash"], tmp_path / "expected.json")
+    assert (tmp_path / "b.json").read_bytes() == expected.read_bytes()
 
 
 def test_an_empty_folder_or_an_earlier_report_may_be_replaced(tmp_path):
@@ -318,3 +242,44 @@ def test_an_empty_folder_or_an_earlier_report_may_be_replaced(tmp_path):
         (earlier / name).write_text("x")
     for folder in (empty, earlier, tmp_path / "absent"):
         check_replaceable(folder)
+
+
+def test_report_writes_next_to_the_results_file_by_default(decay_results, tmp_path):
+    shutil.copy(decay_results.with_suffix(".yaml"), tmp_path)  # the campaign and its file, copied: the report
+    results = Path(shutil.copy(decay_results, tmp_path / "decay.h5"))  # is written beside them
+    result = cli_in_process("report", results)
+    assert result.returncode == 0, result.stderr
+    out = results.with_name("decay-report")
+    files = [p for p in out.rglob("*") if p.is_file()]
+    assert result.stdout.strip() == f"wrote {len(files)} files to {out}: open {out / 'report.html'}"
+    assert (out / "summary.json").is_file() and (out / "tables" / "parameters.csv").is_file()
+    parameters = list(csv.DictReader(open(out / "tables" / "parameters.csv")))
+    assert [(r["parameter"], r["distribution"], float(r["nominal"])) for r in parameters] == \
+        [("a", "normal", 1.0), ("b", "uniform", 1.4)]
+    page = (out / "report.html").read_text()
+    assert "What was run" in page and "design_decay.png" in page and "name: decay-people" in page
+    assert not [p for p in results.parent.iterdir() if p.name.startswith(".decay-report")]
+
+
+@pytest.mark.slow
+def test_several_methods_over_the_same_runs(decay_results, tmp_path):
+    out = tmp_path / "methods"
+    result = cli_in_process("report", decay_results, "--method", "pseudo_galerkin:2", "--method", "least_squares:1",
+                 "--method", "regression", "--order", "2", "--out", out)
+    assert result.returncode == 0, result.stderr
+    labels = [row["label"] for row in csv.DictReader(open(out / "tables" / "files.csv"))]
+    assert [label.split(": ")[1].split(",")[0] for label in labels] == \
+        ["PG order 2", "least squares order 1", "regression order 2"]
+    plots = {p.name for p in (out / "plots").iterdir()}
+    assert {"sobol_compared.png", "bands_compared.png", "mean_band_decay_least_squares1.png"} <= plots
+    summaries = {p.name: json.loads(p.read_text()) for p in (out / "summaries").iterdir()}
+    least = summaries["decay_least_squares1.json"]
+    assert least["method"]["kind"] == "least_squares" and least["method"]["order"] == 1
+    exact = analyse(decay_results, method={"kind": "least_squares", "order": 1}).outputs["x"].mean
+    np.testing.assert_allclose(least["outputs"]["x"]["mean"], exact, rtol=1e-12)
+    for bad, message in ((["--method", "galerkin:2"], "expected KIND[:ORDER]"),
+                         (["--method", "least_squares:two"], "integer ORDER"),
+                         (["--order", "2"], "--order needs --method")):
+        refused = cli_in_process("report", decay_results, *bad, "--out", tmp_path / "bad")
+        assert refused.returncode == 2 and message in refused.stderr and "Traceback" not in refused.stderr, bad
+        assert not (tmp_path / "bad").exists()

@@ -16,6 +16,7 @@ import pytest
 from conftest import UQFLIGHT, cli
 
 from uqflight.report import replace
+from uqflight.report import write_report as write_uqflight_report
 from uqflight.report.replace import clean_leftovers, make_staging, replace_dir
 
 FILES = ("report.html", "report.md", "summary.json", "plots/a.png", "plots/b.png", "tables/t.csv",
@@ -248,3 +249,28 @@ def test_uqflight_report_killed_at_random_times_keeps_a_report(results, tmp_path
         assert (out / "report.html").is_file() and contents(out).keys() == first.keys(), f"trial {trial}"
     assert cli("report", results, "--out", out).returncode == 0
     assert sorted(p.name for p in tmp_path.iterdir()) == ["DIR"]
+
+
+@pytest.mark.slow
+def test_a_report_that_fails_midway_leaves_nothing(decay_results, tmp_path, monkeypatch):
+    import uqflight.report.render as render
+
+    def broken(*args, **kwargs):
+        raise RuntimeError("disk on fire")
+
+    out = tmp_path / "nested" / "report"
+    monkeypatch.setattr(render, "render_markdown", broken)  # after the plots and tables are written
+    with pytest.raises(RuntimeError, match="disk on fire"):
+        write_uqflight_report([decay_results], out)
+    assert list(out.parent.iterdir()) == []
+    old = tmp_path / "old"  # an earlier report: the one thing a report replaces (test_report.py)
+    (old / "tables").mkdir(parents=True)
+    (old / "report.html").write_text("previous report")
+    (old / "tables" / "stale.csv").write_text("x")
+    with pytest.raises(RuntimeError):
+        write_uqflight_report([decay_results], old)
+    assert sorted(p.name for p in old.rglob("*")) == ["report.html", "stale.csv", "tables"]
+    assert (old / "report.html").read_text() == "previous report" and len(list(tmp_path.iterdir())) == 2
+    monkeypatch.undo()
+    written = write_uqflight_report([decay_results], old)
+    assert not (old / "tables" / "stale.csv").exists() and (old / "report.html") in written

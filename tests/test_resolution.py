@@ -1,8 +1,11 @@
-"""uqflight.analysis.resolution: variances judged against the output's own magnitude, not the largest variance."""
+"""uqflight.analysis.resolution: variances judged against the output's own magnitude, not the largest variance;
+in summary.json, Sobol' indices of rounding noise and the CoV of a zero mean are null."""
 import json
 
 import numpy as np
 import pytest
+from conftest import (NORMAL_2D, NORMAL_X, cli_in_process, closed_form_campaign, read_summary, run_python_campaign,
+                      strict_json)
 
 from uqflight.analysis import weighted_mean, weighted_std, weighted_variance
 from uqflight.analysis.resolution import (
@@ -15,6 +18,7 @@ from uqflight.analysis.resolution import (
 )
 from uqflight.designs import build_design
 from uqflight.methods import fit
+from uqflight.statistics import analyse, summary_json
 
 
 def test_the_altitude_example_of_the_issue():
@@ -90,3 +94,24 @@ def test_sobol_or_none_shapes_and_non_finite_values():
     assert sobol_or_none([0.3, np.nan, 0.2], [True, True, False]) == [0.3, None, None]
     with pytest.raises(ValueError, match="do not end"):
         sobol_or_none(np.zeros((2, 3)), np.ones(4, dtype=bool))
+
+
+def test_sobol_indices_are_null_where_the_variance_is_rounding_noise(tmp_path):
+    results = run_python_campaign(tmp_path, closed_form_campaign("sq", "sum_of_squares", NORMAL_2D,
+                                                     "{kind: tensor_grid, points: 4}",
+                                                     "method: {kind: pseudo_galerkin, order: 2}\n"))
+    y = strict_json(summary_json(analyse(results)))["outputs"]["y"]
+    assert y["resolved"] == [False, True, True, True, True]
+    for parameter in ("x1", "x2"):
+        assert y["sobol_first"][parameter][0] is None and y["sobol_total"][parameter][0] is None
+        np.testing.assert_allclose(y["sobol_first"][parameter][1:], 0.5, atol=1e-12)
+
+
+def test_a_zero_mean_is_reported_without_a_crash_and_its_cov_is_null(tmp_path):
+    results = run_python_campaign(tmp_path, closed_form_campaign("id", "identity", NORMAL_X, "{kind: tensor_grid, points: 5}",
+                                                     "method: {kind: pseudo_galerkin, order: 1}\n"))
+    done = cli_in_process("report", results, "--out", tmp_path / "r")
+    assert done.returncode == 0, done.stderr
+    y = read_summary(tmp_path / "r" / "summary.json")["outputs"]["y"]
+    assert abs(y["mean"][0]) < 1e-15 and y["variance"][0] == pytest.approx(1.0)
+    assert y["cov"] == [None] and y["sobol_first"]["x"] == [pytest.approx(1.0)]

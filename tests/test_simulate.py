@@ -70,3 +70,14 @@ def test_a_trim_that_fails_for_the_stall_says_so_and_how_fast_to_fly():
     assert "fly faster than 155 KTAS at this altitude" in failed.stderr
     flown = cli_in_process("simulate", "--airspeed-ktas", "155", "--duration-s", "1", "--no-files")
     assert flown.returncode == 0, flown.stderr  # the advice holds
+
+
+def test_units_are_visible_in_simulate_help():
+    text = " ".join(cli_in_process("simulate", "--help").stdout.split())
+    for unit in ("altitude [ft]", "airspeed [kt]", "amplitude [deg]", "start [s]", "[Hz]"):
+        assert unit in text, (unit, text)
+
+
+def test_a_mistyped_property_gets_a_did_you_mean():
+    result = cli_in_process("simulate", "--set", "aero/uq/CLO=0.2", "--duration-s", "1")
+    assert result.returncode == 2 and "did you mean aero/uq/CL0" in result.stderr

@@ -4,8 +4,7 @@ indices are null. Closed form on a Python model first, then the aircraft."""
 import h5py
 import numpy as np
 import pytest
-from conftest import ROOT, run_python_campaign
-from test_trust import NORMAL_2D, campaign, strict_json
+from conftest import NORMAL_2D, ROOT, closed_form_campaign, run_python_campaign, strict_json
 
 from uqflight.campaign import load_campaign
 from uqflight.simulators.validation_view import validation_view
@@ -18,7 +17,7 @@ def test_a_spread_below_the_recorded_resolution_is_unresolved(tmp_path):
     """y = 15000 + t (x1² + x2²), t = 0, 0.25, ..., 1, on a 4×4 Gauss–Hermite grid: std(t) = 2t exactly
     (var(x1² + x2²) = 4). A recorded resolution of 0.75 at t = 0.25 (std 0.5) and 1.95 at t = 1 (std 2)
     leaves t = 0.25 unresolved and t = 1 resolved; t = 0 stays unresolved (rounding only)."""
-    results = run_python_campaign(tmp_path, campaign("sq", "sum_of_squares", NORMAL_2D,
+    results = run_python_campaign(tmp_path, closed_form_campaign("sq", "sum_of_squares", NORMAL_2D,
                                                      "{kind: tensor_grid, points: 4}",
                                                      "method: {kind: pseudo_galerkin, order: 2}\n"))
     with ResultStore.open(results) as store:

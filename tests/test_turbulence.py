@@ -89,6 +89,7 @@ def write(folder, name, seed=3, properties=None):
     return path
 
 
+@pytest.mark.slow  # four campaigns of 32 flights; the default suite flies the same turbulence in process (above)
 def test_turbulence_campaigns_are_reproducible_and_their_seed_matters_only_when_the_air_moves(tmp_path):
     runs = {}
     for name, seed, props, workers in (("a", 3, None, 1), ("b", 3, None, 2), ("c", 4, None, 1),

@@ -1,4 +1,4 @@
-"""Models that misbehave on purpose, for the runner's reliability tests (tests/test_reliability.py)."""
+"""Models that misbehave on purpose, for the runner's reliability tests (tests/test_run_faults.py)."""
 import os
 import signal
 import time
