@@ -15,6 +15,8 @@ import matplotlib
 matplotlib.use("Agg")
 matplotlib.rcParams["axes.formatter.useoffset"] = False  # 15000.5 ft, not 0.5 + 1.5e4
 matplotlib.rcParams["svg.fonttype"] = "none"  # SVG text stays text: editable, searchable, smaller
+# titles sit just above their panel (nothing of ours is drawn above an axes): placed, not searched for
+matplotlib.rcParams["axes.titley"] = 1.0
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 from matplotlib.lines import Line2D  # noqa: E402
