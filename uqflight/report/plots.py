@@ -731,13 +731,13 @@ def plot_design_pairs(results, path: Path, title: str) -> Path | None:
         fig.tight_layout(rect=(0, 0.06, 1, 1))
         return write_figure(fig, path)
     side = max(1.7 * (d - 1) + 1.2, 7.0)
-    fig, axes = plt.subplots(d - 1, d - 1, figsize=(side, side - 0.2), squeeze=False)
+    fig = plt.figure(figsize=(side, side - 0.2))
+    # fixed margins in inches: names and 6-pt tick labels outside the grid, none between its panels
+    grid = fig.add_gridspec(d - 1, d - 1, left=0.75 / side, right=1 - 0.2 / side, bottom=0.6 / side,
+                            top=1 - 0.85 / side, wspace=0.12, hspace=0.12)
     for i in range(1, d):
-        for j in range(d - 1):
-            ax = axes[i - 1, j]
-            if j >= i:
-                ax.set_visible(False)
-                continue
+        for j in range(i):  # the lower triangle only: no hidden panels to build
+            ax = fig.add_subplot(grid[i - 1, j])
             handles = _design_points(ax, kappa[:, j], kappa[:, i], weights, failed, signed, xi.shape[0])
             ax.tick_params(labelsize=6)
             ax.xaxis.set_major_locator(MaxNLocator(3))
@@ -753,9 +753,6 @@ def plot_design_pairs(results, path: Path, title: str) -> Path | None:
             ax.grid(alpha=0.3)
     fig.legend(*handles, loc="upper right", fontsize=8, frameon=False)
     fig.suptitle(f"{title}\nphysical values κ", fontsize=11)
-    # fixed margins in inches: names and 6-pt tick labels outside the grid, none between its panels
-    fig.subplots_adjust(left=0.75 / side, right=1 - 0.2 / side, bottom=0.6 / side, top=1 - 0.85 / side,
-                        wspace=0.12, hspace=0.12)
     return write_figure(fig, path)
 
 
@@ -823,8 +820,11 @@ def _design_points(ax, x, y, weights, failed, signed: bool, count: int) -> tuple
     alpha = 0.8 if count <= 500 else 0.25
     negative = (weights < 0) & ~failed
     positive = ~negative & ~failed
-    ax.scatter(x[positive], y[positive], s=sizes[positive], color=COLORS[0], alpha=alpha, lw=0)
-    ax.scatter(x[negative], y[negative], s=sizes[negative], color=COLORS[1], alpha=alpha, lw=0)
+    if signed:
+        ax.scatter(x[positive], y[positive], s=sizes[positive], color=COLORS[0], alpha=alpha, lw=0)
+        ax.scatter(x[negative], y[negative], s=sizes[negative], color=COLORS[1], alpha=alpha, lw=0)
+    else:  # one marker size: drawn as a line's markers (one stamp repeated), many times faster for 10^4 runs
+        ax.plot(x[positive], y[positive], ls="", marker="o", ms=np.sqrt(8.0), mew=0, color=COLORS[0], alpha=alpha)
     ax.scatter(x[failed], y[failed], s=18, color="red", marker="x", lw=1)
     run = "run (area ∝ |weight|)" if signed else "run"
     handles = [Line2D([], [], ls="", marker="o", color=COLORS[0]), Line2D([], [], ls="", marker="x", color="red")]
