@@ -146,6 +146,7 @@ def draw_all(plots: list) -> None:
         for plot in plots:
             plot()
         return
+    _pyplot()  # imported once here, not in each child
     children = [Child(plot) for plot in plots]
     failed = []
     for child in children:
