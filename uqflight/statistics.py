@@ -608,6 +608,8 @@ def json_ready(value):
     if isinstance(value, (list, tuple)):
         return [json_ready(v) for v in value]
     if isinstance(value, np.ndarray):
+        if value.dtype.kind == "f" and np.isfinite(value).all():  # the common case: the floats as they are
+            return value.tolist()
         return json_ready(value.tolist())
     if isinstance(value, (np.bool_, bool)):
         return bool(value)
