@@ -50,7 +50,19 @@ PRIOR_MEAN, PRIOR_STD = np.array([1.0, -0.5]), np.array([0.1, 0.05])  # ±30 % i
 TRUTH = np.array([1.12, -0.46])
 SIGMA = 0.05
 H = np.column_stack([np.ones_like(TIME), TIME])
-Z_LIMIT = 3.0  # each statistic within 3 of its own standard errors
+# Each statistic within z_limit(K) of its own standard errors, K the comparisons a test makes: the
+# Bonferroni bound that keeps a correct sampler's chance of failing the whole test at FAMILY_ALARM
+# (a flat 3 over the 35 z-scores of six chains fails a correct sampler about once in ten changes of its
+# chains' rounding; measured: the z-scores of 24 seeds spread as N(0, 1), the largest 3.3).
+FAMILY_ALARM = 0.01
+STATISTICS = 5  # the means and stds of a and b, their correlation
+
+
+def z_limit(comparisons: int) -> float:
+    """The two-sided normal quantile that `comparisons` z-scores all stay within with 1 − FAMILY_ALARM."""
+    from scipy.special import ndtri
+
+    return float(ndtri(1.0 - FAMILY_ALARM / (2 * comparisons)))
 
 
 def make_results(folder):
@@ -173,16 +185,18 @@ def check(results, tmp_path, seed, noise, steps):
 @pytest.mark.parametrize("noise", [True, False], ids=["noise_given", "noise_inferred"])
 def test_calibrate_matches_the_exact_posterior(results, tmp_path, noise):
     scores = check(results, tmp_path, 0, noise, steps=2000)
-    assert all(abs(z) < Z_LIMIT for z, _ in scores.values()), scores
+    assert all(abs(z) < z_limit(STATISTICS) for z, _ in scores.values()), scores  # 3.09
 
 
 @pytest.mark.slow
 @pytest.mark.parametrize("noise", [True, False], ids=["noise_given", "noise_inferred"])
 def test_calibrate_matches_the_exact_posterior_over_seeds(results, tmp_path, noise):
-    """Six flights and chains: every statistic within 3 standard errors, and so is its mean z over the
-    seeds (× √6): a bias of 1 % in the stds, invisible in one chain, shows there."""
+    """Six flights and chains: every statistic within 3.63 standard errors, and so is its mean z over
+    the seeds (× √6): a bias of 2 % in the stds (about 1.6 standard errors in one chain, invisible
+    there) shows in the mean z (about 3.9)."""
     scores = [check(results, tmp_path, seed, noise, steps=4000) for seed in range(1, 7)]
+    limit = z_limit(STATISTICS * (len(scores) + 1))  # 3.63: 30 z-scores and 5 means over the seeds
     for name in scores[0]:
         z = np.array([s[name][0] for s in scores])
-        assert np.all(np.abs(z) < Z_LIMIT), (name, z)
-        assert abs(z.sum() / math.sqrt(z.size)) < Z_LIMIT, (name, z)
+        assert np.all(np.abs(z) < limit), (name, z)
+        assert abs(z.sum() / math.sqrt(z.size)) < limit, (name, z)
