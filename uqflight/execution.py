@@ -47,7 +47,7 @@ from .campaign import Campaign
 from .campaign.reading import parameters_attribute
 from .campaign.schema import WORKER_BYTES
 from .designs import Design, is_adaptive
-from .forking import FORKS, Child, ChildFailed
+from .forking import FORKS, Child, ChildFailed, wait_all
 from .parameters import seed_names
 from .progress import Progress
 from .refinement import run_rounds
@@ -162,21 +162,15 @@ def simulate(campaign: Campaign, kappa: np.ndarray, outputs: list[str], processe
     chunks = np.array_split(np.arange(len(kappa)), max(1, min(processes, len(kappa))))
     if len(chunks) == 1 or not FORKS:
         return _simulate_rows(campaign, kappa, outputs)
-    children = [Child(lambda rows=rows: _simulate_rows(campaign, kappa[rows], outputs)) for rows in chunks]
-    found = []
-    for child in children:
-        try:
-            found.append(child.wait())
-        except ChildFailed as exc:
-            found.append(f"the process flying this run {exc}")
-    time = next((f[0] for f in found if not isinstance(f, str)), None)
+    found = wait_all([Child(lambda rows=rows: _simulate_rows(campaign, kappa[rows], outputs)) for rows in chunks])
+    time = next((f[0] for f in found if not isinstance(f, ChildFailed)), None)
     if time is None:  # every child died: the time grid from the simulator here
         time = _simulate_rows(campaign, kappa[:0], outputs)[0]
     values = {name: np.full((len(kappa), len(time)), np.nan) for name in outputs}
     failures = []
     for rows, f in zip(chunks, found):
-        if isinstance(f, str):  # a child that died: its runs failed, with how
-            failures += [f] * len(rows)
+        if isinstance(f, ChildFailed):  # a child that died: its runs failed, with how
+            failures += [f"the process flying this run {f}"] * len(rows)
             continue
         failures += f[2]
         for name in outputs:

@@ -49,3 +49,14 @@ class Child:
         if status != 0 or not payload:
             raise ChildFailed(f"failed (exit {status})")
         return pickle.loads(payload)
+
+
+def wait_all(children: list[Child]) -> list:
+    """Wait for every child in turn: its result, or the ChildFailed saying how it failed, in their order."""
+    outcomes = []
+    for child in children:
+        try:
+            outcomes.append(child.wait())
+        except ChildFailed as exc:
+            outcomes.append(exc)
+    return outcomes

@@ -9,7 +9,7 @@ import h5py
 import numpy as np
 import yaml
 
-from ..forking import FORKS, Child, ChildFailed
+from ..forking import FORKS, Child, ChildFailed, wait_all
 from ..labels import label, parameter_label, short_label
 from ..statistics import json_ready as strict
 
@@ -147,13 +147,7 @@ def draw_all(plots: list) -> None:
             plot()
         return
     _pyplot()  # imported once here, not in each child
-    children = [Child(plot) for plot in plots]
-    failed = []
-    for child in children:
-        try:
-            child.wait()
-        except ChildFailed as exc:
-            failed.append(str(exc))
+    failed = [str(outcome) for outcome in wait_all([Child(plot) for plot in plots]) if isinstance(outcome, ChildFailed)]
     if failed:
         raise RuntimeError(f"cannot write a calibration plot: its process {failed[0]} (the error is printed above)")
 

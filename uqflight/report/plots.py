@@ -22,7 +22,7 @@ import numpy as np  # noqa: E402
 from matplotlib.lines import Line2D  # noqa: E402
 from matplotlib.ticker import FixedLocator, FuncFormatter, LogLocator, MaxNLocator, NullFormatter  # noqa: E402
 
-from ..forking import FORKS, Child, ChildFailed  # noqa: E402
+from ..forking import FORKS, Child, ChildFailed, wait_all  # noqa: E402
 from ..labels import label, short_label  # noqa: E402,F401 (plots.label: the report's captions)
 
 TIME_LABEL = "time [s]"
@@ -236,13 +236,8 @@ def _wait_all() -> list[str]:
 
 def _failures(children: list) -> list[str]:
     """Wait for the (child, figure) pairs; the figures whose child failed."""
-    failed = []
-    for child, path in children:
-        try:
-            child.wait()
-        except ChildFailed:
-            failed.append(path)
-    return failed
+    outcomes = wait_all([child for child, _ in children])
+    return [path for (_, path), outcome in zip(children, outcomes) if isinstance(outcome, ChildFailed)]
 
 
 def _write(fig, path: Path, rect=(0, 0, 1, 1)) -> Path:
