@@ -21,7 +21,7 @@ from typing import Callable
 
 import numpy as np
 
-from ..parameters.germs import GERMS
+from ..parameters.germs import GERMS, germ_columns
 
 
 class DataError(ValueError):
@@ -198,7 +198,7 @@ class LogPosterior:
         self._lower = np.array([law.support[0] for law in self._laws])
         self._upper = np.array([law.support[1] for law in self._laws])
         self._bounded = bool(np.isfinite(self._lower).any() or np.isfinite(self._upper).any())
-        self._germ_columns = [(germ, [k for k, g in enumerate(self.germs) if g == germ]) for germ in dict.fromkeys(self.germs)]
+        self._germ_columns = germ_columns(self.germs)
         self._log_scales = np.array([math.log(term.scale) for term in self.inferred])
         self._given_sigma = np.array([np.nan if term.sigma is None else term.sigma for term in terms])
         self._inferred_columns = [k for k, term in enumerate(terms) if term.sigma is None]

@@ -8,7 +8,7 @@ from itertools import combinations_with_replacement
 
 import numpy as np
 
-from ..parameters.germs import GERMS, check_germs
+from ..parameters.germs import GERMS, check_germs, germ_columns
 
 
 def total_degree_indices(dim: int, order: int) -> np.ndarray:
@@ -43,10 +43,8 @@ class Basis:
     def __init__(self, germs, indices: np.ndarray):
         self.germs = check_germs(germs)
         self.indices = np.asarray(indices, dtype=int)
-        self._groups = []  # (input columns, recurrence) per germ
-        for germ in dict.fromkeys(self.germs):
-            columns = [k for k, g in enumerate(self.germs) if g == germ]
-            self._groups.append((columns, _Recurrence(germ, int(self.indices[:, columns].max(initial=0)))))
+        self._groups = [(columns, _Recurrence(germ, int(self.indices[:, columns].max(initial=0))))
+                        for germ, columns in germ_columns(self.germs)]  # (input columns, recurrence) per germ
 
     def __call__(self, xi: np.ndarray) -> np.ndarray:
         xi = np.asarray(xi, dtype=float).reshape(-1, len(self.germs))

@@ -120,6 +120,12 @@ def check_germs(germs) -> list[str]:
     return germs
 
 
+def germ_columns(germs: list[str]) -> list[tuple[str, list[int]]]:
+    """(germ, the input columns it drives) for each distinct germ, in order of first use: the inputs
+    one vectorised call of that germ can serve together."""
+    return [(germ, [k for k, g in enumerate(germs) if g == germ]) for germ in dict.fromkeys(germs)]
+
+
 def germ_quantiles(u: np.ndarray, germs: list[str]) -> np.ndarray:
     """ξ (N, d) from uniforms u (N, d): column k through the quantile of germ k."""
     u = np.asarray(u, dtype=float)
