@@ -16,6 +16,7 @@ from uqflight.analysis import (
     weighted_std,
     weighted_variance,
 )
+from uqflight.analysis.moments import hazen_quantiles
 from uqflight.methods import fit
 from uqflight.parameters.germs import draw_germs
 
@@ -49,6 +50,20 @@ def test_weighted_quantile_band_agrees_with_the_hazen_quantile_of_equal_weights(
         lower, upper = quantile_band(Y, weights)
         np.testing.assert_allclose(lower, np.quantile(Y, 0.005, axis=0, method="hazen"), atol=1e-9)
         np.testing.assert_allclose(upper, np.quantile(Y, 0.995, axis=0, method="hazen"), atol=1e-9)
+
+
+@pytest.mark.parametrize("n", [2, 3, 17, 113, 20000])
+@pytest.mark.parametrize("kind", ["normal", "ties", "constant", "nan"])
+def test_hazen_quantiles_are_numpys_to_the_bit(n, kind):
+    # the fast selection must give numpy's numbers exactly, at both ends, at ties and with a NaN (numpy's path)
+    rng = np.random.default_rng(n)
+    Y = {"normal": rng.standard_normal((n, 5)), "ties": rng.integers(0, 3, (n, 5)).astype(float),
+         "constant": np.full((n, 5), 2.5), "nan": rng.standard_normal((n, 5))}[kind]
+    if kind == "nan":
+        Y[n // 2, 1] = np.nan
+    probabilities = np.array([0.0, 1e-9, 0.005, 0.3, 0.5, 0.5 / n, 1 - 0.5 / n, 0.995, 0.995, 1 - 1e-12, 1.0])
+    found = hazen_quantiles(Y, probabilities)
+    np.testing.assert_array_equal(found, np.quantile(Y, probabilities, axis=0, method="hazen"))
 
 
 def test_quantile_band_of_a_normal_sample_is_2_5758_sigma():

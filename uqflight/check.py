@@ -16,6 +16,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .json_text import json_text
 from .statistics import BadInput, Statistics, json_ready
 
 BASELINE_KIND = "uqflight-baseline"
@@ -78,7 +79,7 @@ def baseline_json(stats: Statistics, campaign_hash: str) -> dict:
 def write_baseline(stats: Statistics, campaign_hash: str, path: Path) -> Path:
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    path.write_text(json.dumps(baseline_json(stats, campaign_hash), indent=1, allow_nan=False) + "\n", encoding="utf-8")
+    path.write_text(json_text(baseline_json(stats, campaign_hash)), encoding="utf-8")
     return path
 
 

@@ -606,10 +606,13 @@ def json_ready(value):
     if isinstance(value, dict):
         return {str(k): json_ready(v) for k, v in value.items()}
     if isinstance(value, (list, tuple)):
+        if all(type(v) is float for v in value) and math.isfinite(sum(value)):  # finite floats as they are
+            return list(value)
         return [json_ready(v) for v in value]
     if isinstance(value, np.ndarray):
-        if value.dtype.kind == "f" and np.isfinite(value).all():  # the common case: the floats as they are
-            return value.tolist()
+        if value.dtype.kind == "f":  # the floats as they are, NaN and infinity as None
+            finite = np.isfinite(value)
+            return value.tolist() if finite.all() else np.where(finite, value.astype(object), None).tolist()
         return json_ready(value.tolist())
     if isinstance(value, (np.bool_, bool)):
         return bool(value)

@@ -2,12 +2,12 @@
 from __future__ import annotations
 
 import csv
-import json
 import re
 from pathlib import Path
 
 import numpy as np
 
+from ..json_text import json_text
 from ..statistics import summary_json
 from .loading import Entry, file_name
 
@@ -61,7 +61,7 @@ def inert(value):
 
 
 def _write_json(path: Path, data: dict) -> Path:
-    path.write_text(json.dumps(data, indent=1, allow_nan=False) + "\n", encoding="utf-8")
+    path.write_text(json_text(data), encoding="utf-8")
     return path
 
 
