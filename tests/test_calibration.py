@@ -24,7 +24,9 @@ from typer.testing import CliRunner
 from uqflight.calibration.command import register
 from uqflight.calibration.likelihood import (DataError, FlightData, LogPosterior, interpolate_in_time, parse_noise,
                                              read_flight_csv)
-from uqflight.calibration.sampler import sample, split_rhat
+from uqflight.calibration import sampler as sampler_module
+from uqflight.calibration.sampler import CHECK_EVERY, FIRST_CHECK, sample, split_rhat
+from uqflight.calibration.size import MAX_STEPS
 from uqflight.calibration.surrogate import calibration_surrogate, load_campaign_file
 from uqflight.campaign import parse_campaign
 from uqflight.execution import run_campaign
@@ -329,6 +331,41 @@ def test_the_sampler_is_reproducible_from_its_seed():
             for seed in (5, 5, 6)]
     np.testing.assert_array_equal(runs[0], runs[1])
     assert not np.array_equal(runs[0], runs[2])
+
+
+def test_an_adaptive_chain_stops_at_the_second_passing_check_and_is_the_fixed_chain_of_its_length():
+    # a correlated 2-D Gaussian: emcee's DE move has tau of about 8 there, so 50 tau are reached well before MAX_STEPS
+    precision = np.linalg.inv(np.array([[1.0, 0.8], [0.8, 1.0]]))
+    log_prob = lambda theta: -0.5 * np.einsum("mi,ij,mj->m", theta, precision, theta)  # noqa: E731
+    draw = lambda rng, n: rng.standard_normal((n, 2))  # noqa: E731
+    adaptive = sample(log_prob, 2, ["x", "y"], np.zeros(2), draw, walkers=16, steps=None, seed=3)
+    steps = adaptive.samples.shape[0]
+    assert FIRST_CHECK + CHECK_EVERY <= steps < MAX_STEPS and steps % CHECK_EVERY == 0
+    assert adaptive.diagnostics["converged"] and adaptive.diagnostics["steps"] == steps
+    assert adaptive.diagnostics["stopping"].startswith("adaptive")
+    fixed = sample(log_prob, 2, ["x", "y"], np.zeros(2), draw, walkers=16, steps=steps, seed=3)
+    np.testing.assert_array_equal(adaptive.samples, fixed.samples)
+    assert fixed.diagnostics["stopping"] == "fixed" and adaptive.burn == fixed.burn == steps // 2
+    # the check before passed too, and the one before that did not (or it was the first)
+    verdicts = [sample(log_prob, 2, ["x", "y"], np.zeros(2), draw, walkers=16, steps=n, seed=3)
+                .diagnostics["converged"] for n in (steps - CHECK_EVERY, steps - 2 * CHECK_EVERY)]
+    assert verdicts[0] and (not verdicts[1] or steps - 2 * CHECK_EVERY < FIRST_CHECK)
+
+
+def test_an_adaptive_chain_that_never_converges_stops_at_its_longest_and_says_what_failed(monkeypatch):
+    # a target that drifts by 0.05 sigma per call: the halves of every chain disagree at every check
+    monkeypatch.setattr(sampler_module, "MAX_STEPS", FIRST_CHECK + 2 * CHECK_EVERY)
+    calls = [0]
+
+    def log_prob(theta):
+        calls[0] += 1
+        return -0.5 * ((theta - 0.05 * calls[0]) ** 2).sum(axis=1)
+
+    draw = lambda rng, n: rng.standard_normal((n, 2))  # noqa: E731
+    chain = sample(log_prob, 2, ["x", "y"], np.zeros(2), draw, walkers=8, steps=None, seed=0)
+    assert chain.samples.shape[0] == FIRST_CHECK + 2 * CHECK_EVERY
+    assert not chain.diagnostics["converged"]
+    assert any("split-R̂" in problem for problem in chain.diagnostics["problems"])
 
 
 @pytest.mark.slow

@@ -165,7 +165,7 @@ def simulate(settings: dict | None = None, *, aircraft: str = "bacm", altitude_f
 
 
 def calibrate(results, data, out, noise: dict | None = None, outputs: list[str] | None = None, seed: int = 0,
-              walkers: int | None = None, steps: int = 6000, method: str | None = None, order: int | None = None,
+              walkers: int | None = None, steps: int | None = None, method: str | None = None, order: int | None = None,
               campaign=None, predictive_draws: int = 50):
     """Calibrate the parameters of the campaign of `results` on flight data (a CSV as `uqflight simulate
     --out` writes it), as `uqflight calibrate` does (docs/calibration.md); writes posterior.h5,

@@ -31,7 +31,9 @@ def calibrate_command(
     seed: int = typer.Option(0, help="Seeds the optimiser starts, the walkers and the predictive draws."),
     walkers: Optional[int] = typer.Option(None, help="Ensemble walkers (even, >= 2 x dimensions; default "
                                                      "max(32, 2 x dimensions + 2))."),
-    steps: int = typer.Option(6000, help="Steps per walker; the first half is burn-in."),
+    steps: Optional[int] = typer.Option(None, help="Steps per walker, exactly; the first half is burn-in. Default: "
+                                                   "until the chain has converged (checked every 250 steps from "
+                                                   "1000 on; two checks in a row), at most 6000."),
     method: Optional[str] = typer.Option(None, metavar="KIND[:ORDER]", help="Surrogate method (default: the "
                                          "results file's), as report and surrogate export take it: "
                                          "pseudo_galerkin, least_squares:3, regression, ..."),

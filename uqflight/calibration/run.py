@@ -19,7 +19,7 @@ from .likelihood import DataError, LogPosterior, interpolate_in_time, parse_nois
 from .outputs import (OUTPUT_FILES, calibrated_campaign, corner_plot, draw_all, informed, marginal, marginals_plot,
                       predictive_plot, write_json, write_posterior)
 from .sampler import sample
-from .size import PREDICTIVE_NOISE_DRAWS, campaign_memory_limit, check_size
+from .size import MAX_STEPS, PREDICTIVE_NOISE_DRAWS, campaign_memory_limit, check_size
 from .surrogate import (SurrogateError, calibration_surrogate, check_campaign_text, portable_mapping,
                         parameter_specs, prior_summaries, simulate, to_physical, to_standard)
 
@@ -47,11 +47,12 @@ class Calibration:
 
 
 def calibrate(results, data, out, outputs: list[str] | None = None, noise: list[str] = (), seed: int = 0,
-              walkers: int | None = None, steps: int = 6000, method: str | None = None, order: int | None = None,
+              walkers: int | None = None, steps: int | None = None, method: str | None = None, order: int | None = None,
               campaign: str | None = None, predictive_draws: int = 50, truth: dict | None = None,
               progress=None) -> Calibration:
     """Calibrate the campaign of `results` on flight `data`; see docs/calibration.md. `progress` (a
-    uqflight.progress.Progress) is told the stages and counts the sampler's steps.
+    uqflight.progress.Progress) is told the stages and counts the sampler's steps. `steps`: exactly that
+    many per walker, or None: until converged (calibration.sampler, at most MAX_STEPS).
 
     Raises DataError / SurrogateError (bad input, data too large for memory: calibration.size),
     ValueError (bad settings), NotConverged.
@@ -71,7 +72,7 @@ def _calibrate(results, data, out, outputs, noise, seed, walkers, steps, method,
     _stage(progress, f"fitting the surrogate of {results}")
     surrogate, flight, given, posterior = _fitted(results, data, outputs, noise, method, order, campaign)
     walkers = walkers or max(32, 2 * posterior.ndim + 2)
-    if steps < 100:
+    if steps is not None and steps < 100:
         raise ValueError(f"--steps: expected at least 100, got {steps}")
     fitted = clock.perf_counter()
     sampling = Sampling(surrogate, flight, given, walkers, steps, seed, out, progress)
@@ -140,7 +141,7 @@ class Sampling:
     flight: object
     given: dict
     walkers: int
-    steps: int
+    steps: int | None
     seed: int
     out: Path
     progress: object  # a uqflight.progress.Progress, or None
@@ -158,7 +159,7 @@ class Sampling:
 
     def chain(self, posterior, seed):
         """A converged chain of `posterior`, or NotConverged (with a hint for noise-free data)."""
-        _stage(self.progress, f"sampling the posterior ({self.walkers} walkers)", self.steps, "steps")
+        _stage(self.progress, f"sampling the posterior ({self.walkers} walkers)", self.steps or MAX_STEPS, "steps")
         chain = sample(posterior, posterior.ndim, posterior.labels, posterior.start(),
                        lambda rng, n: self.prior_draw(posterior, rng, n), self.walkers, self.steps, seed,
                        progress=self.progress)

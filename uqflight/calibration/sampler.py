@@ -1,7 +1,9 @@
 """emcee's ensemble sampler with its differential-evolution move, seeded, with the convergence rule of `calibrate`.
 
 Start: the posterior mode (BFGS from the prior mean and a few prior draws), the walkers in a small
-ball around it. The first half of the steps is burn-in and dropped. The kept half converged when
+ball around it. The first half of the steps is burn-in and dropped. Without a number of steps the
+chain stops at the first check (every CHECK_EVERY steps from FIRST_CHECK on) where the rules below
+hold at that check and the one before, and at MAX_STEPS at the latest. The kept half converged when
 
 * it is at least MIN_TAU_MULTIPLE (50) integrated autocorrelation times τ long (emcee's τ with
   tol=0, the largest over the parameters);
@@ -22,11 +24,14 @@ import numpy as np
 from scipy import optimize
 from threadpoolctl import threadpool_limits
 
+from .size import MAX_STEPS
+
 MIN_TAU_MULTIPLE = 50.0
 MAX_RHAT = 1.05
 MIN_ACCEPTANCE, MAX_ACCEPTANCE = 0.1, 0.9
 MIN_WALKER_ACCEPTANCE = 0.02
 STARTS = 6  # optimiser starts: the prior mean and STARTS - 1 prior draws
+FIRST_CHECK, CHECK_EVERY = 1000, 250  # an adaptive chain's convergence checks, in steps
 
 
 # emcee's differential-evolution move alone: its stationary distribution is the target, and on the
@@ -94,9 +99,11 @@ def find_mode(log_prob: Callable, start: np.ndarray, prior_draws: np.ndarray) ->
 
 
 def sample(log_prob: Callable, ndim: int, labels: list[str], start: np.ndarray, prior_draw: Callable,
-           walkers: int, steps: int, seed: int, progress=None, moves=None) -> Chain:
+           walkers: int, steps: int | None, seed: int, progress=None, moves=None) -> Chain:
     """Run the ensemble (vectorised log_prob: (M, D) → (M,)), seeded; diagnostics in chain.diagnostics.
-    `moves`: emcee's [(move, weight)] (default MOVES); `progress` (a uqflight.progress.Progress) counts the steps."""
+    `steps`: exactly that many, or None: adaptive (see the module). The first S steps are the same
+    either way, so an adaptive chain that stopped at S is the fixed chain of S steps. `moves`: emcee's
+    [(move, weight)] (default MOVES); `progress` (a uqflight.progress.Progress) counts the steps."""
     if walkers < 2 * ndim:
         raise ValueError(f"--walkers: expected at least 2 × {ndim} parameters = {2 * ndim}, got {walkers}")
     if walkers % 2:
@@ -118,11 +125,27 @@ def _sample(log_prob, ndim, labels, start, prior_draw, walkers, steps, seed, pro
         raise ValueError("cannot place the walkers where the posterior is positive around its mode")
     sampler = emcee.EnsembleSampler(walkers, ndim, log_prob, vectorize=True, moves=moves)
     sampler.random_state = np.random.RandomState(seed).get_state()
-    for _ in sampler.sample(initial, iterations=steps):  # what run_mcmc does, step by step
+    passed = False  # the previous check's verdict
+    for step, _ in enumerate(sampler.sample(initial, iterations=steps or MAX_STEPS), 1):  # run_mcmc, step by step
         if progress:
             progress.advance()
-    chain = Chain(sampler.get_chain(), sampler.get_log_prob(), sampler.acceptance_fraction.copy(),
-                  steps // 2, list(labels), mode)
+        if steps is None and step >= FIRST_CHECK and step % CHECK_EVERY == 0 and step < MAX_STEPS:
+            converged = _chain_so_far(sampler, labels, mode).diagnostics["converged"]
+            if converged and passed:
+                break
+            passed = converged
+    chain = _chain_so_far(sampler, labels, mode)
+    chain.diagnostics["stopping"] = ("fixed" if steps else
+                                     f"adaptive: checked every {CHECK_EVERY} steps from {FIRST_CHECK} on, stopped "
+                                     f"where two checks in a row passed, at most {MAX_STEPS}")
+    return chain
+
+
+def _chain_so_far(sampler, labels, mode) -> Chain:
+    """The steps the sampler has taken, the first half burn-in, diagnosed."""
+    samples = sampler.get_chain()
+    chain = Chain(samples, sampler.get_log_prob(), sampler.acceptance_fraction.copy(), len(samples) // 2,
+                  list(labels), mode)
     chain.diagnostics = diagnose(chain)
     return chain
 

@@ -15,6 +15,7 @@ from ..campaign.schema import DEFAULT_LIMITS
 from .likelihood import DataError
 
 DEFAULT_WALKERS = 32  # the fewest `calibrate` uses when --walkers is not given
+MAX_STEPS = 6000  # the longest an adaptive chain (no --steps) runs (calibration.sampler)
 PREDICTIVE_NOISE_DRAWS = 40  # noise draws per simulator run for the 95 % predictive band
 
 
@@ -38,12 +39,12 @@ def campaign_memory_limit(results) -> float:
         return DEFAULT_LIMITS["max_memory_gb"]
 
 
-def check_size(data, outputs: list[str] | None, walkers: int | None, steps: int, predictive_draws: int,
+def check_size(data, outputs: list[str] | None, walkers: int | None, steps: int | None, predictive_draws: int,
                max_memory_gb: float) -> None:
     """DataError when the calibration of `data` would need more than `max_memory_gb`; reads the
     header and counts lines, nothing more."""
     path = Path(data)
-    walkers = walkers or DEFAULT_WALKERS
+    walkers, steps = walkers or DEFAULT_WALKERS, steps or MAX_STEPS  # an adaptive chain may take MAX_STEPS
     budget = max_memory_gb * 1e9
     chain = 8.0 * walkers * steps * 3  # the chain (and emcee's copy) of at least one parameter, its log-probability
     if chain > budget:
