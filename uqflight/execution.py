@@ -150,19 +150,28 @@ def prepare_store(campaign: Campaign, design: Design, out: Path, force: bool, no
         quantities=list(campaign.quantities), capacity=campaign.runs if is_adaptive(design.kind) else None)
 
 
-def simulate(campaign: Campaign, kappa: np.ndarray, outputs: list[str], processes: int = 1):
+def simulate(campaign: Campaign, kappa: np.ndarray, outputs: list[str], processes: int = 1, meanwhile=None):
     """Fly (or call) the campaign's simulator at every row of kappa (M, d), as a worker of `uqflight run`
     does (e.g. the calibration's posterior-predictive runs): in this process, or split over `processes`
     forked children (where the system forks). Each run starts from a fresh simulator state, so the
-    numbers do not depend on the split.
+    numbers do not depend on the split. `meanwhile` (no arguments) is called here while the children fly,
+    e.g. an import the caller needs next.
 
     Returns (time (T,), {output: (M, T)} with NaN rows for failed runs, [failure reasons]).
     """
     kappa = np.asarray(kappa, dtype=float)
     chunks = np.array_split(np.arange(len(kappa)), max(1, min(processes, len(kappa))))
     if len(chunks) == 1 or not FORKS:
-        return _simulate_rows(campaign, kappa, outputs)
-    found = wait_all([Child(lambda rows=rows: _simulate_rows(campaign, kappa[rows], outputs)) for rows in chunks])
+        found = _simulate_rows(campaign, kappa, outputs)
+        if meanwhile is not None:
+            meanwhile()
+        return found
+    children = [Child(lambda rows=rows: _simulate_rows(campaign, kappa[rows], outputs)) for rows in chunks]
+    try:
+        if meanwhile is not None:
+            meanwhile()
+    finally:
+        found = wait_all(children)
     time = next((f[0] for f in found if not isinstance(f, ChildFailed)), None)
     if time is None:  # every child died: the time grid from the simulator here
         time = _simulate_rows(campaign, kappa[:0], outputs)[0]

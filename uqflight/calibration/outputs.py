@@ -146,13 +146,14 @@ def draw_all(plots: list) -> None:
         for plot in plots:
             plot()
         return
-    _pyplot()  # imported once here, not in each child
+    pyplot()  # imported once here, not in each child
     failed = [str(outcome) for outcome in wait_all([Child(plot) for plot in plots]) if isinstance(outcome, ChildFailed)]
     if failed:
         raise RuntimeError(f"cannot write a calibration plot: its process {failed[0]} (the error is printed above)")
 
 
-def _pyplot():
+def pyplot():
+    """matplotlib.pyplot on the Agg backend (imported on first use: a second on this machine)."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -169,14 +170,14 @@ def corner_plot(path: Path, draws: np.ndarray, names: list[str], truth=None, bin
 
 def _write(fig, path: Path) -> None:
     fig.savefig(path, dpi=90)
-    _pyplot().close(fig)
+    pyplot().close(fig)
 
 
 def corner_figure(draws: np.ndarray, names: list[str], truth=None, bins: int = 40, properties: list[str] | None = None):
     """A lower-triangle corner plot in physical values, axes labelled with the parameters' units:
     histograms on the diagonal, 2-D histograms below; the posterior mean dashed (+ below the
     diagonal) and the truth (`truth`, NaN where unknown) red."""
-    plt = _pyplot()
+    plt = pyplot()
     d = draws.shape[1]
     labels = _labels(names, properties)
     size = min(2.0 * d + 0.6, 16.0)
@@ -234,7 +235,7 @@ def marginals_figure(prior: np.ndarray, posterior: np.ndarray, names: list[str],
                      properties: list[str] | None = None):
     """Prior against posterior histogram of every parameter (physical values with their units,
     densities), the posterior mean dashed and the truth (when given) red."""
-    plt = _pyplot()
+    plt = pyplot()
     d = posterior.shape[1]
     cols = min(d, 4)
     rows = math.ceil(d / cols)
@@ -272,7 +273,7 @@ def marginals_figure(prior: np.ndarray, posterior: np.ndarray, names: list[str],
 def predictive_plot(path: Path, time, data: dict, runs: dict, band: dict, units: dict, failed: int) -> None:
     """Per output: the data, the simulator runs of the posterior draws and the 95 % predictive band
     (left), and the same about the runs' median (right), where the noise can be seen."""
-    plt = _pyplot()
+    plt = pyplot()
     outputs = list(data)
     fig, axes = plt.subplots(len(outputs), 2, figsize=(13, 2.4 * len(outputs) + 0.6), squeeze=False, sharex=True)
     for row, name in enumerate(outputs):

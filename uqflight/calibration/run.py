@@ -17,7 +17,7 @@ from ..parameters.germs import GERMS
 
 from .likelihood import DataError, LogPosterior, interpolate_in_time, parse_noise, read_flight_csv
 from .outputs import (OUTPUT_FILES, calibrated_campaign, corner_plot, draw_all, informed, marginal, marginals_plot,
-                      predictive_plot, write_json, write_posterior)
+                      predictive_plot, pyplot, write_json, write_posterior)
 from .sampler import sample
 from .size import MAX_STEPS, PREDICTIVE_NOISE_DRAWS, campaign_memory_limit, check_size
 from .surrogate import (SurrogateError, calibration_surrogate, check_campaign_text, portable_mapping,
@@ -344,7 +344,8 @@ def _predictive(chain, posterior, surrogate, flight, rng, count):
     xi = draws[pick, :len(surrogate.names)]
     kappa = to_physical(surrogate.parameters, xi, surrogate.campaign.dependence)
     processes = min(surrogate.campaign.execution["workers"], os.cpu_count() or 1)  # the campaign's, on this machine
-    sim_time, runs, failures = simulate(surrogate.campaign, kappa, list(flight.values), processes)
+    # matplotlib (a second to import) is loaded while the flights run: the plots come next
+    sim_time, runs, failures = simulate(surrogate.campaign, kappa, list(flight.values), processes, meanwhile=pyplot)
     ok = np.all([np.all(np.isfinite(runs[o]), axis=1) for o in runs], axis=0)
     errors = {}
     basis = surrogate.basis(xi[ok])
