@@ -214,11 +214,11 @@ def corner_figure(draws: np.ndarray, names: list[str], truth=None, bins: int = 4
             if i == d - 1:
                 ax.set_xlabel(labels[j], fontsize=8)
             else:
-                ax.set_xticklabels([])
+                ax.tick_params(labelbottom=False)
             if j == 0 and i > 0:
                 ax.set_ylabel(labels[i], fontsize=8)
             elif j > 0 and i != j:
-                ax.set_yticklabels([])
+                ax.tick_params(labelleft=False)  # hides them without building the ticks now
             ax.tick_params(labelsize=6)
     fig.legend(handles=_marks(known), loc="upper right", fontsize=9, frameon=False)
     fig.suptitle("posterior (physical values)")

@@ -154,7 +154,8 @@ def diagnose(chain: Chain) -> dict:
     """Acceptance, τ, split-R̂ and the verdict, with what to change when not converged."""
     kept = chain.kept
     n_kept, walkers, _ = kept.shape
-    tau = np.array([emcee.autocorr.integrated_time(kept[:, :, [k]], tol=0)[0] for k in range(kept.shape[2])])
+    with np.errstate(invalid="ignore", divide="ignore"):  # a constant chain: τ NaN, a problem below, no warning
+        tau = np.array([emcee.autocorr.integrated_time(kept[:, :, [k]], tol=0)[0] for k in range(kept.shape[2])])
     rhat = split_rhat(kept)
     tau_max = float(np.max(tau))
     acceptance = chain.acceptance

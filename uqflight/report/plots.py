@@ -740,11 +740,11 @@ def plot_design_pairs(results, path: Path, title: str) -> Path | None:
             if j == 0:
                 ax.set_ylabel(names[i], fontsize=8)
             else:
-                ax.set_yticklabels([])
+                ax.tick_params(labelleft=False)  # hides them without building the ticks now
             if i == d - 1:
                 ax.set_xlabel(names[j], fontsize=8)
             else:
-                ax.set_xticklabels([])
+                ax.tick_params(labelbottom=False)
             ax.grid(alpha=0.3)
     fig.legend(*handles, loc="upper right", fontsize=8, frameon=False)
     fig.suptitle(f"{title}\nphysical values κ", fontsize=11)
