@@ -74,8 +74,8 @@ def write_report(paths: list[Path], out_dir: Path | None = None, reference: Path
 
 
 def _write_into(out_dir: Path, entries: list[Entry], ref: Entry | None, times, progress: Progress) -> None:
-    # the page's modules import matplotlib (half a second): loaded only when a page is drawn, so that
-    # `surrogate export` and `report --method` parsing (report.loading) start fast
+    # the page's own modules (matplotlib itself comes with .plots, imported with this package);
+    # `surrogate export` does without either: it imports no uqflight.report module
     from .plots import background_rendering
     from .render import render_html, render_markdown
     from .sections import Table, build_sections, files_section
