@@ -1,12 +1,14 @@
 """Off a terminal, `report`, `surrogate export` and `calibrate` log their stages and percentages on
 stderr (uqflight.progress, the mechanism `run` uses): real processes, stderr a pipe."""
 import io
+import json
 import re
 
 import numpy as np
 import pytest
 from conftest import cli, run_python_campaign
 
+from uqflight.calibration.size import MAX_STEPS
 from uqflight.execution import Progress
 
 MODEL = """
@@ -64,6 +66,21 @@ def test_calibrate_logs_the_sampler_steps(results, tmp_path):
     lines = logged(run.stderr, "calibrate")
     assert any(line.startswith("calibrate: sampling the posterior") and "(100 %)" in line for line in lines)
     assert lines[0].startswith("calibrate: fitting the surrogate")
+
+
+def test_calibrate_says_where_an_adaptive_chain_converged(results, tmp_path):
+    rng = np.random.default_rng(1)
+    time = np.linspace(0.0, 1.0, 11)
+    data = tmp_path / "flight.csv"
+    data.write_text("time_s,y\n" + "".join(f"{t:g},{float(1.1 - 0.45 * t + 0.05 * rng.standard_normal())!r}\n" for t in time))
+    run = cli("calibrate", results, "--data", data, "--out", tmp_path / "cal", "--noise", "y=0.05",
+              "--predictive-draws", "2")
+    assert run.returncode == 0, run.stderr
+    steps = json.loads((tmp_path / "cal" / "summary.json").read_text())["diagnostics"]["steps"]
+    assert steps < MAX_STEPS
+    lines = logged(run.stderr, "calibrate")
+    assert any("until converged, at most 6000 steps" in line for line in lines)
+    assert any(f"converged at {steps} steps" in line and "(100 %)" in line for line in lines), lines
 
 
 def test_the_progress_counts_resumed_runs_and_fits_the_terminal(monkeypatch):

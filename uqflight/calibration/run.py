@@ -159,10 +159,16 @@ class Sampling:
 
     def chain(self, posterior, seed):
         """A converged chain of `posterior`, or NotConverged (with a hint for noise-free data)."""
-        _stage(self.progress, f"sampling the posterior ({self.walkers} walkers)", self.steps or MAX_STEPS, "steps")
+        until = "" if self.steps else f"; until converged, at most {MAX_STEPS} steps"
+        _stage(self.progress, f"sampling the posterior ({self.walkers} walkers{until})", self.steps or MAX_STEPS,
+               "steps")
         chain = sample(posterior, posterior.ndim, posterior.labels, posterior.start(),
                        lambda rng, n: self.prior_draw(posterior, rng, n), self.walkers, self.steps, seed,
                        progress=self.progress)
+        taken = chain.samples.shape[0]
+        if self.progress is not None and taken < (self.steps or MAX_STEPS):  # stopped once converged: the stage is done
+            self.progress.advance(MAX_STEPS - taken, f"sampling the posterior ({self.walkers} walkers): converged at "
+                                                     f"{taken} steps")
         if chain.diagnostics["converged"]:
             return chain
         germs = self.surrogate.germs
