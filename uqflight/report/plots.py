@@ -163,12 +163,13 @@ PANEL_MARGINS = {"left": 0.9, "right": 0.25, "column_gap": 1.0, "top": 0.72, "ro
                  "legend_row": 0.22}
 
 
-def _fix_panel_layout(fig, legend_rows: int) -> None:
-    """Place the panels of a `_panels` figure with PANEL_MARGINS (and room for `legend_rows` of legend
-    below): what tight_layout would find for these fonts, without measuring every text."""
+def _fix_panel_layout(fig, legend_rows: int, right: float | None = None) -> None:
+    """Place the panels of a figure with a `panel_grid` (rows, columns) with PANEL_MARGINS (and room for
+    `legend_rows` of legend below, `right` inches on the right, e.g. for a colour bar): what tight_layout
+    would find for these fonts, without measuring every text."""
     rows, columns = fig.panel_grid
     width, height = fig.get_size_inches()
-    m = PANEL_MARGINS
+    m = {**PANEL_MARGINS, **({} if right is None else {"right": right})}
     bottom = m["bottom"] + m["legend_row"] * legend_rows
     panel_width = (width - m["left"] - m["right"] - (columns - 1) * m["column_gap"]) / columns
     panel_height = (height - m["top"] - bottom - (rows - 1) * m["row_gap"]) / rows
@@ -177,8 +178,9 @@ def _fix_panel_layout(fig, legend_rows: int) -> None:
                         hspace=m["row_gap"] / panel_height)
 
 
-def _save(fig, path: Path, legend_handles=None, legend_columns: int = 3) -> Path:
-    """Place a shared legend under the panels (when given) and write the PNG."""
+def _save(fig, path: Path, legend_handles=None, legend_columns: int = 3, right: float | None = None) -> Path:
+    """Place a shared legend under the panels (when given) and write the figure: a `panel_grid` figure
+    laid out by _fix_panel_layout (`right`: its right margin in inches), any other by tight_layout."""
     rect, legend_rows = (0, 0, 1, 1), 0
     if legend_handles:
         handles, labels = legend_handles
@@ -187,7 +189,7 @@ def _save(fig, path: Path, legend_handles=None, legend_columns: int = 3) -> Path
         legend_rows = 1 + (len(labels) - 1) // legend_columns
         rect = (0, 0.04 + 0.025 * (legend_rows - 1), 1, 1)
     if hasattr(fig, "panel_grid"):
-        _fix_panel_layout(fig, legend_rows)
+        _fix_panel_layout(fig, legend_rows, right)
         return write_figure(fig, path)
     return _write(fig, path, rect)
 

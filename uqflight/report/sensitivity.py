@@ -9,7 +9,6 @@ import numpy as np
 from matplotlib.patches import Patch
 
 from . import plots
-from .trajectories import save_fixed
 
 NEGLIGIBLE = 1e-4  # a variance below this share of its largest over time (std < 1 % of its largest) is negligible
 TINY_INDEX = 1e-3  # indices below this print as "<0.001"
@@ -109,4 +108,5 @@ def plot_sensitivity(outputs: dict, path: Path, title: str) -> Path | None:
     handles = [Patch(color=c) for c in (*plots.COLORS[:len(parameters)], INTERACTIONS, "k", GREY)]
     labels = [*parameters, "interactions", "Var(t)", f"variance < {NEGLIGIBLE:g} of its max, or unresolved"]
     fig.suptitle(title, fontsize=12)
-    return save_fixed(fig, path, (handles, labels), legend_columns=6)
+    fig.panel_grid = axes.shape
+    return plots._save(fig, path, (handles, labels), legend_columns=6)

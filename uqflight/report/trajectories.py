@@ -21,18 +21,6 @@ SCATTER_INPUTS = 2  # inputs shown per output: the most influential
 COLOR_MAP = "viridis"
 
 
-def save_fixed(fig, path: Path, legend=None, legend_columns: int = 4, right: float = 0.2) -> Path:
-    """Lay the panels out with fixed margins in inches (matplotlib's tight layout would draw the figure
-    once more to measure it) and write it in the report's format (plots.write_figure); `legend` (handles, labels) goes under the panels."""
-    width, height = fig.get_size_inches()
-    bottom = 0.55 + (0.25 * -(-len(legend[1]) // legend_columns) if legend else 0.0)
-    fig.subplots_adjust(left=0.95 / width, right=1 - right / width, top=1 - 0.75 / height, bottom=bottom / height,
-                        hspace=0.62, wspace=0.3)
-    if legend:
-        fig.legend(*legend, loc="lower center", ncol=legend_columns, fontsize=8, frameon=False)
-    return plots.write_figure(fig, path)
-
-
 def run_subset(status: np.ndarray, count: int, seed: int) -> np.ndarray:
     """`count` successful runs (all when fewer), drawn without replacement with `seed`, ascending: the same
     runs for the same file and seed, whatever else the report draws."""
@@ -64,7 +52,7 @@ def plot_spaghetti(results: Path, outputs: dict, path: Path, title: str, seed: i
     handles = [Line2D([], [], color=plots.COLORS[0], lw=0.8), Line2D([], [], color="k", lw=1.4),
                Line2D([], [], color="k", lw=0.9, ls="--")]
     labels = [f"{rows.size} runs", "mean", "99 % band"]
-    return save_fixed(fig, path, (handles, labels), 3), int(rows.size)
+    return plots._save(fig, path, (handles, labels), 3), int(rows.size)
 
 
 def _influence(sobol_total: dict, i: int, kappa: np.ndarray, y: np.ndarray, names: list[str]) -> np.ndarray:
@@ -126,10 +114,11 @@ def plot_scatter(kappa: np.ndarray, names: list[str], rows_of: dict, path: Path,
             ax.grid(alpha=0.3)
         row[0].set_ylabel(text, fontsize=8)
     fig.suptitle(title, fontsize=12)
+    fig.panel_grid = axes.shape
     bar = fig.colorbar(plots.plt.cm.ScalarMappable(cmap=COLOR_MAP), cax=fig.add_axes((1 - 0.9 / fig.get_size_inches()[0], 0.15, 0.012, 0.7)))
     bar.set_ticks([0, 1], labels=["low", "high"])
     bar.set_label("the colouring input, named above each panel", fontsize=8)
-    return save_fixed(fig, path, right=1.4)  # the colour bar in the right margin
+    return plots._save(fig, path, right=1.4)  # the colour bar in the right margin
 
 
 def trajectories_section(entries: list, times: list[float], out_dir: Path):
