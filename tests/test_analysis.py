@@ -64,6 +64,8 @@ def test_hazen_quantiles_are_numpys_to_the_bit(n, kind):
     probabilities = np.array([0.0, 1e-9, 0.005, 0.3, 0.5, 0.5 / n, 1 - 0.5 / n, 0.995, 0.995, 1 - 1e-12, 1.0])
     found = hazen_quantiles(Y, probabilities)
     np.testing.assert_array_equal(found, np.quantile(Y, probabilities, axis=0, method="hazen"))
+    for shaped in (0.3, probabilities.reshape(-1, 1)):  # a single probability, and a column of them: numpy's shapes
+        np.testing.assert_array_equal(hazen_quantiles(Y, shaped), np.quantile(Y, shaped, axis=0, method="hazen"))
 
 
 def test_quantile_band_of_a_normal_sample_is_2_5758_sigma():

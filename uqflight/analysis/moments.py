@@ -119,7 +119,7 @@ def hazen_quantiles(Y, probabilities) -> np.ndarray:
     rows = np.array(Y.T, order="C")  # a copy, partitioned in place: one row per time
     if not np.isfinite(rows).all():
         return np.quantile(Y, probabilities, axis=0, method="hazen")
-    n = rows.shape[1]
+    n, shape, probabilities = rows.shape[1], probabilities.shape, probabilities.ravel()
     virtual = n * probabilities + (0.5 + probabilities * (1 - 0.5 - 0.5)) - 1  # numpy's virtual index
     previous = np.clip(np.floor(virtual), 0, n - 1).astype(np.intp)
     previous[virtual >= n - 1] = n - 1
@@ -135,7 +135,7 @@ def hazen_quantiles(Y, probabilities) -> np.ndarray:
         difference = b - a
         value = a + difference * t
         bounds.append(b - difference * (1 - t) if t >= 0.5 else value)
-    return np.array(bounds).reshape(probabilities.shape + (Y.shape[1],))
+    return np.array(bounds).reshape(shape + (Y.shape[1],))
 
 
 def quantile_band(Y, weights=None, level: float = 0.99) -> tuple[np.ndarray, np.ndarray]:
