@@ -4,7 +4,6 @@ from __future__ import annotations
 import csv
 import io
 import os
-import signal
 from collections import Counter
 from pathlib import Path
 from typing import List, Optional
@@ -15,6 +14,7 @@ import typer
 from .arguments import check_campaign_file, check_output, check_results_file
 from .calibration.command import register as register_calibrate
 from .console import echo
+from . import stopping
 from .progress import Progress
 
 from .methods import METHOD_KINDS
@@ -303,11 +303,7 @@ def run(
         echo(f"error: --workers: expected an integer >= 1, got {workers}", err=True)
         raise typer.Exit(2)
     resume = f"uqflight run {campaign_file}" + (f" --out {out}" if out else "")
-    if signal.getsignal(signal.SIGINT) is signal.SIG_IGN:
-        # started with SIGINT ignored (a script's `uqflight run ... &`, some test harnesses): Ctrl-C or
-        # kill -INT would be lost and a run waiting on workers would never stop; it stops cleanly instead
-        signal.signal(signal.SIGINT, signal.default_int_handler)
-    previous = _stop_on_sigterm()
+    previous = stopping.install()  # SIGINT and SIGTERM stop cleanly, even if a handler's exception is lost
     try:
         summary = run_campaign(campaign, out=out, workers=workers, executor=executor, scheduler=scheduler,
                                force=force, progress=True, restart=restart)
@@ -324,12 +320,12 @@ def run(
         echo(f"error: {campaign_file}: {exc}", err=True)
         raise typer.Exit(2)
     except KeyboardInterrupt as exc:
-        code = 143 if isinstance(exc, Terminated) else 130
+        code = 143 if isinstance(exc, stopping.Terminated) else 130
         echo(f"\n{'terminated' if code == 143 else 'interrupted'}: the finished runs are stored; "
              f"rerun `{resume}` to resume", err=True)
         raise typer.Exit(code)
     finally:
-        signal.signal(signal.SIGTERM, previous)
+        stopping.restore(previous)
     echo(summary.describe())
 
 
@@ -342,17 +338,6 @@ def _exit_now(code: int):
     sys.stdout.flush()
     sys.stderr.flush()
     os._exit(code)
-
-
-class Terminated(KeyboardInterrupt):
-    """SIGTERM, handled like SIGINT: a clean stop."""
-
-
-def _stop_on_sigterm():
-    def stop(signum, frame):
-        raise Terminated()
-
-    return signal.signal(signal.SIGTERM, stop)
 
 
 @app.command()

@@ -49,6 +49,7 @@ from .campaign.schema import WORKER_BYTES
 from .designs import Design, is_adaptive
 from .forking import FORKS, Child, ChildFailed, wait_all
 from .parameters import seed_names
+from .stopping import check as check_stop
 from .progress import Progress
 from .refinement import run_rounds
 from .store import ResultStore, Status, compact, open_for_campaign
@@ -563,6 +564,7 @@ class WorkerPool:
         busy: list[WorkerProcess] = []
         finished: deque = deque()  # results held back until every idle worker has its next chunk
         while queue or busy or finished:
+            check_stop()  # a SIGINT or SIGTERM whose exception was lost in a callback
             while queue and len(busy) < self.workers:
                 task = queue.popleft()
                 if task.settled:
@@ -701,6 +703,7 @@ def _execute_dask(tasks, spec, n_times, outputs, workers: int, scheduler: str | 
         running = {submit(queue.pop()) for _ in range(min(in_flight, len(queue)))}
         told = False
         while running:
+            check_stop()
             try:
                 done, running = wait(running, timeout=NO_WORKERS_NOTICE_S, return_when="FIRST_COMPLETED")
             except TimeoutError:
