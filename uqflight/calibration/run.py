@@ -160,15 +160,15 @@ class Sampling:
     def chain(self, posterior, seed):
         """A converged chain of `posterior`, or NotConverged (with a hint for noise-free data)."""
         until = "" if self.steps else f"; until converged, at most {MAX_STEPS} steps"
-        _stage(self.progress, f"sampling the posterior ({self.walkers} walkers{until})", self.steps or MAX_STEPS,
-               "steps")
+        most = self.steps or MAX_STEPS
+        _stage(self.progress, f"sampling the posterior ({self.walkers} walkers{until})", most, "steps")
         chain = sample(posterior, posterior.ndim, posterior.labels, posterior.start(),
                        lambda rng, n: self.prior_draw(posterior, rng, n), self.walkers, self.steps, seed,
                        progress=self.progress)
         taken = chain.samples.shape[0]
-        if self.progress is not None and taken < (self.steps or MAX_STEPS):  # stopped once converged: the stage is done
-            self.progress.advance(MAX_STEPS - taken, f"sampling the posterior ({self.walkers} walkers): converged at "
-                                                     f"{taken} steps")
+        if self.progress is not None and taken < most:  # stopped once converged: the stage is done
+            self.progress.advance(most - taken, f"sampling the posterior ({self.walkers} walkers): converged at "
+                                                f"{taken} steps")
         if chain.diagnostics["converged"]:
             return chain
         germs = self.surrogate.germs

@@ -130,11 +130,12 @@ def _sample(log_prob, ndim, labels, start, prior_draw, walkers, steps, seed, pro
         if progress:
             progress.advance()
         if steps is None and step >= FIRST_CHECK and step % CHECK_EVERY == 0 and step < MAX_STEPS:
-            converged = _chain_so_far(sampler, labels, mode).diagnostics["converged"]
-            if converged and passed:
-                break
-            passed = converged
-    chain = _chain_so_far(sampler, labels, mode)
+            chain = _chain_so_far(sampler, labels, mode)
+            if chain.diagnostics["converged"] and passed:
+                break  # the chain just diagnosed is the one returned
+            passed = chain.diagnostics["converged"]
+    else:
+        chain = _chain_so_far(sampler, labels, mode)
     chain.diagnostics["stopping"] = ("fixed" if steps else
                                      f"adaptive: checked every {CHECK_EVERY} steps from {FIRST_CHECK} on, stopped "
                                      f"where two checks in a row passed, at most {MAX_STEPS}")

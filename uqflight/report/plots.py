@@ -182,11 +182,12 @@ def _fix_panel_layout(fig, legend_rows: int, right: float | None = None) -> None
     would find for these fonts, without measuring every text."""
     rows, columns = fig.panel_grid
     width, height = fig.get_size_inches()
-    m = {**PANEL_MARGINS, **({} if right is None else {"right": right})}
+    m = PANEL_MARGINS
+    right = m["right"] if right is None else right
     bottom = m["bottom"] + m["legend_row"] * legend_rows
-    panel_width = (width - m["left"] - m["right"] - (columns - 1) * m["column_gap"]) / columns
+    panel_width = (width - m["left"] - right - (columns - 1) * m["column_gap"]) / columns
     panel_height = (height - m["top"] - bottom - (rows - 1) * m["row_gap"]) / rows
-    fig.subplots_adjust(left=m["left"] / width, right=1 - m["right"] / width, top=1 - m["top"] / height,
+    fig.subplots_adjust(left=m["left"] / width, right=1 - right / width, top=1 - m["top"] / height,
                         bottom=bottom / height, wspace=m["column_gap"] / panel_width,
                         hspace=m["row_gap"] / panel_height)
 
