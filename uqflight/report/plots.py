@@ -37,6 +37,8 @@ OFFSET_DATUM = 10.0  # min|mean| above this many times the mean's excursion: an 
 DECAY_ONSET = 1e-3  # without a known pulse start, coefficient decay is drawn from where degree >= 1 reaches
 #                     this share of its largest value
 FORMATS = ("png", "svg", "pdf")
+FAST_PNG = {"pil_kwargs": {"compress_level": 1}}  # zlib's fastest level: the same pixels, written in half the
+#                                                   time of the default 6, the files about 15 % larger
 _format = ["png"]  # the export format of the figures (`exporting`)
 
 
@@ -76,7 +78,8 @@ def shown_path(path: Path) -> Path:
 
 def _save_as(fig, path: Path, dpi: int = DPI) -> None:
     """Write `fig` as the page's file of `path` (and a PDF beside it when the export format is pdf)."""
-    fig.savefig(shown_path(path), dpi=dpi)
+    shown = shown_path(path)
+    fig.savefig(shown, dpi=dpi, **(FAST_PNG if shown.suffix == ".png" else {}))
     if _format[0] == "pdf":
         fig.savefig(Path(path).with_suffix(".pdf"))
 
