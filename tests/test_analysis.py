@@ -102,6 +102,30 @@ def test_pdf_over_time_matches_scipy_kde_and_integrates_to_one():
         assert abs(density[t].sum() * (support[t, 1] - support[t, 0]) - 1) < 1e-3
 
 
+@pytest.mark.parametrize("runs", [1, 2047, 2048, 2049, 5000])
+def test_binning_in_row_blocks_is_one_pass_of_linear_binning(runs):
+    # the rows are binned BIN_ROWS at a time: the shares passed on are summed per block, so the
+    # counts may differ from one pass in the last bit only (1e-12 of the largest count is generous)
+    from uqflight.analysis.density import BIN_ROWS, _linear_bins
+
+    assert BIN_ROWS == 2048
+    rng = np.random.default_rng(runs)
+    Y = rng.normal(size=(runs, 5)) * [1.0, 2.0, 1e-3, 5.0, 1.0] + [0.0, 3.0, 1.0, -2.0, 1e4]
+    lower, grid_points = Y.min(axis=0) - 0.1, 50
+    spacing = (Y.max(axis=0) + 0.1 - lower) / (grid_points - 1)
+    position = np.clip((Y - lower) / spacing, 0, grid_points - 1)
+    left = np.minimum(position.astype(int), grid_points - 2)
+    share = position - left
+    expected_counts, expected_right = np.zeros((5, grid_points)), np.zeros((5, grid_points))
+    for t in range(5):
+        np.add.at(expected_counts[t], left[:, t], 1 - share[:, t])
+        np.add.at(expected_right[t], left[:, t], share[:, t])
+    counts, to_right = _linear_bins(Y, lower, spacing, grid_points)
+    np.testing.assert_allclose(counts.reshape(5, -1), expected_counts, rtol=0, atol=1e-12 * runs)
+    np.testing.assert_allclose(to_right.reshape(5, -1), expected_right, rtol=0, atol=1e-12 * runs)
+    assert (counts + to_right).sum() == pytest.approx(5 * runs, rel=1e-14)
+
+
 def test_pdf_of_a_constant_column_is_a_narrow_unit_peak():
     Y = np.column_stack([np.full(500, 3.0), np.random.default_rng(3).normal(size=500)])
     support, density = pdf_over_time(Y)

@@ -14,6 +14,7 @@ BANDWIDTH_RULES = {
     "scott": lambda n: n ** (-1.0 / 5.0),
     "silverman": lambda n: (0.75 * n) ** (-1.0 / 5.0),
 }
+BIN_ROWS = 2048  # samples binned at once: (2048, T) buffers
 KERNEL_REACH = 4.0  # bandwidths beyond the extreme samples kept in the support (tail mass < 4e-5)
 
 
@@ -46,16 +47,7 @@ def kde_on_grid(Y, lower, upper, bandwidth, grid_points: int) -> tuple[np.ndarra
     spacing = (upper - lower) / (grid_points - 1)
     support = lower[:, None] + spacing[:, None] * np.arange(grid_points)
 
-    position = Y - lower
-    position /= spacing
-    np.clip(position, 0, grid_points - 1, out=position)
-    left = position.astype(np.intp)
-    np.minimum(left, grid_points - 2, out=left)  # in place: 5x faster than a new array
-    position -= left  # now the share of each sample that goes to its right neighbour
-    left += grid_points * np.arange(n_times)
-    size = n_times * grid_points
-    to_right = np.bincount(left.ravel(), position.ravel(), minlength=size)
-    counts = np.bincount(left.ravel(), minlength=size) - to_right
+    counts, to_right = _linear_bins(Y, lower, spacing, grid_points)
     counts[1:] += to_right[:-1]  # left + 1 stays inside its own column since left <= G - 2
 
     length = 1 << int(np.ceil(np.log2(2 * grid_points)))
@@ -64,6 +56,32 @@ def kde_on_grid(Y, lower, upper, bandwidth, grid_points: int) -> tuple[np.ndarra
     spectrum = np.fft.rfft(counts.reshape(n_times, grid_points), length, axis=1) * kernel
     density = np.fft.irfft(spectrum, length, axis=1)[:, :grid_points] / (n_runs * spacing[:, None])
     return support, np.clip(density, 0.0, None)
+
+
+def _linear_bins(Y, lower, spacing, grid_points: int) -> tuple[np.ndarray, np.ndarray]:
+    """Each sample of column t split between grid points left and left + 1 of that column: the shares
+    kept at each point (counts) and passed to its right neighbour (to_right), flattened (T·G,). Rows
+    are taken BIN_ROWS at a time into reused buffers that stay in cache (twice as fast as whole
+    columns); the shares passed on are summed per row block, which may change their last bit."""
+    n_runs, n_times = Y.shape
+    size = n_times * grid_points
+    samples, to_right = np.zeros(size, dtype=np.intp), np.zeros(size)
+    position = np.empty((min(BIN_ROWS, n_runs), n_times))
+    left = np.empty(position.shape, dtype=np.intp)
+    columns = grid_points * np.arange(n_times)
+    for start in range(0, n_runs, BIN_ROWS):
+        rows = Y[start:start + BIN_ROWS]
+        share, index = position[:len(rows)], left[:len(rows)]
+        np.subtract(rows, lower, out=share)
+        share /= spacing
+        np.clip(share, 0, grid_points - 1, out=share)
+        index[...] = share  # truncated, as astype
+        np.minimum(index, grid_points - 2, out=index)
+        share -= index  # now the share of each sample that goes to its right neighbour
+        index += columns
+        to_right += np.bincount(index.ravel(), share.ravel(), minlength=size)
+        samples += np.bincount(index.ravel(), minlength=size)
+    return samples - to_right, to_right
 
 
 def pdf_over_time(Y, grid_points: int = 200, rule: str = "scott", std=None) -> tuple[np.ndarray, np.ndarray]:
