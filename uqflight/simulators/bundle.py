@@ -60,6 +60,8 @@ def _unzip(data: bytes, unsafe) -> dict[str, bytes]:
     """The bundle's files, once every name passes `unsafe(name)` (None, or why not) and their count and
     declared total size are within the limits; reading stops at the declared sizes (zipfile checks
     each file's length and CRC), so no file grows past what was checked."""
+    # what zipfile raises on a hostile or broken archive: RuntimeError for an encrypted file,
+    # NotImplementedError for a compression method it lacks
     unreadable = (zipfile.BadZipFile, zlib.error, EOFError, ValueError, RuntimeError, NotImplementedError)
     try:
         archive = zipfile.ZipFile(io.BytesIO(data))
