@@ -16,7 +16,7 @@ from uqflight.analysis import (
     weighted_std,
     weighted_variance,
 )
-from uqflight.analysis.moments import hazen_quantiles
+from uqflight.analysis.moments import hazen_quantiles, order_statistics
 from uqflight.methods import fit
 from uqflight.parameters.germs import draw_germs
 
@@ -66,6 +66,23 @@ def test_hazen_quantiles_are_numpys_to_the_bit(n, kind):
     np.testing.assert_array_equal(found, np.quantile(Y, probabilities, axis=0, method="hazen"))
     for shaped in (0.3, probabilities.reshape(-1, 1)):  # a single probability, and a column of them: numpy's shapes
         np.testing.assert_array_equal(hazen_quantiles(Y, shaped), np.quantile(Y, shaped, axis=0, method="hazen"))
+
+
+def test_tail_selection_is_a_full_partition_where_its_subsample_misleads():
+    # every 16th run (the threshold's subsample) sits below the rest in column 0 and above it in column 1:
+    # the thresholds keep too few runs and those columns take the whole-column partition; column 2 is the
+    # common case; both ends, and k = N − 1, must be numpy's order statistics exactly
+    rng = np.random.default_rng(3)
+    n = 20000
+    Y = rng.standard_normal((n, 3))
+    Y[::16, 0] -= 10.0
+    Y[::16, 1] += 10.0
+    ks = [0, 5, 99, 100, 998, n - 1001, n - 101, n - 100, n - 2, n - 1]
+    found = order_statistics(Y, ks)
+    ordered = np.sort(Y, axis=0)
+    for k in ks:
+        np.testing.assert_array_equal(found[k][0], ordered[k])
+        np.testing.assert_array_equal(found[k][1], ordered[min(k + 1, n - 1)])
 
 
 def test_quantile_band_of_a_normal_sample_is_2_5758_sigma():
