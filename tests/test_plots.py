@@ -14,6 +14,7 @@ from matplotlib.image import imread
 from conftest import cli_in_process
 from test_report import run
 from uqflight.report import plots, write_report
+from uqflight.report.formats import exporting
 from uqflight.report.loading import load_entries
 from uqflight.report.render import figure_html
 from uqflight.report.sections import Figure
@@ -57,7 +58,7 @@ def svg_texts(path: Path) -> list[str]:
 
 
 def draw_svg(function, *args, **kwargs) -> Path:
-    with plots.exporting("svg"):
+    with exporting("svg"):
         return function(*args, **kwargs)
 
 
@@ -164,7 +165,7 @@ def test_report_format_svg_embeds_svg_and_pdf_links_pdf(files, tmp_path):
     assert not list((out / "plots").glob("*.png")) and list((out / "plots").glob("*.svg"))
     page = (out / "report.html").read_text()
     assert page.count("data:image/svg+xml;base64,") == len(list((out / "plots").glob("*.svg")))
-    with plots.exporting("pdf"):
+    with exporting("pdf"):
         shown = plots.plot_cov(load_entries([files["grid"]], None, None)[0][0].outputs, tmp_path / "cov.png", "c")
     assert shown.suffix == ".png" and shown.with_suffix(".pdf").read_bytes().startswith(b"%PDF")
     assert 'href="cov.pdf">PDF</a>' in figure_html("f", Figure(shown.name, "caption"), tmp_path)

@@ -170,7 +170,7 @@ def _from_tail(Y: np.ndarray, sub: np.ndarray, k: int, rank: int, low_side: bool
     m = sub.shape[1]
     j = min(m - 1, 2 * rank // TAIL_STRIDE + 8)  # expected twice the candidates needed, and more
     threshold = sub[:, j] if low_side else sub[:, m - 1 - j]
-    run, column = np.nonzero((Y <= threshold) if low_side else (Y >= threshold))  # the tail's runs
+    run, column = np.divmod(np.flatnonzero((Y <= threshold) if low_side else (Y >= threshold)), columns)  # the tail
     count = np.bincount(column, minlength=columns)
     low, high = np.empty(columns), np.empty(columns)
     for c in np.flatnonzero(count < rank):  # a threshold that kept too few: the whole column

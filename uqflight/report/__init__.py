@@ -16,8 +16,11 @@ and OUT is never absent.
 """
 from __future__ import annotations
 
+import importlib
 import os
 import shutil
+import threading
+from contextlib import contextmanager
 from pathlib import Path
 
 from ..check import write_baseline
@@ -25,11 +28,12 @@ from ..progress import Progress
 from ..methods.parsing import parse_methods
 from .files import _write_text, write_csv, write_statistics_tables, write_summaries
 from .loading import Entry, load_entries
-from .plots import FORMATS, exporting
+from .formats import FORMATS, exporting
 from .replace import check_replaceable, make_staging, replace_dir
 
 __all__ = ["check_replaceable", "default_out_dir", "parse_methods", "write_report"]
 
+PAGE_MODULES = ("uqflight.report.plots", "uqflight.report.render", "uqflight.report.sections")
 DEFAULT_TIMES = (10.0, 25.0, float("inf"))  # the tables' times: 10 s, 25 s and the final time
 
 
@@ -47,16 +51,17 @@ def write_report(paths: list[Path], out_dir: Path | None = None, reference: Path
 
     `method`: one override {"kind", "order"}, a list of them (each file analysed with each, overlaid
     in the plots), or None (each campaign's own). `progress` (a Progress) is told each stage. `partial`,
-    `allow_aliasing`: see statistics.analyse. `fmt`: the figures' format (plots.FORMATS; see
-    plots.exporting). Everything is written into a temporary folder first and
+    `allow_aliasing`: see statistics.analyse. `fmt`: the figures' format (formats.FORMATS; see
+    formats.exporting). Everything is written into a temporary folder first and
     moved into place at the end; nothing is written when a file is refused (statistics.BadInput)."""
     out_dir = Path(os.path.abspath(out_dir if out_dir is not None else default_out_dir(paths[0])))
     if fmt not in FORMATS:
         raise ValueError(f"figure format: expected one of {', '.join(FORMATS)}, got {fmt!r}")
     check_replaceable(out_dir)
     progress = progress or Progress(0, quiet=True)
-    entries, ref = load_entries(paths, reference, method, progress=progress, partial=partial,
-                                allow_aliasing=allow_aliasing)
+    with importing_ahead(PAGE_MODULES):  # matplotlib loads on the core the analysis leaves free at times
+        entries, ref = load_entries(paths, reference, method, progress=progress, partial=partial,
+                                    allow_aliasing=allow_aliasing)
     out_dir.parent.mkdir(parents=True, exist_ok=True)
     staging = make_staging(out_dir)
     try:
@@ -73,9 +78,22 @@ def write_report(paths: list[Path], out_dir: Path | None = None, reference: Path
     return written
 
 
+@contextmanager
+def importing_ahead(modules: tuple[str, ...]):
+    """Import `modules` in a thread while the body runs (a module body is mostly Python, the analysis mostly
+    numpy, which releases the GIL); leaving waits for the imports. An import that fails is raised again,
+    here or where the module is imported next."""
+    thread = threading.Thread(target=lambda: [importlib.import_module(m) for m in modules], daemon=True)
+    thread.start()
+    try:
+        yield
+    finally:
+        thread.join()
+
+
 def _write_into(out_dir: Path, entries: list[Entry], ref: Entry | None, times, progress: Progress) -> None:
-    # the page's own modules (matplotlib itself comes with .plots, imported with this package);
-    # `surrogate export` does without either: it imports no uqflight.report module
+    # the page's own modules (matplotlib comes with .plots); imported ahead by write_report, and
+    # by nothing that `surrogate export` imports
     from .plots import background_rendering
     from .render import render_html, render_markdown
     from .sections import Table, build_sections, files_section

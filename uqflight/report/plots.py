@@ -24,6 +24,7 @@ from matplotlib.ticker import FixedLocator, FuncFormatter, LogLocator, MaxNLocat
 
 from ..forking import FORKS, Child, ChildFailed, wait_all  # noqa: E402
 from ..labels import label, short_label  # noqa: E402,F401 (plots.label: the report's captions)
+from .formats import export_format, shown_path  # noqa: E402
 
 TIME_LABEL = "time [s]"
 DPI = 110
@@ -36,23 +37,8 @@ LOW_QUANTILE = 0.02  # error and decay axes start below the lowest line's 2 % qu
 OFFSET_DATUM = 10.0  # min|mean| above this many times the mean's excursion: an offset datum (h, V), no CoV
 DECAY_ONSET = 1e-3  # without a known pulse start, coefficient decay is drawn from where degree >= 1 reaches
 #                     this share of its largest value
-FORMATS = ("png", "svg", "pdf")
 FAST_PNG = {"pil_kwargs": {"compress_level": 1}}  # zlib's fastest level: the same pixels, written in half the
 #                                                   time of the default 6, the files about 15 % larger
-_format = ["png"]  # the export format of the figures (`exporting`)
-
-
-@contextmanager
-def exporting(fmt: str):
-    """Write the figures drawn inside as `fmt`: png; svg (vector; the page embeds it); pdf (vector,
-    beside a PNG of the same name that the page shows)."""
-    if fmt not in FORMATS:
-        raise ValueError(f"unknown figure format {fmt!r}: expected one of {', '.join(FORMATS)}")
-    previous, _format[0] = _format[0], fmt
-    try:
-        yield
-    finally:
-        _format[0] = previous
 
 
 def write_figure(fig, path: Path, dpi: int = DPI, rect=None) -> Path:
@@ -71,16 +57,11 @@ def write_figure(fig, path: Path, dpi: int = DPI, rect=None) -> Path:
     return shown_path(path)
 
 
-def shown_path(path: Path) -> Path:
-    """The file of `path`'s figure that the page shows, in the export format."""
-    return Path(path).with_suffix(".svg" if _format[0] == "svg" else ".png")
-
-
 def _save_as(fig, path: Path, dpi: int = DPI) -> None:
     """Write `fig` as the page's file of `path` (and a PDF beside it when the export format is pdf)."""
     shown = shown_path(path)
     fig.savefig(shown, dpi=dpi, **(FAST_PNG if shown.suffix == ".png" else {}))
-    if _format[0] == "pdf":
+    if export_format() == "pdf":
         fig.savefig(Path(path).with_suffix(".pdf"))
 
 
@@ -455,6 +436,7 @@ def plot_cov(outputs: dict, path: Path, title: str) -> Path:
         ax.grid(alpha=0.3, which="both")
         ax.legend(fontsize=8, loc="best")
     fig.suptitle(title, fontsize=12)
+    fig.panel_grid = (1, len(groups))
     return _save(fig, path)
 
 
@@ -769,7 +751,9 @@ def plot_design_pairs(results, path: Path, title: str) -> Path | None:
         _kappa_table(table, xi, kappa, names[:d])
         fig.legend(*handles, loc="lower center", ncol=3, fontsize=8, frameon=False)
         fig.suptitle(title, fontsize=11)
-        fig.tight_layout(rect=(0, 0.06, 1, 1))
+        # fixed margins in inches: tick labels and names left of and below the scatter, the legend under it
+        fig.subplots_adjust(left=0.75 / 11, right=1 - 0.2 / 11, bottom=0.95 / 4.8, top=1 - 0.7 / 4.8,
+                            wspace=0.3 / 4.9)
         return write_figure(fig, path)
     side = max(1.7 * (d - 1) + 1.2, 7.0)
     fig = plt.figure(figsize=(side, side - 0.2))
