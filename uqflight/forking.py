@@ -7,6 +7,7 @@ from __future__ import annotations
 import gc
 import os
 import pickle
+import select
 import traceback
 from typing import Callable
 
@@ -39,6 +40,10 @@ class Child:
         os.close(write)
         self._read = read
 
+    def fileno(self) -> int:
+        """The pipe the result comes through: readable once the child has written it, or has ended."""
+        return self._read
+
     def wait(self):
         """The child's result; ChildFailed when it raised or died."""
         with os.fdopen(self._read, "rb") as pipe:  # read first: a large result would block the child
@@ -60,3 +65,10 @@ def wait_all(children: list[Child]) -> list:
         except ChildFailed as exc:
             outcomes.append(exc)
     return outcomes
+
+
+def first_done(children: list[Child]) -> int:
+    """The index of a child among `children` that has finished (or is writing its result), waiting
+    until one has."""
+    ready, _, _ = select.select(children, [], [])
+    return children.index(ready[0])

@@ -22,7 +22,7 @@ import numpy as np  # noqa: E402
 from matplotlib.lines import Line2D  # noqa: E402
 from matplotlib.ticker import FixedLocator, FuncFormatter, LogLocator, MaxNLocator, NullFormatter  # noqa: E402
 
-from ..forking import FORKS, Child, ChildFailed, wait_all  # noqa: E402
+from ..forking import FORKS, Child, ChildFailed, first_done, wait_all  # noqa: E402
 from ..labels import label, short_label  # noqa: E402,F401 (plots.label: the report's captions)
 from .formats import export_format, shown_path  # noqa: E402
 
@@ -71,8 +71,8 @@ def _in_background(work, name: str) -> None:
         work()
         return
     children = _background["children"]
-    while len(children) >= _background["limit"]:
-        _background["failed"] += _failures([children.pop(0)])
+    while len(children) >= _background["limit"]:  # wait for whichever child is done first
+        _background["failed"] += _failures([children.pop(first_done([child for child, _ in children]))])
     children.append((Child(work), name))
 
 

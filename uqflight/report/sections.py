@@ -235,6 +235,11 @@ def statistics_section(entries: list[Entry], ref: Entry | None, times: list[floa
     plot_dir = out_dir / "plots"
     blocks = []
     for entry in entries:
+        pdfs = {name: (out, plot_dir / f"pdf_{entry.stem}_{file_name(name)}.png",
+                       f"PDF of {plots.short_label(name)}: {entry.label}") for name, out in entry.outputs.items()}
+        over_time = [name for name, out in entry.outputs.items() if out.time.size > 1]  # drawn on one figure,
+        # first: its child takes longest, and the next figures are drawn beside it
+        shown = dict(zip(over_time, plots.plot_pdfs_over_time([pdfs[name] for name in over_time], times)))
         overlay = ref.outputs if ref is not None and not _same_file(ref.stats.path, entry.stats.path) else None
         blocks.append(Figure(_rel(plots.plot_mean_band(entry.outputs, plot_dir / f"mean_band_{entry.stem}.png",
                                                        f"Mean and 99 % band: {entry.label}", overlay), out_dir),
@@ -245,10 +250,6 @@ def statistics_section(entries: list[Entry], ref: Entry | None, times: list[floa
                              f"Modified coefficient of variation std(t) / max|mean| of the outputs of {entry.label} "
                              "(paper Fig. 8); outputs on an offset datum (min|mean| more than "
                              f"{plots.OFFSET_DATUM:g} × the mean's excursion, e.g. an altitude) as std in their unit."))
-        pdfs = {name: (out, plot_dir / f"pdf_{entry.stem}_{file_name(name)}.png",
-                       f"PDF of {plots.short_label(name)}: {entry.label}") for name, out in entry.outputs.items()}
-        over_time = [name for name, out in entry.outputs.items() if out.time.size > 1]  # drawn on one figure
-        shown = dict(zip(over_time, plots.plot_pdfs_over_time([pdfs[name] for name in over_time], times)))
         for name, out in entry.outputs.items():
             path = shown.get(name) or plots.plot_pdf_over_time(*pdfs[name], times)
             blocks.append(Figure(_rel(path, out_dir), f"PDF of {plots.label(name, out.units)} over time of "
