@@ -194,3 +194,21 @@ def test_pdfs_drawn_on_one_figure_have_the_pixels_of_a_figure_each(decay_results
                                             for out in order], [1.0, 3.0])
         for out, path in zip(order, shared):
             np.testing.assert_array_equal(imread(path), alone[out.name])
+
+
+def test_the_cycle_collector_is_off_while_drawing_and_collects_on_leaving():
+    import gc
+    import weakref
+
+    class Node:
+        pass
+
+    assert gc.isenabled()
+    with plots.collecting_at_the_end():
+        assert not gc.isenabled()
+        node = Node()
+        node.me = node  # a cycle: only the collector frees it
+        alive = weakref.ref(node)
+        del node
+        assert alive() is not None
+    assert gc.isenabled() and alive() is None
