@@ -11,13 +11,16 @@ side by side with their targets (issue 26).
             outputs x 1001 times, 7 normal inputs: its run is not JSBSim's)     target <= 10 s
 
 Measure on a quiet machine (nothing else running): every time here is wall clock of a fresh process,
-interpreter start-up and imports included.
+interpreter start-up and imports included. The package's bytecode is compiled first, as an installed
+package's is (pip compiles it; an editable install writes it on first import, unless
+PYTHONDONTWRITEBYTECODE is set: then every process would compile uqflight's sources again, 0.1-0.2 s).
 
 Run: .venv/bin/python benchmarks/report_cost.py [--work DIR] [--skip-calibrate]
 """
 from __future__ import annotations
 
 import argparse
+import compileall
 import subprocess
 import sys
 import tempfile
@@ -77,6 +80,7 @@ def main() -> None:
     parser.add_argument("--work", type=Path, help="folder for the files (default: a temporary one)")
     parser.add_argument("--skip-calibrate", action="store_true", help="leave out the calibration (113 more flights)")
     args = parser.parse_args()
+    compileall.compile_dir(ROOT / "uqflight", quiet=1)
     work = args.work or Path(tempfile.mkdtemp(prefix="report-cost-"))
     work.mkdir(parents=True, exist_ok=True)
     rows = []

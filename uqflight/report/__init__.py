@@ -81,9 +81,16 @@ def write_report(paths: list[Path], out_dir: Path | None = None, reference: Path
 @contextmanager
 def importing_ahead(modules: tuple[str, ...]):
     """Import `modules` in a thread while the body runs (a module body is mostly Python, the analysis mostly
-    numpy, which releases the GIL); leaving waits for the imports. An import that fails is raised again,
-    here or where the module is imported next."""
-    thread = threading.Thread(target=lambda: [importlib.import_module(m) for m in modules], daemon=True)
+    numpy, which releases the GIL); leaving waits for the imports. An import that fails here is left to
+    fail where the module is imported for use (Python keeps no half-imported module)."""
+    def load():
+        for name in modules:
+            try:
+                importlib.import_module(name)
+            except Exception:  # noqa: BLE001 (raised again, with its own traceback, by the import for use)
+                return
+
+    thread = threading.Thread(target=load, daemon=True)
     thread.start()
     try:
         yield

@@ -1,0 +1,26 @@
+"""The report's modules load ahead of use: matplotlib is imported in a thread during the analysis."""
+import subprocess
+import sys
+
+import pytest
+
+from uqflight.report import importing_ahead
+
+
+def test_the_report_package_imports_no_matplotlib_until_the_page_is_drawn():
+    code = "import sys, uqflight.report; print('matplotlib' in sys.modules)"
+    assert subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout.strip() == "False"
+
+
+def test_modules_imported_ahead_are_there_on_leaving_and_a_failure_is_left_to_the_import_for_use(tmp_path, monkeypatch,
+                                                                                                capfd):
+    (tmp_path / "ahead_fine.py").write_text("VALUE = 1\n")
+    (tmp_path / "ahead_broken.py").write_text("raise RuntimeError('broken on import')\n")
+    monkeypatch.syspath_prepend(str(tmp_path))
+    with importing_ahead(("ahead_fine", "ahead_broken")):
+        pass
+    assert sys.modules["ahead_fine"].VALUE == 1 and "ahead_broken" not in sys.modules
+    assert "broken on import" not in capfd.readouterr().err  # nothing printed by the thread
+    with pytest.raises(RuntimeError, match="broken on import"):
+        import ahead_broken  # noqa: F401
+    del sys.modules["ahead_fine"]
