@@ -176,7 +176,8 @@ def _from_tail(Y: np.ndarray, sub: np.ndarray, k: int, rank: int, low_side: bool
     for c in np.flatnonzero(count < rank):  # a threshold that kept too few: the whole column
         whole = np.partition(Y[:, c], (k, min(k + 1, n - 1)))
         low[c], high[c] = whole[k], whole[min(k + 1, n - 1)]
-    order = np.argsort(column, kind="stable")  # the candidates grouped by column
+    # the candidates grouped by column (a stable sort of 16-bit keys is numpy's radix sort, 7x faster)
+    order = np.argsort(column.astype(np.uint16) if columns <= 1 << 16 else column, kind="stable")
     run, column = run[order], column[order]
     start = np.cumsum(count) - count
     packed = np.full((columns, max(int(count.max()), 1)), np.inf)
