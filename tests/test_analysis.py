@@ -66,6 +66,9 @@ def test_hazen_quantiles_are_numpys_to_the_bit(n, kind):
     np.testing.assert_array_equal(found, np.quantile(Y, probabilities, axis=0, method="hazen"))
     for shaped in (0.3, probabilities.reshape(-1, 1)):  # a single probability, and a column of them: numpy's shapes
         np.testing.assert_array_equal(hazen_quantiles(Y, shaped), np.quantile(Y, shaped, axis=0, method="hazen"))
+    empty = Y[:, :0]  # no times at all: numpy's empty answer
+    np.testing.assert_array_equal(hazen_quantiles(empty, probabilities), np.quantile(empty, probabilities, axis=0,
+                                                                                    method="hazen"))
 
 
 def test_tail_selection_is_a_full_partition_where_its_subsample_misleads():

@@ -180,7 +180,7 @@ def _from_tail(Y: np.ndarray, sub: np.ndarray, k: int, rank: int, low_side: bool
     order = np.argsort(column.astype(np.uint16) if columns <= 1 << 16 else column, kind="stable")
     run, column = run[order], column[order]
     start = np.cumsum(count) - count
-    packed = np.full((columns, max(int(count.max()), 1)), np.inf)
+    packed = np.full((columns, int(count.max(initial=1))), np.inf)
     packed[column, np.arange(column.size) - start[column]] = Y[run, column]
     packed.sort(axis=1)  # each row: its column's candidates ascending, then the +inf padding
     kept = np.flatnonzero(count >= rank)
