@@ -29,4 +29,4 @@ def export_format() -> str:
 
 def shown_path(path: Path) -> Path:
     """The file of `path`'s figure that the page shows, in the export format."""
-    return Path(path).with_suffix(".svg" if _format[0] == "svg" else ".png")
+    return Path(path).with_suffix(".svg" if export_format() == "svg" else ".png")
