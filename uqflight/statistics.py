@@ -39,7 +39,8 @@ from .analysis.exceedance import exceedance_from_pce, exceedance_from_runs
 from .analysis.failures import grid_failure_probability
 from .analysis.proportions import sampled_proportion
 from .analysis.floors import central_moments, floors_from_moments, kld_floor
-from .analysis.moments import modified_cov, standardised_moments, weighted_moments, weighted_quantiles
+from .analysis.moments import (modified_cov, sorted_by_time, standardised_moments, weighted_moments,
+                               weighted_quantiles)
 from .analysis.resolution import RESOLUTION_RTOL, resolved_variance
 from .analysis.sobol import pick_freeze_indices
 from .designs import REGISTRY as DESIGNS
@@ -441,8 +442,10 @@ def _over_time_blocks(rows, scale, n_times: int, weights, pick_freeze_dimensions
     def block(start: int) -> dict:
         stop = min(start + TIME_BLOCK, n_times)
         Y = rows[:, start:stop] if scale is None else rows @ scale[:, start:stop]
-        found = {"quantiles": weighted_quantiles(Y, probabilities, weights), "final": Y[:, -1].copy()}
-        found["support"], found["density"] = pdf_over_time(Y, PDF_POINTS, std=None if std is None else std[start:stop])
+        ordered = sorted_by_time(Y)  # each time's values sorted once: its quantiles, extremes and bins
+        found = {"quantiles": weighted_quantiles(Y, probabilities, weights, ordered), "final": Y[:, -1].copy()}
+        found["support"], found["density"] = pdf_over_time(Y, PDF_POINTS, std=None if std is None else std[start:stop],
+                                                           ordered=ordered)
         if exact is None:
             found["skewness"], found["kurtosis"] = standardised_moments(Y, weights)
         if from_runs and weights is None:
@@ -451,7 +454,7 @@ def _over_time_blocks(rows, scale, n_times: int, weights, pick_freeze_dimensions
             found.update(pick_freeze_indices(Y, pick_freeze_dimensions, n_boot=options.bootstrap, seed=options.seed))
         return found
 
-    # blocks in ANALYSIS_THREADS threads (numpy's selection, FFTs and BLAS release the GIL); each block's
+    # blocks in ANALYSIS_THREADS threads (numpy's sort, FFTs and BLAS release the GIL); each block's
     # numbers are its own, joined in time order: the same bits in any thread count
     with ThreadPoolExecutor(ANALYSIS_THREADS) as pool:
         found = list(pool.map(block, range(0, n_times, TIME_BLOCK)))

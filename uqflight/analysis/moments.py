@@ -72,14 +72,14 @@ def weighted_std(Y, weights=None, unbiased: bool = False) -> np.ndarray:
     return np.sqrt(np.clip(weighted_variance(Y, weights, unbiased), 0.0, None))
 
 
-def weighted_quantiles(Y, probabilities, weights=None) -> np.ndarray:
+def weighted_quantiles(Y, probabilities, weights=None, ordered=None) -> np.ndarray:
     """The weighted quantiles of each column of Y (N, T) at `probabilities` (P,): (P, T).
 
     Runs are sorted per time; the j-th sorted run sits at cumulative weight Σ_{i<j} w_i + w_j/2
     (Hazen positions) and the quantile is interpolated linearly between them. Equal weights
-    (Monte Carlo, the large case) take numpy's selection-based Hazen quantile, which gives the
-    same numbers without a full sort. Needs weights ≥ 0: for a signed sparse grid, sample its
-    PCE instead.
+    (Monte Carlo, the large case) take numpy's Hazen quantile (`hazen_quantiles`; `ordered`:
+    sorted_by_time(Y) when the caller has it). Needs weights ≥ 0: for a signed sparse grid, sample
+    its PCE instead.
     """
     Y = as_runs_by_time(Y)
     w = probability_weights(weights, len(Y))
@@ -89,7 +89,7 @@ def weighted_quantiles(Y, probabilities, weights=None) -> np.ndarray:
         raise ValueError("quantiles need at least two runs")
     probabilities = np.asarray(probabilities, dtype=float)
     if np.ptp(w) == 0:
-        return hazen_quantiles(Y, probabilities)
+        return hazen_quantiles(Y, probabilities, ordered)
     order = np.argsort(Y, axis=0)
     sorted_weights = w[order]
     positions = np.cumsum(sorted_weights, axis=0)
@@ -107,88 +107,40 @@ def weighted_quantiles(Y, probabilities, weights=None) -> np.ndarray:
     return np.array(bounds)
 
 
-def hazen_quantiles(Y, probabilities) -> np.ndarray:
+def sorted_by_time(Y) -> np.ndarray:
+    """Each column of Y (N, T) in ascending order, one row per time: (T, N). Sorted once, it gives every
+    quantile and the extremes by indexing, and the density's binning by search (analysis.density)."""
+    rows = np.array(as_runs_by_time(Y).T, order="C")
+    rows.sort(axis=1)
+    return rows
+
+
+def hazen_quantiles(Y, probabilities, ordered=None) -> np.ndarray:
     """numpy's `quantile(Y, probabilities, axis=0, method="hazen")`, (P, T), the same numbers, faster.
 
-    numpy selects every index it needs, and the first and last, in one joint partition; here each
-    quantile needs only its two neighbouring order statistics (`order_statistics`: from the few runs
-    in the tail beyond a threshold when the quantile is extreme). Y must be finite (it is checked:
-    numpy's answer is used otherwise). The interpolation is numpy's own (`_lerp`)."""
-    Y = as_runs_by_time(Y)
+    numpy partitions each column anew for every call; here the columns are sorted once (`ordered`:
+    sorted_by_time(Y) when the caller has it, which is then all that is read) and each quantile is
+    interpolated between its two neighbouring order statistics with numpy's own `_lerp`. A column
+    that is not finite takes numpy's answer."""
     probabilities = np.asarray(probabilities, dtype=float)
-    if not np.isfinite(Y).all():
-        return np.quantile(Y, probabilities, axis=0, method="hazen")
-    n, shape, probabilities = Y.shape[0], probabilities.shape, probabilities.ravel()
+    ordered = sorted_by_time(Y) if ordered is None else ordered
+    n = ordered.shape[1]
+    # NaN sorts last and ±inf to the ends: the ends tell whether every value is finite
+    if n == 0 or not (np.isfinite(ordered[:, 0]).all() and np.isfinite(ordered[:, -1]).all()):
+        return np.quantile(ordered, probabilities, axis=1, method="hazen")
+    shape, probabilities = probabilities.shape, probabilities.ravel()
     virtual = n * probabilities + (0.5 + probabilities * (1 - 0.5 - 0.5)) - 1  # numpy's virtual index
     previous = np.clip(np.floor(virtual), 0, n - 1).astype(np.intp)
     previous[virtual >= n - 1] = n - 1
     gamma = virtual - previous
-    pairs = order_statistics(Y, sorted(set(previous.tolist())))
     bounds = []
     for k, v, t in zip(previous, virtual, gamma):
-        a, b = pairs[k][0], (pairs[k][1] if 0 <= v < n - 1 else pairs[k][0])  # beyond either end: that end's value
+        a = ordered[:, k]
+        b = ordered[:, k + 1] if 0 <= v < n - 1 else a  # beyond either end: that end's value
         difference = b - a
         value = a + difference * t
         bounds.append(b - difference * (1 - t) if t >= 0.5 else value)
-    return np.array(bounds).reshape(shape + (Y.shape[1],))
-
-
-TAIL_STRIDE = 16  # a tail threshold is taken from every 16th run
-TAIL_SHARE = 0.05  # order statistics within this share of either end are selected from the tail's runs alone
-
-
-def order_statistics(Y: np.ndarray, ks) -> dict[int, tuple[np.ndarray, np.ndarray]]:
-    """The k-th and (k+1)-th smallest of each column of the finite Y (N, T), 0-based, for each k in `ks`
-    (the k-th twice for k = N − 1): {k: ((T,), (T,))}, exactly those values.
-
-    An order statistic near an end is found among the runs beyond a threshold, taken from a subsample
-    with a margin: every run on the other side is known to sort after (or before) all of them, so the
-    candidates' own ranks give the answer. A column whose threshold keeps too few runs, and any k away
-    from the ends, takes a partition of the whole column."""
-    n = Y.shape[0]
-    found, middle, sub = {}, [], None
-    for k in ks:
-        low_side = k + 1 < n - k
-        rank = k + 2 if low_side else n - k  # the candidates needed on that side (k and k + 1, or k alone)
-        if n >= 64 * TAIL_STRIDE and rank <= TAIL_SHARE * n:
-            sub = np.sort(Y[::TAIL_STRIDE].T, axis=1) if sub is None else sub  # (T, N / stride), each row sorted
-            found[k] = _from_tail(Y, sub, k, rank, low_side)
-        else:
-            middle.append(k)
-    if middle:
-        rows = np.array(Y.T, order="C")  # a copy, partitioned in place: one row per time
-        for k in middle:
-            rows.partition(k, axis=1)
-            found[k] = (rows[:, k].copy(), rows[:, k + 1:].min(axis=1) if k + 1 < n else rows[:, k].copy())
-    return found
-
-
-def _from_tail(Y: np.ndarray, sub: np.ndarray, k: int, rank: int, low_side: bool) -> tuple[np.ndarray, np.ndarray]:
-    """`order_statistics` for one k within `rank` runs of the low (or high) end of every column; `sub`: a
-    sorted subsample of each column, (T, M)."""
-    n, columns = Y.shape
-    m = sub.shape[1]
-    j = min(m - 1, 2 * rank // TAIL_STRIDE + 8)  # expected twice the candidates needed, and more
-    threshold = sub[:, j] if low_side else sub[:, m - 1 - j]
-    run, column = np.divmod(np.flatnonzero((Y <= threshold) if low_side else (Y >= threshold)), columns)  # the tail
-    count = np.bincount(column, minlength=columns)
-    low, high = np.empty(columns), np.empty(columns)
-    for c in np.flatnonzero(count < rank):  # a threshold that kept too few: the whole column
-        whole = np.partition(Y[:, c], (k, min(k + 1, n - 1)))
-        low[c], high[c] = whole[k], whole[min(k + 1, n - 1)]
-    # the candidates grouped by column (a stable sort of 16-bit keys is numpy's radix sort, 7x faster)
-    order = np.argsort(column.astype(np.uint16) if columns <= 1 << 16 else column, kind="stable")
-    run, column = run[order], column[order]
-    start = np.cumsum(count) - count
-    packed = np.full((columns, int(count.max(initial=1))), np.inf)
-    packed[column, np.arange(column.size) - start[column]] = Y[run, column]
-    packed.sort(axis=1)  # each row: its column's candidates ascending, then the +inf padding
-    kept = np.flatnonzero(count >= rank)
-    # low side: the candidates are the column's smallest; high side: its largest, after n - count others
-    at = np.full(kept.size, k) if low_side else k - (n - count[kept])
-    low[kept] = packed[kept, at]
-    high[kept] = packed[kept, np.minimum(at + 1, count[kept] - 1)] if k + 1 < n else low[kept]
-    return low, high
+    return np.array(bounds).reshape(shape + (ordered.shape[0],))
 
 
 def quantile_band(Y, weights=None, level: float = 0.99) -> tuple[np.ndarray, np.ndarray]:
