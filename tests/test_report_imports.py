@@ -4,7 +4,8 @@ import sys
 
 import pytest
 
-from uqflight.report import importing_ahead
+from uqflight.progress import Progress
+from uqflight.report import FirstCount, importing_ahead
 
 
 def test_the_report_package_imports_no_matplotlib_until_the_page_is_drawn():
@@ -17,10 +18,30 @@ def test_modules_imported_ahead_are_there_on_leaving_and_a_failure_is_left_to_th
     (tmp_path / "ahead_fine.py").write_text("VALUE = 1\n")
     (tmp_path / "ahead_broken.py").write_text("raise RuntimeError('broken on import')\n")
     monkeypatch.syspath_prepend(str(tmp_path))
-    with importing_ahead(("ahead_fine", "ahead_broken")):
-        pass
+    with importing_ahead(("ahead_fine", "ahead_broken")) as start:
+        start()
+        start()  # once only
     assert sys.modules["ahead_fine"].VALUE == 1 and "ahead_broken" not in sys.modules
     assert "broken on import" not in capfd.readouterr().err  # nothing printed by the thread
     with pytest.raises(RuntimeError, match="broken on import"):
         import ahead_broken  # noqa: F401
     del sys.modules["ahead_fine"]
+
+
+def test_nothing_is_imported_ahead_unless_started(tmp_path, monkeypatch):
+    (tmp_path / "ahead_unstarted.py").write_text("VALUE = 1\n")
+    monkeypatch.syspath_prepend(str(tmp_path))
+    with importing_ahead(("ahead_unstarted",)):
+        pass
+    assert "ahead_unstarted" not in sys.modules
+
+
+def test_the_hook_runs_once_at_the_first_counted_stage(capsys):
+    calls = []
+    progress = FirstCount(Progress(0, quiet=True), lambda: calls.append(1))
+    progress.stage("opening")  # no count: the file is opened and checked
+    assert calls == []
+    progress.stage("analysing", 5, "outputs")
+    progress.advance()
+    progress.stage("analysing the next", 5, "outputs")
+    assert calls == [1] and progress.done == 0 and progress.total == 5

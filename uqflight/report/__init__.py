@@ -59,9 +59,11 @@ def write_report(paths: list[Path], out_dir: Path | None = None, reference: Path
         raise ValueError(f"figure format: expected one of {', '.join(FORMATS)}, got {fmt!r}")
     check_replaceable(out_dir)
     progress = progress or Progress(0, quiet=True)
-    with importing_ahead(PAGE_MODULES):  # matplotlib loads on the core the analysis leaves free at times
-        entries, ref = load_entries(paths, reference, method, progress=progress, partial=partial,
-                                    allow_aliasing=allow_aliasing)
+    # matplotlib loads in a thread while the analysis's numpy work leaves the interpreter free, from the
+    # first counted stage on (before it, opening and checking a file is Python, which a thread would slow)
+    with importing_ahead(PAGE_MODULES) as start_importing:
+        entries, ref = load_entries(paths, reference, method, progress=FirstCount(progress, start_importing),
+                                    partial=partial, allow_aliasing=allow_aliasing)
     out_dir.parent.mkdir(parents=True, exist_ok=True)
     staging = make_staging(out_dir)
     try:
@@ -80,9 +82,9 @@ def write_report(paths: list[Path], out_dir: Path | None = None, reference: Path
 
 @contextmanager
 def importing_ahead(modules: tuple[str, ...]):
-    """Import `modules` in a thread while the body runs (a module body is mostly Python, the analysis mostly
-    numpy, which releases the GIL); leaving waits for the imports. An import that fails here is left to
-    fail where the module is imported for use (Python keeps no half-imported module)."""
+    """Yields `start()`, which imports `modules` in a thread (a module body is mostly Python, the analysis
+    mostly numpy, which releases the GIL); leaving waits for the imports, if started. An import that fails
+    here is left to fail where the module is imported for use (Python keeps no half-imported module)."""
     def load():
         for name in modules:
             try:
@@ -91,11 +93,33 @@ def importing_ahead(modules: tuple[str, ...]):
                 return
 
     thread = threading.Thread(target=load, daemon=True)
-    thread.start()
+
+    def start():
+        if thread.ident is None:
+            thread.start()
+
     try:
-        yield
+        yield start
     finally:
-        thread.join()
+        if thread.ident is not None:
+            thread.join()
+
+
+class FirstCount:
+    """`progress`, calling `hook` once at the first stage with a count (the analysis of the first file's
+    outputs); everything else is the wrapped Progress's."""
+
+    def __init__(self, progress: Progress, hook):
+        self._progress, self._hook = progress, hook
+
+    def stage(self, text: str, total: int = 0, unit: str = "steps") -> None:
+        if total and self._hook is not None:
+            hook, self._hook = self._hook, None
+            hook()
+        self._progress.stage(text, total, unit)
+
+    def __getattr__(self, name):
+        return getattr(self._progress, name)
 
 
 def _write_into(out_dir: Path, entries: list[Entry], ref: Entry | None, times, progress: Progress) -> None:
