@@ -18,9 +18,11 @@ def test_modules_imported_ahead_are_there_on_leaving_and_a_failure_is_left_to_th
     (tmp_path / "ahead_fine.py").write_text("VALUE = 1\n")
     (tmp_path / "ahead_broken.py").write_text("raise RuntimeError('broken on import')\n")
     monkeypatch.syspath_prepend(str(tmp_path))
-    with importing_ahead(("ahead_fine", "ahead_broken")) as start:
+    called = []
+    with importing_ahead(("ahead_fine", "ahead_broken"), then=lambda: called.append(1)) as start:
         start()
         start()  # once only
+    assert called == []  # not after a failed import
     assert sys.modules["ahead_fine"].VALUE == 1 and "ahead_broken" not in sys.modules
     assert "broken on import" not in capfd.readouterr().err  # nothing printed by the thread
     with pytest.raises(RuntimeError, match="broken on import"):
@@ -45,3 +47,33 @@ def test_the_hook_runs_once_at_the_first_counted_stage(capsys):
     progress.advance()
     progress.stage("analysing the next", 5, "outputs")
     assert calls == [1] and progress.done == 0 and progress.total == 5
+
+
+def test_then_runs_in_the_thread_after_the_imports(tmp_path, monkeypatch):
+    import threading
+
+    (tmp_path / "ahead_then.py").write_text("VALUE = 2\n")
+    monkeypatch.syspath_prepend(str(tmp_path))
+    seen = []
+    with importing_ahead(("ahead_then",), then=lambda: seen.append((sys.modules["ahead_then"].VALUE,
+                                                                      threading.current_thread()))) as start:
+        start()
+    assert seen and seen[0][0] == 2 and seen[0][1] is not threading.main_thread()
+    del sys.modules["ahead_then"]
+
+
+def test_the_fonts_are_warmed_once_from_any_thread_without_pyplot_figures(monkeypatch):
+    import threading
+
+    import matplotlib.pyplot as plt
+
+    from uqflight.report import plots
+
+    monkeypatch.setattr(plots, "_warmed", False)
+    before = plt.get_fignums()
+    thread = threading.Thread(target=plots.warm_text_caches)
+    thread.start()
+    thread.join()
+    assert plots._warmed and plt.get_fignums() == before
+    monkeypatch.setattr(plots, "Figure", None)  # drawn once only: a second call draws nothing
+    plots.warm_text_caches()

@@ -61,7 +61,7 @@ def write_report(paths: list[Path], out_dir: Path | None = None, reference: Path
     progress = progress or Progress(0, quiet=True)
     # matplotlib loads in a thread while the analysis's numpy work leaves the interpreter free, from the
     # first counted stage on (before it, opening and checking a file is Python, which a thread would slow)
-    with importing_ahead(PAGE_MODULES) as start_importing:
+    with importing_ahead(PAGE_MODULES, then=_warm_fonts) as start_importing:
         entries, ref = load_entries(paths, reference, method, progress=FirstCount(progress, start_importing),
                                     partial=partial, allow_aliasing=allow_aliasing)
     out_dir.parent.mkdir(parents=True, exist_ok=True)
@@ -81,16 +81,19 @@ def write_report(paths: list[Path], out_dir: Path | None = None, reference: Path
 
 
 @contextmanager
-def importing_ahead(modules: tuple[str, ...]):
+def importing_ahead(modules: tuple[str, ...], then=None):
     """Yields `start()`, which imports `modules` in a thread (a module body is mostly Python, the analysis
-    mostly numpy, which releases the GIL); leaving waits for the imports, if started. An import that fails
-    here is left to fail where the module is imported for use (Python keeps no half-imported module)."""
+    mostly numpy, which releases the GIL), then calls `then()` there; leaving waits for them, if started.
+    An import that fails here is left to fail where the module is imported for use (Python keeps no
+    half-imported module), and `then` is not called."""
     def load():
-        for name in modules:
-            try:
+        try:
+            for name in modules:
                 importlib.import_module(name)
-            except Exception:  # noqa: BLE001 (raised again, with its own traceback, by the import for use)
-                return
+            if then is not None:
+                then()
+        except Exception:  # noqa: BLE001 (raised again, with its own traceback, by the import for use)
+            return
 
     thread = threading.Thread(target=load, daemon=True)
 
@@ -103,6 +106,12 @@ def importing_ahead(modules: tuple[str, ...]):
     finally:
         if thread.ident is not None:
             thread.join()
+
+
+def _warm_fonts() -> None:
+    from .plots import warm_text_caches
+
+    warm_text_caches()
 
 
 class FirstCount:

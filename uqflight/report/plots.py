@@ -20,6 +20,8 @@ matplotlib.rcParams["svg.fonttype"] = "none"  # SVG text stays text: editable, s
 matplotlib.rcParams["axes.titley"] = 1.0
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
+from matplotlib.backends.backend_agg import FigureCanvasAgg  # noqa: E402
+from matplotlib.figure import Figure  # noqa: E402
 from matplotlib.lines import Line2D  # noqa: E402
 from matplotlib.ticker import FixedLocator, FuncFormatter, LogLocator, MaxNLocator, NullFormatter  # noqa: E402
 
@@ -206,7 +208,7 @@ def background_rendering(processes: int | None = None):
         yield
         return
     _background = {"children": [], "limit": processes or os.cpu_count() or 1, "failed": []}
-    _warm_text_caches()
+    warm_text_caches()
     with collecting_at_the_end():
         try:
             yield
@@ -234,15 +236,24 @@ def collecting_at_the_end():
         gc.collect()
 
 
-def _warm_text_caches() -> None:
-    """Draw a small figure with the report's fonts and digits once here, so that every forked child
-    inherits the loaded fonts and their glyph and metric caches instead of building them again."""
-    fig, ax = plt.subplots(figsize=(2, 1))
+_warmed = False  # warm_text_caches has drawn in this process
+
+
+def warm_text_caches() -> None:
+    """Draw a small figure with the report's fonts and digits, once per process, so that every forked child
+    inherits the loaded fonts and their glyph caches instead of building them again. Without pyplot:
+    any one thread may call it (write_report does, during the analysis)."""
+    global _warmed
+    if _warmed:
+        return
+    fig = Figure(figsize=(2, 1))
+    FigureCanvasAgg(fig)
+    ax = fig.add_subplot()
     for size in (6, 7, 8, 9, 10, 11, 12):
         ax.text(0, 0, "0123456789.−-×⁰¹²³⁴⁵⁶⁷⁸⁹ time [s] deg ft kt", fontsize=size)
     ax.set_title("warm", fontsize=10)
     fig.canvas.draw()
-    plt.close(fig)
+    _warmed = True
 
 
 def _wait_all() -> list[str]:
