@@ -2,7 +2,7 @@
 import numpy as np
 
 from .density import KERNEL_REACH, kde_bandwidth, kde_on_grid
-from .moments import as_runs_by_time
+from .moments import as_runs_by_time, sorted_by_time
 
 DENSITY_FLOOR = 1e-10  # relative to the larger peak density; see kl_divergence
 
@@ -18,12 +18,14 @@ def kl_divergence(samples_p, samples_q, grid_points: int = 512, rule: str = "sco
     arrays (one column per time, the same T) give (T,).
     """
     p, q = as_runs_by_time(samples_p), as_runs_by_time(samples_q)
-    bandwidth_p, bandwidth_q = kde_bandwidth(p, rule), kde_bandwidth(q, rule)
+    ordered_p, ordered_q = sorted_by_time(p), sorted_by_time(q)  # their extremes, and the KDEs' binning
+    bandwidth_p = kde_bandwidth(p, rule, extremes=(ordered_p[:, 0], ordered_p[:, -1]))
+    bandwidth_q = kde_bandwidth(q, rule, extremes=(ordered_q[:, 0], ordered_q[:, -1]))
     reach = KERNEL_REACH * np.maximum(bandwidth_p, bandwidth_q)
-    lower = np.minimum(p.min(axis=0), q.min(axis=0)) - reach
-    upper = np.maximum(p.max(axis=0), q.max(axis=0)) + reach
-    support, density_p = kde_on_grid(p, lower, upper, bandwidth_p, grid_points)
-    _, density_q = kde_on_grid(q, lower, upper, bandwidth_q, grid_points)
+    lower = np.minimum(ordered_p[:, 0], ordered_q[:, 0]) - reach
+    upper = np.maximum(ordered_p[:, -1], ordered_q[:, -1]) + reach
+    support, density_p = kde_on_grid(p, lower, upper, bandwidth_p, grid_points, ordered_p)
+    _, density_q = kde_on_grid(q, lower, upper, bandwidth_q, grid_points, ordered_q)
 
     floor = DENSITY_FLOOR * np.maximum(density_p.max(axis=1), density_q.max(axis=1))[:, None]
     present = density_p > floor
