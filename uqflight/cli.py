@@ -15,6 +15,7 @@ from .arguments import check_campaign_file, check_output, check_results_file
 from .calibration.command import register as register_calibrate
 from .console import echo
 from . import stopping
+from .leaving import leave
 from .progress import Progress
 
 from .methods import METHOD_KINDS
@@ -32,6 +33,15 @@ app = typer.Typer(help="Uncertainty quantification campaigns on a JSBSim flight-
 surrogate_app = typer.Typer(help="The PCE surrogate of a results file: export it as JSON.", no_args_is_help=True,
                             context_settings=CONTEXT, rich_markup_mode=None)
 app.add_typer(surrogate_app, name="surrogate")
+
+
+def main() -> None:
+    """The `uqflight` console script: `app`, then an exit without the interpreter's teardown (uqflight.leaving)."""
+    try:
+        app()
+    except SystemExit as done:
+        leave(done.code)
+    leave(0)
 
 
 def _calibration_page(out: Path) -> Path:
