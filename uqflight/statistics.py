@@ -441,13 +441,18 @@ def _over_time_blocks(rows, scale, n_times: int, weights, pick_freeze_dimensions
 
     def block(start: int) -> dict:
         stop = min(start + TIME_BLOCK, n_times)
-        Y = rows[:, start:stop] if scale is None else rows @ scale[:, start:stop]
+        if scale is None:
+            Y = rows[:, start:stop]
+        elif from_runs:
+            Y = rows @ scale[:, start:stop]
+        else:  # a PCE's draws, built time by time (the same products): sorting them copies no transpose
+            Y = (scale[:, start:stop].T @ rows.T).T
         ordered = sorted_by_time(Y)  # each time's values sorted once: its quantiles, extremes and bins
         found = {"quantiles": weighted_quantiles(Y, probabilities, weights, ordered), "final": Y[:, -1].copy()}
         found["support"], found["density"] = pdf_over_time(Y, PDF_POINTS, std=None if std is None else std[start:stop],
                                                            ordered=ordered)
-        if exact is None:
-            found["skewness"], found["kurtosis"] = standardised_moments(Y, weights)
+        if exact is None:  # summed run by run, as in the runs' own layout
+            found["skewness"], found["kurtosis"] = standardised_moments(np.ascontiguousarray(Y), weights)
         if from_runs and weights is None:
             found["fourth"] = central_moments(Y)[2]
         if pick_freeze_dimensions:
