@@ -16,11 +16,8 @@ and OUT is never absent.
 """
 from __future__ import annotations
 
-import importlib
 import os
 import shutil
-import threading
-from contextlib import contextmanager
 from pathlib import Path
 
 from ..check import write_baseline
@@ -33,7 +30,6 @@ from .replace import check_replaceable, make_staging, replace_dir
 
 __all__ = ["check_replaceable", "default_out_dir", "parse_methods", "write_report"]
 
-PAGE_MODULES = ("uqflight.report.plots", "uqflight.report.render", "uqflight.report.sections")
 DEFAULT_TIMES = (10.0, 25.0, float("inf"))  # the tables' times: 10 s, 25 s and the final time
 
 
@@ -59,11 +55,8 @@ def write_report(paths: list[Path], out_dir: Path | None = None, reference: Path
         raise ValueError(f"figure format: expected one of {', '.join(FORMATS)}, got {fmt!r}")
     check_replaceable(out_dir)
     progress = progress or Progress(0, quiet=True)
-    # matplotlib loads in a thread while the analysis's numpy work leaves the interpreter free, from the
-    # first counted stage on (before it, opening and checking a file is Python, which a thread would slow)
-    with importing_ahead(PAGE_MODULES, then=_warm_fonts) as start_importing:
-        entries, ref = load_entries(paths, reference, method, progress=FirstCount(progress, start_importing),
-                                    partial=partial, allow_aliasing=allow_aliasing)
+    entries, ref = load_entries(paths, reference, method, progress=progress, partial=partial,
+                                allow_aliasing=allow_aliasing)
     out_dir.parent.mkdir(parents=True, exist_ok=True)
     staging = make_staging(out_dir)
     try:
@@ -80,60 +73,10 @@ def write_report(paths: list[Path], out_dir: Path | None = None, reference: Path
     return written
 
 
-@contextmanager
-def importing_ahead(modules: tuple[str, ...], then=None):
-    """Yields `start()`, which imports `modules` in a thread (a module body is mostly Python, the analysis
-    mostly numpy, which releases the GIL), then calls `then()` there; leaving waits for them, if started.
-    An import that fails here is left to fail where the module is imported for use (Python keeps no
-    half-imported module), and `then` is not called."""
-    def load():
-        try:
-            for name in modules:
-                importlib.import_module(name)
-            if then is not None:
-                then()
-        except Exception:  # noqa: BLE001 (raised again, with its own traceback, by the import for use)
-            return
-
-    thread = threading.Thread(target=load, daemon=True)
-
-    def start():
-        if thread.ident is None:
-            thread.start()
-
-    try:
-        yield start
-    finally:
-        if thread.ident is not None:
-            thread.join()
-
-
-def _warm_fonts() -> None:
-    from .plots import warm_text_caches
-
-    warm_text_caches()
-
-
-class FirstCount:
-    """`progress`, calling `hook` once at the first stage with a count (the analysis of the first file's
-    outputs); everything else is the wrapped Progress's."""
-
-    def __init__(self, progress: Progress, hook):
-        self._progress, self._hook = progress, hook
-
-    def stage(self, text: str, total: int = 0, unit: str = "steps") -> None:
-        if total and self._hook is not None:
-            hook, self._hook = self._hook, None
-            hook()
-        self._progress.stage(text, total, unit)
-
-    def __getattr__(self, name):
-        return getattr(self._progress, name)
-
-
 def _write_into(out_dir: Path, entries: list[Entry], ref: Entry | None, times, progress: Progress) -> None:
-    # the page's own modules (matplotlib comes with .plots); imported ahead by write_report, and
-    # by nothing that `surrogate export` imports
+    # the page's own modules (matplotlib comes with .plots), imported here: by nothing that `surrogate
+    # export` imports, and after the analysis, whose threads an import beside them slowed by more than
+    # the import costs
     from .plots import background_rendering
     from .render import render_html, render_markdown
     from .sections import Table, build_sections, files_section

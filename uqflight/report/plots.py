@@ -242,7 +242,7 @@ _warmed = False  # warm_text_caches has drawn in this process
 def warm_text_caches() -> None:
     """Draw a small figure with the report's fonts and digits, once per process, so that every forked child
     inherits the loaded fonts and their glyph caches instead of building them again. Without pyplot:
-    any one thread may call it (write_report does, during the analysis)."""
+    any one thread may call it."""
     global _warmed
     if _warmed:
         return
