@@ -283,3 +283,16 @@ def test_several_methods_over_the_same_runs(decay_results, tmp_path):
         refused = cli_in_process("report", decay_results, *bad, "--out", tmp_path / "bad")
         assert refused.returncode == 2 and message in refused.stderr and "Traceback" not in refused.stderr, bad
         assert not (tmp_path / "bad").exists()
+
+
+def test_data_files_that_cannot_be_written_fail_the_report_and_leave_nothing(pg, tmp_path, monkeypatch, capfd):
+    import uqflight.report as report
+
+    def refuse(entries, out_dir):
+        raise OSError("no space left on device")
+
+    monkeypatch.setattr(report, "write_statistics_tables", refuse)  # the forked writer inherits it
+    with pytest.raises(RuntimeError, match="cannot write summary.json and the statistics tables: the writer failed"):
+        report.write_report([pg], tmp_path / "out")
+    assert "no space left on device" in capfd.readouterr().err  # the writer's own traceback
+    assert list(tmp_path.iterdir()) == []  # no report, no staging folder

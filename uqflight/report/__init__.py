@@ -21,6 +21,7 @@ import shutil
 from pathlib import Path
 
 from ..check import write_baseline
+from ..forking import FORKS, Child, ChildFailed
 from ..progress import Progress
 from ..methods.parsing import parse_methods
 from .files import _write_text, write_csv, write_statistics_tables, write_summaries
@@ -74,18 +75,19 @@ def write_report(paths: list[Path], out_dir: Path | None = None, reference: Path
 
 
 def _write_into(out_dir: Path, entries: list[Entry], ref: Entry | None, times, progress: Progress) -> None:
-    # the page's own modules (matplotlib comes with .plots), imported here: by nothing that `surrogate
-    # export` imports, and after the analysis, whose threads an import beside them slowed by more than
-    # the import costs
-    from .plots import background_rendering
-    from .render import render_html, render_markdown
-    from .sections import Table, build_sections, files_section
-
     for sub in ("plots", "tables"):
         (out_dir / sub).mkdir(parents=True, exist_ok=True)
     progress.stage("writing summaries and tables")
-    written = write_summaries(entries, out_dir)
-    written += write_statistics_tables(entries, out_dir)
+    # the data files are written by a forked child while the page's own modules (matplotlib comes with
+    # .plots) are imported here, each on a core of its own; imported by nothing that `surrogate export`
+    # imports, and after the analysis, whose threads an import beside them slowed by more than it costs
+    child = Child(lambda: _data_files(entries, out_dir)) if FORKS else None
+    try:
+        from .plots import background_rendering
+        from .render import render_html, render_markdown
+        from .sections import Table, build_sections, files_section
+    finally:
+        written = _data_files(entries, out_dir) if child is None else _written_by(child)
     progress.stage("drawing the plots", _drawing_stages(entries), "sections")
     with background_rendering():  # figures written in forked children while the next is built
         sections = build_sections(entries, ref, times, out_dir, progress=lambda text: progress.advance(1, text))
@@ -98,6 +100,19 @@ def _write_into(out_dir: Path, entries: list[Entry], ref: Entry | None, times, p
     title = f"uqflight report: {entries[0].label}" + (f" and {len(entries) - 1} more" if len(entries) > 1 else "")
     _write_text(out_dir / "report.html", render_html(title, sections, out_dir))
     _write_text(out_dir / "report.md", render_markdown(title, sections, out_dir))
+
+
+def _data_files(entries: list[Entry], out_dir: Path) -> list[Path]:
+    """summary.json (and summaries/) and the statistics tables over time, written into `out_dir`."""
+    return write_summaries(entries, out_dir) + write_statistics_tables(entries, out_dir)
+
+
+def _written_by(child: Child) -> list[Path]:
+    """The files a child writing the data files wrote; RuntimeError when it failed (its error printed)."""
+    try:
+        return child.wait()
+    except ChildFailed as exc:
+        raise RuntimeError(f"cannot write summary.json and the statistics tables: the writer {exc}") from None
 
 
 def _drawing_stages(entries: list[Entry]) -> int:
