@@ -12,8 +12,8 @@ PACKAGE = Path(__file__).resolve().parents[1] / "uqflight"
 # Lowest first; a module may import its own layer and those below. Longest prefix wins.
 LAYERS = [
     ("uqflight.paper", "uqflight.labels", "uqflight.tsvd", "uqflight.simulators.base", "uqflight.parameters.germs",
-     "uqflight.console", "uqflight.progress", "uqflight.forking", "uqflight.json_text", "uqflight.stopping", "uqflight.leaving",
-     "uqflight.arguments"),
+     "uqflight.console", "uqflight.progress", "uqflight.forking", "uqflight.json_text", "uqflight.stopping",
+     "uqflight.leaving", "uqflight.arguments"),
     ("uqflight.parameters", "uqflight.analysis", "uqflight.simulators", "uqflight.quantities"),
     ("uqflight.designs",),
     ("uqflight.methods",),
