@@ -1,6 +1,7 @@
 """`uqflight report` on real results files of closed-form and JSBSim campaigns (`check`: test_check.py)."""
 import csv
 import json
+import os
 import re
 import shutil
 import subprocess
@@ -296,3 +297,32 @@ def test_data_files_that_cannot_be_written_fail_the_report_and_leave_nothing(pg,
         report.write_report([pg], tmp_path / "out")
     assert "no space left on device" in capfd.readouterr().err  # the writer's own traceback
     assert list(tmp_path.iterdir()) == []  # no report, no staging folder
+
+
+def test_a_page_module_that_cannot_be_imported_is_the_error_told_even_when_the_writer_fails(
+        pg, tmp_path, monkeypatch, capfd):
+    import sys
+
+    import uqflight.report as report
+    from uqflight.forking import Child
+
+    def refuse(entries, out_dir):
+        raise OSError("no space left on device")
+
+    writers = []
+
+    def recorded(work):
+        writers.append(Child(work))
+        return writers[-1]
+
+    monkeypatch.setattr(report, "write_statistics_tables", refuse)
+    monkeypatch.setattr(report, "Child", recorded)
+    monkeypatch.setitem(sys.modules, "uqflight.report.render", None)  # `from .render import ...` fails
+    with pytest.raises(ImportError, match="uqflight.report.render"):
+        report.write_report([pg], tmp_path / "out")
+    capfd.readouterr()
+    assert list(tmp_path.iterdir()) == []  # no report, no staging folder
+    assert len(writers) == (1 if report.FORKS else 0)
+    for writer in writers:  # reaped: no child is left behind
+        with pytest.raises(ChildProcessError):
+            os.waitpid(writer.pid, os.WNOHANG)

@@ -21,7 +21,7 @@ import shutil
 from pathlib import Path
 
 from ..check import write_baseline
-from ..forking import FORKS, Child, ChildFailed
+from ..forking import FORKS, Child, ChildFailed, wait_all
 from ..progress import Progress
 from ..methods.parsing import parse_methods
 from .files import _write_text, write_csv, write_statistics_tables, write_summaries
@@ -86,8 +86,11 @@ def _write_into(out_dir: Path, entries: list[Entry], ref: Entry | None, times, p
         from .plots import background_rendering
         from .render import render_html, render_markdown
         from .sections import Table, build_sections, files_section
-    finally:
-        written = _data_files(entries, out_dir) if child is None else _written_by(child)
+    except BaseException:  # the import's error is the one to tell; the writer is reaped, whatever it did
+        if child is not None:
+            wait_all([child])
+        raise
+    written = _data_files(entries, out_dir) if child is None else _written_by(child)
     progress.stage("drawing the plots", _drawing_stages(entries), "sections")
     with background_rendering():  # figures written in forked children while the next is built
         sections = build_sections(entries, ref, times, out_dir, progress=lambda text: progress.advance(1, text))
