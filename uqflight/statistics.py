@@ -25,9 +25,11 @@ from __future__ import annotations
 import json
 import math
 import os
-from concurrent.futures import ThreadPoolExecutor
+from collections import deque
+from concurrent.futures import Executor, ThreadPoolExecutor
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Callable
 
 import numpy as np
 from threadpoolctl import threadpool_limits
@@ -230,17 +232,26 @@ def analyse(path, reference: str | None = None, options: Options | None = None, 
         if progress is not None:
             progress.stage(f"analysing {Path(path).name} ({method['kind']} order {method['order']})",
                            len(store.output_names) + len(store.quantity_names), "outputs")
-        # two outputs at once (each with its time blocks in threads): one output's serial steps (the fit,
-        # the exact moments) overlap the other's blocks; every output's numbers are its own
+        # one pool of threads for every output's time blocks: each output's serial steps (reading it, the fit,
+        # the draws, the exact moments) run here while the blocks of the one before it run in the pool; at
+        # most ANALYSIS_THREADS outputs in flight, so that as many outputs' samples are held at once
         with ThreadPoolExecutor(ANALYSIS_THREADS) as pool:
-            found = pool.map(lambda name: _output_statistics(store, name, method, germs, design_kind, ok, options),
-                             store.output_names)
-            for name, out in zip(store.output_names, found):
-                stats.outputs[name] = out
+            in_flight: deque = deque()
+
+            def finish_oldest():
+                name, finish = in_flight.popleft()
+                out = stats.outputs[name] = finish()
                 if stats.replicates > 1:
                     out.replicate_moments = _replicate_moments(store, name, stats.replicates)
                 if progress is not None:
                     progress.advance()
+
+            for name in store.output_names:
+                in_flight.append((name, _start_output(store, name, method, germs, design_kind, ok, options, pool)))
+                if len(in_flight) >= ANALYSIS_THREADS:
+                    finish_oldest()
+            while in_flight:
+                finish_oldest()
         for name in store.quantity_names:
             stats.quantities[name] = quantity_statistics(store, stats, name, germs, ok, options,
                                                          analysis.get("exceedance", {}).get(name, []))
@@ -328,6 +339,15 @@ def output_basis(store: ResultStore, name: str, ok: np.ndarray) -> tuple[np.ndar
 
 def _output_statistics(store: ResultStore, name: str, method: dict, germs: list[str], design_kind: str,
                        ok: np.ndarray, options: Options) -> OutputStatistics:
+    """The statistics of output `name` over the `ok` runs, its time blocks in ANALYSIS_THREADS threads."""
+    with ThreadPoolExecutor(ANALYSIS_THREADS) as pool:
+        return _start_output(store, name, method, germs, design_kind, ok, options, pool)()
+
+
+def _start_output(store: ResultStore, name: str, method: dict, germs: list[str], design_kind: str,
+                  ok: np.ndarray, options: Options, pool: Executor) -> Callable[[], OutputStatistics]:
+    """Read and fit output `name` here and hand its time blocks to `pool`; returns what waits for them
+    and gives the output's statistics."""
     xi, weights = store.xi[ok], store.weights[ok]
     kind, order = method["kind"], method["order"]
     entry = method_entry(kind)
@@ -353,40 +373,46 @@ def _output_statistics(store: ResultStore, name: str, method: dict, germs: list[
         draws = draw_germs(germs, options.band_samples, options.seed)
         rows, row_scale, band_weights = orthonormal_basis(germs, pce.indices, draws), pce.coefficients, None
     pick_freeze = from_runs and DESIGNS[design_kind].sobol_from_runs and ok.all()
-    blocks = _over_time_blocks(rows, row_scale, store.time.size, band_weights,
-                               len(store.parameter_names) if pick_freeze else 0, options, from_runs, pce)
-    magnitude = np.max(np.sqrt(mean**2 + np.maximum(variance, 0.0)))  # the output's own size over its history
-    rtol = JSBSIM_RESOLUTION if "aircraft_hash" in store.attrs else RESOLUTION_RTOL
-    resolution = store.resolution(name)  # the simulator's own resolution: its two valid trims' drift
-    atol = truncation if resolution is None else np.maximum(truncation, resolution)
-    resolved = resolved_variance(variance, mean, scale=magnitude, rtol=rtol, n=int(ok.sum()),
-                                 weights=None if from_runs else weights, atol=atol)
-    stats = OutputStatistics(name, store.units.get(name, ""), store.time, mean, variance, blocks["band"],
-                             blocks["support"], blocks["density"], modified_cov(mean, np.sqrt(np.maximum(variance, 0))),
-                             resolved, quantiles=dict(zip(options.quantiles, blocks["quantiles"])),
-                             skewness=blocks["skewness"], kurtosis=blocks["kurtosis"],
-                             final_samples=blocks["final"], fourth_central=blocks.get("fourth"))
-    names = store.parameter_names
+    joined_blocks = _over_time_blocks(rows, row_scale, store.time.size, band_weights,
+                                      len(store.parameter_names) if pick_freeze else 0, options, from_runs, pool, pce)
 
-    def masked(indices):
-        return np.where(resolved, indices, np.nan)
+    def finish() -> OutputStatistics:
+        blocks = joined_blocks()
+        magnitude = np.max(np.sqrt(mean**2 + np.maximum(variance, 0.0)))  # the output's own size over its history
+        rtol = JSBSIM_RESOLUTION if "aircraft_hash" in store.attrs else RESOLUTION_RTOL
+        resolution = store.resolution(name)  # the simulator's own resolution: its two valid trims' drift
+        atol = truncation if resolution is None else np.maximum(truncation, resolution)
+        resolved = resolved_variance(variance, mean, scale=magnitude, rtol=rtol, n=int(ok.sum()),
+                                     weights=None if from_runs else weights, atol=atol)
+        cov = modified_cov(mean, np.sqrt(np.maximum(variance, 0)))
+        stats = OutputStatistics(name, store.units.get(name, ""), store.time, mean, variance, blocks["band"],
+                                 blocks["support"], blocks["density"], cov, resolved,
+                                 quantiles=dict(zip(options.quantiles, blocks["quantiles"])),
+                                 skewness=blocks["skewness"], kurtosis=blocks["kurtosis"],
+                                 final_samples=blocks["final"], fourth_central=blocks.get("fourth"))
+        names = store.parameter_names
 
-    if pce is not None:
-        stats.pce = pce
-        stats.sobol_first = dict(zip(names, masked(pce.sobol_first())))
-        stats.sobol_total = dict(zip(names, masked(pce.sobol_total())))
-        stats.coefficient_decay = _coefficient_decay(pce)
-        stats.selection = pce.selection
-        if entry.rule in ("fit", "selection"):
-            stats.loo_error = _loo_error(entry, xi, weights, expand(basis), germs, pce.indices)
-        elif entry.moments == "pce" and order >= 1:
-            stats.convergence = _lower_order_difference(kind, xi, weights, basis, scale, germs, order, x0, pce)
-    elif pick_freeze:
-        stats.sobol_first = dict(zip(names, masked(blocks["first"])))
-        stats.sobol_total = dict(zip(names, masked(blocks["total"])))
-        stats.sobol_first_ci = dict(zip(names, np.moveaxis(blocks["first_ci"], 1, 0)))
-        stats.sobol_total_ci = dict(zip(names, np.moveaxis(blocks["total_ci"], 1, 0)))
-    return stats
+        def masked(indices):
+            return np.where(resolved, indices, np.nan)
+
+        if pce is not None:
+            stats.pce = pce
+            stats.sobol_first = dict(zip(names, masked(pce.sobol_first())))
+            stats.sobol_total = dict(zip(names, masked(pce.sobol_total())))
+            stats.coefficient_decay = _coefficient_decay(pce)
+            stats.selection = pce.selection
+            if entry.rule in ("fit", "selection"):
+                stats.loo_error = _loo_error(entry, xi, weights, expand(basis), germs, pce.indices)
+            elif entry.moments == "pce" and order >= 1:
+                stats.convergence = _lower_order_difference(kind, xi, weights, basis, scale, germs, order, x0, pce)
+        elif pick_freeze:
+            stats.sobol_first = dict(zip(names, masked(blocks["first"])))
+            stats.sobol_total = dict(zip(names, masked(blocks["total"])))
+            stats.sobol_first_ci = dict(zip(names, np.moveaxis(blocks["first_ci"], 1, 0)))
+            stats.sobol_total_ci = dict(zip(names, np.moveaxis(blocks["total_ci"], 1, 0)))
+        return stats
+
+    return finish
 
 
 def _replicate_moments(store: ResultStore, name: str, replicates: int) -> tuple[np.ndarray, np.ndarray]:
@@ -429,12 +455,13 @@ def _lower_order_difference(kind, xi, weights, basis, scale, germs, order, x0, p
 
 
 def _over_time_blocks(rows, scale, n_times: int, weights, pick_freeze_dimensions: int, options: Options,
-                      from_runs: bool, pce: PCE | None = None) -> dict:
+                      from_runs: bool, pool: Executor, pce: PCE | None = None) -> Callable[[], dict]:
     """Quantiles, 99 % band, skewness and kurtosis, PDFs, final-time samples (the runs' fourth central
     moments, pick-freeze indices) of Y = rows @ scale (scale None: Y = rows), rebuilding Y for
-    TIME_BLOCK times at once: the memory stays that of one block whatever the number of runs or draws.
-    Every statistic here is per time, so blocks change nothing. A `pce`'s skewness and kurtosis are its
-    exact ones (methods.pce_moments), not those of its draws; the KDE's std comes from the factors."""
+    TIME_BLOCK times at once: the memory stays that of one block per thread whatever the number of runs or
+    draws. Every statistic here is per time, so blocks change nothing. A `pce`'s skewness and kurtosis are
+    its exact ones (methods.pce_moments), not those of its draws; the KDE's std comes from the factors.
+    The blocks are handed to `pool`; returns what waits for them and joins them."""
     probabilities = (0.5 * (1 - BAND_LEVEL), 0.5 * (1 + BAND_LEVEL), *options.quantiles)
     exact = None if pce is None else pce_standardised_moments(pce.germs, pce.indices, pce.coefficients)
     std = None if scale is None else np.sqrt(np.maximum(weighted_moments(rows, None, scale, unbiased=True)[1], 0.0))
@@ -459,10 +486,14 @@ def _over_time_blocks(rows, scale, n_times: int, weights, pick_freeze_dimensions
             found.update(pick_freeze_indices(Y, pick_freeze_dimensions, n_boot=options.bootstrap, seed=options.seed))
         return found
 
-    # blocks in ANALYSIS_THREADS threads (numpy's sort, FFTs and BLAS release the GIL); each block's
-    # numbers are its own, joined in time order: the same bits in any thread count
-    with ThreadPoolExecutor(ANALYSIS_THREADS) as pool:
-        found = list(pool.map(block, range(0, n_times, TIME_BLOCK)))
+    # blocks in the pool's threads (numpy's sort, FFTs and BLAS release the GIL); each block's numbers are
+    # its own, joined in time order: the same bits in any thread count
+    futures = [pool.submit(block, start) for start in range(0, n_times, TIME_BLOCK)]
+    return lambda: _joined([future.result() for future in futures], exact, pick_freeze_dimensions)
+
+
+def _joined(found: list[dict], exact, pick_freeze_dimensions: int) -> dict:
+    """The time blocks' statistics (`_over_time_blocks`) joined in time order."""
     parts = {key: [f[key] for f in found] for key in found[0]}
     quantiles = np.concatenate(parts["quantiles"], axis=1)
     skewness, kurtosis = exact or (np.concatenate(parts["skewness"]), np.concatenate(parts["kurtosis"]))
