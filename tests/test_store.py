@@ -6,7 +6,9 @@ import hashlib
 import inspect
 import json
 import os
+import shutil
 import signal
+import struct
 import subprocess
 import sys
 import time
@@ -284,6 +286,38 @@ def test_resume_after_sigkill_equals_an_uninterrupted_file(tmp_path, reference, 
         if pending.size:
             write_runs(store, np.array_split(pending, min(5, pending.size)))
     assert_same_results(path, reference)
+
+
+def test_data_past_the_end_the_superblock_records_is_refused_with_the_remedy_and_resumes_to_the_same_bits(
+        tmp_path, reference):
+    """A kill inside HDF5's flush can write objects before the superblock that records the end of the
+    file's space (seen under load in the test above: "addr overflow ... eoa"). Here the recorded end
+    (a version-0 superblock's end-of-file address, bytes 40-48) is set back to 90 % of the file."""
+    path = tmp_path / "short.h5"
+    shutil.copy(reference, path)
+    size = path.stat().st_size
+    with open(path, "r+b") as fh:
+        assert fh.read(9)[8] == 0  # superblock version 0
+        fh.seek(40)
+        assert struct.unpack("<Q", fh.read(8))[0] == size
+        fh.seek(40)
+        fh.write(struct.pack("<Q", size * 9 // 10))
+    with pytest.raises(uqflight.store.results.CorruptFile, match=r"addr overflow.*resuming the campaign"):
+        ResultStore.open(path).status
+    with ResultStore.open(path, "a") as store:  # the recorded end moved to the file's: nothing is lost
+        assert store.pending().size == 0 and store.repaired == 0
+    assert_same_results(path, reference)
+    with open(path, "rb") as fh:
+        fh.seek(40)
+        assert struct.unpack("<Q", fh.read(8))[0] >= size  # written back: a plain read works too
+    cut = tmp_path / "cut.h5"  # the same, but the bytes past the recorded end are gone too: not mendable
+    shutil.copy(reference, cut)
+    with open(cut, "r+b") as fh:
+        fh.seek(40)
+        fh.write(struct.pack("<Q", size * 9 // 10))
+        fh.truncate(size * 9 // 10)
+    with pytest.raises(uqflight.store.results.CorruptFile, match=r"cut short.*--restart"):
+        ResultStore.open(cut, "a")
 
 
 @pytest.mark.parametrize("dataset, tsvd", [("outputs/alpha_deg", False), ("outputs/alpha_deg", True),

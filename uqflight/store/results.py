@@ -26,7 +26,8 @@ flushes and fsyncs again (one flush would let HDF5 write its cached chunks in it
 kill or full disk could then leave a status without its data), so a killed process loses at most
 the batch in flight and `pending()` tells exactly what to rerun. The tSVD form replaces an output's
 factors and buffer together, staged in `/tsvd/<name>/next`; reopening with mode "a" finishes or
-discards such a half-done step (`compressed`).
+discards such a half-done step (`compressed`). A kill inside a flush can leave objects past the
+end the superblock records; reopening with mode "a" moves that end to the file's (`file_end`).
 
 Determinism: runs complete in any order; the raw rows land in their design rows, and the tSVD folds
 the ok runs in design order with one BLAS thread (`compressed`), so the file depends neither on the
@@ -53,6 +54,8 @@ from ..quantities import is_quantity_key
 from ..simulators.base import Status
 from .chunks import chunk_blocks, grow_rows
 from .compressed import TsvdStorage
+from .file_end import HINT as END_HINT
+from .file_end import extend_to_file_end, past_recorded_end
 from .layout import is_time_grid, layout_problems
 from .raw import RawStorage
 from .rounds import read_index_set, write_index_set
@@ -76,12 +79,28 @@ class CorruptFile(ValueError):
     """A results file whose contents fail their checks (checksum, unknown status codes)."""
 
 
+READ_ERRORS = (OSError, RuntimeError)  # what h5py raises for data or links it cannot read
+
+
 def read_error(exc: BaseException) -> str:
     """One line on an HDF5 read error; a failed checksum is called what it is."""
     text = " ".join(str(exc).split())
     if "filter" in text.lower() or "checksum" in text.lower():
         return f"data corrupted: a checksum (fletcher32) does not match ({text})"
+    if past_recorded_end(text):
+        return f"{text}: {END_HINT}"
     return text
+
+
+def _unreadable(path, exc: BaseException, extended: bool) -> CorruptFile:
+    """The CorruptFile for a file that fails a read on opening; `extended`: its recorded end was moved to
+    the file's already (file_end), so a read past it is past the bytes on disk."""
+    text = " ".join(str(exc).split())
+    if extended and past_recorded_end(text):
+        return CorruptFile(f"{path}: {text}: data past the end of the file on disk (the file was cut short, "
+                           "e.g. copied or written out incompletely): it cannot be mended; fly the campaign "
+                           "again (`uqflight run CAMPAIGN --out FILE --restart`)")
+    return CorruptFile(f"{path}: {read_error(exc)}")
 
 
 def fit_reason(reason: str, size: int) -> bytes:
@@ -183,19 +202,26 @@ class ResultStore:
             raise ValueError(f"mode must be 'r' or 'a', got {mode!r}")
         f = h5py.File(path, "r", locking=False) if while_written and mode == "r" else \
             h5py.File(path, "r" if mode == "r" else "r+")
-        if "samples/status" not in f:
+        # before anything is written: space past the recorded end is not free (file_end)
+        extended = mode == "a" and extend_to_file_end(f)
+        try:
+            ours = "samples/status" in f
+            store = cls(f) if ours else None
+        except READ_ERRORS as exc:
+            f.close()
+            raise _unreadable(path, exc, extended) from exc
+        if not ours:
             f.close()
             raise ValueError(f"{path} is not a uqflight results file (no /samples/status)")
-        store = cls(f)
         try:
             if mode == "a":  # finish or drop a step a killed writer left half done, first
                 for storage in store._storages:
                     storage.mend()
             problems = layout_problems(f)
             status = None if problems else store.status
-        except OSError as exc:
+        except READ_ERRORS as exc:
             f.close()
-            raise CorruptFile(f"{path}: {read_error(exc)}") from exc
+            raise _unreadable(path, exc, extended) from exc
         if problems:
             f.close()
             raise CorruptFile(f"{path}: {'; '.join(problems[:3])}{' (and more)' if len(problems) > 3 else ''}: "
@@ -209,9 +235,9 @@ class ResultStore:
         if mode == "a":
             try:
                 store.repaired = store._repair_lost_runs()
-            except OSError as exc:
+            except READ_ERRORS as exc:
                 f.close()
-                raise CorruptFile(f"{path}: {read_error(exc)}") from exc
+                raise _unreadable(path, exc, extended) from exc
             status = store.status
             for storage in store._storages:
                 storage.settle(status)

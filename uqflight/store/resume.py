@@ -6,7 +6,7 @@ from pathlib import Path
 
 import h5py
 
-from .results import ResultStore, text_hash
+from .results import READ_ERRORS, ResultStore, text_hash
 
 
 FLOWN = ("aircraft_hash", "scenario")  # what a results file's runs flew beside the campaign text (the
@@ -40,7 +40,7 @@ def open_for_campaign(path, *, campaign_text: str, force: bool = False, restart:
             with h5py.File(path, "r") as f:
                 stored, stored_flown = f.attrs.get("campaign_hash"), {key: f.attrs.get(key) for key in FLOWN}
                 ours = stored is not None and "samples/status" in f
-        except OSError as exc:  # e.g. killed while the file was being created: nothing to resume
+        except READ_ERRORS as exc:  # e.g. killed while the file was being created: nothing to resume
             if not force:
                 reason = " ".join(str(exc).split())[:200]
                 raise FileExistsError(f"{path} is a damaged HDF5 file ({reason}); choose another results "
