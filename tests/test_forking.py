@@ -1,10 +1,10 @@
-"""Forked children (uqflight.forking): results through the pipe, failures reported, the first one done."""
+"""Forked children (uqflight.forking): results through the pipe, failures reported, jobs shared."""
 import os
 import time
 
 import pytest
 
-from uqflight.forking import FORKS, Child, ChildFailed, first_done, wait_all
+from uqflight.forking import FORKS, Child, ChildFailed, share_work, wait_all
 
 pytestmark = pytest.mark.skipif(not FORKS, reason="the system cannot fork")
 
@@ -16,12 +16,30 @@ def test_a_childs_result_comes_back_and_a_failure_is_reported():
     assert isinstance(outcomes[2], ChildFailed) and "exit 9" in str(outcomes[2])
 
 
-def test_first_done_is_the_child_that_finished_not_the_oldest():
-    slow = Child(lambda: time.sleep(5) or "slow")
-    quick = Child(lambda: "quick")
-    children = [slow, quick]
-    assert first_done(children) == 1
-    assert quick.wait() == "quick"
-    os.kill(slow.pid, 9)  # not waited for its sleep: killed, and reported as such
-    with pytest.raises(ChildFailed, match="signal 9"):
-        slow.wait()
+def test_shared_jobs_each_run_once_and_come_back_in_their_order(tmp_path):
+    def job(k):
+        (tmp_path / f"{k}-{os.getpid()}").write_text("")  # who ran it
+        time.sleep(0.02)
+        return k * k
+
+    order = list(range(12))[::-1]  # taken from the last: the results still come back in the jobs' order
+    assert share_work([lambda k=k: job(k) for k in range(12)], order, processes=3) == [k * k for k in range(12)]
+    runs = sorted(path.name.split("-") for path in tmp_path.iterdir())
+    assert sorted(int(k) for k, _ in runs) == list(range(12))  # each job once
+    started = []
+    assert share_work([lambda: 1, lambda: 2], processes=1, starting=started.append) == [1, 2]
+    assert started == [0, 1]  # without children, every job here, each told as it starts
+
+
+def test_a_job_failing_here_is_raised_after_the_children_are_reaped():
+    parent = os.getpid()
+
+    def job():
+        if os.getpid() == parent:
+            raise ZeroDivisionError("here")
+        time.sleep(0.3)
+
+    with pytest.raises(ZeroDivisionError, match="here"):
+        share_work([job] * 6, processes=2)
+    with pytest.raises(ChildProcessError):  # no child of this test left running or unreaped
+        os.waitpid(-1, os.WNOHANG)

@@ -1,13 +1,13 @@
-"""Work done in a forked child while the parent goes on (figures written in the background, runs split
-over processes). The child inherits the parent's memory, so nothing is pickled on the way in; its
-result comes back pickled through a pipe. It runs no handler of the parent's and leaves with
-os._exit; a child that fails or dies is reported as such when waited for."""
+"""Work done in a forked child while the parent goes on (the data files beside the page's imports, runs
+split over processes, the report's sections shared between processes). The child inherits the parent's
+memory, so nothing is pickled on the way in; its result comes back pickled through a pipe. It runs no
+handler of the parent's and leaves with os._exit; a child that fails or dies is reported as such when
+waited for."""
 from __future__ import annotations
 
 import gc
 import os
 import pickle
-import select
 import traceback
 from typing import Callable
 
@@ -67,8 +67,56 @@ def wait_all(children: list[Child]) -> list:
     return outcomes
 
 
-def first_done(children: list[Child]) -> int:
-    """The index of a child among `children` that has finished (or is writing its result), waiting
-    until one has."""
-    ready, _, _ = select.select(children, [], [])
-    return children.index(ready[0])
+def share_work(jobs: list[Callable[[], object]], order: list[int] | None = None, processes: int | None = None,
+               starting: Callable[[int], None] | None = None) -> list:
+    """The result of every job, in the jobs' order, the jobs shared between this process and `processes` − 1
+    forked children (default: one per further CPU). Each process takes the next job no process has taken,
+    in `order` (a permutation of the indices, default as given: put the costliest first), so none idles
+    while another has several left. `starting(index)` is told here as each of this process's own jobs
+    starts. A job's error here is raised once the children are reaped; ChildFailed when a child's job
+    raised (its traceback printed) or a child died."""
+    order = list(range(len(jobs))) if order is None else list(order)
+    processes = min(len(order), processes or os.cpu_count() or 1) if FORKS else 1
+    if processes <= 1:
+        results = _results_of(jobs, order, starting)
+        return [results[index] for index in range(len(jobs))]
+    read, write = os.pipe()  # the queue: each job's index as 4 bytes, taken by one read of 4 bytes
+
+    def taken():
+        while record := os.read(read, 4):  # b"" once the queue is empty and written to the end
+            yield int.from_bytes(record, "little")
+
+    def child_work():
+        os.close(write)
+        return _results_of(jobs, taken())
+
+    queue, children = os.fdopen(write, "wb"), []
+    try:
+        for _ in range(processes - 1):
+            children.append(Child(child_work))
+        queue.write(b"".join(index.to_bytes(4, "little") for index in order))
+        queue.close()
+        results = _results_of(jobs, taken(), starting)
+    except BaseException:
+        queue.close()
+        for _ in taken():  # the jobs no one has taken yet are dropped: the children end with their current one
+            pass
+        raise
+    finally:
+        outcomes = wait_all(children)
+        os.close(read)
+    for outcome in outcomes:
+        if isinstance(outcome, ChildFailed):
+            raise outcome
+        results.update(outcome)
+    return [results[index] for index in range(len(jobs))]
+
+
+def _results_of(jobs: list[Callable[[], object]], indices, starting=None) -> dict[int, object]:
+    """{index: jobs[index]()} for each index taken from `indices`, told to `starting` first."""
+    results = {}
+    for index in indices:
+        if starting is not None:
+            starting(index)
+        results[index] = jobs[index]()
+    return results

@@ -83,7 +83,6 @@ def _write_into(out_dir: Path, entries: list[Entry], ref: Entry | None, times, p
     # imports, and after the analysis, whose threads an import beside them slowed by more than it costs
     child = Child(lambda: _data_files(entries, out_dir)) if FORKS else None
     try:
-        from .plots import background_rendering
         from .render import render_html, render_markdown
         from .sections import Table, build_sections, files_section
     except BaseException:  # the import's error is the one to tell; the writer is reaped, whatever it did
@@ -91,10 +90,11 @@ def _write_into(out_dir: Path, entries: list[Entry], ref: Entry | None, times, p
             wait_all([child])
         raise
     written = _data_files(entries, out_dir) if child is None else _written_by(child)
-    progress.stage("drawing the plots", _drawing_stages(entries), "sections")
-    with background_rendering():  # figures written in forked children while the next is built
-        sections = build_sections(entries, ref, times, out_dir, progress=lambda text: progress.advance(1, text))
-    progress.advance(progress.total)
+    try:
+        sections = build_sections(entries, ref, times, out_dir, progress)
+    except ChildFailed as exc:
+        raise RuntimeError(f"cannot draw the report's plots: a process drawing them {exc} (its error is printed "
+                           "above)") from None
     for table in (block for section in sections for block in section.blocks if isinstance(block, Table)):
         written.append(write_csv(out_dir / table.file, table.header, table.rows))
     written += [out_dir / "report.html", out_dir / "report.md"]
@@ -116,11 +116,3 @@ def _written_by(child: Child) -> list[Path]:
         return child.wait()
     except ChildFailed as exc:
         raise RuntimeError(f"cannot write summary.json and the statistics tables: the writer {exc}") from None
-
-
-def _drawing_stages(entries: list[Entry]) -> int:
-    """The stages build_sections tells, plus the last one's end: the run and statistics sections, and the
-    errors, quantities and Sobol' sections when there are any."""
-    optional = (any(e.has_errors for e in entries), any(e.stats.quantities for e in entries),
-                any(e.has_sobol for e in entries))
-    return 2 + sum(optional)

@@ -7,7 +7,6 @@ point) is drawn as markers instead of lines.
 from __future__ import annotations
 
 import gc
-import os
 from contextlib import contextmanager
 from pathlib import Path
 
@@ -25,7 +24,6 @@ from matplotlib.figure import Figure  # noqa: E402
 from matplotlib.lines import Line2D  # noqa: E402
 from matplotlib.ticker import FixedLocator, FuncFormatter, LogLocator, MaxNLocator, NullFormatter  # noqa: E402
 
-from ..forking import FORKS, Child, ChildFailed, first_done, wait_all  # noqa: E402
 from ..labels import label, short_label  # noqa: E402,F401 (plots.label: the report's captions)
 from .formats import export_format, shown_path  # noqa: E402
 
@@ -46,16 +44,12 @@ FAST_PNG = {"pil_kwargs": {"compress_level": 1}}  # zlib's fastest level: the sa
 
 def write_figure(fig, path: Path, dpi: int = DPI, rect=None) -> Path:
     """Lay `fig` out (tight_layout within `rect`, when given), save it as `path` in the export format and
-    close it: here, or in a forked child under background_rendering. Returns the file the page shows
-    (the SVG for svg, the PNG for png and pdf: a pdf is written beside it)."""
+    close it. Returns the file the page shows (the SVG for svg, the PNG for png and pdf: a pdf is
+    written beside it)."""
     path = Path(path)
-
-    def save():
-        if rect is not None:
-            fig.tight_layout(rect=rect)
-        _save_as(fig, path, dpi)
-
-    _in_background(save, str(shown_path(path)))
+    if rect is not None:
+        fig.tight_layout(rect=rect)
+    _save_as(fig, path, dpi)
     plt.close(fig)
     return shown_path(path)
 
@@ -66,17 +60,6 @@ def _save_as(fig, path: Path, dpi: int = DPI) -> None:
     fig.savefig(shown, dpi=dpi, **(FAST_PNG if shown.suffix == ".png" else {}))
     if export_format() == "pdf":
         fig.savefig(Path(path).with_suffix(".pdf"))
-
-
-def _in_background(work, name: str) -> None:
-    """`work()` in a forked child under background_rendering (waiting while `limit` children run), else here."""
-    if _background is None:
-        work()
-        return
-    children = _background["children"]
-    while len(children) >= _background["limit"]:  # wait for whichever child is done first
-        _background["failed"] += _failures([children.pop(first_done([child for child, _ in children]))])
-    children.append((Child(work), name))
 
 
 SUPERSCRIPTS = str.maketrans("-0123456789", "⁻⁰¹²³⁴⁵⁶⁷⁸⁹")
@@ -195,37 +178,12 @@ def _save(fig, path: Path, legend_handles=None, legend_columns: int = 3, right: 
     return _write(fig, path, rect)
 
 
-_background: dict | None = None  # inside background_rendering(): "children" (pid, figure), "limit", "failed"
-
-
-@contextmanager
-def background_rendering(processes: int | None = None):
-    """Inside, each figure is laid out and written by a forked child while the caller builds the next
-    (at most `processes` children at once, default the CPU count): the same PNG bytes, in a fraction of
-    the time on several cores. Leaving waits for every child; RuntimeError names a figure that failed."""
-    global _background
-    if not FORKS or _background is not None:
-        yield
-        return
-    _background = {"children": [], "limit": processes or os.cpu_count() or 1, "failed": []}
-    warm_text_caches()
-    with collecting_at_the_end():
-        try:
-            yield
-        except BaseException:
-            _wait_all()
-            raise
-        failed = _wait_all()
-    if failed:
-        raise RuntimeError(f"cannot write the plot {failed[0]} (its error is printed above)")
-
-
 @contextmanager
 def collecting_at_the_end():
     """Python's cycle collector off inside, one collection on leaving. A figure is thousands of artists
     that reference each other; collecting every 700 allocations (and scanning every long-lived object
-    now and then) costs a third of building them. The closed figures' memory is freed on leaving; the
-    drawing children inherit the setting and end with os._exit."""
+    now and then) costs a third of building them. The closed figures' memory is freed on leaving; forked
+    children drawing sections inherit the setting and end with os._exit."""
     was_enabled = gc.isenabled()
     gc.disable()
     try:
@@ -240,9 +198,9 @@ _warmed = False  # warm_text_caches has drawn in this process
 
 
 def warm_text_caches() -> None:
-    """Draw a small figure with the report's fonts and digits, once per process, so that every forked child
-    inherits the loaded fonts and their glyph caches instead of building them again. Without pyplot:
-    any one thread may call it."""
+    """Draw a small figure with the report's fonts and digits, once per process, so that a child forked
+    afterwards inherits the loaded fonts and their glyph caches instead of building them again. Without
+    pyplot: any one thread may call it."""
     global _warmed
     if _warmed:
         return
@@ -256,21 +214,8 @@ def warm_text_caches() -> None:
     _warmed = True
 
 
-def _wait_all() -> list[str]:
-    """Wait for every child writing a figure; the figures that failed. Ends background rendering."""
-    global _background
-    state, _background = _background, None
-    return state["failed"] + _failures(state["children"])
-
-
-def _failures(children: list) -> list[str]:
-    """Wait for the (child, figure) pairs; the figures whose child failed."""
-    outcomes = wait_all([child for child, _ in children])
-    return [path for (_, path), outcome in zip(children, outcomes) if isinstance(outcome, ChildFailed)]
-
-
 def _write(fig, path: Path, rect=(0, 0, 1, 1)) -> Path:
-    """tight_layout within `rect`, then `write_figure` (both in the child under background_rendering)."""
+    """tight_layout within `rect`, then `write_figure`."""
     return write_figure(fig, path, rect=rect)
 
 
@@ -360,37 +305,32 @@ def plot_pdf_over_time(out, path: Path, title: str, slice_times: list[float]) ->
 def plot_pdfs_over_time(figures: list, slice_times: list[float]) -> list[Path]:
     """plot_pdf_over_time of each (output over time, path, title) in `figures`, drawn on one figure whose
     data, labels and legends are replaced from one output to the next: its axes, ticks and colour bar are
-    built once (a third less CPU than a figure each, the same pixels). All of it in one child under
-    background_rendering. Returns the files the page shows."""
+    built once (a third less CPU than a figure each, the same pixels). Returns the files the page shows."""
     if not figures:
         return []
-
-    def draw_all():
-        fig, (top, bottom) = plt.subplots(2, 1, figsize=(9, 8.2), gridspec_kw={"height_ratios": [3, 2]})
-        fig.panel_grid = (2, 1)
-        for k, (out, path, title) in enumerate(figures):
-            for ax in (top, bottom):  # the previous output's data go; the axes' limits follow the new data
-                for artist in [*ax.lines, *ax.collections]:
-                    artist.remove()
-                ax.ignore_existing_data_limits = True
-            mesh = _pdf_heat_map(top, out)
-            if k == 0:
-                fig.colorbar(mesh, ax=top, label="density / peak density at that time")
-            for color, index in zip(COLORS, time_indices(out.time, slice_times)):
-                bottom.plot(out.pdf_support[index], out.pdf_density[index], color=color,
-                            label=f"t = {out.time[index]:g} s")
-            bottom.set_xlabel(label(out.name, out.units), fontsize=9)
-            bottom.set_ylabel(f"probability density [1/{out.units}]" if out.units else "probability density",
-                              fontsize=9)
-            bottom.set_title("density at selected times", fontsize=10)
-            bottom.legend(fontsize=8)
-            bottom.grid(alpha=0.3)
-            fig.suptitle(title, fontsize=12)
-            _fix_panel_layout(fig, 0)
-            _save_as(fig, path)
-        plt.close(fig)
-
-    _in_background(draw_all, ", ".join(str(shown_path(path)) for _, path, _ in figures))
+    fig, (top, bottom) = plt.subplots(2, 1, figsize=(9, 8.2), gridspec_kw={"height_ratios": [3, 2]})
+    fig.panel_grid = (2, 1)
+    for k, (out, path, title) in enumerate(figures):
+        for ax in (top, bottom):  # the previous output's data go; the axes' limits follow the new data
+            for artist in [*ax.lines, *ax.collections]:
+                artist.remove()
+            ax.ignore_existing_data_limits = True
+        mesh = _pdf_heat_map(top, out)
+        if k == 0:
+            fig.colorbar(mesh, ax=top, label="density / peak density at that time")
+        for color, index in zip(COLORS, time_indices(out.time, slice_times)):
+            bottom.plot(out.pdf_support[index], out.pdf_density[index], color=color,
+                        label=f"t = {out.time[index]:g} s")
+        bottom.set_xlabel(label(out.name, out.units), fontsize=9)
+        bottom.set_ylabel(f"probability density [1/{out.units}]" if out.units else "probability density",
+                          fontsize=9)
+        bottom.set_title("density at selected times", fontsize=10)
+        bottom.legend(fontsize=8)
+        bottom.grid(alpha=0.3)
+        fig.suptitle(title, fontsize=12)
+        _fix_panel_layout(fig, 0)
+        _save_as(fig, path)
+    plt.close(fig)
     return [shown_path(path) for _, path, _ in figures]
 
 

@@ -4,10 +4,13 @@ from __future__ import annotations
 import json
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Callable
 
 import numpy as np
 
 from . import plots
+from .formats import shown_path
+from ..forking import share_work
 from .sensitivity import NEGLIGIBLE, index_text, plot_sensitivity
 from ..campaign.reading import stored_parameters
 from .loading import Entry, _same_file, campaign_settings, design_info, file_name, flight_facts, method_label
@@ -44,55 +47,77 @@ class Section:
 
 def build_sections(entries: list[Entry], ref: Entry | None, times: list[float], out_dir: Path,
                    progress=None) -> list[Section]:
-    """The report's sections, drawing their plots into out_dir/plots."""
+    """The report's sections, drawing their plots into out_dir/plots. The sections are built by this
+    process and a forked child per further core (forking.share_work), the costliest first: each
+    process draws its sections' figures itself, with the fonts it has loaded. `progress` (a Progress)
+    counts the sections done and names the one this process is drawing."""
+    jobs = section_jobs(entries, ref, times, out_dir)
+    order = sorted(range(len(jobs)), key=lambda k: -jobs[k][0])
+    if progress is not None:
+        progress.stage("drawing the plots", len(jobs), "sections")
+
+    def starting(k: int) -> None:
+        if progress is not None:
+            progress.advance(0 if k == order[0] else 1, jobs[k][1])
+
+    plots.warm_text_caches()  # before the fork: every process inherits the loaded fonts
+    with plots.collecting_at_the_end():
+        sections = share_work([build for _, _, build in jobs], order, starting=starting)
+    if progress is not None:
+        progress.advance(len(jobs), "drawn")
+    return [section for section in sections if section is not None]
+
+
+def section_jobs(entries: list[Entry], ref: Entry | None, times: list[float],
+                 out_dir: Path) -> list[tuple[int, str, Callable[[], Section | None]]]:
+    """The report's sections in page order as (cost, stage, build): `cost` the panels it draws, roughly
+    (what sets how long it takes), `stage` what the progress says while it is drawn, `build` what
+    returns the section (None: nothing to show). The PDF figures are a job of their own, which the
+    statistics section shows."""
     from .headline import headline_section
     from .trajectories import trajectories_section
 
-    tell = progress or (lambda text: None)
-    sections = [headline_section(entries[0], times)]
-    notes = notes_section(entries)
-    if notes is not None:
-        sections.append(notes)
-    sections += [run_section(entries, out_dir), inputs_section(entries, ref)]
-    failures = failures_section(entries)
-    if failures is not None:
-        sections.append(failures)
-    tell("drawing the statistics over time")
-    sections.append(statistics_section(entries, ref, times, out_dir))
-    tell("drawing the runs")
-    runs = trajectories_section(entries, times, out_dir)
-    if runs is not None:
-        sections.append(runs)
+    k = len(entries)
+    outputs = max(len(e.outputs) for e in entries)
+    inputs = max(len(e.stats.parameter_names) for e in entries)
+    jobs = [(0, "writing the headline", lambda: headline_section(entries[0], times)),
+            (0, "writing the notes", lambda: notes_section(entries)),
+            (k, "drawing the design", lambda: run_section(entries, out_dir)),
+            (0, "writing the inputs", lambda: inputs_section(entries, ref)),
+            (0, "writing the failures", lambda: failures_section(entries)),
+            ((outputs + 1) * k + (outputs if k >= 2 else 0), "drawing the statistics over time",
+             lambda: statistics_section(entries, ref, times, out_dir)),
+            (2 * outputs * k, "drawing the PDFs", lambda: draw_pdfs(entries, times, out_dir)),
+            ((outputs + inputs) * k, "drawing the runs", lambda: trajectories_section(entries, times, out_dir))]
     if any(e.has_errors for e in entries):
-        tell("drawing the errors against the reference")
-        sections.append(accuracy_section(entries, out_dir))
+        jobs.append((2 * outputs + 2, "drawing the errors against the reference",
+                     lambda: accuracy_section(entries, out_dir)))
     if any(e.stats.quantities for e in entries):
         from .quantities import quantities_section
 
-        tell("drawing the quantities of interest")
-        sections.append(quantities_section(entries, out_dir))
+        quantities = max(len(e.stats.quantities) for e in entries)
+        jobs.append((2 * quantities * k, "drawing the quantities of interest",
+                     lambda: quantities_section(entries, out_dir)))
     if any(getattr(e.stats, "index_set", None) for e in entries):
         from .index_set import index_set_section
 
-        tell("drawing the adaptive grid's index set")
-        sections.append(index_set_section(entries, out_dir))
+        jobs.append((k, "drawing the adaptive grid's index set", lambda: index_set_section(entries, out_dir)))
     if any(e.stats.seeds for e in entries):
         from .variance_split import variance_split_section
 
-        split = variance_split_section(entries, times)
-        if split is not None:
-            sections.append(split)
+        jobs.append((0, "writing the variance split", lambda: variance_split_section(entries, times)))
     if any(e.has_sobol for e in entries):
-        tell("drawing the Sobol' indices")
-        sections.append(sensitivity_section(entries, times, out_dir))
+        jobs.append((3 * outputs * k, "drawing the Sobol' indices",
+                     lambda: sensitivity_section(entries, times, out_dir)))
     decay = [e for e in entries if any(getattr(o, "coefficient_decay", None) for o in e.outputs.values())]
     if decay:
-        sections.append(decay_section(decay, out_dir))
+        jobs.append((outputs * len(decay), "drawing the coefficient decay", lambda: decay_section(decay, out_dir)))
     extra = [ref] if ref is not None and not any(_same_file(ref.stats.path, e.stats.path) for e in entries) else []
     monte_carlo = [e for e in entries + extra if e.monte_carlo]
     if len(monte_carlo) >= 2:
-        sections.append(monte_carlo_section(monte_carlo, out_dir))
-    return sections
+        jobs.append((2 * outputs, "drawing the Monte Carlo files compared",
+                     lambda: monte_carlo_section(monte_carlo, out_dir)))
+    return jobs
 
 
 def notes_section(entries: list[Entry]) -> Section | None:
@@ -235,11 +260,6 @@ def statistics_section(entries: list[Entry], ref: Entry | None, times: list[floa
     plot_dir = out_dir / "plots"
     blocks = []
     for entry in entries:
-        pdfs = {name: (out, plot_dir / f"pdf_{entry.stem}_{file_name(name)}.png",
-                       f"PDF of {plots.short_label(name)}: {entry.label}") for name, out in entry.outputs.items()}
-        over_time = [name for name, out in entry.outputs.items() if out.time.size > 1]  # drawn on one figure,
-        # first: its child takes longest, and the next figures are drawn beside it
-        shown = dict(zip(over_time, plots.plot_pdfs_over_time([pdfs[name] for name in over_time], times)))
         overlay = ref.outputs if ref is not None and not _same_file(ref.stats.path, entry.stats.path) else None
         blocks.append(Figure(_rel(plots.plot_mean_band(entry.outputs, plot_dir / f"mean_band_{entry.stem}.png",
                                                        f"Mean and 99 % band: {entry.label}", overlay), out_dir),
@@ -250,10 +270,9 @@ def statistics_section(entries: list[Entry], ref: Entry | None, times: list[floa
                              f"Modified coefficient of variation std(t) / max|mean| of the outputs of {entry.label} "
                              "(paper Fig. 8); outputs on an offset datum (min|mean| more than "
                              f"{plots.OFFSET_DATUM:g} × the mean's excursion, e.g. an altitude) as std in their unit."))
-        for name, out in entry.outputs.items():
-            path = shown.get(name) or plots.plot_pdf_over_time(*pdfs[name], times)
-            blocks.append(Figure(_rel(path, out_dir), f"PDF of {plots.label(name, out.units)} over time of "
-                                 f"{entry.label} (paper Figs. 6-7, right) and at the selected times."))
+        for name, (out, path, _) in pdf_figures(entry, out_dir).items():
+            blocks.append(Figure(_rel(shown_path(path), out_dir), f"PDF of {plots.label(name, out.units)} over "
+                                 f"time of {entry.label} (paper Figs. 6-7, right) and at the selected times."))
     if len(entries) >= 2:
         labelled = [(e.label, e.outputs) for e in entries] + ([(f"reference {ref.label}", ref.outputs)]
                                                              if ref is not None else [])
@@ -273,6 +292,22 @@ def statistics_section(entries: list[Entry], ref: Entry | None, times: list[floa
                          "cov [-]", *(title for _, title in extra)], rows, "tables/statistics_at_times.csv"))
     return Section("Statistics over time", "statistics", "Plots of every file and method; the full statistics over "
                    "time of every file and output are in tables/statistics_<file>_<output>.csv.", blocks)
+
+
+def pdf_figures(entry: Entry, out_dir: Path) -> dict[str, tuple]:
+    """(output, path, title) of the PDF figure of each output of `entry`, by output name."""
+    return {name: (out, out_dir / "plots" / f"pdf_{entry.stem}_{file_name(name)}.png",
+                   f"PDF of {plots.short_label(name)}: {entry.label}") for name, out in entry.outputs.items()}
+
+
+def draw_pdfs(entries: list[Entry], times: list[float], out_dir: Path) -> None:
+    """The PDF figures of every file (shown by statistics_section): those over time on one figure per file."""
+    for entry in entries:
+        figures = pdf_figures(entry, out_dir).values()
+        plots.plot_pdfs_over_time([f for f in figures if f[0].time.size > 1], times)
+        for out, path, title in figures:
+            if out.time.size == 1:
+                plots.plot_pdf_over_time(out, path, title, times)
 
 
 def _extra_statistics(entries: list[Entry]) -> list[tuple[str, str]]:
