@@ -51,7 +51,7 @@ from .designs.adaptive import index_set_summary
 from .methods import PCE, METHODS, failed_runs_note, fit, method_entry, method_settings, normalised
 from .methods.basis import orthonormal_basis
 from .methods.loo import relative_loo_error
-from .methods.pce_moments import pce_standardised_moments
+from .methods.pce_moments import pce_standardised_moments, triple_products
 from .methods.validity import method_problem
 from .parameters.distributions import SEED_REFUSAL
 from .parameters.germs import draw_germs
@@ -237,6 +237,7 @@ def analyse(path, reference: str | None = None, options: Options | None = None, 
         # most ANALYSIS_THREADS outputs in flight, so that as many outputs' samples are held at once
         with ThreadPoolExecutor(ANALYSIS_THREADS) as pool:
             in_flight: deque = deque()
+            reused = Reused()
 
             def finish_oldest():
                 name, finish = in_flight.popleft()
@@ -247,7 +248,8 @@ def analyse(path, reference: str | None = None, options: Options | None = None, 
                     progress.advance()
 
             for name in store.output_names:
-                in_flight.append((name, _start_output(store, name, method, germs, design_kind, ok, options, pool)))
+                in_flight.append((name, _start_output(store, name, method, germs, design_kind, ok, options, pool,
+                                                      reused)))
                 if len(in_flight) >= ANALYSIS_THREADS:
                     finish_oldest()
             while in_flight:
@@ -344,10 +346,42 @@ def _output_statistics(store: ResultStore, name: str, method: dict, germs: list[
         return _start_output(store, name, method, germs, design_kind, ok, options, pool)()
 
 
+class Reused:
+    """What consecutive outputs of one file share when their expansions have the same basis: the band
+    draws' basis values and the triple products, each kept for the last basis only (so that the memory
+    is one basis's whatever the number of outputs). Used from one thread."""
+
+    def __init__(self):
+        self._last: dict[str, tuple] = {}
+
+    def get(self, what: str, key: tuple, compute: Callable[[], np.ndarray]) -> np.ndarray:
+        """`compute()`, or its value of the previous call with the same `what` and `key` (read-only)."""
+        last = self._last.get(what)
+        if last is None or last[0] != key:
+            value = compute()
+            value.flags.writeable = False
+            self._last[what] = last = (key, value)
+        return last[1]
+
+    def band_rows(self, germs: list[str], indices: np.ndarray, options: Options) -> np.ndarray:
+        """Ψ_α of the `options.band_samples` seeded draws of the germs, (N, Z)."""
+        indices = np.asarray(indices, dtype=int)
+        key = (tuple(germs), indices.shape, indices.tobytes(), options.band_samples, options.seed)
+        return self.get("band rows", key, lambda: orthonormal_basis(
+            germs, indices, draw_germs(germs, options.band_samples, options.seed)))
+
+    def triple_products(self, germs: list[str], indices: np.ndarray, square_indices: np.ndarray) -> np.ndarray:
+        """methods.pce_moments.triple_products, once per basis."""
+        key = (tuple(germs), indices.shape, indices.tobytes(), square_indices.shape, square_indices.tobytes())
+        return self.get("triple products", key, lambda: triple_products(germs, indices, square_indices))
+
+
 def _start_output(store: ResultStore, name: str, method: dict, germs: list[str], design_kind: str,
-                  ok: np.ndarray, options: Options, pool: Executor) -> Callable[[], OutputStatistics]:
+                  ok: np.ndarray, options: Options, pool: Executor,
+                  reused: Reused | None = None) -> Callable[[], OutputStatistics]:
     """Read and fit output `name` here and hand its time blocks to `pool`; returns what waits for them
-    and gives the output's statistics."""
+    and gives the output's statistics. `reused`: what the outputs of one analysis share (Reused)."""
+    reused = reused or Reused()
     xi, weights = store.xi[ok], store.weights[ok]
     kind, order = method["kind"], method["order"]
     entry = method_entry(kind)
@@ -370,11 +404,11 @@ def _start_output(store: ResultStore, name: str, method: dict, germs: list[str],
     if from_runs:  # bands, PDFs and pick-freeze indices from the runs themselves
         rows, row_scale, band_weights = basis, scale, (None if entry.moments == "sample" else weights / weights.sum())
     else:
-        draws = draw_germs(germs, options.band_samples, options.seed)
-        rows, row_scale, band_weights = orthonormal_basis(germs, pce.indices, draws), pce.coefficients, None
+        rows, row_scale, band_weights = reused.band_rows(germs, pce.indices, options), pce.coefficients, None
     pick_freeze = from_runs and DESIGNS[design_kind].sobol_from_runs and ok.all()
     joined_blocks = _over_time_blocks(rows, row_scale, store.time.size, band_weights,
-                                      len(store.parameter_names) if pick_freeze else 0, options, from_runs, pool, pce)
+                                      len(store.parameter_names) if pick_freeze else 0, options, from_runs, pool, pce,
+                                      reused)
 
     def finish() -> OutputStatistics:
         blocks = joined_blocks()
@@ -455,15 +489,18 @@ def _lower_order_difference(kind, xi, weights, basis, scale, germs, order, x0, p
 
 
 def _over_time_blocks(rows, scale, n_times: int, weights, pick_freeze_dimensions: int, options: Options,
-                      from_runs: bool, pool: Executor, pce: PCE | None = None) -> Callable[[], dict]:
+                      from_runs: bool, pool: Executor, pce: PCE | None = None,
+                      reused: Reused | None = None) -> Callable[[], dict]:
     """Quantiles, 99 % band, skewness and kurtosis, PDFs, final-time samples (the runs' fourth central
     moments, pick-freeze indices) of Y = rows @ scale (scale None: Y = rows), rebuilding Y for
     TIME_BLOCK times at once: the memory stays that of one block per thread whatever the number of runs or
     draws. Every statistic here is per time, so blocks change nothing. A `pce`'s skewness and kurtosis are
     its exact ones (methods.pce_moments), not those of its draws; the KDE's std comes from the factors.
-    The blocks are handed to `pool`; returns what waits for them and joins them."""
+    The blocks are handed to `pool`; returns what waits for them and joins them. `reused`: the triple
+    products of outputs before (Reused)."""
     probabilities = (0.5 * (1 - BAND_LEVEL), 0.5 * (1 + BAND_LEVEL), *options.quantiles)
-    exact = None if pce is None else pce_standardised_moments(pce.germs, pce.indices, pce.coefficients)
+    products = triple_products if reused is None else reused.triple_products
+    exact = None if pce is None else pce_standardised_moments(pce.germs, pce.indices, pce.coefficients, products)
     std = None if scale is None else np.sqrt(np.maximum(weighted_moments(rows, None, scale, unbiased=True)[1], 0.0))
 
     def block(start: int) -> dict:

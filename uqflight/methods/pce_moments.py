@@ -30,9 +30,12 @@ def triple_products(germs: list[str], indices: np.ndarray, square_indices: np.nd
     return products
 
 
-def pce_standardised_moments(germs: list[str], indices, coefficients) -> tuple[np.ndarray, np.ndarray] | None:
+def pce_standardised_moments(germs: list[str], indices, coefficients,
+                             products=triple_products) -> tuple[np.ndarray, np.ndarray] | None:
     """Skewness E[Z³]/σ³ and Pearson's kurtosis E[Z⁴]/σ⁴ of the PCE (coefficients (Z, T)), each (T,),
-    NaN where σ = 0; None when the triple products would exceed MAX_TENSOR_ENTRIES (sample instead)."""
+    NaN where σ = 0; None when the triple products would exceed MAX_TENSOR_ENTRIES (sample instead).
+    `products`: what gives the triple products (triple_products, or a memo of it where many expansions
+    share a basis)."""
     indices = np.asarray(indices, dtype=int)
     coefficients = np.asarray(coefficients, dtype=float).reshape(len(indices), -1)
     varying = indices.any(axis=1)
@@ -43,7 +46,7 @@ def pce_standardised_moments(germs: list[str], indices, coefficients) -> tuple[n
     square_indices = total_degree_indices(indices.shape[1], 2 * order)
     if len(indices) ** 2 * len(square_indices) > MAX_TENSOR_ENTRIES:
         return None
-    products = triple_products(germs, indices, square_indices).reshape(len(indices) ** 2, -1)
+    products = products(germs, indices, square_indices).reshape(len(indices) ** 2, -1)
     position = {tuple(row): k for k, row in enumerate(square_indices)}
     linear_rows = [position[tuple(row)] for row in indices]  # where Z's terms sit in the basis Φ
     third, fourth = np.empty(centred.shape[1]), np.empty(centred.shape[1])
