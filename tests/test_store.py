@@ -6,6 +6,7 @@ import hashlib
 import inspect
 import json
 import os
+import re
 import shutil
 import signal
 import struct
@@ -318,6 +319,47 @@ def test_data_past_the_end_the_superblock_records_is_refused_with_the_remedy_and
         fh.truncate(size * 9 // 10)
     with pytest.raises(uqflight.store.results.CorruptFile, match=r"cut short.*--restart"):
         ResultStore.open(cut, "a")
+
+
+def set_recorded_end(path, end: int) -> None:
+    """A version-0 superblock's end-of-file address (bytes 40-48) set to `end`."""
+    with open(path, "r+b") as fh:
+        assert fh.read(9)[8] == 0
+        fh.seek(40)
+        fh.write(struct.pack("<Q", end))
+
+
+def test_a_resume_whose_first_look_at_the_file_reads_past_its_recorded_end_mends_it(tmp_path, reference):
+    """The same kill, where what the resume reads first (the root's attributes, the /samples/status link)
+    lies past the recorded end: before, the resume called the file damaged and advised --force, which
+    would have thrown away every run. The recorded end is set below each place where that first look
+    fails in its own way (the root's metadata lies in the file's first 16 KiB)."""
+    path = tmp_path / "short.h5"
+
+    def first_look(end: int) -> str:
+        shutil.copy(reference, path)
+        set_recorded_end(path, end)
+        try:
+            with h5py.File(path, "r") as f:
+                f.attrs.get("campaign_hash"), f.attrs.get("aircraft_hash"), "samples/status" in f
+        except (OSError, RuntimeError) as exc:
+            return re.sub(r"\d+", "N", " ".join(str(exc).split()))  # HDF5's reason, without its addresses
+        return "read"
+
+    failures: dict[str, int] = {}
+    for end in range(16384, 1024, -128):
+        failures.setdefault(first_look(end), end)
+    opened = {reason: end for reason, end in failures.items() if reason != "read" and "open file" not in reason}
+    assert len(opened) == 4, failures  # the link check, and three ways of failing to read the attributes
+    for reason, end in opened.items():
+        first_look(end)
+        with open_for_campaign(path, campaign_text=CAMPAIGN, **create_args()) as store:
+            assert store.pending().size == 0 and store.repaired == 0, reason
+        assert_same_results(path, reference)
+    unopened = max(end for reason, end in failures.items() if "open file" in reason)
+    first_look(unopened)  # below the root group's own header: HDF5 cannot open the file to move the end
+    with pytest.raises(FileExistsError, match="past the end its superblock records, which cannot be moved"):
+        open_for_campaign(path, campaign_text=CAMPAIGN, **create_args())
 
 
 @pytest.mark.parametrize("dataset, tsvd", [("outputs/alpha_deg", False), ("outputs/alpha_deg", True),

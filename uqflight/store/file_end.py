@@ -5,7 +5,8 @@ after the objects it allocated space for. A writer killed part-way through a flu
 on disk that point past that recorded end, with their bytes written: every read of them then fails
 ("addr overflow ... eoa"). HDF5's own remedy (`h5clear --increment`) is H5Fincrement_filesize, which
 moves the recorded end to the end of the file on disk; `extend_to_file_end` calls it through the HDF5
-library h5py runs on, for a file opened to resume. What the kill left half written is then found as
+library h5py runs on, for a file opened to resume (and `extend_file` for a file whose resume check
+failed on it). What the kill left half written is then found as
 after any kill: by the checksums and the status (see uqflight.store.results).
 """
 from __future__ import annotations
@@ -22,8 +23,11 @@ HINT = ("a writer was killed while HDF5 flushed the file, which left data past i
 
 
 def past_recorded_end(text: str) -> bool:
-    """Whether an HDF5 error message says a read went past the file's recorded end."""
-    return "addr overflow" in text and "eoa" in text
+    """Whether an HDF5 error message says a read went past the file's recorded end (its end of allocation,
+    EOA: "addr overflow ... eoa = ...", "actual len exceeds EOA", "address of object past end of
+    allocation", "len not positive after adjustment for EOA")."""
+    text = text.lower()
+    return "eoa" in text or "end of allocation" in text
 
 
 def extend_to_file_end(f: h5py.File) -> bool:
@@ -33,6 +37,16 @@ def extend_to_file_end(f: h5py.File) -> bool:
     if increment is None:
         return False
     return increment(f.id.id, 0) >= 0
+
+
+def extend_file(path) -> bool:
+    """extend_to_file_end of the file at `path`, opened for writing and closed again; False when it cannot
+    be opened or the library cannot be reached."""
+    try:
+        with h5py.File(path, "r+") as f:
+            return extend_to_file_end(f)
+    except (OSError, RuntimeError):
+        return False
 
 
 @functools.lru_cache(maxsize=1)

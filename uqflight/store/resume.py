@@ -6,6 +6,7 @@ from pathlib import Path
 
 import h5py
 
+from .file_end import extend_file, past_recorded_end
 from .results import READ_ERRORS, ResultStore, text_hash
 
 
@@ -37,12 +38,12 @@ def open_for_campaign(path, *, campaign_text: str, force: bool = False, restart:
                                   f"overwrites it, even with --force: remove it yourself (rm {path}) or "
                                   "choose another results file")
         try:
-            with h5py.File(path, "r") as f:
-                stored, stored_flown = f.attrs.get("campaign_hash"), {key: f.attrs.get(key) for key in FLOWN}
-                ours = stored is not None and "samples/status" in f
+            stored, stored_flown, ours = _stored_campaign(path)
         except READ_ERRORS as exc:  # e.g. killed while the file was being created: nothing to resume
             if not force:
                 reason = " ".join(str(exc).split())[:200]
+                if past_recorded_end(reason):  # and _stored_campaign could not move that end
+                    reason += "; its data run past the end its superblock records, which cannot be moved"
                 raise FileExistsError(f"{path} is a damaged HDF5 file ({reason}); choose another results "
                                       "file, or force to overwrite it") from exc
             stored, stored_flown = None, {}
@@ -71,6 +72,23 @@ def open_for_campaign(path, *, campaign_text: str, force: bool = False, restart:
         if path.exists():
             path.unlink()
         raise
+
+
+def _stored_campaign(path: Path) -> tuple:
+    """The file's campaign_hash, its FLOWN attributes, and whether it is a uqflight results file. A read
+    past the file's recorded end (a writer killed inside HDF5's flush, file_end) moves that end to the
+    file's and reads again: such a file resumes like any other."""
+    def read() -> tuple:
+        with h5py.File(path, "r") as f:
+            stored = f.attrs.get("campaign_hash")
+            return stored, {key: f.attrs.get(key) for key in FLOWN}, stored is not None and "samples/status" in f
+
+    try:
+        return read()
+    except READ_ERRORS as exc:
+        if not (past_recorded_end(str(exc)) and extend_file(path)):
+            raise
+    return read()
 
 
 def compact(path) -> None:
