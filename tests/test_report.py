@@ -326,3 +326,29 @@ def test_a_page_module_that_cannot_be_imported_is_the_error_told_even_when_the_w
     for writer in writers:  # reaped: no child is left behind
         with pytest.raises(ChildProcessError):
             os.waitpid(writer.pid, os.WNOHANG)
+
+
+@pytest.mark.skipif(not hasattr(os, "fork"), reason="the system cannot fork")
+def test_a_section_that_fails_in_the_child_sharing_the_drawing_fails_the_report_and_leaves_nothing(
+        pg, tmp_path, monkeypatch, capfd):
+    import time
+
+    import uqflight.report as report
+    import uqflight.report.sections as sections
+
+    parent, jobs_of = os.getpid(), sections.section_jobs
+
+    def failing_in_the_child(build):
+        def job():
+            if os.getpid() != parent:
+                raise OSError("no space left on device")
+            time.sleep(0.5)  # here, each section waits: the child takes the next ones meanwhile
+            return build()
+        return job
+
+    monkeypatch.setattr(sections, "section_jobs", lambda *args: [(cost, stage, failing_in_the_child(build))
+                                                                 for cost, stage, build in jobs_of(*args)])
+    with pytest.raises(RuntimeError, match=r"cannot draw the report's plots: a process drawing them failed \(exit 1\)"):
+        report.write_report([pg], tmp_path / "out")
+    assert "no space left on device" in capfd.readouterr().err  # the child's traceback
+    assert list(tmp_path.iterdir()) == []  # no report, no staging folder

@@ -8,6 +8,7 @@ from __future__ import annotations
 import gc
 import os
 import pickle
+import select
 import traceback
 from typing import Callable
 
@@ -74,7 +75,7 @@ def share_work(jobs: list[Callable[[], object]], order: list[int] | None = None,
     in `order` (a permutation of the indices, default as given: put the costliest first), so none idles
     while another has several left. `starting(index)` is told here as each of this process's own jobs
     starts. A job's error here is raised once the children are reaped; ChildFailed when a child's job
-    raised (its traceback printed) or a child died."""
+    raised (its traceback printed) or a child died, as soon as this process's job at the time is done."""
     order = list(range(len(jobs))) if order is None else list(order)
     processes = min(len(order), processes or os.cpu_count() or 1) if FORKS else 1
     if processes <= 1:
@@ -90,19 +91,23 @@ def share_work(jobs: list[Callable[[], object]], order: list[int] | None = None,
         os.close(write)
         return _results_of(jobs, taken())
 
+    def taken_here():  # until a child has ended: it ends when the queue is empty, or when it failed
+        for index in taken():
+            yield index
+            if select.select(children, [], [], 0)[0]:
+                return
+
     queue, children = os.fdopen(write, "wb"), []
     try:
         for _ in range(processes - 1):
             children.append(Child(child_work))
         queue.write(b"".join(index.to_bytes(4, "little") for index in order))
         queue.close()
-        results = _results_of(jobs, taken(), starting)
-    except BaseException:
+        results = _results_of(jobs, taken_here(), starting)
+    finally:
         queue.close()
         for _ in taken():  # the jobs no one has taken yet are dropped: the children end with their current one
             pass
-        raise
-    finally:
         outcomes = wait_all(children)
         os.close(read)
     for outcome in outcomes:

@@ -93,8 +93,8 @@ def _write_into(out_dir: Path, entries: list[Entry], ref: Entry | None, times, p
     try:
         sections = build_sections(entries, ref, times, out_dir, progress)
     except ChildFailed as exc:
-        raise RuntimeError(f"cannot draw the report's plots: a process drawing them {exc} (its error is printed "
-                           "above)") from None
+        raise RuntimeError(f"cannot draw the report's plots: a process drawing them {exc} (any error it printed "
+                           "is above)") from None
     for table in (block for section in sections for block in section.blocks if isinstance(block, Table)):
         written.append(write_csv(out_dir / table.file, table.header, table.rows))
     written += [out_dir / "report.html", out_dir / "report.md"]
