@@ -56,9 +56,12 @@ def build_sections(entries: list[Entry], ref: Entry | None, times: list[float], 
     if progress is not None:
         progress.stage("drawing the plots", len(jobs), "sections")
 
-    def starting(k: int) -> None:
+    started = []
+
+    def starting(k: int) -> None:  # this process's job before it is done
         if progress is not None:
-            progress.advance(0 if k == order[0] else 1, jobs[k][1])
+            progress.advance(1 if started else 0, jobs[k][1])
+        started.append(k)
 
     plots.warm_text_caches()  # before the fork: every process inherits the loaded fonts
     with plots.collecting_at_the_end():
