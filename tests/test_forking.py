@@ -43,3 +43,53 @@ def test_a_job_failing_here_is_raised_after_the_children_are_reaped():
         share_work([job] * 6, processes=2)
     with pytest.raises(ChildProcessError):  # no child of this test left running or unreaped
         os.waitpid(-1, os.WNOHANG)
+
+
+def test_a_failing_child_tells_its_error_even_when_the_parent_held_stderr_at_the_fork(monkeypatch, capfd):
+    """A thread of the parent inside a write to sys.stderr at the fork (as a progress bar's refresh can
+    be) leaves the child a lock no one will release: the child's traceback goes to the descriptor."""
+    import io
+    import threading
+
+    read, write = os.pipe()
+    blocked = io.TextIOWrapper(io.BufferedWriter(io.FileIO(write, "w")), write_through=True)
+    monkeypatch.setattr("sys.stderr", blocked)
+    def write():
+        try:
+            blocked.write("x" * (1 << 20))
+        except OSError:  # the pipe closed, at the end
+            pass
+
+    writer = threading.Thread(target=write, daemon=True)
+    writer.start()  # more than the pipe holds: it blocks inside the write, holding the buffer's lock
+    for _ in range(3000):  # until the pipe is full: then the writer is blocked inside its write
+        if queued(read) >= 60000:
+            break
+        time.sleep(0.01)
+    assert queued(read) >= 60000
+    child = Child(lambda: 1 / 0)
+    done = first_ready(child, 60.0)
+    if not done:
+        os.kill(child.pid, 9)
+    with pytest.raises(ChildFailed):
+        child.wait()
+    os.close(read)  # the writer's write fails now, and it ends
+    assert done, "the child hung on sys.stderr's lock"
+    assert "ZeroDivisionError" in capfd.readouterr().err
+
+
+def first_ready(child: Child, timeout: float) -> bool:
+    import select
+
+    return bool(select.select([child], [], [], timeout)[0])
+
+
+def queued(fd: int) -> int:
+    """The bytes waiting in a pipe."""
+    import array
+    import fcntl
+    import termios
+
+    count = array.array("i", [0])
+    fcntl.ioctl(fd, termios.FIONREAD, count)
+    return count[0]

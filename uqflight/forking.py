@@ -34,7 +34,7 @@ class Child:
                 with os.fdopen(write, "wb") as pipe:
                     pipe.write(payload)
             except BaseException:
-                traceback.print_exc()
+                _tell_error(traceback.format_exc())
                 code = 1
             os._exit(code)
         gc.unfreeze()
@@ -55,6 +55,18 @@ class Child:
         if status != 0 or not payload:
             raise ChildFailed(f"failed (exit {status})")
         return pickle.loads(payload)
+
+
+def _tell_error(text: str) -> None:
+    """`text` on the standard error's file descriptor itself: in a forked child, sys.stderr's lock may be
+    held for good by a thread of the parent that was writing at the fork (a progress bar's refresh) and
+    does not exist here."""
+    data = text.encode(errors="replace")
+    try:
+        while data:
+            data = data[os.write(2, data):]
+    except OSError:
+        pass
 
 
 def wait_all(children: list[Child]) -> list:
