@@ -343,7 +343,7 @@ def _output_statistics(store: ResultStore, name: str, method: dict, germs: list[
                        ok: np.ndarray, options: Options) -> OutputStatistics:
     """The statistics of output `name` over the `ok` runs, its time blocks in ANALYSIS_THREADS threads."""
     with ThreadPoolExecutor(ANALYSIS_THREADS) as pool:
-        return _start_output(store, name, method, germs, design_kind, ok, options, pool)()
+        return _start_output(store, name, method, germs, design_kind, ok, options, pool, Reused())()
 
 
 class Reused:
@@ -377,11 +377,9 @@ class Reused:
 
 
 def _start_output(store: ResultStore, name: str, method: dict, germs: list[str], design_kind: str,
-                  ok: np.ndarray, options: Options, pool: Executor,
-                  reused: Reused | None = None) -> Callable[[], OutputStatistics]:
+                  ok: np.ndarray, options: Options, pool: Executor, reused: Reused) -> Callable[[], OutputStatistics]:
     """Read and fit output `name` here and hand its time blocks to `pool`; returns what waits for them
     and gives the output's statistics. `reused`: what the outputs of one analysis share (Reused)."""
-    reused = reused or Reused()
     xi, weights = store.xi[ok], store.weights[ok]
     kind, order = method["kind"], method["order"]
     entry = method_entry(kind)
@@ -489,8 +487,7 @@ def _lower_order_difference(kind, xi, weights, basis, scale, germs, order, x0, p
 
 
 def _over_time_blocks(rows, scale, n_times: int, weights, pick_freeze_dimensions: int, options: Options,
-                      from_runs: bool, pool: Executor, pce: PCE | None = None,
-                      reused: Reused | None = None) -> Callable[[], dict]:
+                      from_runs: bool, pool: Executor, pce: PCE | None, reused: Reused) -> Callable[[], dict]:
     """Quantiles, 99 % band, skewness and kurtosis, PDFs, final-time samples (the runs' fourth central
     moments, pick-freeze indices) of Y = rows @ scale (scale None: Y = rows), rebuilding Y for
     TIME_BLOCK times at once: the memory stays that of one block per thread whatever the number of runs or
@@ -499,8 +496,8 @@ def _over_time_blocks(rows, scale, n_times: int, weights, pick_freeze_dimensions
     The blocks are handed to `pool`; returns what waits for them and joins them. `reused`: the triple
     products of outputs before (Reused)."""
     probabilities = (0.5 * (1 - BAND_LEVEL), 0.5 * (1 + BAND_LEVEL), *options.quantiles)
-    products = triple_products if reused is None else reused.triple_products
-    exact = None if pce is None else pce_standardised_moments(pce.germs, pce.indices, pce.coefficients, products)
+    exact = None if pce is None else pce_standardised_moments(pce.germs, pce.indices, pce.coefficients,
+                                                              reused.triple_products)
     std = None if scale is None else np.sqrt(np.maximum(weighted_moments(rows, None, scale, unbiased=True)[1], 0.0))
 
     def block(start: int) -> dict:
