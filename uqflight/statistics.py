@@ -56,6 +56,7 @@ from .methods.validity import method_problem
 from .parameters.distributions import SEED_REFUSAL
 from .parameters.germs import draw_germs
 from .store import CorruptFile, ResultStore, Status
+from .store.results import one_line
 
 PDF_POINTS = 120
 TIME_BLOCK = 100  # recorded times whose runs or surrogate draws are rebuilt at once
@@ -176,8 +177,7 @@ def read_statistics(path, method: dict | None = None, partial: bool = False,
     except CorruptFile as exc:
         raise BadInput(str(exc) if str(exc).startswith(f"{path}:") else f"{path}: {exc}") from exc
     except (OSError, ValueError, KeyError) as exc:
-        reason = " ".join(str(exc).split())  # one line, whatever h5py or the analysis said
-        raise BadInput(f"{path}: cannot analyse the results file ({reason})") from exc
+        raise BadInput(f"{path}: cannot analyse the results file ({one_line(exc)})") from exc
 
 
 def analyse(path, reference: str | None = None, options: Options | None = None, method: dict | None = None,

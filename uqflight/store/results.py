@@ -82,9 +82,14 @@ class CorruptFile(ValueError):
 READ_ERRORS = (OSError, RuntimeError)  # what h5py raises for data or links it cannot read
 
 
+def one_line(exc: BaseException) -> str:
+    """An error's message on one line (h5py's span several)."""
+    return " ".join(str(exc).split())
+
+
 def read_error(exc: BaseException) -> str:
     """One line on an HDF5 read error; a failed checksum is called what it is."""
-    text = " ".join(str(exc).split())
+    text = one_line(exc)
     if "filter" in text.lower() or "checksum" in text.lower():
         return f"data corrupted: a checksum (fletcher32) does not match ({text})"
     if past_recorded_end(text):
@@ -95,9 +100,8 @@ def read_error(exc: BaseException) -> str:
 def _unreadable(path, exc: BaseException, extended: bool) -> CorruptFile:
     """The CorruptFile for a file that fails a read on opening; `extended`: its recorded end was moved to
     the file's already (file_end), so a read past it is past the bytes on disk."""
-    text = " ".join(str(exc).split())
-    if extended and past_recorded_end(text):
-        return CorruptFile(f"{path}: {text}: data past the end of the file on disk (the file was cut short, "
+    if extended and past_recorded_end(str(exc)):
+        return CorruptFile(f"{path}: {one_line(exc)}: data past the end of the file on disk (the file was cut short, "
                            "e.g. copied or written out incompletely): it cannot be mended; fly the campaign "
                            "again (`uqflight run CAMPAIGN --out FILE --restart`)")
     return CorruptFile(f"{path}: {read_error(exc)}")

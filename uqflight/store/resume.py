@@ -7,7 +7,7 @@ from pathlib import Path
 import h5py
 
 from .file_end import extend_file, past_recorded_end
-from .results import READ_ERRORS, ResultStore, text_hash
+from .results import READ_ERRORS, ResultStore, one_line, text_hash
 
 
 FLOWN = ("aircraft_hash", "scenario")  # what a results file's runs flew beside the campaign text (the
@@ -41,7 +41,7 @@ def open_for_campaign(path, *, campaign_text: str, force: bool = False, restart:
             stored, stored_flown, ours = _stored_campaign(path)
         except READ_ERRORS as exc:  # e.g. killed while the file was being created: nothing to resume
             if not force:
-                reason = " ".join(str(exc).split())[:200]
+                reason = one_line(exc)[:200]
                 if past_recorded_end(reason):  # and _stored_campaign could not move that end
                     reason += "; its data run past the end its superblock records, which cannot be moved"
                 raise FileExistsError(f"{path} is a damaged HDF5 file ({reason}); choose another results "
