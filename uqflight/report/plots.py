@@ -26,6 +26,7 @@ from matplotlib.ticker import FixedLocator, FuncFormatter, LogLocator, MaxNLocat
 
 from ..labels import label, short_label  # noqa: E402,F401 (plots.label: the report's captions)
 from .formats import export_format, shown_path  # noqa: E402
+from .png import write_png  # noqa: E402
 
 TIME_LABEL = "time [s]"
 DPI = 110
@@ -38,8 +39,6 @@ LOW_QUANTILE = 0.02  # error and decay axes start below the lowest line's 2 % qu
 OFFSET_DATUM = 10.0  # min|mean| above this many times the mean's excursion: an offset datum (h, V), no CoV
 DECAY_ONSET = 1e-3  # without a known pulse start, coefficient decay is drawn from where degree >= 1 reaches
 #                     this share of its largest value
-FAST_PNG = {"pil_kwargs": {"compress_level": 1}}  # zlib's fastest level: the same pixels, written in half the
-#                                                   time of the default 6, the files about 15 % larger
 
 
 def write_figure(fig, path: Path, dpi: int = DPI, rect=None) -> Path:
@@ -57,7 +56,10 @@ def write_figure(fig, path: Path, dpi: int = DPI, rect=None) -> Path:
 def _save_as(fig, path: Path, dpi: int = DPI) -> None:
     """Write `fig` as the page's file of `path` (and a PDF beside it when the export format is pdf)."""
     shown = shown_path(path)
-    fig.savefig(shown, dpi=dpi, **(FAST_PNG if shown.suffix == ".png" else {}))
+    if shown.suffix == ".png":
+        write_png(fig, shown, dpi)
+    else:
+        fig.savefig(shown, dpi=dpi)
     if export_format() == "pdf":
         fig.savefig(Path(path).with_suffix(".pdf"))
 
