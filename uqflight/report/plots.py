@@ -131,15 +131,15 @@ def plot_flight(time: np.ndarray, outputs: dict[str, np.ndarray], path: Path, ti
 
 
 def _panels(count: int, title: str, row_height: float = 2.9):
-    """A figure with one panel per output: one column up to two outputs, else two; unused panels hidden."""
+    """A figure with one panel per output: one column up to two outputs, else two, the last row's free
+    places left empty (no axes is built there)."""
     columns = 1 if count <= 2 else 2
     rows = -(-count // columns)
-    fig, axes = plt.subplots(rows, columns, figsize=(6.2 * columns, row_height * rows + 0.9), squeeze=False)
-    for ax in axes.flat[count:]:
-        ax.set_visible(False)
+    fig = plt.figure(figsize=(6.2 * columns, row_height * rows + 0.9))
+    axes = [fig.add_subplot(rows, columns, k + 1) for k in range(count)]
     fig.suptitle(title, fontsize=12)
     fig.panel_grid = (rows, columns)  # laid out by _save with fixed margins, not a layout pass
-    return fig, list(axes.flat[:count])
+    return fig, axes
 
 
 # margins of a panel grid, in inches: tick labels and the axis label on the left of each panel; its title
