@@ -43,7 +43,7 @@ def open_for_campaign(path, *, campaign_text: str, force: bool = False, restart:
             if not force:
                 reason = one_line(exc)[:200]
                 if past_recorded_end(reason):  # and _stored_campaign could not move that end
-                    reason += "; its data run past the end its superblock records, which cannot be moved"
+                    reason += "; its data run past the end its superblock records, and that end could not be mended"
                 raise FileExistsError(f"{path} is a damaged HDF5 file ({reason}); choose another results "
                                       "file, or force to overwrite it") from exc
             stored, stored_flown = None, {}
