@@ -4,7 +4,7 @@ import time
 
 import pytest
 
-from uqflight.forking import FORKS, Child, ChildFailed, share_work, wait_all
+from uqflight.forking import FORKS, Child, ChildFailed, Standby, share_work, wait_all
 
 pytestmark = pytest.mark.skipif(not FORKS, reason="the system cannot fork")
 
@@ -76,6 +76,115 @@ def test_a_failing_child_tells_its_error_even_when_the_parent_held_stderr_at_the
     os.close(read)  # the writer's write fails now, and it ends
     assert done, "the child hung on sys.stderr's lock"
     assert "ZeroDivisionError" in capfd.readouterr().err
+
+
+def test_a_standby_gets_ready_then_does_its_work_telling_on_the_way(tmp_path):
+    def prepare():
+        (tmp_path / "ready").write_text(str(os.getpid()))
+
+    def work(payload, tell):
+        for k in range(3):
+            tell(("step", k))
+        return {"twice": [2 * x for x in payload], "pid": os.getpid(), "group": os.getpgid(0)}
+
+    standby = Standby(prepare, work)
+    standby.start(list(range(100000)))  # larger than a pipe holds: sent from a thread, this process goes on
+    heard = []
+    result = standby.wait(heard.append)
+    standby.close()  # after a wait: nothing left to do
+    assert heard == [("step", 0), ("step", 1), ("step", 2)]
+    assert result["twice"] == [2 * x for x in range(100000)]
+    assert result["pid"] != os.getpid() and result["group"] == result["pid"]  # a process group of its own
+    assert (tmp_path / "ready").read_text() == str(result["pid"])
+
+
+def test_a_standby_closed_before_its_work_ends_without_doing_it(tmp_path):
+    standby = Standby(lambda: None, lambda payload, tell: (tmp_path / "worked").write_text(""))
+    standby.close()
+    assert not (tmp_path / "worked").exists()
+    with pytest.raises(ChildProcessError):  # reaped
+        os.waitpid(standby.child.pid, os.WNOHANG)
+
+
+def test_closing_a_working_standby_ends_it_and_the_children_it_forked(tmp_path):
+    def work(payload, tell):
+        helper = Child(lambda: time.sleep(120))
+        (tmp_path / "helper").write_text(str(helper.pid))
+        time.sleep(120)
+
+    standby = Standby(lambda: None, work)
+    standby.start(None)
+    for _ in range(3000):
+        if (tmp_path / "helper").exists() and (tmp_path / "helper").read_text():
+            break
+        time.sleep(0.01)
+    helper = int((tmp_path / "helper").read_text())
+    standby.close()  # without it this test waits two minutes for the standby
+    with pytest.raises(ChildProcessError):
+        os.waitpid(standby.child.pid, os.WNOHANG)
+    for _ in range(3000):  # the helper, the standby's child, ends too (then reaped by init)
+        if not alive(helper):
+            break
+        time.sleep(0.01)
+    assert not alive(helper)
+
+
+def test_a_standby_whose_work_fails_is_reported_with_its_error(capfd):
+    standby = Standby(lambda: None, lambda payload, tell: payload / 0)
+    standby.start(1)
+    with pytest.raises(ChildFailed, match="exit 1"):
+        standby.wait()
+    standby.close()
+    assert "ZeroDivisionError" in capfd.readouterr().err
+
+
+def test_a_standby_writes_to_stderr_even_when_the_parent_held_it_at_the_fork(monkeypatch, capfd):
+    """As for a failing Child, but the standby writes through sys.stderr itself (a library's warning while
+    it imports): it gets sys.stderr opened anew on its descriptor."""
+    import io
+    import sys
+    import threading
+
+    inside, release = threading.Event(), threading.Event()
+
+    class Stalling(io.RawIOBase):  # the standard error, whose write stalls (a refresh in progress)
+        def writable(self):
+            return True
+
+        def fileno(self):
+            return 2
+
+        def write(self, data):
+            inside.set()
+            release.wait()
+            return len(data)
+
+    blocked = io.TextIOWrapper(io.BufferedWriter(Stalling()), write_through=True)
+    monkeypatch.setattr("sys.stderr", blocked)
+    writer = threading.Thread(target=lambda: blocked.write("r" * 100000), daemon=True)  # beyond its buffer
+    writer.start()
+    assert inside.wait(60)  # the writer is inside its write, holding the stream's lock
+    standby = Standby(lambda: print("warning from the standby", file=sys.stderr), lambda payload, tell: "done")
+    standby.start(None)
+    done = first_ready(standby.child, 60.0)
+    if not done:
+        os.kill(standby.child.pid, 9)
+    try:
+        assert done, "the standby hung on sys.stderr's lock"
+        assert standby.wait() == "done"
+    finally:
+        standby.close()
+        release.set()
+    assert "warning from the standby" in capfd.readouterr().err
+
+
+def alive(pid: int) -> bool:
+    """Whether process `pid` exists and is not a zombie."""
+    try:
+        with open(f"/proc/{pid}/stat") as stat:
+            return stat.read().rsplit(")", 1)[1].split()[0] != "Z"
+    except FileNotFoundError:
+        return False
 
 
 def first_ready(child: Child, timeout: float) -> bool:

@@ -17,7 +17,7 @@ from uqflight.report import plots, write_report
 from uqflight.report.formats import exporting
 from uqflight.report.loading import load_entries
 from uqflight.report.render import figure_html
-from uqflight.report.sections import Figure
+from uqflight.report.blocks import Figure
 
 PHUGOID = """
 name: phugoid-{name}

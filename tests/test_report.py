@@ -5,6 +5,7 @@ import os
 import re
 import shutil
 import subprocess
+import sys
 from pathlib import Path
 
 import h5py
@@ -286,46 +287,66 @@ def test_several_methods_over_the_same_runs(decay_results, tmp_path):
         assert not (tmp_path / "bad").exists()
 
 
-def test_data_files_that_cannot_be_written_fail_the_report_and_leave_nothing(pg, tmp_path, monkeypatch, capfd):
+def _recording_drawers(monkeypatch, report) -> list:
+    """The Standby drawers write_report forks, recorded (to check they are reaped)."""
+    drawers = []
+
+    def recorded(*args):
+        drawers.append(report.Standby.__wrapped__(*args))
+        return drawers[-1]
+
+    recorded.__wrapped__ = report.Standby
+    monkeypatch.setattr(report, "Standby", recorded)
+    return drawers
+
+
+def _assert_reaped(drawers, report) -> None:
+    assert len(drawers) == (1 if report.FORKS else 0)
+    for drawer in drawers:  # no child is left behind, running or unreaped
+        with pytest.raises(ChildProcessError):
+            os.waitpid(drawer.child.pid, os.WNOHANG)
+
+
+def test_data_files_that_cannot_be_written_fail_the_report_and_leave_nothing(pg, tmp_path, monkeypatch):
     import uqflight.report as report
 
     def refuse(entries, out_dir):
         raise OSError("no space left on device")
 
-    monkeypatch.setattr(report, "write_statistics_tables", refuse)  # the forked writer inherits it
-    with pytest.raises(RuntimeError, match="cannot write summary.json and the statistics tables: the writer failed"):
+    drawers = _recording_drawers(monkeypatch, report)
+    monkeypatch.setattr(report, "write_statistics_tables", refuse)
+    with pytest.raises(OSError, match="no space left on device"):  # the CLI: "cannot write the report: ...", exit 2
         report.write_report([pg], tmp_path / "out")
-    assert "no space left on device" in capfd.readouterr().err  # the writer's own traceback
     assert list(tmp_path.iterdir()) == []  # no report, no staging folder
+    _assert_reaped(drawers, report)
 
 
-def test_a_page_module_that_cannot_be_imported_is_the_error_told_even_when_the_writer_fails(
+def test_a_page_module_that_cannot_be_imported_is_the_error_told_and_the_drawer_is_reaped(
         pg, tmp_path, monkeypatch, capfd):
     import sys
 
     import uqflight.report as report
-    from uqflight.forking import Child
 
-    def refuse(entries, out_dir):
-        raise OSError("no space left on device")
-
-    writers = []
-
-    def recorded(work):
-        writers.append(Child(work))
-        return writers[-1]
-
-    monkeypatch.setattr(report, "write_statistics_tables", refuse)
-    monkeypatch.setattr(report, "Child", recorded)
+    drawers = _recording_drawers(monkeypatch, report)
     monkeypatch.setitem(sys.modules, "uqflight.report.render", None)  # `from .render import ...` fails
     with pytest.raises(ImportError, match="uqflight.report.render"):
         report.write_report([pg], tmp_path / "out")
     capfd.readouterr()
     assert list(tmp_path.iterdir()) == []  # no report, no staging folder
-    assert len(writers) == (1 if report.FORKS else 0)
-    for writer in writers:  # reaped: no child is left behind
-        with pytest.raises(ChildProcessError):
-            os.waitpid(writer.pid, os.WNOHANG)
+    _assert_reaped(drawers, report)
+
+
+@pytest.mark.skipif(not hasattr(os, "fork"), reason="the system cannot fork")
+def test_the_reports_own_process_never_imports_matplotlib(pg, tmp_path):
+    """The drawer (a child that got ready during the analysis) draws everything: the report's process
+    writes the data files and the page without matplotlib."""
+    code = ("import sys; from uqflight.report import write_report; "
+            f"write_report([{str(pg)!r}], {str(tmp_path / 'out')!r}); "
+            "print(sorted(m for m in sys.modules if m.split('.')[0] == 'matplotlib'))")
+    result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300)
+    assert result.returncode == 0, result.stderr
+    assert result.stdout.strip() == "[]"
+    assert (tmp_path / "out" / "plots" / "mean_band_pg.png").is_file()
 
 
 @pytest.mark.skipif(not hasattr(os, "fork"), reason="the system cannot fork")
@@ -338,11 +359,11 @@ def test_a_section_that_fails_in_the_child_sharing_the_drawing_fails_the_report_
 
     parent, jobs_of = os.getpid(), sections.section_jobs
 
-    def failing_in_the_child(build):
+    def failing_in_the_child(build):  # the drawer's own child, the drawer being this test's child
         def job():
-            if os.getpid() != parent:
+            if os.getppid() != parent:
                 raise OSError("no space left on device")
-            time.sleep(0.5)  # here, each section waits: the child takes the next ones meanwhile
+            time.sleep(0.5)  # in the drawer, each section waits: its child takes the next ones meanwhile
             return build()
         return job
 

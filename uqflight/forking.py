@@ -1,14 +1,17 @@
-"""Work done in a forked child while the parent goes on (the data files beside the page's imports, runs
-split over processes, the report's sections shared between processes). The child inherits the parent's
-memory, so nothing is pickled on the way in; its result comes back pickled through a pipe. It runs no
-handler of the parent's and leaves with os._exit; a child that fails or dies is reported as such when
-waited for."""
+"""Work done in a forked child while the parent goes on (runs split over processes, the report's sections
+shared between processes, drawn by a child that got ready during the analysis). The child inherits the
+parent's memory, so nothing is pickled on the way in (but a Standby's payload); its result comes back
+pickled through a pipe. It runs no handler of the parent's and leaves with os._exit; a child that fails
+or dies is reported as such when waited for."""
 from __future__ import annotations
 
 import gc
 import os
 import pickle
 import select
+import signal
+import sys
+import threading
 import traceback
 from typing import Callable
 
@@ -46,9 +49,12 @@ class Child:
         return self._read
 
     def wait(self):
-        """The child's result; ChildFailed when it raised or died."""
-        with os.fdopen(self._read, "rb") as pipe:  # read first: a large result would block the child
-            payload = pipe.read()
+        """The child's result; ChildFailed when it raised or died. After a wait cut short (an interrupt while
+        reading), a second one reaps the child."""
+        read, self._read, payload = self._read, None, b""
+        if read is not None:
+            with os.fdopen(read, "rb") as pipe:  # read first: a large result would block the child
+                payload = pipe.read()
         status = os.waitstatus_to_exitcode(os.waitpid(self.pid, 0)[1])
         if status < 0:
             raise ChildFailed(f"died (signal {-status})")
@@ -137,3 +143,123 @@ def _results_of(jobs: list[Callable[[], object]], indices, starting=None) -> dic
             starting(index)
         results[index] = jobs[index]()
     return results
+
+
+class Standby:
+    """A child forked now that gets ready (`prepare()`, e.g. imports) while this process goes on, then
+    waits for its work: `start(payload)` sends it `payload` (pickled, from a thread: this process goes on
+    at once) and the child returns `work(payload, tell)`; `tell(message)` sends this process a small
+    picklable message (under 4 kB), which `wait(heard)` passes to `heard` as it comes. The child leads a
+    process group of its own with the children it forks: an interrupt of the terminal reaches this
+    process only, and `close()` ends the whole group, whatever it was doing."""
+
+    def __init__(self, prepare: Callable[[], None], work: Callable[[object, Callable[[object], None]], object]):
+        payload_read, self._payload = os.pipe()
+        self._messages, messages_write = os.pipe()
+        self._sender: threading.Thread | None = None
+        self._reaped = False
+
+        def standby():
+            os.setpgid(0, 0)
+            _fresh_standard_streams()
+            os.close(self._payload)
+            os.close(self._messages)
+            prepare()
+            with os.fdopen(payload_read, "rb") as pipe:
+                data = pipe.read()
+            if not data:  # closed without work
+                return None
+            return work(pickle.loads(data), lambda message: _send_message(messages_write, message))
+
+        self.child = Child(standby)
+        try:
+            os.setpgid(self.child.pid, self.child.pid)  # also here: close() may come before the child's own call
+        except OSError:  # the child did it first (or has already ended)
+            pass
+        os.close(payload_read)
+        os.close(messages_write)
+
+    def start(self, payload) -> None:
+        """Send the child its work's payload."""
+        data, fd = pickle.dumps(payload, protocol=pickle.HIGHEST_PROTOCOL), self._payload
+        self._payload = None
+
+        def send():
+            try:
+                with os.fdopen(fd, "wb") as pipe:
+                    pipe.write(data)
+            except BrokenPipeError:  # the child ended before reading it: wait() says how
+                pass
+
+        self._sender = threading.Thread(target=send, daemon=True)
+        self._sender.start()
+
+    def wait(self, heard: Callable[[object], None] | None = None):
+        """The child's result, its messages passed to `heard` first; ChildFailed as for a Child."""
+        if self._sender is not None:
+            self._sender.join()
+        with os.fdopen(self._messages, "rb", buffering=0) as messages:
+            self._messages = None
+            while (message := self._next_message(messages)) is not None:
+                if heard is not None:
+                    heard(message)
+        try:
+            result = self.child.wait()
+        except ChildFailed:  # reaped all the same
+            self._reaped = True
+            raise
+        self._reaped = True
+        return result
+
+    def _next_message(self, messages):
+        """The next message, or None once the child's result is there (or it has ended) and every message
+        it sent before is read."""
+        ready = select.select([messages, self.child], [], [])[0]
+        if messages not in ready and not select.select([messages], [], [], 0)[0]:
+            return None
+        return _read_message(messages)  # None at the messages' end: the child and its children have ended
+
+    def close(self) -> None:
+        """End the child and the children it forked, unless it has been waited for, and reap it."""
+        for fd in (self._payload, self._messages):
+            if fd is not None:
+                os.close(fd)
+        self._payload = self._messages = None
+        if self._reaped:
+            return
+        try:
+            os.killpg(self.child.pid, signal.SIGTERM)
+        except OSError:  # it has ended, and the group with it
+            pass
+        wait_all([self.child])
+        self._reaped = True
+
+
+def _fresh_standard_streams() -> None:
+    """sys.stdout and sys.stderr opened anew on their descriptors: a thread of the parent inside a write
+    to one at the fork (a progress bar's refresh) leaves its lock held for good here, and a long-lived
+    child may well write (a library's warning). Streams without a descriptor (a test's capture) stay."""
+    for name in ("stdout", "stderr"):
+        stream = getattr(sys, name)
+        try:
+            fd = stream.fileno()
+        except (AttributeError, OSError, ValueError):
+            continue
+        setattr(sys, name, open(fd, "w", buffering=1, encoding=getattr(stream, "encoding", None) or "utf-8",
+                                errors="backslashreplace", closefd=False))
+
+
+def _send_message(fd: int, message) -> None:
+    data = pickle.dumps(message, protocol=pickle.HIGHEST_PROTOCOL)
+    os.write(fd, len(data).to_bytes(4, "little") + data)  # one write under PIPE_BUF: never interleaved
+
+
+def _read_message(pipe):
+    """The next message on `pipe`, or None at its end."""
+    head = pipe.read(4)
+    if len(head) < 4:
+        return None
+    size, data = int.from_bytes(head, "little"), b""
+    while len(data) < size:
+        data += pipe.read(size - len(data))
+    return pickle.loads(data)

@@ -21,12 +21,12 @@ import shutil
 from pathlib import Path
 
 from ..check import write_baseline
-from ..forking import FORKS, Child, ChildFailed, wait_all
+from ..forking import FORKS, ChildFailed, Standby
 from ..progress import Progress
 from ..methods.parsing import parse_methods
 from .files import _write_text, write_csv, write_statistics_tables, write_summaries
 from .loading import Entry, load_entries
-from .formats import FORMATS, exporting
+from .formats import FORMATS, export_format, exporting
 from .replace import check_replaceable, make_staging, replace_dir
 
 __all__ = ["check_replaceable", "default_out_dir", "parse_methods", "write_report"]
@@ -56,45 +56,54 @@ def write_report(paths: list[Path], out_dir: Path | None = None, reference: Path
         raise ValueError(f"figure format: expected one of {', '.join(FORMATS)}, got {fmt!r}")
     check_replaceable(out_dir)
     progress = progress or Progress(0, quiet=True)
-    entries, ref = load_entries(paths, reference, method, progress=progress, partial=partial,
-                                allow_aliasing=allow_aliasing)
-    out_dir.parent.mkdir(parents=True, exist_ok=True)
-    staging = make_staging(out_dir)
+    drawer = Standby(_ready_to_draw, _draw) if FORKS else None  # gets ready while the files are analysed
     try:
-        with exporting(fmt):
-            _write_into(staging, entries, ref, times, progress)
-        written = sorted(out_dir / p.relative_to(staging) for p in staging.rglob("*") if p.is_file())
-        progress.stage(f"moving the report into {out_dir}")
-        replace_dir(staging, out_dir)
-    except BaseException:
-        shutil.rmtree(staging, ignore_errors=True)
-        raise
+        entries, ref = load_entries(paths, reference, method, progress=progress, partial=partial,
+                                    allow_aliasing=allow_aliasing)
+        out_dir.parent.mkdir(parents=True, exist_ok=True)
+        staging = make_staging(out_dir)
+        try:
+            with exporting(fmt):
+                _write_into(staging, entries, ref, times, progress, drawer)
+            written = sorted(out_dir / p.relative_to(staging) for p in staging.rglob("*") if p.is_file())
+            progress.stage(f"moving the report into {out_dir}")
+            replace_dir(staging, out_dir)
+        except BaseException:
+            shutil.rmtree(staging, ignore_errors=True)
+            raise
+    finally:
+        if drawer is not None:
+            drawer.close()
     if baseline:
         written.append(write_baseline(entries[0].stats, entries[0].campaign_hash, baseline))
     return written
 
 
-def _write_into(out_dir: Path, entries: list[Entry], ref: Entry | None, times, progress: Progress) -> None:
+def _write_into(out_dir: Path, entries: list[Entry], ref: Entry | None, times, progress: Progress,
+                drawer: Standby | None) -> None:
+    """The report's files in `out_dir`: the data files written here while `drawer` (a Standby of _draw;
+    None: this process) draws the sections, then the page."""
     for sub in ("plots", "tables"):
         (out_dir / sub).mkdir(parents=True, exist_ok=True)
+    heard = _drawing_progress(progress)
+    if drawer is not None:
+        drawer.start((entries, ref, times, out_dir, export_format()))
     progress.stage("writing summaries and tables")
-    # the data files are written by a forked child while the page's own modules (matplotlib comes with
-    # .plots) are imported here, each on a core of its own; imported by nothing that `surrogate export`
-    # imports, and after the analysis, whose threads an import beside them slowed by more than it costs
-    child = Child(lambda: _data_files(entries, out_dir)) if FORKS else None
-    try:
-        from .render import render_html, render_markdown
-        from .sections import Table, build_sections, files_section
-    except BaseException:  # the import's error is the one to tell; the writer is reaped, whatever it did
-        if child is not None:
-            wait_all([child])
-        raise
-    written = _data_files(entries, out_dir) if child is None else _written_by(child)
-    try:
-        sections = build_sections(entries, ref, times, out_dir, progress)
-    except ChildFailed as exc:
-        raise RuntimeError(f"cannot draw the report's plots: a process drawing them {exc} (any error it printed "
-                           "is above)") from None
+    written = _data_files(entries, out_dir)
+    if drawer is None:
+        from .sections import build_sections
+
+        sections = build_sections(entries, ref, times, out_dir, heard)
+    else:
+        try:
+            sections = drawer.wait(heard)
+        except ChildFailed as exc:
+            raise RuntimeError(f"cannot draw the report's plots: a process drawing them {exc} (any error it "
+                               "printed is above)") from None
+    heard(("drawn", None))
+    from .blocks import Table, files_section
+    from .render import render_html, render_markdown
+
     for table in (block for section in sections for block in section.blocks if isinstance(block, Table)):
         written.append(write_csv(out_dir / table.file, table.header, table.rows))
     written += [out_dir / "report.html", out_dir / "report.md"]
@@ -105,14 +114,44 @@ def _write_into(out_dir: Path, entries: list[Entry], ref: Entry | None, times, p
     _write_text(out_dir / "report.md", render_markdown(title, sections, out_dir))
 
 
+def _ready_to_draw() -> None:
+    """What the drawer does before its work: import the drawing (matplotlib) and load the fonts."""
+    from . import sections  # noqa: F401
+    from .plots import warm_text_caches
+
+    warm_text_caches()
+
+
+def _draw(payload, tell) -> list:
+    """The drawer's work: the sections of (entries, ref, times, out_dir, figure format), shared with a
+    child of its own per further CPU; `tell` gets what `build_sections` tells."""
+    entries, ref, times, out_dir, fmt = payload
+    from .sections import build_sections
+
+    with exporting(fmt):
+        return build_sections(entries, ref, times, out_dir, tell)
+
+
+def _drawing_progress(progress: Progress):
+    """What turns build_sections' messages into `progress`: the stage and its count of sections, the
+    section this process (or the drawer) is drawing, named as it starts and counted as done as the next
+    starts; ("drawn", None) ends it."""
+    stages, started = [], []
+
+    def heard(message) -> None:
+        kind, value = message
+        if kind == "jobs":
+            stages[:] = value
+            progress.stage("drawing the plots", len(stages), "sections")
+        elif kind == "starting":
+            progress.advance(1 if started else 0, stages[value])
+            started.append(value)
+        else:
+            progress.advance(len(stages), "drawn")
+
+    return heard
+
+
 def _data_files(entries: list[Entry], out_dir: Path) -> list[Path]:
     """summary.json (and summaries/) and the statistics tables over time, written into `out_dir`."""
     return write_summaries(entries, out_dir) + write_statistics_tables(entries, out_dir)
-
-
-def _written_by(child: Child) -> list[Path]:
-    """The files a child writing the data files wrote; RuntimeError when it failed (its error printed)."""
-    try:
-        return child.wait()
-    except ChildFailed as exc:
-        raise RuntimeError(f"cannot write summary.json and the statistics tables: the writer {exc}") from None

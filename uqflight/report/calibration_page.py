@@ -7,7 +7,7 @@ from pathlib import Path
 
 from ..labels import parameter_unit
 from .render import render_html
-from .sections import Figure, Section, Table
+from .blocks import Figure, Section, Table
 
 PAGE = "report.html"
 FIGURES = (("plots/corner.png", "Posterior pairs and marginals in physical values; posterior mean dashed and +, "

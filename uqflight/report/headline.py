@@ -9,7 +9,7 @@ import numpy as np
 from . import plots
 from .loading import Entry
 from .sensitivity import top_contributors
-from .sections import Section, Table
+from .blocks import Section, Table
 
 NO_INDICES = "no Sobol' indices"
 

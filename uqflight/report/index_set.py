@@ -10,7 +10,7 @@ import numpy as np
 
 from . import plots
 from .loading import Entry
-from .sections import Figure, Section, Table, _rel
+from .blocks import Figure, Section, Table, _rel
 
 
 def plot_index_set(index_set: dict, parameters: list[str], path: Path, title: str) -> Path:

@@ -8,7 +8,7 @@ import numpy as np
 
 from . import plots
 from .loading import Entry
-from .sections import Figure, Section, Table, _rel
+from .blocks import Figure, Section, Table, _rel
 
 
 def _top_index(out) -> tuple[str, float] | tuple[None, None]:

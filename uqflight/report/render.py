@@ -9,7 +9,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .sections import Figure, Section
+from .blocks import Figure, Section
 
 STYLE = """body{font-family:sans-serif;max-width:1200px;margin:2em auto;padding:0 1em;color:#222}
 table{border-collapse:collapse;margin:.5em 0 1.5em;font-size:.85em;display:block;overflow-x:auto}

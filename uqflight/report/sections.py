@@ -2,13 +2,13 @@
 from __future__ import annotations
 
 import json
-from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Callable
 
 import numpy as np
 
 from . import plots
+from .blocks import Figure, Section, Table, _rel
 from .formats import shown_path
 from ..forking import share_work
 from .sensitivity import NEGLIGIBLE, index_text, plot_sensitivity
@@ -18,56 +18,20 @@ from .loading import Entry, _same_file, campaign_settings, design_info, file_nam
 BELOW_FLOOR = "below reference resolution"
 UNRESOLVED = "unresolved"
 
-@dataclass
-class Figure:
-    file: str  # relative to the report directory
-    caption: str
-
-
-@dataclass
-class Table:
-    caption: str
-    header: list[str]
-    rows: list[list]
-    file: str  # the CSV, relative to the report directory
-    page: tuple[list[str], list[list]] | None = None  # (header, rows) the page shows instead, e.g. rounded
-    grouped: bool = False  # the page shows the first column once, as a heading row over its rows
-
-
-@dataclass
-class Section:
-    title: str
-    anchor: str
-    text: str
-    blocks: list = field(default_factory=list)
-    preformatted: bool = False  # the text as written (the campaign YAML)
-    notes: bool = False  # a box at the top the reader must see
-    lead: bool = False  # shown before the table of contents (the headline)
-
-
 def build_sections(entries: list[Entry], ref: Entry | None, times: list[float], out_dir: Path,
-                   progress=None) -> list[Section]:
+                   heard: Callable[[tuple], None] | None = None) -> list[Section]:
     """The report's sections, drawing their plots into out_dir/plots. The sections are built by this
     process and a forked child per further core (forking.share_work), the costliest first: each
-    process draws its sections' figures itself, with the fonts it has loaded. `progress` (a Progress)
-    counts the sections done and names the one this process is drawing."""
+    process draws its sections' figures itself, with the fonts it has loaded. `heard`, when given, is
+    told ("jobs", the sections' stage texts) first, then ("starting", k) as this process starts the k-th."""
     jobs = section_jobs(entries, ref, times, out_dir)
     order = sorted(range(len(jobs)), key=lambda k: -jobs[k][0])
-    if progress is not None:
-        progress.stage("drawing the plots", len(jobs), "sections")
-
-    started = []
-
-    def starting(k: int) -> None:  # this process's job before it is done
-        if progress is not None:
-            progress.advance(1 if started else 0, jobs[k][1])
-        started.append(k)
-
+    if heard is not None:
+        heard(("jobs", [stage for _, stage, _ in jobs]))
     plots.warm_text_caches()  # before the fork: every process inherits the loaded fonts
     with plots.collecting_at_the_end():
-        sections = share_work([build for _, _, build in jobs], order, starting=starting)
-    if progress is not None:
-        progress.advance(len(jobs), "drawn")
+        sections = share_work([build for _, _, build in jobs], order,
+                              starting=None if heard is None else lambda k: heard(("starting", k)))
     return [section for section in sections if section is not None]
 
 
@@ -505,16 +469,6 @@ def monte_carlo_section(entries: list[Entry], out_dir: Path) -> Section:
                    "The Monte Carlo files side by side, e.g. normal against uniform inputs (paper Figs. 4-5).",
                    [Figure(_rel(bands, out_dir), "Mean and 99 % band edges of each Monte Carlo file minus the first's."),
                     Figure(_rel(pdfs, out_dir), "PDF of each output at the final time for each Monte Carlo file.")])
-
-
-def files_section(written: list[Path], out_dir: Path) -> Section:
-    listing = "\n".join(f"- {_rel(p, out_dir)}" for p in written)
-    return Section("Data files", "data", "Written beside this page (plots in plots/):\n" + listing)
-
-
-
-def _rel(path: Path, out_dir: Path) -> str:
-    return Path(path).relative_to(out_dir).as_posix()
 
 
 def _file_stem(entry: Entry) -> str:

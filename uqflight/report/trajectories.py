@@ -127,7 +127,8 @@ def trajectories_section(entries: list, times: list[float], out_dir: Path):
     when there is nothing to draw (one input and no output over time)."""
     from ..designs import is_sampled
     from .loading import campaign_settings
-    from .sections import Figure, Section, _file_stem, _files, _rel
+    from .blocks import Figure, Section, _rel
+    from .sections import _file_stem, _files
 
     blocks = []
     for e in _files(entries):

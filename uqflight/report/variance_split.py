@@ -8,7 +8,7 @@ import numpy as np
 
 from ..statistics import variance_split
 from .loading import Entry
-from .sections import Section, Table
+from .blocks import Section, Table
 
 
 def _row(label: str, name: str, out, seed: str, at: int) -> list:
