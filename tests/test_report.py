@@ -373,3 +373,18 @@ def test_a_section_that_fails_in_the_child_sharing_the_drawing_fails_the_report_
         report.write_report([pg], tmp_path / "out")
     assert "no space left on device" in capfd.readouterr().err  # the child's traceback
     assert list(tmp_path.iterdir()) == []  # no report, no staging folder
+
+
+def test_without_a_drawer_the_report_draws_the_same_files_itself(pg, tmp_path, monkeypatch):
+    """Where the system cannot fork there is no drawer (report.FORKS): this process draws the sections,
+    the same bytes as the drawer's."""
+    import uqflight.report as report
+
+    report.write_report([pg], tmp_path / "drawer")
+    monkeypatch.setattr(report, "FORKS", False)
+    report.write_report([pg], tmp_path / "here")
+    drawn = sorted(p.relative_to(tmp_path / "drawer") for p in (tmp_path / "drawer").rglob("*") if p.is_file())
+    assert drawn == sorted(p.relative_to(tmp_path / "here") for p in (tmp_path / "here").rglob("*") if p.is_file())
+    for name in drawn:
+        if name.suffix in (".png", ".csv", ".json", ".md"):
+            assert (tmp_path / "drawer" / name).read_bytes() == (tmp_path / "here" / name).read_bytes(), name
