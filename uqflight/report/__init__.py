@@ -12,7 +12,9 @@ Layout of the report directory:
 
 The report is written into a staging folder beside OUT and swapped into place when complete
 (`replace`): a report that fails or is interrupted leaves OUT as it was (no half-written directory),
-and OUT is never absent.
+and OUT is never absent. The figures are drawn by a drawer forked before the files are read
+(forking.Standby), which imports matplotlib while they are analysed; this process writes the data
+files and the page and never imports it.
 """
 from __future__ import annotations
 
