@@ -138,9 +138,10 @@ def test_a_standby_whose_work_fails_is_reported_with_its_error(capfd):
     assert "ZeroDivisionError" in capfd.readouterr().err
 
 
-def test_a_standby_writes_to_stderr_even_when_the_parent_held_it_at_the_fork(monkeypatch, capfd):
-    """As for a failing Child, but the standby writes through sys.stderr itself (a library's warning while
-    it imports): it gets sys.stderr opened anew on its descriptor."""
+@pytest.mark.parametrize("kind", ["child", "standby"])
+def test_a_child_writes_to_stderr_even_when_the_parent_held_it_at_the_fork(kind, monkeypatch, capfd):
+    """As for a failing Child, but the child writes through sys.stderr itself (a library's warning while
+    a standby imports, or while a child draws): it gets sys.stderr opened anew on its descriptor."""
     import io
     import sys
     import threading
@@ -164,18 +165,27 @@ def test_a_standby_writes_to_stderr_even_when_the_parent_held_it_at_the_fork(mon
     writer = threading.Thread(target=lambda: blocked.write("r" * 100000), daemon=True)  # beyond its buffer
     writer.start()
     assert inside.wait(60)  # the writer is inside its write, holding the stream's lock
-    standby = Standby(lambda: print("warning from the standby", file=sys.stderr), lambda payload, tell: "done")
-    standby.start(None)
-    done = first_ready(standby.child, 60.0)
+    def warn():
+        print(f"warning from the {kind}", file=sys.stderr)
+        return "done"
+
+    if kind == "standby":
+        standby = Standby(warn, lambda payload, tell: "done")
+        standby.start(None)
+        child = standby.child
+    else:
+        child = Child(warn)
+    done = first_ready(child, 60.0)
     if not done:
-        os.kill(standby.child.pid, 9)
+        os.kill(child.pid, 9)
     try:
-        assert done, "the standby hung on sys.stderr's lock"
-        assert standby.wait() == "done"
+        assert done, f"the {kind} hung on sys.stderr's lock"
+        assert (standby.wait() if kind == "standby" else child.wait()) == "done"
     finally:
-        standby.close()
+        if kind == "standby":
+            standby.close()
         release.set()
-    assert "warning from the standby" in capfd.readouterr().err
+    assert f"warning from the {kind}" in capfd.readouterr().err
 
 
 def alive(pid: int) -> bool:

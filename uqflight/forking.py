@@ -31,6 +31,7 @@ class Child:
         self.pid = os.fork()
         if self.pid == 0:  # the child
             os.close(read)
+            _fresh_standard_streams()
             code = 0
             try:
                 payload = pickle.dumps(work(), protocol=pickle.HIGHEST_PROTOCOL)
@@ -151,7 +152,8 @@ class Standby:
     at once) and the child returns `work(payload, tell)`; `tell(message)` sends this process a small
     picklable message (under 4 kB), which `wait(heard)` passes to `heard` as it comes. The child leads a
     process group of its own with the children it forks: an interrupt of the terminal reaches this
-    process only, and `close()` ends the whole group, whatever it was doing."""
+    process only, and `close()` ends the whole group, whatever it was doing. (Like every Child, it writes
+    through sys.stdout and sys.stderr opened anew.)"""
 
     def __init__(self, prepare: Callable[[], None], work: Callable[[object, Callable[[object], None]], object]):
         payload_read, self._payload = os.pipe()
@@ -161,7 +163,6 @@ class Standby:
 
         def standby():
             os.setpgid(0, 0)
-            _fresh_standard_streams()
             os.close(self._payload)
             os.close(self._messages)
             prepare()
@@ -236,16 +237,17 @@ class Standby:
 
 
 def _fresh_standard_streams() -> None:
-    """sys.stdout and sys.stderr opened anew on their descriptors: a thread of the parent inside a write
-    to one at the fork (a progress bar's refresh) leaves its lock held for good here, and a long-lived
-    child may well write (a library's warning). Streams without a descriptor (a test's capture) stay."""
-    for name in ("stdout", "stderr"):
+    """sys.stdout and sys.stderr opened anew on their descriptors, in a forked child: a thread of the
+    parent inside a write to one at the fork (a progress bar's refresh) leaves its lock held for good
+    there, and a child may well write (a library's warning). Buffered as Python buffers them (stderr by
+    line); streams without a descriptor (a test's capture) stay."""
+    for name, buffering in (("stdout", -1), ("stderr", 1)):
         stream = getattr(sys, name)
         try:
             fd = stream.fileno()
         except (AttributeError, OSError, ValueError):
             continue
-        setattr(sys, name, open(fd, "w", buffering=1, encoding=getattr(stream, "encoding", None) or "utf-8",
+        setattr(sys, name, open(fd, "w", buffering=buffering, encoding=getattr(stream, "encoding", None) or "utf-8",
                                 errors="backslashreplace", closefd=False))
 
 
