@@ -212,3 +212,40 @@ def queued(fd: int) -> int:
     count = array.array("i", [0])
     fcntl.ioctl(fd, termios.FIONREAD, count)
     return count[0]
+
+
+KILLED_PARENT = """
+import os, sys, time
+from uqflight.forking import Child, Standby
+
+def work(payload, tell):
+    helper = Child(lambda: time.sleep(120))
+    print(helper.pid, flush=True)
+    time.sleep(120)
+
+child = Child(lambda: time.sleep(120))
+print(child.pid, flush=True)
+Standby(lambda: None, work).start(None)
+time.sleep(120)
+"""
+
+
+def test_children_die_with_a_parent_killed_outright(tmp_path):
+    """A parent killed by SIGKILL (no handler runs) takes its children along: a Child, and a Standby with the
+    helper it forked. Without it they would each sleep on for two minutes."""
+    import signal
+    import subprocess
+    import sys
+
+    parent = subprocess.Popen([sys.executable, "-c", KILLED_PARENT], stdout=subprocess.PIPE, text=True)
+    try:
+        child, helper = int(parent.stdout.readline()), int(parent.stdout.readline())
+        assert alive(child) and alive(helper)
+    finally:
+        parent.send_signal(signal.SIGKILL)
+        parent.wait()
+    for _ in range(3000):
+        if not alive(child) and not alive(helper):
+            break
+        time.sleep(0.01)
+    assert not alive(child) and not alive(helper)

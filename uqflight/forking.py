@@ -2,7 +2,7 @@
 shared between processes, drawn by a child that got ready during the analysis). The child inherits the
 parent's memory, so nothing is pickled on the way in (but a Standby's payload); its result comes back
 pickled through a pipe. It runs no handler of the parent's and leaves with os._exit; a child that fails
-or dies is reported as such when waited for."""
+or dies is reported as such when waited for. A child dies with its parent (die_with_parent)."""
 from __future__ import annotations
 
 import gc
@@ -12,6 +12,7 @@ import select
 import signal
 import sys
 import threading
+import time
 import traceback
 from typing import Callable
 
@@ -27,9 +28,11 @@ class Child:
 
     def __init__(self, work: Callable[[], object]):
         read, write = os.pipe()
+        parent = os.getpid()
         gc.freeze()  # the parent's objects stay out of the child's collections: fewer pages copied on write
         self.pid = os.fork()
         if self.pid == 0:  # the child
+            die_with_parent(parent)
             os.close(read)
             _fresh_standard_streams()
             code = 0
@@ -62,6 +65,29 @@ class Child:
         if status != 0 or not payload:
             raise ChildFailed(f"failed (exit {status})")
         return pickle.loads(payload)
+
+
+def die_with_parent(parent: int, watch: bool = False) -> None:
+    """Ask the kernel to SIGKILL this process when its parent `parent` dies (Linux): a parent killed outright
+    (SIGKILL, a crash) leaves no child working on for no one. `watch`: a thread checks for it as well, every
+    half second, for a worker (not for a forked Child, which starts no thread of its own: it may fork)."""
+    if sys.platform.startswith("linux"):
+        try:
+            import ctypes
+
+            ctypes.CDLL(None, use_errno=True).prctl(1, signal.SIGKILL, 0, 0, 0)  # PR_SET_PDEATHSIG
+        except (OSError, AttributeError):
+            pass
+    if os.getppid() != parent:  # the parent died before the prctl
+        os._exit(70)
+
+    def watching():
+        while os.getppid() == parent:
+            time.sleep(0.5)
+        os._exit(70)
+
+    if watch:
+        threading.Thread(target=watching, daemon=True, name="uqflight-parent-watchdog").start()
 
 
 def _tell_error(text: str) -> None:

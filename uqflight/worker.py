@@ -16,13 +16,13 @@ import json
 import os
 import signal
 import sys
-import threading
 import time
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
+from .forking import die_with_parent
 from .quantities import quantity_key
 from .quantities.recorder import QuantityRecorder
 from .simulators import FlightError, make_simulator
@@ -142,28 +142,6 @@ def nominal_flight(spec: WorkerSpec, kappa: np.ndarray, measure_resolution: bool
                          else None, failure)
 
 
-def _die_with_parent(parent: int) -> None:
-    """Ask the kernel to SIGKILL this process when its parent dies, and watch for it anyway."""
-    if sys.platform.startswith("linux"):
-        try:
-            import ctypes
-
-            libc = ctypes.CDLL(None, use_errno=True)
-            libc.prctl(1, signal.SIGKILL, 0, 0, 0)  # PR_SET_PDEATHSIG
-        except (OSError, AttributeError):
-            pass
-
-    def watch():
-        while True:
-            if os.getppid() != parent:
-                os._exit(70)
-            time.sleep(0.5)
-
-    if os.getppid() != parent:  # the parent died before the prctl
-        os._exit(70)
-    threading.Thread(target=watch, daemon=True, name="uqflight-parent-watchdog").start()
-
-
 def main(argv=None) -> None:
     """Serve the runner on the socket `fd` until it closes."""
     from multiprocessing.connection import Connection
@@ -172,7 +150,7 @@ def main(argv=None) -> None:
     fd, parent = int(argv[0]), int(argv[1])
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     signal.signal(signal.SIGTERM, signal.SIG_DFL)
-    _die_with_parent(parent)
+    die_with_parent(parent, watch=True)
     conn = Connection(fd)
     while True:
         try:
