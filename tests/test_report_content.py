@@ -141,3 +141,29 @@ def test_the_runs_drawn_are_the_same_on_every_report(phugoid_report, tmp_path):
         p.name for p in (report / "plots").iterdir()}
     assert "nodes, not random draws" in (report / "report.md").read_text()
     assert math.isfinite(outputs["h_ft"].variance[-1])
+
+
+DECAY_ONE_INPUT = """
+name: decay-one
+seed: 5
+simulator: {kind: python, function: "uqflight.simulators.models:exp_decay"}
+parameters:
+  a: {distribution: normal, lower: 0.5, upper: 1.5}
+design: {kind: monte_carlo, samples: 40}
+method: {kind: monte_carlo}
+analysis: {band_samples: 500, bootstrap: 0}
+"""
+
+
+def test_one_input_is_scattered_in_one_uncoloured_panel_per_output(tmp_path):
+    """With one input, the output against it is the whole response: one panel, no colouring input to name."""
+    from PIL import Image
+
+    from uqflight.report.plots import DPI
+
+    write_report([run_python_campaign(tmp_path, DECAY_ONE_INPUT, "decay")], tmp_path / "report")
+    with Image.open(tmp_path / "report" / "plots" / "scatter_decay.png") as image:
+        assert image.size[0] == round(8.0 * DPI)  # one panel: the figure's least width, not two panels' 9.2 in
+    markdown = (tmp_path / "report" / "report.md").read_text()
+    assert "(a row each) against its one input in physical values, 40 runs (at most 1000, seed 5)." in markdown
+    assert "colour" not in markdown[markdown.index("against its one input"):][:200]

@@ -89,12 +89,12 @@ def scatter_rows(results: Path, outputs: dict, quantities: dict, time: float, se
 def plot_scatter(kappa: np.ndarray, names: list[str], rows_of: dict, path: Path, title: str) -> Path | None:
     """One row per output or quantity (`rows_of` as `scatter_rows` gives them), one panel per input among
     its SCATTER_INPUTS most influential, against the input's physical value; each panel coloured by the
-    most influential other input, from its low to its high value among the drawn runs. None without rows
-    or with fewer than two inputs."""
-    if not rows_of or len(names) < 2:
+    most influential other input, from its low to its high value among the drawn runs (one input: one
+    panel per row, in one colour, with no colour bar). None without rows."""
+    if not rows_of:
         return None
     shown = min(SCATTER_INPUTS, len(names))
-    fig, axes = plots.plt.subplots(len(rows_of), shown, figsize=(3.6 * shown + 2.0, 2.2 * len(rows_of) + 1.0),
+    fig, axes = plots.plt.subplots(len(rows_of), shown, figsize=(max(3.6 * shown + 2.0, 8.0), 2.2 * len(rows_of) + 1.0),
                                    squeeze=False)
     for row, (text, (values, sobol_total, i)) in zip(axes, rows_of.items()):
         keep = np.isfinite(values)
@@ -102,19 +102,24 @@ def plot_scatter(kappa: np.ndarray, names: list[str], rows_of: dict, path: Path,
         influence = _influence(sobol_total, i, x, y, names)
         ranked = list(np.argsort(-influence, kind="stable"))
         for ax, j in zip(row, ranked[:shown]):
-            other = next(k for k in ranked if k != j)
-            low, high = x[:, other].min(initial=np.inf), x[:, other].max(initial=-np.inf)
-            shade = (x[:, other] - low) / (high - low) if high > low else np.full(len(x), 0.5)
-            ax.scatter(x[:, j], y, c=shade, cmap=COLOR_MAP, vmin=0, vmax=1, s=9, lw=0)
+            other = next((k for k in ranked if k != j), None)
+            if other is None:
+                ax.scatter(x[:, j], y, color=plots.COLORS[0], s=9, lw=0)
+            else:
+                low, high = x[:, other].min(initial=np.inf), x[:, other].max(initial=-np.inf)
+                shade = (x[:, other] - low) / (high - low) if high > low else np.full(len(x), 0.5)
+                ax.scatter(x[:, j], y, c=shade, cmap=COLOR_MAP, vmin=0, vmax=1, s=9, lw=0)
+                ax.set_title(f"colour: {names[other]}", fontsize=8)
             ax.set_xlabel(names[j], fontsize=8)
-            ax.set_title(f"colour: {names[other]}", fontsize=8)
             ax.tick_params(labelsize=7)
             ax.xaxis.set_major_locator(MaxNLocator(4))
             ax.yaxis.set_major_locator(MaxNLocator(4))
             ax.grid(alpha=0.3)
         row[0].set_ylabel(text, fontsize=8)
-    fig.suptitle(title, fontsize=12)
+    fig.suptitle(title, fontsize=12)  # 8 in wide at least: the title fits above one panel
     fig.panel_grid = axes.shape
+    if len(names) < 2:
+        return plots._save(fig, path)
     bar = fig.colorbar(plots.plt.cm.ScalarMappable(cmap=COLOR_MAP), cax=fig.add_axes((1 - 0.9 / fig.get_size_inches()[0], 0.15, 0.012, 0.7)))
     bar.set_ticks([0, 1], labels=["low", "high"])
     bar.set_label("the colouring input, named above each panel", fontsize=8)
@@ -124,7 +129,7 @@ def plot_scatter(kappa: np.ndarray, names: list[str], rows_of: dict, path: Path,
 def trajectories_section(entries: list, times: list[float], out_dir: Path):
     """Per results file: the spaghetti plot and the scatter of the outputs at the last of `times` and of the
     quantities against the inputs, seeded by the campaign's seed (the same runs on every report); None
-    when there is nothing to draw (one input and no output over time)."""
+    when there is nothing to draw (no output and no quantity)."""
     from ..designs import is_sampled
     from .loading import campaign_settings
     from .blocks import Figure, Section, _rel
@@ -144,18 +149,20 @@ def trajectories_section(entries: list, times: list[float], out_dir: Path):
                                  f"(drawn with the campaign's seed {seed}, at most {SPAGHETTI_RUNS}), thin, with "
                                  f"the mean (solid) and the 99 % band (dashed) of {e.label}." + nodes))
         rows = scatter_rows(results, e.outputs, e.stats.quantities, times[-1], seed)
-        how = ("coloured by the other input with the largest total Sobol' index" if e.has_sobol else
-               "coloured by the other input most correlated with it (squared correlation; the file has no "
-               "Sobol' indices)")
+        single = len(rows["names"]) < 2
+        against = "its one input" if single else f"its {SCATTER_INPUTS} most influential inputs"
+        how = "" if single else (", each panel coloured by " + (
+            "the other input with the largest total Sobol' index" if e.has_sobol else
+            "the other input most correlated with it (squared correlation; the file has no Sobol' indices)")
+            + ", low to high")
         path = plot_scatter(rows["kappa"], rows["names"], {**rows["outputs"], **rows["quantities"]},
                             out_dir / "plots" / f"scatter_{stem}.png", f"Outputs and quantities against the "
                             f"inputs: {e.label}")
         if path is not None:
             blocks.append(Figure(_rel(path, out_dir), "Each output (at the last selected time)"
                                  + (" and each quantity of interest" if rows["quantities"] else "")
-                                 + f" of {stem} (a row each) against its {SCATTER_INPUTS} most influential inputs "
-                                 f"in physical values, {len(rows['kappa'])} runs (at most {SCATTER_RUNS}, seed "
-                                 f"{seed}), each panel {how}, low to high." + nodes))
+                                 + f" of {stem} (a row each) against {against} in physical values, "
+                                 f"{len(rows['kappa'])} runs (at most {SCATTER_RUNS}, seed {seed}){how}." + nodes))
     if not blocks:
         return None
     return Section("Trajectories and scatter", "trajectories", "The runs themselves: what the statistics "
