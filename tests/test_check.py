@@ -5,6 +5,7 @@ baselines that are no baselines and tolerances that let anything through are ref
 import json
 from pathlib import Path
 
+import h5py
 import pytest
 from conftest import cli_in_process
 from test_quantities import python_campaign
@@ -23,7 +24,9 @@ def quantity_files(tmp_path_factory):
                            "{kind: sobol, samples: 64}")
     results, baseline = folder / "q.h5", folder / "baseline.json"
     run_campaign(parse_campaign(text, str(folder / "q.yaml")), out=results, workers=1)
-    write_baseline(analyse(results), "", baseline)  # what `report --write-baseline` writes
+    with h5py.File(results, "r") as f:
+        campaign_hash = str(f.attrs["campaign_hash"])
+    write_baseline(analyse(results), campaign_hash, baseline)  # what `report --write-baseline` writes
     return results, baseline
 
 
@@ -65,13 +68,16 @@ def test_a_baseline_without_quantities_is_compared_on_its_outputs(quantity_files
 
 
 # -- baselines that are no baselines, and tolerances that let anything through
-def baseline_text(mean):
-    return ('{"kind": "uqflight-baseline", "version": 1, "outputs": {"y": {"time": [0, 1], "mean": %s, '
-            '"variance": [1, 1], "band99": {"lower": [0, 0], "upper": [1, 1]}, "sobol_first": {}, '
-            '"sobol_total": {}}}}' % mean)
+HASH = "0" * 64
 
 
-@pytest.mark.parametrize("mean", ["[Infinity, 1]", "[-Infinity, 1]", "[1e999, 1]"])
+def baseline_text(mean, version="1", campaign_hash=f'"{HASH}"'):
+    return ('{"kind": "uqflight-baseline", "version": %s, "campaign_hash": %s, "outputs": {"y": {"time": [0, 1], '
+            '"mean": %s, "variance": [1, 1], "band99": {"lower": [0, 0], "upper": [1, 1]}, "sobol_first": {}, '
+            '"sobol_total": {}}}}' % (version, campaign_hash, mean))
+
+
+@pytest.mark.parametrize("mean", ["[Infinity, 1]", "[-Infinity, 1]", "[1e999, 1]", f"[{10 ** 400}, 1]"])
 def test_check_refuses_infinite_baseline_values(tmp_path, mean):
     from uqflight.check import BadInput, load_baseline
 
@@ -87,6 +93,19 @@ def test_check_accepts_nan_and_null_baseline_values(tmp_path):
     path = tmp_path / "b.json"
     path.write_text(baseline_text("[NaN, null]"))
     assert load_baseline(path)["outputs"]["y"]["mean"][1] is None
+
+
+@pytest.mark.parametrize("version, campaign_hash, field", [
+    ("999", f'"{HASH}"', "version"), ("null", f'"{HASH}"', "version"), ("1", '""', "campaign_hash"),
+    ("1", "null", "campaign_hash"), ("1", '"abc"', "campaign_hash")])
+def test_check_refuses_a_baseline_of_another_version_or_without_its_campaign(tmp_path, version, campaign_hash, field):
+    # a baseline without its campaign's hash would let a file of another campaign pass its check
+    from uqflight.check import BadInput, load_baseline
+
+    path = tmp_path / "b.json"
+    path.write_text(baseline_text("[1, 1]", version, campaign_hash))
+    with pytest.raises(BadInput, match=f"b.json: {field}: expected .*--write-baseline"):
+        load_baseline(path)
 
 
 def test_check_refuses_deeply_nested_json(tmp_path):

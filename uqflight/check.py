@@ -11,11 +11,13 @@ from __future__ import annotations
 
 import json
 import math
+import re
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
+from .campaign.schema import shown
 from .json_text import json_text
 from .statistics import BadInput, Statistics, json_ready
 
@@ -103,6 +105,14 @@ def load_baseline(path: Path) -> dict:
     if not isinstance(data, dict) or data.get("kind") != BASELINE_KIND:
         raise BadInput(f"{path}: not a uqflight baseline (expected a JSON object with \"kind\": \"{BASELINE_KIND}\"; "
                        "write one with `uqflight report RESULTS.h5 --out DIR --write-baseline FILE`)")
+    rewrite = "write one with `uqflight report RESULTS.h5 --out DIR --write-baseline FILE`"
+    if data.get("version") != BASELINE_VERSION:
+        raise BadInput(f"{path}: version: expected {BASELINE_VERSION} (the baselines this uqflight writes), got "
+                       f"{shown(data.get('version'))}; {rewrite}")
+    if not isinstance(data.get("campaign_hash"), str) or not re.fullmatch(r"[0-9a-f]{64}", data["campaign_hash"]):
+        raise BadInput(f"{path}: campaign_hash: expected the sha256 of the campaign the baseline was written from "
+                       f"(64 hex digits), got {shown(data.get('campaign_hash'))}: without it, a file of "
+                       f"another campaign could pass; {rewrite}")
     outputs = data.get("outputs")
     if not isinstance(outputs, dict) or not outputs:
         raise BadInput(f"{path}: outputs: expected a non-empty mapping of output names to statistics")
@@ -139,11 +149,19 @@ def _numbers(where: str, values, length: int | None) -> int:
     if not isinstance(values, list) or not all(v is None or (isinstance(v, (int, float)) and not isinstance(v, bool))
                                                for v in values):
         raise BadInput(f"{where}: expected a list of numbers")
-    if any(v is not None and math.isinf(v) for v in values):  # e.g. 1e999 parses as inf: it would match anything
+    if any(v is not None and _infinite(v) for v in values):  # 1e999 parses as inf: it would match anything
         raise BadInput(f"{where}: expected finite numbers (null for undefined), got an infinite value")
     if not values or (length is not None and len(values) != length):
         raise BadInput(f"{where}: expected {length or 'at least one'} values (one per time), got {len(values)}")
     return len(values)
+
+
+def _infinite(value: int | float) -> bool:
+    """Whether a JSON number is beyond every float: inf, or an integer of 400 digits (NaN is not)."""
+    try:
+        return math.isinf(value)
+    except OverflowError:
+        return True
 
 
 def compare(stats: Statistics, baseline: dict, rtol: float, atol: float) -> Comparison:
