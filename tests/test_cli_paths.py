@@ -11,7 +11,7 @@ import time
 from pathlib import Path
 
 import pytest
-from conftest import (NORMAL_2D, UQFLIGHT, cli_in_process, closed_form_campaign, hostile_campaign, mounted_tmpfs,
+from conftest import (NORMAL_2D, UQFLIGHT, cli, cli_in_process, closed_form_campaign, hostile_campaign, mounted_tmpfs,
                       run_python_campaign, scheduler_address)
 
 from uqflight.execution import run_campaign
@@ -67,6 +67,35 @@ def test_an_unwritable_output_is_refused_before_any_work_with_one_message(result
         result = cli_in_process(*args, option, tmp_path / "a-file")
         assert result.returncode == 2
         assert result.stderr == f"error: --out {tmp_path / 'a-file'}: is a file, not a folder; choose another path\n"
+
+
+def test_an_output_that_is_the_commands_own_input_is_refused(results, tmp_path):
+    copy = tmp_path / "r.h5"  # a copy: the refusal must leave it whole, and a failure must not spoil the fixture
+    copy.write_bytes(results.read_bytes())
+    yaml = results.with_suffix(".yaml")
+    for args, option, target in [(["surrogate", "export", copy], "--out", copy),
+                                 (["report", copy, "--out", tmp_path / "rep"], "--write-baseline", copy),
+                                 (["design", yaml], "--csv", yaml), (["run", yaml], "--out", yaml)]:
+        before = target.read_bytes()
+        result = cli_in_process(*args, option, target)
+        assert result.returncode == 2, (args, result.stdout, result.stderr)
+        assert result.stderr == (f"error: {option} {target}: is the input {target}: it would be overwritten; "
+                                 "choose another path\n")
+        assert target.read_bytes() == before
+
+
+@pytest.mark.parametrize("command", ["simulate --out", "design --csv", "surrogate export --out",
+                                     "report --write-baseline"])
+def test_an_output_that_is_a_pipe_or_device_is_refused(results, tmp_path, command):
+    # surrogate export writes a temporary file and renames it: a device (/dev/full, as root) would be replaced
+    args, option = writers(results, tmp_path)[command]
+    fifo = tmp_path / "fifo"
+    os.mkfifo(fifo)
+    result = cli(*args, option, fifo, timeout=60)  # in a process of its own: writing to a pipe nobody reads blocks
+    assert result.returncode == 2 and result.stdout == ""
+    assert result.stderr == (f"error: {option} {fifo}: is not a regular file (a device, pipe or socket); "
+                             "choose another path\n")
+    assert fifo.is_fifo()
 
 
 def test_files_of_the_wrong_kind_are_named_for_what_they_are(results, tmp_path):

@@ -4,6 +4,7 @@ kind, named for what it is ("r.h5 is a results file (HDF5), not a campaign file"
 from __future__ import annotations
 
 import os
+import stat
 from pathlib import Path
 
 import typer
@@ -13,21 +14,29 @@ from .console import echo
 CAMPAIGN_KEYS = ("simulator:", "parameters:", "design:")  # lines a campaign file starts
 
 
-def check_output(path: Path, option: str, folder: bool = False, create: bool = False) -> None:
+def check_output(path: Path, option: str, folder: bool = False, create: bool = False, inputs=()) -> None:
     """Exit 2 naming `option` when `path` cannot be written: a file (a folder with `folder`) whose
-    folder exists and is writable; with `create`, missing folders are made later, under a writable one."""
-    problem = output_problem(Path(path), folder, create)
+    folder exists and is writable; with `create`, missing folders are made later, under a writable one.
+    `inputs`: the command's input files, which its output must not replace."""
+    problem = output_problem(Path(path), folder, create, inputs)
     if problem:
         echo(f"error: {option} {path}: {problem}; choose another path", err=True)
         raise typer.Exit(2)
 
 
-def output_problem(path: Path, folder: bool = False, create: bool = False) -> str | None:
-    """Why `path` cannot be written, or None."""
+def output_problem(path: Path, folder: bool = False, create: bool = False, inputs=()) -> str | None:
+    """Why `path` cannot be written, or None: among the reasons, it is one of `inputs` (the command would
+    destroy what it reads), or a device, pipe or socket (written through a temporary file and a rename,
+    it would be replaced by a regular file)."""
     if path.is_dir() and not folder:
         return "is a folder, not a file"
     if folder and (path.is_file() or path.is_symlink() and not path.is_dir()):
         return "is a file, not a folder"
+    for given in inputs:
+        if path.exists() and Path(given).exists() and os.path.samefile(path, given):
+            return f"is the input {given}: it would be overwritten"
+    if path.exists() and not path.is_dir() and not stat.S_ISREG(path.stat().st_mode):
+        return "is not a regular file (a device, pipe or socket)"
     parent = Path(os.path.abspath(path)).parent
     while create and not parent.exists() and parent != parent.parent:
         parent = parent.parent

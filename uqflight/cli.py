@@ -305,7 +305,8 @@ def run(
     from .store import CorruptFile
 
     campaign = _load(campaign_file)
-    check_output(out or Path(campaign.storage["path"]), "--out" if out else "storage.path", create=True)
+    check_output(out or Path(campaign.storage["path"]), "--out" if out else "storage.path", create=True,
+                 inputs=[campaign_file])
     if executor not in (None, "local", "dask"):
         echo(f"error: --executor: expected local or dask, got {executor!r}", err=True)
         raise typer.Exit(2)
@@ -476,7 +477,7 @@ def report(
     if not out.exists() and not out.is_symlink():  # an existing DIR is the report's to judge (check_replaceable)
         check_output(out, "--out", folder=True, create=True)
     if write_baseline:
-        check_output(write_baseline, "--write-baseline")
+        check_output(write_baseline, "--write-baseline", inputs=[*results, *([reference] if reference else [])])
     if times is not None:
         _check_times(times, selected, results)
     try:
@@ -530,7 +531,7 @@ def design(
     """Print a campaign's design (the points and weights the runs would use) as CSV, without running it."""
     to_stdout = csv_path is None or str(csv_path) == "-"
     if not to_stdout:
-        check_output(csv_path, "--csv")
+        check_output(csv_path, "--csv", inputs=[campaign_file])
     campaign = _load(campaign_file)
     points = campaign.design()
     kappa = campaign.to_physical(points.xi)
@@ -572,7 +573,7 @@ def surrogate_export(
     except ValueError as exc:
         raise typer.BadParameter(str(exc), param_hint="--method")
     check_results_file(results)
-    check_output(out, "--out")
+    check_output(out, "--out", inputs=[results])
     try:
         with Progress(0, label="surrogate export") as progress:
             export(results, out, override, progress)
