@@ -27,9 +27,9 @@ from ..forking import FORKS, ChildFailed, Standby
 from ..progress import Progress
 from ..methods.parsing import parse_methods
 from .files import _write_text, write_csv, write_statistics_tables, write_summaries
-from .loading import Entry, load_entries
+from .loading import Entry, bounded, load_entries
 from .formats import FORMATS, export_format, exporting
-from .replace import check_replaceable, make_staging, replace_dir
+from .replace import OUT_NAME_BYTES, check_replaceable, make_staging, replace_dir
 
 __all__ = ["check_replaceable", "default_out_dir", "parse_methods", "write_report"]
 
@@ -37,9 +37,9 @@ DEFAULT_TIMES = (10.0, 25.0, float("inf"))  # the tables' times: 10 s, 25 s and 
 
 
 def default_out_dir(results: Path) -> Path:
-    """The report folder next to the (first) results file: RESULTS-report/."""
+    """The report folder next to the (first) results file: RESULTS-report/ (a long RESULTS cut, see bounded)."""
     results = Path(results)
-    return results.with_name(f"{results.stem}-report")
+    return results.with_name(bounded(results.stem, OUT_NAME_BYTES - len("-report")) + "-report")
 
 
 def write_report(paths: list[Path], out_dir: Path | None = None, reference: Path | None = None,

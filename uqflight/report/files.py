@@ -9,7 +9,7 @@ import numpy as np
 
 from ..json_text import json_text
 from ..statistics import summary_json
-from .loading import Entry, file_name
+from .loading import Entry, bounded
 
 
 def write_summaries(entries: list[Entry], out_dir: Path) -> list[Path]:
@@ -17,7 +17,8 @@ def write_summaries(entries: list[Entry], out_dir: Path) -> list[Path]:
     written = [_write_json(out_dir / "summary.json", summary_json(entries[0].stats))]
     if len(entries) > 1:
         (out_dir / "summaries").mkdir(exist_ok=True)
-        written += [_write_json(out_dir / "summaries" / f"{e.stem}.json", summary_json(e.stats)) for e in entries]
+        written += [_write_json(out_dir / "summaries" / bounded(f"{e.stem}.json"), summary_json(e.stats))
+                    for e in entries]
     return written
 
 
@@ -34,7 +35,7 @@ def write_statistics_tables(entries: list[Entry], out_dir: Path) -> list[Path]:
             if out.errors:
                 header += ["eps_m [-]", "eps_v [-]"]
                 columns += [out.errors["eps_m"], out.errors["eps_v"]]
-            path = out_dir / "tables" / f"statistics_{entry.stem}_{file_name(name)}.csv"
+            path = out_dir / "tables" / bounded(f"statistics_{entry.stem}_{entry.output_files[name]}.csv")
             written.append(write_csv(path, header, np.column_stack(columns).tolist()))
     return written
 

@@ -9,7 +9,7 @@ from pathlib import Path
 import numpy as np
 
 from . import plots
-from .loading import Entry
+from .loading import Entry, bounded
 from .blocks import Figure, Section, Table, _rel
 
 
@@ -58,7 +58,7 @@ def index_set_section(entries: list[Entry], out_dir: Path) -> Section:
             rows.append([entry.label, parameters[k], int(refined[k]), int(levels[:, k].max()),
                          int(np.count_nonzero(levels[:, k])),
                          int(np.count_nonzero((levels[:, k] > 0) & (np.count_nonzero(levels, axis=1) > 1)))])
-        path = plot_index_set(index_set, parameters, out_dir / "plots" / f"index_set_{entry.stem}.png",
+        path = plot_index_set(index_set, parameters, out_dir / "plots" / bounded(f"index_set_{entry.stem}.png"),
                               f"Adaptive grid: {entry.label}")
         blocks.append(Figure(_rel(path, out_dir), f"The index set of {entry.label}: each row a multi-index (its "
                                                   "1-D level per input, 0 = the centre point only), in the order "

@@ -3,7 +3,9 @@ from __future__ import annotations
 
 import copy
 import functools
+import hashlib
 import json
+import os
 import re
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -26,6 +28,7 @@ class Entry:
     inputs: str
     attrs: dict = field(default_factory=dict)  # the results file's root attributes
     path: str = ""  # the results file (several entries share one with several --method)
+    output_files: dict = field(default_factory=dict)  # output name → its part of file names, unique in the entry
 
     @property
     def outputs(self) -> dict:
@@ -127,8 +130,10 @@ def _entry(path: Path, stats: Statistics, attrs: dict, stems: set[str], with_met
     stem = _unique(file_name(name), stems)
     runs = f"partial: {stats.completed} of {stats.runs} runs" if stats.partial else f"{stats.runs} runs"
     label = f"{stats.campaign_name or stem}: {method_label(stats.method)}, {runs}"
+    taken: set[str] = set()
+    output_files = {name: _unique(file_name(name), taken) for name in stats.outputs}
     return Entry(stats, stem, label, str(attrs.get("campaign_hash", "")),
-                 input_distributions(str(attrs.get("campaign", ""))), dict(attrs), str(path))
+                 input_distributions(str(attrs.get("campaign", ""))), dict(attrs), str(path), output_files)
 
 
 def design_info(attrs: dict) -> dict:
@@ -143,6 +148,24 @@ def design_info(attrs: dict) -> dict:
 def file_name(name: str) -> str:
     """An output or file name made safe for a file name: "velocities/vc-kts" → "velocities_vc-kts"."""
     return re.sub(r"[^A-Za-z0-9_.-]", "_", name)
+
+
+NAME_BYTES = 255  # the longest name of one file or folder (ext4, XFS, Btrfs: bytes; APFS, NTFS: 255 characters)
+
+
+def bounded(name: str, limit: int = NAME_BYTES) -> str:
+    """`name` (a file name, its extension kept) as it is when its UTF-8 takes at most `limit` bytes; else cut
+    and given "-" and 16 hex digits of the whole name's SHA-256 before its extension, so that names sharing
+    a long start stay apart."""
+    data = name.encode()
+    if len(data) <= limit:
+        return name
+    stem, ext = os.path.splitext(name)
+    if len(ext) > 8:  # a dot in the name, not an extension
+        stem, ext = name, ""
+    tag = "-" + hashlib.sha256(data).hexdigest()[:16]
+    keep = stem.encode()[:limit - len(tag) - len(ext.encode())].decode(errors="ignore")
+    return keep + tag + ext
 
 
 def _same_file(a, b) -> bool:

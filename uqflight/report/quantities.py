@@ -7,7 +7,7 @@ from pathlib import Path
 import numpy as np
 
 from . import plots
-from .loading import Entry
+from .loading import Entry, bounded
 from .blocks import Figure, Section, Table, _rel
 
 
@@ -75,13 +75,13 @@ def quantities_section(entries: list[Entry], out_dir: Path) -> Section:
                                    item["upper"], item["method"], item["note"]])
         defined = {name: q.output for name, q in quantities.items() if q.output is not None}
         if defined:
-            path = plot_quantity_pdfs(defined, out_dir / "plots" / f"quantity_pdfs_{entry.stem}.png",
+            path = plot_quantity_pdfs(defined, out_dir / "plots" / bounded(f"quantity_pdfs_{entry.stem}.png"),
                                       f"Quantities of interest: {entry.label}")
             blocks.append(Figure(_rel(path, out_dir), f"PDFs of the quantities of {entry.label} (kernel density "
                                                       "estimate), the mean solid, the 99 % band dashed."))
         with_sobol = {name: out for name, out in defined.items() if out.sobol_first}
         if with_sobol:
-            path = plot_quantity_sobol(with_sobol, out_dir / "plots" / f"quantity_sobol_{entry.stem}.png",
+            path = plot_quantity_sobol(with_sobol, out_dir / "plots" / bounded(f"quantity_sobol_{entry.stem}.png"),
                                        f"Sobol' indices of the quantities: {entry.label}")
             blocks.append(Figure(_rel(path, out_dir), f"First-order and total Sobol' indices of the quantities of "
                                                       f"{entry.label}; an unresolved index is drawn as none."))

@@ -39,6 +39,7 @@ REPORT_FILES = {"report.html": None, "report.md": None, "summary.json": None,  #
 AT_FDCWD, RENAME_EXCHANGE = -100, 2
 LOCK_TEXT = b"uqflight: reports to the folder beside this file take turns on it\n"
 TAG = re.compile(r"(\d+)-(\d+|x)-([0-9a-f]{8})\.[0-9a-f]{8}")
+OUT_NAME_BYTES = 192  # the longest report folder name: its staging folder's name (+ about 50 bytes) fits in 255
 
 
 def _host() -> str:
@@ -60,7 +61,12 @@ def make_staging(out_dir: Path) -> Path:
 
 def check_replaceable(out_dir: Path) -> None:
     """Refuse (FileExistsError) to replace anything at `out_dir` but nothing, an empty folder or an
-    earlier report: a folder holding only what a report writes (a user's file there is never deleted)."""
+    earlier report: a folder holding only what a report writes (a user's file there is never deleted);
+    OSError(ENAMETOOLONG) for a name longer than OUT_NAME_BYTES of UTF-8."""
+    if len(out_dir.name.encode()) > OUT_NAME_BYTES:
+        raise OSError(errno.ENAMETOOLONG, f"the report folder's name is {len(out_dir.name.encode())} bytes (UTF-8), "
+                      f"at most {OUT_NAME_BYTES} are taken (its staging folder beside it needs the rest): "
+                      "choose a shorter --out")
     if not out_dir.exists() and not out_dir.is_symlink():
         return
     if out_dir.is_dir() and not out_dir.is_symlink():

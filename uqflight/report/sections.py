@@ -13,7 +13,8 @@ from .formats import shown_path
 from ..forking import share_work
 from .sensitivity import NEGLIGIBLE, index_text, plot_sensitivity
 from ..campaign.reading import stored_parameters
-from .loading import Entry, _same_file, campaign_settings, design_info, file_name, flight_facts, method_label
+from .loading import (Entry, _same_file, bounded, campaign_settings, design_info, file_name, flight_facts,
+                      method_label)
 
 BELOW_FLOOR = "below reference resolution"
 UNRESOLVED = "unresolved"
@@ -152,7 +153,8 @@ def run_section(entries: list[Entry], out_dir: Path) -> Section:
                         ["file", "parameter", "property", "distribution", "lower", "upper", "nominal", "interval"],
                         parameter_rows, "tables/parameters.csv"))
     for e in _files(entries):
-        path = plots.plot_design_pairs(e.path or e.stats.path, out_dir / "plots" / f"design_{_file_stem(e)}.png",
+        path = plots.plot_design_pairs(e.path or e.stats.path,
+                                       out_dir / "plots" / bounded(f"design_{_file_stem(e)}.png"),
                                        f"Design: {e.attrs.get('design_kind', e.stats.design_kind)}, "
                                        f"{e.stats.runs} points ({_file_stem(e)})")
         if path is not None:
@@ -228,11 +230,11 @@ def statistics_section(entries: list[Entry], ref: Entry | None, times: list[floa
     blocks = []
     for entry in entries:
         overlay = ref.outputs if ref is not None and not _same_file(ref.stats.path, entry.stats.path) else None
-        blocks.append(Figure(_rel(plots.plot_mean_band(entry.outputs, plot_dir / f"mean_band_{entry.stem}.png",
+        blocks.append(Figure(_rel(plots.plot_mean_band(entry.outputs, plot_dir / bounded(f"mean_band_{entry.stem}.png"),
                                                        f"Mean and 99 % band: {entry.label}", overlay), out_dir),
                              f"Mean and 99 % band of each output over time of {entry.label} (paper Figs. 6-7)"
                              + ("; the reference dashed." if overlay else ".")))
-        blocks.append(Figure(_rel(plots.plot_cov(entry.outputs, plot_dir / f"cov_{entry.stem}.png",
+        blocks.append(Figure(_rel(plots.plot_cov(entry.outputs, plot_dir / bounded(f"cov_{entry.stem}.png"),
                                                  f"Spread over time: {entry.label}"), out_dir),
                              f"Modified coefficient of variation std(t) / max|mean| of the outputs of {entry.label} "
                              "(paper Fig. 8); outputs on an offset datum (min|mean| more than "
@@ -263,7 +265,7 @@ def statistics_section(entries: list[Entry], ref: Entry | None, times: list[floa
 
 def pdf_figures(entry: Entry, out_dir: Path) -> dict[str, tuple]:
     """(output, path, title) of the PDF figure of each output of `entry`, by output name."""
-    return {name: (out, out_dir / "plots" / f"pdf_{entry.stem}_{file_name(name)}.png",
+    return {name: (out, out_dir / "plots" / bounded(f"pdf_{entry.stem}_{entry.output_files[name]}.png"),
                    f"PDF of {plots.short_label(name)}: {entry.label}") for name, out in entry.outputs.items()}
 
 
@@ -379,12 +381,12 @@ def sensitivity_section(entries: list[Entry], times: list[float], out_dir: Path)
     with_sobol = [e for e in entries if e.has_sobol]
     blocks = []
     for entry in with_sobol:
-        path = plots.plot_sobol(entry.outputs, out_dir / "plots" / f"sobol_{entry.stem}.png",
+        path = plots.plot_sobol(entry.outputs, out_dir / "plots" / bounded(f"sobol_{entry.stem}.png"),
                                 f"First-order Sobol' indices: {entry.label}")
         blocks.append(Figure(_rel(path, out_dir), f"First-order Sobol' indices over time of {entry.label} "
                                                   "(paper Fig. 21)" + (", bootstrap 95 % intervals shaded."
                                                                        if entry.pick_freeze else ".")))
-        path = plot_sensitivity(entry.outputs, out_dir / "plots" / f"sensitivity_{entry.stem}.png",
+        path = plot_sensitivity(entry.outputs, out_dir / "plots" / bounded(f"sensitivity_{entry.stem}.png"),
                                 f"Partial variances and Sobol' indices: {entry.label}")
         if path is not None:
             blocks.append(Figure(_rel(path, out_dir), f"Per output of {entry.label}: the partial variances "
@@ -449,7 +451,7 @@ def decay_section(entries: list[Entry], out_dir: Path) -> Section:
     for e in entries:
         excitation = (campaign_settings(str(e.attrs.get("campaign", ""))).get("simulator") or {}).get("excitation")
         start = excitation.get("start_s") if isinstance(excitation, dict) else None
-        path = plots.plot_coefficient_decay(e.outputs, out_dir / "plots" / f"coefficient_decay_{e.stem}.png",
+        path = plots.plot_coefficient_decay(e.outputs, out_dir / "plots" / bounded(f"coefficient_decay_{e.stem}.png"),
                                             f"PCE coefficients by total degree: {e.label}", start_s=start)
         blocks.append(Figure(_rel(path, out_dir), f"Root-sum-square of the PCE coefficients of each total degree "
                              f"from 1 on over time, {e.label}, from the excitation's start on: a fast decay "

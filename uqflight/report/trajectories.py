@@ -131,7 +131,7 @@ def trajectories_section(entries: list, times: list[float], out_dir: Path):
     quantities against the inputs, seeded by the campaign's seed (the same runs on every report); None
     when there is nothing to draw (no output and no quantity)."""
     from ..designs import is_sampled
-    from .loading import campaign_settings
+    from .loading import bounded, campaign_settings
     from .blocks import Figure, Section, _rel
     from .sections import _file_stem, _files
 
@@ -143,7 +143,7 @@ def trajectories_section(entries: list, times: list[float], out_dir: Path):
                  f" The points are the {e.stats.design_kind}'s nodes, not random draws: how they spread says "
                  "nothing of the inputs' distribution.")
         if any(out.time.size > 1 for out in e.outputs.values()):
-            path, drawn = plot_spaghetti(results, e.outputs, out_dir / "plots" / f"spaghetti_{stem}.png",
+            path, drawn = plot_spaghetti(results, e.outputs, out_dir / "plots" / bounded(f"spaghetti_{stem}.png"),
                                          f"Runs, mean and 99 % band: {e.label}", seed)
             blocks.append(Figure(_rel(path, out_dir), f"{drawn} of the {e.stats.completed} successful runs of {stem} "
                                  f"(drawn with the campaign's seed {seed}, at most {SPAGHETTI_RUNS}), thin, with "
@@ -156,7 +156,7 @@ def trajectories_section(entries: list, times: list[float], out_dir: Path):
             "the other input most correlated with it (squared correlation; the file has no Sobol' indices)")
             + ", low to high")
         path = plot_scatter(rows["kappa"], rows["names"], {**rows["outputs"], **rows["quantities"]},
-                            out_dir / "plots" / f"scatter_{stem}.png", f"Outputs and quantities against the "
+                            out_dir / "plots" / bounded(f"scatter_{stem}.png"), f"Outputs and quantities against the "
                             f"inputs: {e.label}")
         if path is not None:
             blocks.append(Figure(_rel(path, out_dir), "Each output (at the last selected time)"
