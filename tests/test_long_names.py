@@ -1,11 +1,12 @@
 """Any output name `run` accepts gives a report: file names built from names stay within 255 bytes of UTF-8
-(a long one cut, with a hash of the whole), short ones as they always were."""
+(a long one cut, with a hash of the whole), short ones as they always were; `info` lists names one entry each."""
 import csv
 import shutil
 
 import pytest
 from conftest import cli_in_process
 
+from uqflight.console import shown
 from uqflight.report.loading import bounded
 
 LONG = "L" * 300
@@ -101,3 +102,11 @@ def test_bounded_cuts_utf8_between_characters():
     assert len(name.encode()) <= 255 and name.endswith(".png") and name.startswith("α" * 100)
     assert bounded("x" * 251 + ".png") == "x" * 251 + ".png"
 
+
+def test_info_lists_names_one_entry_each(folder):
+    done = cli_in_process("info", folder / "r.h5")
+    assert done.returncode == 0, done.stderr
+    [outputs] = [line for line in done.stdout.splitlines() if line.startswith("outputs:")]
+    assert "alpha_deg, 'y\\noutputs: forged' (5 times" in outputs
+    assert [shown(n) for n in ("a_b", "a, b", " a", "it's", "\x1b[2J", "")] == \
+           ["a_b", "'a, b'", "' a'", '"it\'s"', "'\\x1b[2J'", "''"]

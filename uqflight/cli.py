@@ -13,7 +13,7 @@ import typer
 
 from .arguments import check_campaign_file, check_output, check_results_file
 from .calibration.command import register as register_calibrate
-from .console import echo
+from .console import echo, shown
 from . import stopping
 from .leaving import leave
 from .progress import Progress
@@ -387,14 +387,14 @@ def _describe_results(results, store, Status) -> None:
     status = store.status
     attrs = store.attrs
     echo(f"file: {results}")
-    echo(f"campaign: {attrs.get('campaign_name', '?')} (sha256 {store.campaign_hash[:12]})")
+    echo(f"campaign: {shown(str(attrs.get('campaign_name', '?')))} (sha256 {store.campaign_hash[:12]})")
     echo(f"design: {attrs.get('design_kind', '?')} {attrs.get('design_info', '')}")
     state = store.index_set()  # an adaptive grid's refinement (/design)
     if state is not None:
         echo(f"index set: {len(state.indices)} multi-indices, {state.rounds} rounds, "
              f"{'stopped by ' + state.stopped if state.stopped else 'refining (resume to go on)'}")
-    echo(f"parameters: {', '.join(store.parameter_names)}")
-    echo(f"outputs: {', '.join(store.output_names)} ({store.time.size} times, "
+    echo(f"parameters: {', '.join(map(shown, store.parameter_names))}")
+    echo(f"outputs: {', '.join(map(shown, store.output_names))} ({store.time.size} times, "
          f"{store.time[0]:g} to {store.time[-1]:g} s)")
     counts = {s.name.lower(): int(np.sum(status == s)) for s in Status}
     echo("runs: " + ", ".join(f"{v} {k}" for k, v in counts.items()) + f" (of {status.size})")

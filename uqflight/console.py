@@ -19,6 +19,14 @@ def clean(text: str) -> str:
     return CONTROL.sub("", text)
 
 
+def shown(name: str) -> str:
+    """A name from a file as one unambiguous entry of a listing: as it is when plain, else as repr shows it
+    (quoted, control characters escaped such as \\n): a name holding a newline, a comma or a quote, or
+    starting or ending with a space."""
+    plain = name.isprintable() and name == name.strip() and not any(c in name for c in ",'\"")
+    return name if plain and name else repr(name)
+
+
 def echo(message: object = "", err: bool = False, nl: bool = True) -> None:
     """typer.echo of `message` cleaned; a reader gone (closed pipe) exits quietly with 141."""
     try:
