@@ -135,7 +135,8 @@ KEYS = {
     "storage.tsvd.tol": "Relative truncation tolerance in (0, 1). Default 1e-8.",
     "storage.tsvd.batch": "Runs per SVD update, >= 1. Default 1000.",
     # analysis
-    "analysis.band_samples": "Draws of the PCE for the bands and PDFs, >= 100. Default 20000: on the paper's "
+    "analysis.band_samples": "Draws of the PCE for the bands and PDFs, from 100 to 10^6 (a million draws of an "
+                             "output take about 1.6 GB to sort). Default 20000: on the paper's "
                              "expansion the band's sampling error is about 3.5 % of the output's std, "
                              "and grows as 1/sqrt(draws) (`benchmarks/band_samples.py`).",
     "analysis.bootstrap": "Resamplings for the pick-freeze Sobol' intervals, >= 0 (0: none). Default 200.",

@@ -34,6 +34,8 @@ TSVD_KEYS = ("tol", "batch")
 DEFAULT_ORDER = 2
 DEPENDENCE_KEYS = ("kind", "parameters", "correlation")
 ANALYSIS_KEYS = ("band_samples", "bootstrap", "quantiles", "exceedance")
+# A million draws of one output are sorted 100 times at once (statistics.TIME_BLOCK): about 1.6 GB in two threads.
+MAX_BAND_SAMPLES = 10**6
 # Refused before anything is built (see `check_size`); a campaign raises them under `limits:`.
 WORKER_BYTES = 60e6  # memory of one local worker process: Python, numpy, JSBSim, the aircraft (52 MB measured)
 DEFAULT_LIMITS = {"max_runs": 1_000_000, "max_memory_gb": 8.0, "max_disk_gb": 100.0, "max_pce_terms": MAX_TERMS}
@@ -529,6 +531,10 @@ def analysis(check: Checker, value, quantities: dict | None = None) -> dict:
 
         analysis["exceedance"] = check_exceedance(check, analysis["exceedance"], quantities or {})
     analysis["band_samples"] = check.integer(analysis.get("band_samples", 20000), "analysis.band_samples", 100)
+    if analysis["band_samples"] > MAX_BAND_SAMPLES:
+        check.fail("analysis.band_samples", f"expected at most {MAX_BAND_SAMPLES} draws (a million draws of an "
+                                            "output, sorted 100 times at once, take about 1.6 GB in two threads), "
+                                            f"got {analysis['band_samples']}")
     analysis["bootstrap"] = check.integer(analysis.get("bootstrap", 200), "analysis.bootstrap", 0)
     if "quantiles" in analysis:  # kept only when given (default: statistics.DEFAULT_QUANTILES)
         value = analysis["quantiles"]
