@@ -205,3 +205,21 @@ def test_hostile_campaign_yaml_is_one_message_with_exit_2(tmp_path, name):
     assert result.stderr.startswith(f"error: {path}: YAML error at line 2") and message in result.stderr
     assert len(result.stderr.strip().splitlines()) == 1 and "Traceback" not in result.stderr
 
+
+
+LIST_AS_NAME = {  # name: (the campaign's last lines, the field, what the message says)
+    "a method kind": ("method: {kind: [pseudo_galerkin]}\n", "method.kind", "expected one of integration"),
+    "a correlated parameter": ("dependence: {kind: gaussian_copula, parameters: [[a], b], correlation: [[1, 0], "
+                               "[0, 1]]}\n", "dependence.parameters[0]", "expected one of the campaign's parameters"),
+}
+
+
+@pytest.mark.parametrize("name", LIST_AS_NAME)
+def test_a_list_where_a_name_is_expected_is_refused_naming_the_field(name):
+    lines, field, message = LIST_AS_NAME[name]
+    text = ("name: lists\nsimulator: {kind: python, function: \"uqflight.simulators.models:exp_decay\"}\n"
+            "parameters:\n  a: {distribution: normal, lower: 0.5, upper: 1.5}\n"
+            "  b: {distribution: normal, lower: 1.0, upper: 2.0}\ndesign: {kind: monte_carlo, samples: 10}\n" + lines)
+    with pytest.raises(CampaignError) as caught:
+        parse_campaign(text, "lists.yaml")
+    assert caught.value.field == field and message in str(caught.value)

@@ -160,6 +160,7 @@ def build_campaign(check: Checker, data: dict, simulator: dict, parameters: list
         quantities = check_quantities(check, data.get("quantities"), simulator)
     analysis = schema.analysis(check, data.get("analysis", {}), quantities)
     limits = schema.limits(check, data.get("limits", {}))
-    dependence = schema.dependence(check, data.get("dependence"), parameters, simulator)
+    dependence = schema.dependence(check, data.get("dependence"), [p.name for p in parameters], seeds,
+                                   simulator.get("properties", {}))
     return Campaign(check.source, text, name, data.get("seed", 0), simulator, parameters, data["design"], method,
                     execution, storage, analysis, limits, quantities=quantities, dependence=dependence)

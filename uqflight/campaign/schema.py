@@ -367,24 +367,22 @@ def check_seeds(check: Checker, parameters: list[Parameter], design_kind, method
         check.fail(where, f"{SEED_REFUSAL} ({method['kind']})")
 
 
-def dependence(check: Checker, value, parameters: list[Parameter], simulator: dict) -> GaussianCopula | None:
+def dependence(check: Checker, value, known: list[str], seeds: list[str], fixed=()) -> GaussianCopula | None:
     """`dependence: {kind: gaussian_copula, parameters: [...], correlation: [[...]]}`: the copula over
-    the named parameters (default: every parameter but a seed, in campaign order), or None."""
+    the named parameters (`known`, the campaign's, default: every one but the `seeds`, in campaign order),
+    or None. `fixed`: the simulator's fixed properties, which a name may not be."""
     if value is None:
         return None
     value = check.mapping(value, "dependence", DEPENDENCE_KEYS, required=("kind", "correlation"))
     check.string(value["kind"], "dependence.kind", DEPENDENCE_KINDS)
-    seeds = seed_names(parameters)
-    known = [p.name for p in parameters]
     names = value.get("parameters", [name for name in known if name not in seeds])
     if not isinstance(names, list) or len(names) < 2:
         check.fail("dependence.parameters", f"expected a list of at least two parameter names, got {shown(names)}")
-    fixed = simulator.get("properties", {})
     for i, name in enumerate(names):
         path = f"dependence.parameters[{i}]"
         if not isinstance(name, str) or name not in known:
-            what = (" is a fixed property (simulator.properties), not an uncertain parameter" if name in fixed
-                    else "")
+            what = (" is a fixed property (simulator.properties), not an uncertain parameter"
+                    if isinstance(name, str) and name in fixed else "")
             check.fail(path, f"expected one of the campaign's parameters ({', '.join(known)}), got {shown(name)}{what}")
         if name in seeds:
             check.fail(path, f"{name} is a seed: a random stream's seed cannot be correlated")
@@ -474,7 +472,8 @@ def function_property(check: Checker, spec: dict, path: str, kind: str, aircraft
 
 
 def method(check: Checker, value) -> dict:
-    entry = METHODS.get(value.get("kind")) if isinstance(value, dict) else None
+    kind = value.get("kind") if isinstance(value, dict) else None
+    entry = METHODS.get(kind) if isinstance(kind, str) else None
     if entry is not None and entry.settings:  # a kind with keys of its own (sparse): exactly those
         keys = ("kind", entry.order_key, *(key for key, _ in entry.settings))
         method = dict(check.mapping(value, "method", keys, required=("kind",)))
