@@ -566,6 +566,7 @@ def surrogate_export(
     """Export the PCE of every output over time as JSON: germs, multi-indices, coefficients per output
     and time, the parameters' distributions (name, distribution, lower, upper, nominal), the time
     grid, method and order. Load it in Python with uqflight.surrogate.load(path).evaluate(kappa)."""
+    from .statistics import BadInput
     from .surrogate import SurrogateError, export
 
     try:
@@ -577,7 +578,7 @@ def surrogate_export(
     try:
         with Progress(0, label="surrogate export") as progress:
             export(results, out, override, progress)
-    except SurrogateError as exc:
+    except (SurrogateError, BadInput) as exc:
         echo(f"error: {exc}", err=True)
         raise typer.Exit(2)
     except (OSError, KeyError, ValueError) as exc:
