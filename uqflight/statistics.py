@@ -45,6 +45,8 @@ from .analysis.moments import (modified_cov, sorted_by_time, standardised_moment
                                weighted_quantiles)
 from .analysis.resolution import RESOLUTION_RTOL, resolved_variance
 from .analysis.sobol import pick_freeze_indices
+from .campaign.attributes import StoredFacts, stored_facts
+from .campaign.schema import CampaignError
 from .designs import REGISTRY as DESIGNS
 from .designs import is_sampled
 from .designs.adaptive import index_set_summary
@@ -154,11 +156,13 @@ class QuantityStatistics:
     exceedance: list[dict] = field(default_factory=list)
 
 
-def campaign_facts(store: ResultStore) -> tuple[dict, list[str], dict]:
-    """The method, the germs and the analysis options a results file was made with."""
-    attrs = store.attrs
-    return (json.loads(attrs["method"]), json.loads(attrs["germs"]),
-            json.loads(attrs.get("analysis", "{}")))
+def campaign_facts(store: ResultStore, path) -> StoredFacts:
+    """The method, germs, analysis options, seeds and copula the results file `path` was made with, checked
+    as its campaign was: BadInput naming the file, the attribute and the field."""
+    try:
+        return stored_facts(store.attrs, str(path), store.parameter_names, store.quantity_names)
+    except CampaignError as exc:
+        raise BadInput(str(exc)) from exc
 
 
 def read_statistics(path, method: dict | None = None, partial: bool = False,
@@ -192,8 +196,9 @@ def analyse(path, reference: str | None = None, options: Options | None = None, 
     # one BLAS thread: the matrices are tall and thin (runs or draws × terms), where several threads are no
     # faster, and 10-20x slower on a loaded machine; the time blocks run in threads instead
     with ResultStore.open(path) as store, threadpool_limits(limits=1):
-        stored_method, germs, analysis = campaign_facts(store)
-        method = {"order": 2, **normalised(stored_method), **normalised(method or {})}
+        facts = campaign_facts(store, path)
+        germs, analysis = facts.germs, facts.analysis
+        method = {"order": 2, **normalised(facts.method), **normalised(method or {})}
         allow_aliasing = allow_aliasing or bool(method.get("allow_aliasing"))
         options = options or Options(**{k: (tuple(v) if k == "quantiles" else v) for k, v in analysis.items()
                                         if k in ("band_samples", "bootstrap", "quantiles")})
@@ -214,11 +219,9 @@ def analyse(path, reference: str | None = None, options: Options | None = None, 
         stats.index_set = None if state is None else index_set_summary(state, store.parameter_names)
         problem = method_problem(method["kind"], method["order"], store.xi[ok], store.weights[ok], germs, sampled,
                                  missing=int(status.size - ok.sum()), allow_aliasing=allow_aliasing)
-        seeds = json.loads(store.attrs.get("seeds", "[]"))
-        if seeds and not (sampled and method_entry(method["kind"]).runs_on_sampled):
-            problem = f"parameter {seeds[0]} is a seed: {SEED_REFUSAL}"
-        stats.seeds = seeds
-        stats.dependence = json.loads(store.attrs.get("dependence", "null"))
+        if facts.seeds and not (sampled and method_entry(method["kind"]).runs_on_sampled):
+            problem = f"parameter {facts.seeds[0]} is a seed: {SEED_REFUSAL}"
+        stats.seeds, stats.dependence = facts.seeds, facts.dependence
         if stats.dependence:
             stats.notes.append(f"dependent inputs: {', '.join(stats.dependence['parameters'])} are correlated by a "
                                "Gaussian copula (Nataf); the mean, variance, bands and densities are those of the "

@@ -93,11 +93,11 @@ def fit_surrogate(path, method: dict | None = None, partial: bool = False, allow
     does not depend on them, and its bands and PDFs are not exported); `progress`: see analyse."""
     from .designs import REGISTRY as DESIGNS
     from .methods import METHOD_KINDS, exported_kind, normalised
-    from .statistics import Options, analyse
+    from .statistics import Options, analyse, campaign_facts
     from .store import ResultStore
 
     with ResultStore.open(path) as store:
-        stored, design_kind = normalised(json.loads(store.attrs["method"])), store.attrs.get("design_kind", "")
+        stored, design_kind = normalised(campaign_facts(store, path).method), store.attrs.get("design_kind", "")
         parameters, units, time = _parameters(store), dict(store.units), np.asarray(store.time, dtype=float)
     override = dict(method or {})
     kind = override.get("kind", stored.get("kind"))

@@ -9,7 +9,6 @@ package, retarget the imports here.
 """
 from __future__ import annotations
 
-import json
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -27,7 +26,7 @@ from ..parameters import to_physical as _to_physical
 from ..parameters import to_standard as _to_standard
 from ..parameters.summaries import parameter_specs, prior_summaries
 from ..simulators.validation_view import validation_view
-from ..statistics import BadInput, Options, output_basis
+from ..statistics import BadInput, Options, campaign_facts, output_basis
 from ..store import ResultStore, Status
 from ..surrogate import SurrogateError, fit_surrogate
 from .likelihood import error_factors_of
@@ -145,8 +144,11 @@ def calibration_surrogate(results, method: str | None = None, order: int | None 
         raise SurrogateError(f"{results}: {exc}") from exc
     with store:
         campaign = _campaign_of(store, results, Path(campaign_path) if campaign_path else None)
-        stored = normalised(json.loads(store.attrs["method"]))
-        germs = json.loads(store.attrs["germs"])
+        try:
+            facts = campaign_facts(store, results)
+        except BadInput as exc:
+            raise SurrogateError(str(exc)) from exc
+        stored, germs = normalised(facts.method), facts.germs
         sampled = is_sampled(store.attrs.get("design_kind", ""))
         kind = method or stored["kind"]
         order = stored.get("order", 2) if order is None else order

@@ -1,0 +1,84 @@
+"""A results file's campaign facts are root attributes of JSON text (method, germs, analysis, seeds,
+dependence): every reading command refuses a malformed one with exit 2 and one line naming the file, the
+attribute and the field, never a traceback. A real file of `uqflight run`, then edited with h5py."""
+import shutil
+
+import h5py
+import numpy as np
+import pytest
+from conftest import DATA, DECAY_TWO_INPUTS, cli_in_process
+
+BASELINE = DATA.parent / "baselines" / "ci-small.json"  # any sound baseline: the results file is refused first
+PG = '{"kind": "pseudo_galerkin", "order": %s}'
+COPULA = '{"kind": "gaussian_copula", "parameters": ["a", "b"], "correlation": %s}'
+MALFORMED = {  # name: (attribute, value, what the message says after "FILE: attribute ATTRIBUTE: ")
+    "method a string": ("method", '"pseudo_galerkin"', "expected a mapping with the keys kind"),
+    "method an integer": ("method", np.int64(5), "expected JSON text, got np.int64(5)"),
+    "method nested 100,000 deep": ("method", "[" * 100_000 + "]" * 100_000, "is not JSON (maximum recursion depth"),
+    "method order NaN": ("method", PG % "NaN", "order: expected an integer >= 0, got nan"),
+    "method order 1e308": ("method", PG % "1e308", "order: expected an integer >= 0, got 1e+308"),
+    "method order -3": ("method", PG % "-3", "order: expected an integer >= 0, got -3"),
+    "method order true": ("method", PG % "true", "order: expected an integer >= 0, got True"),
+    "band_samples 1e12": ("analysis", '{"band_samples": 1e12, "bootstrap": -1}',
+                          "band_samples: expected an integer >= 100, got 1000000000000.0"),
+    "band_samples a word": ("analysis", '{"band_samples": "many"}',
+                            "band_samples: expected an integer >= 100, got 'many'"),
+    "band_samples NaN": ("analysis", '{"band_samples": NaN}', "band_samples: expected an integer >= 100, got nan"),
+    "band_samples 10^12": ("analysis", '{"band_samples": 1000000000000, "bootstrap": 0}',
+                           "band_samples: expected at most 1000000 draws"),
+    "bootstrap -1": ("analysis", '{"bootstrap": -1}', "bootstrap: expected an integer >= 0, got -1"),
+    "seeds a number": ("seeds", "5", "expected a list of distinct parameter names (a, b), got 5"),
+    "seeds an unknown name": ("seeds", '["c"]', "expected a list of distinct parameter names (a, b), got ['c']"),
+    "dependence without kind": ("dependence", '{"parameters": 5}', "kind: is required"),
+    "dependence a list": ("dependence", "[1]", "expected a mapping with the keys kind, parameters, correlation"),
+    "dependence a correlation of 2": ("dependence", COPULA % "[[1, 2], [2, 1]]",
+                                      "correlation[0][1]: expected a correlation in [-1, 1], got 2.0"),
+    "germs too few": ("germs", '["normal"]', "expected a list of 2 germs (normal / uniform), one per parameter"),
+    "germs unknown": ("germs", '["normal", "cauchy"]', "got ['normal', 'cauchy']"),
+}
+
+
+@pytest.fixture(scope="module")
+def sound(tmp_path_factory):
+    """The DECAY_TWO_INPUTS campaign's results file, written by `uqflight run`."""
+    root = tmp_path_factory.mktemp("attrs")
+    (root / "c.yaml").write_text(DECAY_TWO_INPUTS)
+    done = cli_in_process("run", root / "c.yaml", "--out", root / "r.h5")
+    assert done.returncode == 0, done.stderr
+    return root / "r.h5"
+
+
+def malformed(sound, folder, attribute, value):
+    """A copy of the sound file in `folder` with `attribute` set to `value`."""
+    path = folder / "r.h5"
+    shutil.copy(sound, path)
+    with h5py.File(path, "a") as f:
+        f.attrs[attribute] = value
+    return path
+
+
+def refused(result, path, attribute: str, message: str) -> None:
+    assert result.returncode == 2, (result.stdout, result.stderr)
+    assert "Traceback" not in result.stdout + result.stderr
+    line, = result.stderr.strip().splitlines()
+    assert line.startswith(f"error: {path}: attribute {attribute}: ") and message in line, line
+
+
+@pytest.mark.parametrize("name", MALFORMED)
+def test_every_reader_refuses_a_malformed_attribute_naming_file_attribute_and_field(sound, tmp_path, name):
+    attribute, value, message = MALFORMED[name]
+    path = malformed(sound, tmp_path, attribute, value)
+    for command in (["report", path, "--out", tmp_path / "report"], ["check", path, "--baseline", BASELINE],
+                    ["surrogate", "export", path, "--out", tmp_path / "s.json"]):
+        refused(cli_in_process(*command), path, attribute, message)
+    assert not (tmp_path / "report").exists() and not (tmp_path / "s.json").exists()
+
+
+@pytest.mark.parametrize("name", ["method a string", "germs too few"])
+def test_calibrate_refuses_a_malformed_attribute(sound, tmp_path, name):
+    attribute, value, message = MALFORMED[name]
+    path = malformed(sound, tmp_path, attribute, value)
+    data = tmp_path / "data.csv"
+    data.write_text("time_s,x\n0,1.0\n1,0.37\n2,0.14\n")
+    refused(cli_in_process("calibrate", path, "--data", data, "--out", tmp_path / "cal", "--steps", 100),
+            path, attribute, message)
