@@ -132,6 +132,28 @@ def test_calibrate_imports_the_model_only_for_its_predictive_runs(world, tmp_pat
     (world["sentinels"] / "beside").unlink()
 
 
+@pytest.mark.parametrize("where", ["../proj/model.py", "{root}/proj/model.py"])
+def test_calibrate_refuses_a_model_that_a_results_file_places_outside_its_folder(world, tmp_path, where):
+    """A results file whose stored campaign names its model by a path leading out of its folder (edited, or
+    of a campaign that named ../model.py) is refused before any import: it would run code elsewhere."""
+    import h5py
+
+    from uqflight.store.results import text_hash
+
+    results = world["results"] / f"outside-{where[0]}.h5"
+    results.write_bytes((world["results"] / "file.h5").read_bytes())
+    with h5py.File(results, "a") as f:
+        text = str(f.attrs["campaign"]).replace('"model.py:f"', f'"{where.format(root=world["root"])}:f"')
+        f.attrs.update({"campaign": text, "campaign_hash": text_hash(text)})
+    data = tmp_path / "flight.csv"
+    data.write_text("time_s,y\n0,1.1\n1,0.6\n2,0.2\n")
+    run = read(world, "calibrate", results, "--data", data, "--out", tmp_path / "cal", "--noise", "y=0.05")
+    assert run.returncode == 2, run.stdout + run.stderr
+    assert f"error: {results}: simulator.function: the python model " in run.stderr
+    assert "is outside the results file's folder" in run.stderr and "--campaign" in run.stderr
+    assert ran_code(world) == {} and not (tmp_path / "cal").exists()
+
+
 def test_the_reading_path_never_resolves_the_simulator():
     """Structural: the module that rebuilds a results file's campaign never calls what imports code."""
     source = (ROOT / "uqflight" / "campaign" / "reading.py").read_text()

@@ -123,10 +123,16 @@ def _campaign_of(store: ResultStore, results: Path, campaign_path: Path | None) 
     except CampaignError as exc:
         raise SurrogateError(f"cannot rebuild the campaign stored in {results}: {exc}") from exc
     module, _, _ = campaign.simulator.get("function", "").partition(":")
-    if module.endswith(".py") and not (campaign_folder(campaign) / module).is_file():  # looked for, not imported
-        raise SurrogateError(f"the python model {module} that the posterior-predictive runs call is not beside "
-                             f"{source}; pass the campaign file with --campaign (its model file is looked up "
-                             "beside it)")
+    if module.endswith(".py"):  # looked for, not imported
+        folder = campaign_folder(campaign)
+        if campaign_path is None and not (folder / module).resolve().is_relative_to(folder):
+            raise SurrogateError(f"{results}: simulator.function: the python model {module} is outside the results "
+                                 "file's folder, and a results file names only a model beside it; pass the campaign "
+                                 "file with --campaign to fly a model elsewhere")
+        if not (folder / module).is_file():
+            raise SurrogateError(f"the python model {module} that the posterior-predictive runs call is not beside "
+                                 f"{source}; pass the campaign file with --campaign (its model file is looked up "
+                                 "beside it)")
     return campaign
 
 
