@@ -6,11 +6,13 @@ from conftest import DATA, cli_in_process
 MODEL = DATA / "failure_models.py"
 
 
-def run(tmp_path, outputs="", interval="lower: 1.0, upper: 2.0"):
+def run(tmp_path, outputs="", interval="lower: 1.0, upper: 2.0", command="run", function=f"{MODEL}:fails_at_centre"):
     (tmp_path / "c.yaml").write_text(
-        f"name: nominal\nsimulator: {{kind: python, function: \"{MODEL}:fails_at_centre\"{outputs}}}\n"
+        f"name: nominal\nsimulator: {{kind: python, function: \"{function}\"{outputs}}}\n"
         f"parameters:\n  a: {{distribution: uniform, {interval}, nominal: 1.4}}\n"
         "design: {kind: monte_carlo, samples: 8}\n")
+    if command == "plan":
+        return cli_in_process("plan", tmp_path / "c.yaml")
     return cli_in_process("run", tmp_path / "c.yaml", "--out", tmp_path / "c.h5")
 
 
@@ -25,6 +27,16 @@ def test_a_failing_nominal_sample_is_named_with_its_values_and_what_to_do(tmp_pa
     assert "RuntimeError: centre node" in message
     assert "call simulator.function with them" in message and "move the parameters' intervals" in message
     assert not (tmp_path / "c.h5").exists()
+
+
+def test_plan_says_what_run_says_of_a_nominal_sample_that_fails_or_returns_no_outputs(tmp_path):
+    # plan times a nominal run: a model failing there was a traceback with exit 1
+    for function, said in ((f"{MODEL}:fails_at_centre", "the nominal sample failed (a = 1.5: the centre"),
+                           ("os:getcwd", "TypeError: ")):
+        planned, ran = run(tmp_path, command="plan", function=function), run(tmp_path, function=function)
+        assert planned.returncode == ran.returncode == 2, planned.stderr
+        assert planned.stderr.startswith(f"error: {tmp_path / 'c.yaml'}: ") and said in planned.stderr
+        assert len(planned.stderr.strip().splitlines()) == 1 and "Traceback" not in planned.stderr
 
 
 def test_a_campaign_error_found_at_the_nominal_is_not_called_a_failing_sample(tmp_path):

@@ -19,7 +19,7 @@ from .leaving import leave
 from .progress import Progress
 
 from .methods import METHOD_KINDS
-from .simulators.base import FlightError
+from .simulators.base import FlightError, NominalFailed
 from .simulators.aircraft import default_condition
 from .simulators.jsbsim import DEFAULT_OUTPUTS, Excitation, FlightSetup, JSBSimFlight
 
@@ -243,7 +243,14 @@ def plan(campaign_file: Path = typer.Argument(..., metavar="CAMPAIGN", help="Cam
     echo(f"runs: {runs}" + (" at most (design.budget)" if is_adaptive(design.kind) else ""))
     echo(f"results: {Path(campaign.storage['path']).resolve()} (storage.path, from the working directory; "
          "--out to choose)")
-    seconds = _seconds_per_run(campaign)
+    try:
+        seconds = _seconds_per_run(campaign)
+    except NominalFailed as exc:  # its message says it all
+        echo(f"error: {campaign_file}: {exc}", err=True)
+        raise typer.Exit(2)
+    except Exception as exc:  # the simulator's own code (a python model) failed to build or to fly: as `run` says
+        echo(f"error: {campaign_file}: {type(exc).__name__}: {exc}", err=True)
+        raise typer.Exit(2)
     workers = min(campaign.execution["workers"], CORES)
     echo(f"estimated time: {runs * seconds / workers:.0f} s with {workers} worker(s) "
          f"({seconds * 1e3:.0f} ms per run, one nominal run timed now on this machine)")
@@ -265,12 +272,13 @@ def _seconds_per_run(campaign) -> float:
     """One nominal run of the campaign's simulator, timed here (after a first, warming run)."""
     import time
 
-    from .execution import worker_spec
+    from .execution import nominal_kappa, worker_spec
 
     from .quantities.recorder import QuantityRecorder
 
     simulator = worker_spec(campaign).build()
-    nominal = np.array([p.nominal for p in campaign.parameters])
+    nominal = nominal_kappa(campaign)  # the sample `run` flies first, the centre of every law (ξ = 0)
+    simulator.layout(nominal)  # as `run` learns the outputs first: NominalFailed says what to do when it fails
     # the timed run computes the quantities too: a linearisation costs more than the flight
     observers = (QuantityRecorder(campaign.quantities, simulator.source),) if campaign.quantities else ()
     for timed in (False, True):  # the first run loads what every later one reuses (the Newton trim's nominal)
