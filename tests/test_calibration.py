@@ -12,13 +12,15 @@ import json
 import math
 import os
 import signal
+import shutil
 import subprocess
 import time
 
+import h5py
 import numpy as np
 import pytest
 import typer
-from conftest import NORMAL_2D, UQFLIGHT, cli_in_process, closed_form_campaign, run_python_campaign
+from conftest import CLOSED_FORMS, NORMAL_2D, UQFLIGHT, cli_in_process, closed_form_campaign, run_python_campaign
 from typer.testing import CliRunner
 
 from uqflight.calibration.command import register
@@ -32,6 +34,7 @@ from uqflight.campaign import parse_campaign
 from uqflight.execution import run_campaign
 
 MODEL = '''
+import h5py
 import numpy as np
 T = np.linspace(0.0, 2.0, 21)
 
@@ -182,7 +185,10 @@ def test_not_converged_exits_3_and_leaves_no_valid_looking_output(results, tmp_p
     write_csv(data, TIME, synthetic(2))
     out = tmp_path / "out"
     out.mkdir()
-    (out / "summary.json").write_text("{}")  # from an earlier run
+    (out / "summary.json").write_text("{}")  # from an earlier run, whose posterior.h5 marks the folder as its
+    with h5py.File(out / "posterior.h5", "w") as f:
+        f.create_group("draws")
+        f.create_dataset("chain", data=np.zeros((2, 2, 1)))
     run = CliRunner().invoke(app(), ["calibrate", str(results), "--data", str(data), "--out", str(out),
                                      "--steps", "100"])
     assert run.exit_code == 3, run.output
@@ -420,10 +426,13 @@ def test_the_memory_limit_is_the_campaigns_own(tmp_path):
 # -- calibration data and a campaign of one output: hostile inputs refused up front, Ctrl-C
 @pytest.fixture(scope="module")
 def one_output(tmp_path_factory):
-    """y(t) = 15000 + t (x1² + x2²) at 5 times in [0, 1] on a 4x4 grid."""
+    """y(t) = 15000 + t (x1² + x2²) at 5 times in [0, 1] on a 4x4 grid; the model beside the results file,
+    where calibrate's predictive runs look for it."""
     folder = tmp_path_factory.mktemp("calibrate")
-    return run_python_campaign(folder, closed_form_campaign("sq", "sum_of_squares", NORMAL_2D, "{kind: tensor_grid, points: 4}",
-                                                "method: {kind: pseudo_galerkin, order: 2}\n"))
+    shutil.copy(CLOSED_FORMS, folder / CLOSED_FORMS.name)
+    text = closed_form_campaign("sq", "sum_of_squares", NORMAL_2D, "{kind: tensor_grid, points: 4}",
+                                "method: {kind: pseudo_galerkin, order: 2}\n")
+    return run_python_campaign(folder, text.replace(str(CLOSED_FORMS), CLOSED_FORMS.name))
 
 
 
@@ -438,6 +447,24 @@ def test_a_million_row_csv_is_refused_before_it_is_parsed(one_output, tmp_path):
            "predictive draws takes about 34 kB a row, more than the 8 GB memory limit" in result.stderr
     assert len(result.stderr.strip().splitlines()) == 1 and not out.exists()
 
+
+
+def test_a_folder_holding_a_users_files_of_the_calibrations_names_is_refused(one_output, tmp_path):
+    # a calibration replaces summary.json, report.html, ... in --out: only those an earlier calibration wrote
+    data = tmp_path / "flight.csv"
+    data.write_text("time_s,y\n0,15000\n0.5,15001\n1,15002\n")
+    out = tmp_path / "mine"
+    (out / "plots").mkdir(parents=True)
+    (out / "summary.json").write_text('{"mine": true}')
+    (out / "plots" / "corner.png").write_bytes(b"not a calibration's")
+    (out / "notes.txt").write_text("kept")
+    result = cli_in_process("calibrate", one_output, "--data", data, "--out", out, "--noise", "y=0.5")
+    assert result.returncode == 2 and result.stdout == ""
+    assert result.stderr == (f"error: --out {out}: holds summary.json, plots/corner.png, which a calibration would "
+                             "replace and which an earlier calibration did not write (no posterior.h5 of one there); "
+                             "choose another --out, or move them away\n")
+    assert (out / "summary.json").read_text() == '{"mine": true}' and sorted(p.name for p in out.iterdir()) == [
+        "notes.txt", "plots", "summary.json"]
 
 
 def test_a_byte_order_mark_is_no_part_of_the_header(tmp_path):

@@ -18,6 +18,17 @@ EXIT_NOT_CONVERGED = 3
 EXIT_INTERRUPTED = 130
 
 
+def foreign_outputs(out: Path) -> list[str]:
+    """The files in `out` that a calibration would replace (or remove) when `out` is not an earlier
+    calibration's folder (one holding a posterior.h5 that a calibration wrote): a user's summary.json or
+    report.html there is never overwritten."""
+    from .outputs import OUTPUT_FILES, is_posterior_file
+
+    if not out.is_dir() or is_posterior_file(out / "posterior.h5"):
+        return []
+    return [name for name in (*OUTPUT_FILES, "report.html") if (out / name).exists() or (out / name).is_symlink()]
+
+
 def calibrate_command(
     results: Path = typer.Argument(..., metavar="RESULTS", help="Results file (.h5) of the campaign to calibrate: its runs give the "
                                              "surrogate, its campaign the prior and the simulator."),
@@ -59,6 +70,12 @@ def calibrate_command(
     if campaign is not None:
         check_campaign_file(campaign)
     check_output(out, "--out", folder=True, create=True)
+    overwritten = foreign_outputs(out)
+    if overwritten:
+        echo(f"error: --out {out}: holds {', '.join(overwritten)}, which a calibration would replace and which "
+             "an earlier calibration did not write (no posterior.h5 of one there); choose another --out, or move "
+             "them away", err=True)
+        raise typer.Exit(EXIT_BAD_INPUT)
     if order is not None and order < 0:
         echo(f"error: --order: expected an integer >= 0, got {order}", err=True)
         raise typer.Exit(EXIT_BAD_INPUT)

@@ -48,6 +48,17 @@ def write_json(path: Path, data: dict) -> None:
     path.write_text(json.dumps(strict(data), indent=2, allow_nan=False) + "\n", encoding="utf-8")
 
 
+def is_posterior_file(path: Path) -> bool:
+    """Whether `path` is a posterior.h5 that write_posterior wrote (its draws and chain)."""
+    if path.is_symlink() or not path.is_file() or not h5py.is_hdf5(path):
+        return False
+    try:
+        with h5py.File(path, "r") as f:
+            return isinstance(f.get("draws"), h5py.Group) and isinstance(f.get("chain"), h5py.Dataset)
+    except OSError:
+        return False
+
+
 def write_posterior(path: Path, names, properties, xi, kappa, noise_names, sigma, log_prob, chain, labels,
                     burn: int, attrs: dict) -> None:
     """Posterior draws (kept part of the chain, walkers interleaved) in standard and physical variables."""
