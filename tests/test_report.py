@@ -12,7 +12,7 @@ import h5py
 import numpy as np
 import pytest
 
-from conftest import UQFLIGHT, cli, cli_in_process, read_summary
+from conftest import UQFLIGHT, cli, cli_in_process, read_summary, run_python_campaign
 from uqflight.campaign import parse_campaign
 from uqflight.check import write_baseline
 from uqflight.simulators.validation_view import validation_view
@@ -261,6 +261,39 @@ def test_report_writes_next_to_the_results_file_by_default(decay_results, tmp_pa
     page = (out / "report.html").read_text()
     assert "What was run" in page and "design_decay.png" in page and "name: decay-people" in page
     assert not [p for p in results.parent.iterdir() if p.name.startswith(".decay-report")]
+
+
+SAME_NAME = """
+name: decay-{name}
+seed: 3
+simulator: {{kind: python, function: "uqflight.simulators.models:exp_decay"}}
+parameters:
+  a: {{distribution: uniform, lower: 0.5, upper: {upper}}}
+  b: {{distribution: uniform, lower: 1.0, upper: 2.0}}
+design: {{kind: sparse_grid, level: 2}}
+method: {{kind: pseudo_galerkin, order: 1}}
+analysis: {{band_samples: 200, bootstrap: 0}}
+"""
+
+
+def test_two_files_of_one_name_each_get_their_own_design_and_runs_figures(tmp_path):
+    """a/r.h5 and b/r.h5: the per-file figures are r and r-2 as the tables are (b's overwrote a's, and the
+    page showed b's twice), the second the same as a report of b alone draws."""
+    paths = []
+    for folder, upper in (("a", 1.5), ("b", 3.0)):
+        (tmp_path / folder).mkdir()
+        paths.append(run_python_campaign(tmp_path / folder, SAME_NAME.format(name=folder, upper=upper), "r"))
+    write_report(paths, tmp_path / "both")
+    write_report(paths[1:], tmp_path / "alone")
+    page = (tmp_path / "both" / "report.md").read_text()
+    plots = tmp_path / "both" / "plots"
+    for kind in ("design", "spaghetti", "scatter"):
+        first, second = plots / f"{kind}_r.png", plots / f"{kind}_r-2.png"
+        assert first.read_bytes() != second.read_bytes(), kind
+        assert page.count(f"plots/{kind}_r.png") == page.count(f"plots/{kind}_r-2.png") == 1, kind
+    for kind in ("spaghetti", "scatter"):  # the design's title names its file: r-2 here, r alone
+        assert (plots / f"{kind}_r-2.png").read_bytes() == (tmp_path / "alone" / "plots" / f"{kind}_r.png").read_bytes()
+    assert "The design points of r-2 projected" in page and "successful runs of r-2 " in page
 
 
 @pytest.mark.slow

@@ -29,6 +29,7 @@ class Entry:
     attrs: dict = field(default_factory=dict)  # the results file's root attributes
     path: str = ""  # the results file (several entries share one with several --method)
     output_files: dict = field(default_factory=dict)  # output name → its part of file names, unique in the entry
+    file_stem: str = ""  # the results file's part of the names of its own figures (design, runs), unique in the report
 
     @property
     def outputs(self) -> dict:
@@ -111,9 +112,10 @@ def load_entries(paths: list[Path], reference: Path | None, method: dict | list[
     methods = method if isinstance(method, list) else [method]
     methods = methods or [None]
     stems: set[str] = set()
+    file_stems = _file_stems(paths)
     ref = None
     if reference:
-        ref = _entry(reference, *read_statistics(reference, progress=progress), set())
+        ref = _entry(reference, *read_statistics(reference, progress=progress), set(), _file_stems([reference]))
     entries = []
     for path in paths:
         for override in methods:
@@ -121,11 +123,24 @@ def load_entries(paths: list[Path], reference: Path | None, method: dict | list[
                                            progress=progress)
             if ref is not None and not _same_file(path, reference):
                 add_reference_errors(stats, ref.stats)
-            entries.append(_entry(path, stats, attrs, stems, with_method=len(methods) > 1))
+            entries.append(_entry(path, stats, attrs, stems, file_stems, with_method=len(methods) > 1))
     return entries, ref
 
 
-def _entry(path: Path, stats: Statistics, attrs: dict, stems: set[str], with_method: bool = False) -> Entry:
+def _file_stems(paths: list[Path]) -> dict[Path, str]:
+    """Each results file (resolved) → its stem made safe for file names, given -2, -3 when an earlier file
+    has it (a/r.h5 and b/r.h5: "r" and "r-2"); a file given twice keeps its first."""
+    taken: set[str] = set()
+    stems: dict[Path, str] = {}
+    for path in paths:
+        key = Path(path).resolve()
+        if key not in stems:
+            stems[key] = _unique(file_name(Path(path).stem), taken)
+    return stems
+
+
+def _entry(path: Path, stats: Statistics, attrs: dict, stems: set[str], file_stems: dict[Path, str],
+           with_method: bool = False) -> Entry:
     name = Path(path).stem + (f"_{stats.method['kind']}{stats.method.get('order', '')}" if with_method else "")
     stem = _unique(file_name(name), stems)
     runs = f"partial: {stats.completed} of {stats.runs} runs" if stats.partial else f"{stats.runs} runs"
@@ -133,7 +148,8 @@ def _entry(path: Path, stats: Statistics, attrs: dict, stems: set[str], with_met
     taken: set[str] = set()
     output_files = {name: _unique(file_name(name), taken) for name in stats.outputs}
     return Entry(stats, stem, label, str(attrs.get("campaign_hash", "")),
-                 input_distributions(str(attrs.get("campaign", ""))), dict(attrs), str(path), output_files)
+                 input_distributions(str(attrs.get("campaign", ""))), dict(attrs), str(path), output_files,
+                 file_stems[Path(path).resolve()])
 
 
 def design_info(attrs: dict) -> dict:

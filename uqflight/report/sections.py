@@ -13,8 +13,7 @@ from .formats import shown_path
 from ..forking import share_work
 from .sensitivity import NEGLIGIBLE, index_text, plot_sensitivity
 from ..campaign.reading import stored_parameters
-from .loading import (Entry, _same_file, bounded, campaign_settings, design_info, file_name, flight_facts,
-                      method_label)
+from .loading import Entry, _same_file, bounded, campaign_settings, design_info, flight_facts, method_label
 
 BELOW_FLOOR = "below reference resolution"
 UNRESOLVED = "unresolved"
@@ -154,11 +153,11 @@ def run_section(entries: list[Entry], out_dir: Path) -> Section:
                         parameter_rows, "tables/parameters.csv"))
     for e in _files(entries):
         path = plots.plot_design_pairs(e.path or e.stats.path,
-                                       out_dir / "plots" / bounded(f"design_{_file_stem(e)}.png"),
+                                       out_dir / "plots" / bounded(f"design_{e.file_stem}.png"),
                                        f"Design: {e.attrs.get('design_kind', e.stats.design_kind)}, "
-                                       f"{e.stats.runs} points ({_file_stem(e)})")
+                                       f"{e.stats.runs} points ({e.file_stem})")
         if path is not None:
-            blocks.append(Figure(_rel(path, out_dir), f"The design points of {_file_stem(e)} projected on each pair "
+            blocks.append(Figure(_rel(path, out_dir), f"The design points of {e.file_stem} projected on each pair "
                                  "of inputs in physical values (paper Fig. 9); a symmetric grid once, in ξ, with "
                                  "the inputs' values at its levels; negative weights orange, failed runs red crosses."))
     texts = "\n\n".join(f"# {e.path or e.stats.path}\n{str(e.attrs.get('campaign', '')).strip()}"
@@ -471,7 +470,3 @@ def monte_carlo_section(entries: list[Entry], out_dir: Path) -> Section:
                    "The Monte Carlo files side by side, e.g. normal against uniform inputs (paper Figs. 4-5).",
                    [Figure(_rel(bands, out_dir), "Mean and 99 % band edges of each Monte Carlo file minus the first's."),
                     Figure(_rel(pdfs, out_dir), "PDF of each output at the final time for each Monte Carlo file.")])
-
-
-def _file_stem(entry: Entry) -> str:
-    return file_name(Path(entry.path or entry.stats.path).stem)

@@ -133,11 +133,11 @@ def trajectories_section(entries: list, times: list[float], out_dir: Path):
     from ..designs import is_sampled
     from .loading import bounded, campaign_settings
     from .blocks import Figure, Section, _rel
-    from .sections import _file_stem, _files
+    from .sections import _files
 
     blocks = []
     for e in _files(entries):
-        results, stem = Path(e.path or e.stats.path), _file_stem(e)
+        results, stem = Path(e.path or e.stats.path), e.file_stem
         seed = int(campaign_settings(str(e.attrs.get("campaign", ""))).get("seed", 0) or 0)
         nodes = ("" if is_sampled(e.stats.design_kind) else
                  f" The points are the {e.stats.design_kind}'s nodes, not random draws: how they spread says "
