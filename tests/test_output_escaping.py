@@ -6,7 +6,7 @@ import csv
 import pytest
 from conftest import cli_in_process
 
-from uqflight.console import clean
+from uqflight.console import clean, one_line
 from uqflight.report.files import inert
 from uqflight.report.render import md
 
@@ -62,6 +62,21 @@ def test_run_and_info_print_failure_reasons_without_control_characters(hostile):
         assert "failed (" in printed and "gone" in printed, printed
         assert not any(c in printed for c in "\x1b\x07\r\x9b"), repr(printed)
         assert "]0;pwned" + "2Jgone" in printed  # what is left of the sequences is plain text
+
+
+def test_info_prints_a_failure_reason_holding_a_newline_on_one_line(tmp_path):
+    """A reason with a newline was printed over two lines, the second one forged ("outputs: forged")."""
+    (tmp_path / "model.py").write_text("def boom(p):\n    if p['x'] > 0.0:\n"
+                                       "        raise RuntimeError('boom\\noutputs: forged')\n"
+                                       "    return {'y': p['x']}\n")
+    (tmp_path / "c.yaml").write_text(CAMPAIGN.replace("model.py:hostile", "model.py:boom"))
+    assert cli_in_process("run", tmp_path / "c.yaml", "--out", tmp_path / "r.h5", cwd=tmp_path).returncode == 0
+    info = cli_in_process("info", tmp_path / "r.h5")
+    assert info.returncode == 0, info.stderr
+    failed = [line for line in info.stdout.splitlines() if "failed (" in line]
+    assert len(failed) == 1 and failed[0].endswith(": 'RuntimeError: boom\\noutputs: forged'"), info.stdout
+    assert not any(line.startswith("outputs: forged") for line in info.stdout.splitlines())
+    assert [one_line(t) for t in ("a, b: c", "a\u2028b", "x\x1b[2J")] == ["a, b: c", "'a\\u2028b'", "x\x1b[2J"]
 
 
 def test_report_escapes_markdown_and_quotes_formulas(hostile):

@@ -13,7 +13,7 @@ import typer
 
 from .arguments import check_campaign_file, check_output, check_results_file
 from .calibration.command import register as register_calibrate
-from .console import echo, shown
+from .console import echo, one_line, shown
 from . import stopping
 from .leaving import leave
 from .progress import Progress
@@ -410,7 +410,7 @@ def _describe_results(results, store, Status) -> None:
     echo(f"progress: {done} of {status.size} runs done ({100 * done / max(status.size, 1):.1f} %)")
     reasons = Counter(r for r, s in zip(store.reasons, status) if s > 0)
     for reason, n in reasons.most_common(5):
-        echo(f"  failed ({n}): {reason}")
+        echo(f"  failed ({n}): {one_line(reason)}")
     problems = store.verify()  # reads every checksummed chunk: a flipped byte is reported
     for problem in problems:
         echo(f"  problem: {problem}")

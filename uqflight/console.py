@@ -27,6 +27,15 @@ def shown(name: str) -> str:
     return name if plain and name else repr(name)
 
 
+LINE_BREAK = re.compile("[\n\u2028\u2029]")  # what `clean` keeps that starts a new line
+
+
+def one_line(text: str) -> str:
+    """Text from a file that is not a name (a failure reason) on one line: as it is when it holds no line
+    break (echo strips its control characters), else quoted as repr shows it (a newline as \\n)."""
+    return repr(text) if LINE_BREAK.search(text) else text
+
+
 def echo(message: object = "", err: bool = False, nl: bool = True) -> None:
     """typer.echo of `message` cleaned; a reader gone (closed pipe) exits quietly with 141."""
     try:
