@@ -70,7 +70,9 @@ def test_info_prints_a_failure_reason_holding_a_newline_on_one_line(tmp_path):
                                        "        raise RuntimeError('boom\\noutputs: forged')\n"
                                        "    return {'y': p['x']}\n")
     (tmp_path / "c.yaml").write_text(CAMPAIGN.replace("model.py:hostile", "model.py:boom"))
-    assert cli_in_process("run", tmp_path / "c.yaml", "--out", tmp_path / "r.h5", cwd=tmp_path).returncode == 0
+    ran = cli_in_process("run", tmp_path / "c.yaml", "--out", tmp_path / "r.h5", cwd=tmp_path)
+    assert ran.returncode == 0 and "failed (" in ran.stdout  # run's summary lists the reasons too, one line each
+    assert not any(line.startswith("outputs: forged") for line in ran.stdout.splitlines()), ran.stdout
     info = cli_in_process("info", tmp_path / "r.h5")
     assert info.returncode == 0, info.stderr
     failed = [line for line in info.stdout.splitlines() if "failed (" in line]

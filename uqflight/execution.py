@@ -46,6 +46,7 @@ from threadpoolctl import threadpool_limits
 from .campaign import Campaign
 from .campaign.reading import parameters_attribute
 from .campaign.schema import WORKER_BYTES
+from .console import one_line
 from .designs import Design, is_adaptive
 from .forking import FORKS, Child, ChildFailed, wait_all
 from .parameters import seed_names
@@ -100,7 +101,7 @@ class RunSummary:
             lines.append(f"  warning: the nominal flight (every parameter at its law's centre) failed: "
                          f"{self.nominal_failure}; runs near it fail the same way: check the campaign's flight with "
                          "`uqflight simulate` and its --set")
-        lines += [f"  failed ({n}): {reason}" for reason, n in self.failures.most_common(10)]
+        lines += [f"  failed ({n}): {one_line(reason)}" for reason, n in self.failures.most_common(10)]
         return "\n".join(lines)
 
 
