@@ -1,6 +1,7 @@
 """A results file's campaign facts are root attributes of JSON text (method, germs, analysis, seeds,
-dependence): every reading command refuses a malformed one with exit 2 and one line naming the file, the
-attribute and the field, never a traceback. A real file of `uqflight run`, then edited with h5py."""
+dependence, design_info, versions) or text (design_kind, campaign_name, campaign_hash, ...): every reading
+command refuses a malformed one with exit 2 and one line naming the file, the attribute and the field, never
+a traceback. A real file of `uqflight run`, then edited with h5py."""
 import shutil
 
 import h5py
@@ -35,6 +36,21 @@ MALFORMED = {  # name: (attribute, value, what the message says after "FILE: att
                                       "correlation[0][1]: expected a correlation in [-1, 1], got 2.0"),
     "germs too few": ("germs", '["normal"]', "expected a list of 2 germs (normal / uniform), one per parameter"),
     "germs unknown": ("germs", '["normal", "cauchy"]', "got ['normal', 'cauchy']"),
+    "design_info 5": ("design_info", "5", "expected a mapping of the design's facts, got 5"),
+    "design_info not JSON": ("design_info", "{level", "is not JSON (Expecting property name"),
+    "design_info an array": ("design_info", np.array([1, 2]), "expected JSON text, got array([1, 2])"),
+    "replicates 10^12": ("design_info", '{"replicates": 1000000000000}',
+                         "replicates: expected an integer >= 1 dividing the 29 runs, got 1000000000000"),
+    "replicates a word": ("design_info", '{"replicates": "x"}', "replicates: expected an integer >= 1 dividing"),
+    "scramble a number": ("design_info", '{"scramble": 2}', "scramble: expected true or false, got 2"),
+    "design_kind an array": ("design_kind", np.array([1, 2]), "expected one of monte_carlo, sobol, halton"),
+    "design_kind unknown": ("design_kind", "spiral", "expected one of monte_carlo, sobol, halton"),
+    "design_kind missing": ("design_kind", None, "expected one of monte_carlo, sobol, halton"),
+    "versions 5": ("versions", "5", "expected a mapping of package versions, got 5"),
+    "campaign_name an array": ("campaign_name", np.array([1, 2]), "expected text, got array([1, 2])"),
+    "campaign_name an integer": ("campaign_name", np.int64(5), "expected text, got np.int64(5)"),
+    "campaign_hash an array": ("campaign_hash", np.array([1, 2]), "expected text, got array([1, 2])"),
+    "created an array": ("created", np.array([1.0]), "expected text, got array([1.])"),
 }
 
 
@@ -49,11 +65,14 @@ def sound(tmp_path_factory):
 
 
 def malformed(sound, folder, attribute, value):
-    """A copy of the sound file in `folder` with `attribute` set to `value`."""
+    """A copy of the sound file in `folder` with `attribute` set to `value` (None: deleted)."""
     path = folder / "r.h5"
     shutil.copy(sound, path)
     with h5py.File(path, "a") as f:
-        f.attrs[attribute] = value
+        if value is None:
+            del f.attrs[attribute]
+        else:
+            f.attrs[attribute] = value
     return path
 
 
@@ -82,3 +101,16 @@ def test_calibrate_refuses_a_malformed_attribute(sound, tmp_path, name):
     data.write_text("time_s,x\n0,1.0\n1,0.37\n2,0.14\n")
     refused(cli_in_process("calibrate", path, "--data", data, "--out", tmp_path / "cal", "--steps", 100),
             path, attribute, message)
+
+
+@pytest.mark.parametrize("n_base", ["3", '"16"', "null"])
+def test_a_pick_freeze_file_needs_its_base_rows(tmp_path, n_base):
+    """Its failure probability counts the rows A and B, 2 n_base of the n_base (d + 2) runs."""
+    campaign = DECAY_TWO_INPUTS.replace("{kind: sparse_grid, level: 3}", "{kind: pick_freeze, samples: 16}")
+    (tmp_path / "c.yaml").write_text(campaign.replace("pseudo_galerkin, order: 2", "monte_carlo"))
+    path = tmp_path / "r.h5"
+    assert cli_in_process("run", tmp_path / "c.yaml", "--out", path).returncode == 0
+    with h5py.File(path, "a") as f:
+        f.attrs["design_info"] = '{"n_base": %s}' % n_base
+    refused(cli_in_process("report", path, "--out", tmp_path / "report"), path, "design_info",
+            "n_base: expected the base rows n of the 64 runs, n (2 parameters + 2)")

@@ -22,7 +22,6 @@ the sample matrix. Samples are rebuilt (in blocks of times) only for quantiles, 
 """
 from __future__ import annotations
 
-import json
 import math
 import os
 from collections import deque
@@ -143,6 +142,7 @@ class Statistics:
     dependence: dict | None = None  # the inputs' Gaussian copula (parameters.dependence.summary), None: independent
     quantities: dict[str, QuantityStatistics] = field(default_factory=dict)
     index_set: dict | None = None  # an adaptive grid's refinement (designs.adaptive.index_set_summary)
+    design_info: dict = field(default_factory=dict)  # the design's recorded facts (replicates, n_base, ...)
 
 
 @dataclass
@@ -160,7 +160,7 @@ def campaign_facts(store: ResultStore, path) -> StoredFacts:
     """The method, germs, analysis options, seeds and copula the results file `path` was made with, checked
     as its campaign was: BadInput naming the file, the attribute and the field."""
     try:
-        return stored_facts(store.attrs, str(path), store.parameter_names, store.quantity_names)
+        return stored_facts(store.attrs, str(path), store.parameter_names, store.quantity_names, store.status.size)
     except CampaignError as exc:
         raise BadInput(str(exc)) from exc
 
@@ -202,10 +202,7 @@ def analyse(path, reference: str | None = None, options: Options | None = None, 
         allow_aliasing = allow_aliasing or bool(method.get("allow_aliasing"))
         options = options or Options(**{k: (tuple(v) if k == "quantiles" else v) for k, v in analysis.items()
                                         if k in ("band_samples", "bootstrap", "quantiles")})
-        status = store.status
-        design_kind = store.attrs.get("design_kind", "")
-        if design_kind not in DESIGNS:
-            raise BadInput(f"{path}: unknown design kind {design_kind!r} in the file")
+        status, design_kind = store.status, facts.design_kind
         if method["kind"] not in METHODS:
             raise BadInput(f"{path}: unknown method {method['kind']!r}: expected one of {', '.join(METHODS)}")
         sampled = is_sampled(design_kind)
@@ -213,7 +210,7 @@ def analyse(path, reference: str | None = None, options: Options | None = None, 
         pending = int(np.sum(status == Status.PENDING))
         stats = Statistics(str(path), store.attrs.get("campaign_name", ""), method, design_kind,
                            store.parameter_names, int(status.size), int(ok.sum()), int(np.sum(status > 0)),
-                           pending, {}, partial=pending > 0)
+                           pending, {}, partial=pending > 0, design_info=facts.design_info)
         _check_runs(store, stats, sampled, partial)
         state = store.index_set()
         stats.index_set = None if state is None else index_set_summary(state, store.parameter_names)
@@ -230,7 +227,7 @@ def analyse(path, reference: str | None = None, options: Options | None = None, 
             raise BadInput(f"{path}: method {method['kind']} order {method['order']}: {problem}")
         _note_runs(store, stats, sampled, allow_aliasing)
         stats.from_runs = method_entry(method["kind"]).runs_on_sampled and sampled
-        replicates = int(design_info(store).get("replicates", 1))
+        replicates = facts.design_info.get("replicates", 1)
         stats.replicates = replicates if stats.from_runs and ok.all() else 1
         if progress is not None:
             progress.stage(f"analysing {Path(path).name} ({method['kind']} order {method['order']})",
@@ -268,11 +265,6 @@ def analyse(path, reference: str | None = None, options: Options | None = None, 
     return stats
 
 
-def design_info(store: ResultStore) -> dict:
-    """The design's recorded facts (samples, replicates, scramble, n_base, ...)."""
-    return json.loads(store.attrs.get("design_info", "{}"))
-
-
 def _check_runs(store: ResultStore, stats: Statistics, sampled: bool, partial: bool) -> None:
     """Refuse pending runs (unless partial, and then where a subset is valid) and a file with no run done."""
     path, n = stats.path, stats.runs
@@ -295,7 +287,7 @@ def _note_runs(store: ResultStore, stats: Statistics, sampled: bool, allow_alias
     done = status != Status.PENDING
     failed = status[done] > 0
     if sampled:
-        found = sampled_proportion(status > 0, done, DESIGNS[stats.design_kind].draws, design_info(store),
+        found = sampled_proportion(status > 0, done, DESIGNS[stats.design_kind].draws, stats.design_info,
                                    event="failed")
         stats.failure_probability = {**{k: found[k] for k in ("estimate", "lower", "upper", "n_effective")},
                                      "method": found["sentence"]}
@@ -634,7 +626,7 @@ def quantity_statistics(store: ResultStore, stats: Statistics, name: str, germs:
     out = _output_statistics(view, name, stats.method, germs, stats.design_kind, defined, options)
     if out.pce is None:
         exceedance = exceedance_from_runs(values, defined, thresholds, DESIGNS[stats.design_kind].draws,
-                                          design_info(store))
+                                          stats.design_info)
     else:
         exceedance = exceedance_from_pce(out.pce.sample(options.band_samples, options.seed)[:, 0],
                                          int(defined.sum()), thresholds)

@@ -97,11 +97,12 @@ def fit_surrogate(path, method: dict | None = None, partial: bool = False, allow
     from .store import ResultStore
 
     with ResultStore.open(path) as store:
-        stored, design_kind = normalised(campaign_facts(store, path).method), store.attrs.get("design_kind", "")
+        facts = campaign_facts(store, path)
+        stored, design_kind = normalised(facts.method), facts.design_kind
         parameters, units, time = _parameters(store), dict(store.units), np.asarray(store.time, dtype=float)
     override = dict(method or {})
     kind = override.get("kind", stored.get("kind"))
-    if design_kind in DESIGNS and isinstance(kind, str) and kind in METHOD_KINDS:  # else analyse refuses
+    if isinstance(kind, str) and kind in METHOD_KINDS:  # else analyse refuses
         override["kind"] = exported_kind(kind, DESIGNS[design_kind].sampled)
     stats = analyse(path, method=override, partial=partial, allow_aliasing=allow_aliasing,
                     options=options or Options(band_samples=200, bootstrap=0), progress=progress)

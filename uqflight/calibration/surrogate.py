@@ -155,7 +155,7 @@ def calibration_surrogate(results, method: str | None = None, order: int | None 
         except BadInput as exc:
             raise SurrogateError(str(exc)) from exc
         stored, germs = normalised(facts.method), facts.germs
-        sampled = is_sampled(store.attrs.get("design_kind", ""))
+        sampled = is_sampled(facts.design_kind)
         kind = method or stored["kind"]
         order = stored.get("order", 2) if order is None else order
         if kind not in METHOD_KINDS:

@@ -1,28 +1,37 @@
-"""The campaign facts a results file keeps as root attributes of JSON text (`method`, `germs`, `analysis`,
-`seeds`, `dependence`: see execution.py), checked when the file is read by the checks its campaign file
-passed (schema), so that a damaged or hand-edited attribute is one line naming the file, the attribute
-and the field inside it, never a number computed from it.
+"""The campaign facts a results file keeps as root attributes (see execution.py): of JSON text (`method`,
+`germs`, `analysis`, `seeds`, `dependence`, `design_info`, `versions`) or plain text (`design_kind`, the
+provenance in TEXT), checked when the file is read, by the checks its campaign file passed (schema) where
+there are some, so that a damaged or hand-edited attribute is one line naming the file, the attribute and
+the field inside it, never a traceback or a number computed from it.
 """
 from __future__ import annotations
 
 import json
 from dataclasses import dataclass
 
+from ..designs import DESIGN_KINDS
+from ..designs.spec import is_integer
 from ..parameters.germs import GERMS
 from . import schema
 from .schema import CampaignError, Checker, shown
+
+# provenance shown by the report and compared by check (campaign_hash, aircraft_hash, scenario): text when present
+TEXT = ("campaign_name", "campaign_hash", "campaign_path", "created", "aircraft_hash", "scenario")
 
 
 @dataclass(frozen=True)
 class StoredFacts:
     """What a results file was made with: its method, germs, analysis options, the parameters that are
-    seeds, and the copula of dependent inputs (GaussianCopula.summary; None: independent)."""
+    seeds, the copula of dependent inputs (GaussianCopula.summary; None: independent), and its design's kind
+    and recorded facts (designs.Design.info)."""
 
     method: dict
     germs: list[str]
     analysis: dict
     seeds: list[str]
     dependence: dict | None
+    design_kind: str
+    design_info: dict
 
 
 class AttributeChecker(Checker):
@@ -34,10 +43,21 @@ class AttributeChecker(Checker):
         raise CampaignError(f"{self.source}: attribute {attribute}", inside, message)
 
 
-def stored_facts(attrs: dict, source: str, parameters: list[str], quantities: list[str]) -> StoredFacts:
+def stored_facts(attrs: dict, source: str, parameters: list[str], quantities: list[str], runs: int) -> StoredFacts:
     """The checked facts of a results file's root attributes (`source` names it, `parameters` and
-    `quantities` are its names); CampaignError naming the file, the attribute and the field."""
+    `quantities` are its names, `runs` its design's size); CampaignError naming the file, the attribute
+    and the field."""
     check = AttributeChecker(source)
+    for name in TEXT:
+        if name in attrs and not isinstance(attrs[name], str):
+            check.fail(name, f"expected text, got {shown(attrs[name])}")
+    versions = _json(check, attrs, "versions", "{}")
+    if not isinstance(versions, dict):
+        check.fail("versions", f"expected a mapping of package versions, got {shown(versions)}")
+    kind = attrs.get("design_kind")
+    if not isinstance(kind, str) or kind not in DESIGN_KINDS:
+        check.fail("design_kind", f"expected one of {', '.join(DESIGN_KINDS)}, got {shown(kind)}")
+    info = _design_info(check, _json(check, attrs, "design_info", "{}"), kind, runs, len(parameters))
     method = schema.method(check, _json(check, attrs, "method"))
     analysis = schema.analysis(check, _json(check, attrs, "analysis", "{}"), quantities)
     germs = _json(check, attrs, "germs")
@@ -54,7 +74,24 @@ def stored_facts(attrs: dict, source: str, parameters: list[str], quantities: li
     if isinstance(dependence, dict):  # what the indices are of is said again from the names
         dependence = {key: value for key, value in dependence.items() if key != "sobol_of"}
     copula = schema.dependence(check, dependence, parameters, seeds)
-    return StoredFacts(method, germs, analysis, seeds, None if copula is None else copula.summary())
+    return StoredFacts(method, germs, analysis, seeds, None if copula is None else copula.summary(), kind, info)
+
+
+def _design_info(check: Checker, info, kind: str, runs: int, d: int) -> dict:
+    """The design's recorded facts, those the statistics read checked against the file's `runs` and `d`
+    parameters: replicates (blocks of runs), n_base (a pick-freeze design's base rows), scramble."""
+    if not isinstance(info, dict):
+        check.fail("design_info", f"expected a mapping of the design's facts, got {shown(info)}")
+    replicates = info.get("replicates", 1)
+    if not is_integer(replicates) or not 1 <= replicates <= max(runs, 1) or runs % replicates:
+        check.fail("design_info.replicates", f"expected an integer >= 1 dividing the {runs} runs, "
+                                             f"got {shown(replicates)}")
+    if kind == "pick_freeze" and not (is_integer(info.get("n_base")) and info["n_base"] * (d + 2) == runs):
+        check.fail("design_info.n_base", f"expected the base rows n of the {runs} runs, n ({d} parameters + 2), "
+                                         f"got {shown(info.get('n_base'))}")
+    if not isinstance(info.get("scramble", True), bool):
+        check.fail("design_info.scramble", f"expected true or false, got {shown(info['scramble'])}")
+    return info
 
 
 def _json(check: Checker, attrs: dict, name: str, default: str | None = None):

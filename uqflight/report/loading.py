@@ -4,7 +4,6 @@ from __future__ import annotations
 import copy
 import functools
 import hashlib
-import json
 import os
 import re
 from dataclasses import dataclass, field
@@ -150,15 +149,6 @@ def _entry(path: Path, stats: Statistics, attrs: dict, stems: set[str], file_ste
     return Entry(stats, stem, label, str(attrs.get("campaign_hash", "")),
                  input_distributions(str(attrs.get("campaign", ""))), dict(attrs), str(path), output_files,
                  file_stems[Path(path).resolve()])
-
-
-def design_info(attrs: dict) -> dict:
-    """The design's facts (level, rule, ...) from the results file, {} when absent."""
-    try:
-        info = json.loads(attrs.get("design_info", "{}"))
-    except (TypeError, ValueError):
-        return {}
-    return info if isinstance(info, dict) else {}
 
 
 def file_name(name: str) -> str:

@@ -13,7 +13,7 @@ from .formats import shown_path
 from ..forking import share_work
 from .sensitivity import NEGLIGIBLE, index_text, plot_sensitivity
 from ..campaign.reading import stored_parameters
-from .loading import Entry, _same_file, bounded, campaign_settings, design_info, flight_facts, method_label
+from .loading import Entry, _same_file, bounded, campaign_settings, flight_facts, method_label
 
 BELOW_FLOOR = "below reference resolution"
 UNRESOLVED = "unresolved"
@@ -115,23 +115,20 @@ def run_section(entries: list[Entry], out_dir: Path) -> Section:
         text = str(e.attrs.get("campaign", ""))
         settings = campaign_settings(text)
         simulator = settings.get("simulator") or {}
-        info = design_info(e.attrs)
         methods = ", ".join(dict.fromkeys(method_label(x.stats.method) for x in entries
                                           if (x.path or x.stats.path) == (e.path or e.stats.path)))
-        try:
-            versions = ", ".join(f"{k} {v}" for k, v in json.loads(e.attrs.get("versions", "{}")).items())
-        except (TypeError, ValueError):
-            versions = str(e.attrs.get("versions", ""))
+        versions = ", ".join(f"{k} {v}" for k, v in json.loads(e.attrs.get("versions", "{}")).items())
         failed = getattr(e.stats, "failed", 0)
         counts = f"{e.stats.runs} runs, {failed} failed"
         if getattr(e.stats, "pending", 0):
             counts += f", {e.stats.pending} not run"
         flown = flight_facts(simulator)
+        info = ", ".join(f"{k} {v}" for k, v in e.stats.design_info.items())
         facts.append([e.stem, ("flight", flown.get("flight", "-")), ("excitation", flown.get("excitation", "-")),
                       ("simulator", ", ".join(f"{k} {simulator[k]}" for k in ("kind", "aircraft", "function",
                                                                               "duration_s", "output_rate_hz")
                                               if k in simulator)),
-                      ("design", f"{e.attrs.get('design_kind', e.stats.design_kind)} {_mapping(info)}".strip()),
+                      ("design", f"{e.stats.design_kind} {info}".strip()),
                       ("method", methods), ("seed", settings.get("seed", 0)), ("runs", counts),
                       ("created", e.attrs.get("created", "?")), ("aircraft sha256", e.attrs.get("aircraft_hash", "-")),
                       ("campaign sha256", e.campaign_hash), ("versions", versions)])
@@ -154,7 +151,7 @@ def run_section(entries: list[Entry], out_dir: Path) -> Section:
     for e in _files(entries):
         path = plots.plot_design_pairs(e.path or e.stats.path,
                                        out_dir / "plots" / bounded(f"design_{e.file_stem}.png"),
-                                       f"Design: {e.attrs.get('design_kind', e.stats.design_kind)}, "
+                                       f"Design: {e.stats.design_kind}, "
                                        f"{e.stats.runs} points ({e.file_stem})")
         if path is not None:
             blocks.append(Figure(_rel(path, out_dir), f"The design points of {e.file_stem} projected on each pair "
@@ -163,12 +160,6 @@ def run_section(entries: list[Entry], out_dir: Path) -> Section:
     texts = "\n\n".join(f"# {e.path or e.stats.path}\n{str(e.attrs.get('campaign', '')).strip()}"
                           for e in _files(entries))
     return Section("What was run", "run", texts, blocks, preformatted=True)
-
-
-def _mapping(value) -> str:
-    if not isinstance(value, dict):
-        return "" if value is None else str(value)
-    return ", ".join(f"{k} {v}" for k, v in value.items())
 
 
 def failures_section(entries: list[Entry]) -> Section | None:
