@@ -62,6 +62,7 @@ BAD = {
     "bad_tsvd_tol.yaml": ("storage.tsvd.tol", "expected a relative tolerance in (0, 1), got 1.5"),
     "bad_raw_false_without_tsvd.yaml": ("storage.raw", "false needs storage.tsvd"),
     "bad_band_samples.yaml": ("analysis.band_samples", "expected at most 1000000 draws (a million draws of an output"),
+    "bad_bootstrap.yaml": ("analysis.bootstrap", "expected at most 10000 resamplings (10^4 of a pick-freeze design"),
 }
 # A representative handful through the command line (each start costs about a second).
 CLI_BAD = ["bad_yaml_syntax.yaml", "bad_top_key_typo.yaml", "bad_unknown_property.yaml",

@@ -28,6 +28,7 @@ MALFORMED = {  # name: (attribute, value, what the message says after "FILE: att
     "band_samples 10^12": ("analysis", '{"band_samples": 1000000000000, "bootstrap": 0}',
                            "band_samples: expected at most 1000000 draws"),
     "bootstrap -1": ("analysis", '{"bootstrap": -1}', "bootstrap: expected an integer >= 0, got -1"),
+    "bootstrap 10^9": ("analysis", '{"bootstrap": 1000000000}', "bootstrap: expected at most 10000 resamplings"),
     "seeds a number": ("seeds", "5", "expected a list of distinct parameter names (a, b), got 5"),
     "seeds an unknown name": ("seeds", '["c"]', "expected a list of distinct parameter names (a, b), got ['c']"),
     "dependence without kind": ("dependence", '{"parameters": 5}', "kind: is required"),

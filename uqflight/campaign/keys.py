@@ -139,7 +139,11 @@ KEYS = {
                              "output take about 1.6 GB to sort). Default 20000: on the paper's "
                              "expansion the band's sampling error is about 3.5 % of the output's std, "
                              "and grows as 1/sqrt(draws) (`benchmarks/band_samples.py`).",
-    "analysis.bootstrap": "Resamplings for the pick-freeze Sobol' intervals, >= 0 (0: none). Default 200.",
+    "analysis.bootstrap": "Resamplings for the pick-freeze Sobol' intervals, 0 (none) to 10^4. Default 200. "
+                          "Each costs time and memory in every output's every time: on 1024 base rows, 3 "
+                          "inputs and 5 outputs of 1001 times, 10^4 add 45 s of CPU and 1 GB to the report. "
+                          "A 95 % interval's ends are steady from about 2000 on; at 10^4 the error of "
+                          "each 2.5 % tail is 0.16 % (its 6 %): more buys nothing.",
     "analysis.quantiles": "1-20 probabilities in (0, 1) reported over time in summary.json. Default "
                           "[0.005, 0.995]. `quantiles: [0.05, 0.5, 0.95]`",
     "analysis.exceedance": "`{QUANTITY: [{above: X}, {below: Y}]}`: P(QUANTITY > X) and P(QUANTITY < Y). "

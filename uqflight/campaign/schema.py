@@ -36,6 +36,7 @@ DEPENDENCE_KEYS = ("kind", "parameters", "correlation")
 ANALYSIS_KEYS = ("band_samples", "bootstrap", "quantiles", "exceedance")
 # A million draws of one output are sorted 100 times at once (statistics.TIME_BLOCK): about 1.6 GB in two threads.
 MAX_BAND_SAMPLES = 10**6
+MAX_BOOTSTRAP = 10**4
 # Refused before anything is built (see `check_size`); a campaign raises them under `limits:`.
 WORKER_BYTES = 60e6  # memory of one local worker process: Python, numpy, JSBSim, the aircraft (52 MB measured)
 DEFAULT_LIMITS = {"max_runs": 1_000_000, "max_memory_gb": 8.0, "max_disk_gb": 100.0, "max_pce_terms": MAX_TERMS}
@@ -535,6 +536,10 @@ def analysis(check: Checker, value, quantities: dict | None = None) -> dict:
                                             "output, sorted 100 times at once, take about 1.6 GB in two threads), "
                                             f"got {analysis['band_samples']}")
     analysis["bootstrap"] = check.integer(analysis.get("bootstrap", 200), "analysis.bootstrap", 0)
+    if analysis["bootstrap"] > MAX_BOOTSTRAP:
+        check.fail("analysis.bootstrap", f"expected at most {MAX_BOOTSTRAP} resamplings (10^4 of a pick-freeze "
+                                         "design of 1024 base rows take about a minute and 1 GB), "
+                                         f"got {analysis['bootstrap']}")
     if "quantiles" in analysis:  # kept only when given (default: statistics.DEFAULT_QUANTILES)
         value = analysis["quantiles"]
         if not isinstance(value, list) or not value or len(value) > 20:
