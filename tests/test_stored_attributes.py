@@ -52,6 +52,10 @@ MALFORMED = {  # name: (attribute, value, what the message says after "FILE: att
     "campaign_name an integer": ("campaign_name", np.int64(5), "expected text, got np.int64(5)"),
     "campaign_hash an array": ("campaign_hash", np.array([1, 2]), "expected text, got array([1, 2])"),
     "created an array": ("created", np.array([1.0]), "expected text, got array([1.])"),
+    "campaign seed a word": ("campaign", DECAY_TWO_INPUTS.replace("seed: 3", "seed: abc"),
+                             "seed: expected an integer >= 0, got 'abc'"),  # it draws the report's runs
+    "campaign seed a list": ("campaign", DECAY_TWO_INPUTS.replace("seed: 3", "seed: [1]"),
+                             "seed: expected an integer >= 0, got a list"),
 }
 
 

@@ -9,6 +9,8 @@ from __future__ import annotations
 import json
 from dataclasses import dataclass
 
+import yaml
+
 from ..designs import DESIGN_KINDS
 from ..designs.spec import is_integer
 from ..parameters.germs import GERMS
@@ -74,7 +76,19 @@ def stored_facts(attrs: dict, source: str, parameters: list[str], quantities: li
     if isinstance(dependence, dict):  # what the indices are of is said again from the names
         dependence = {key: value for key, value in dependence.items() if key != "sobol_of"}
     copula = schema.dependence(check, dependence, parameters, seeds)
+    _check_seed(check, attrs.get("campaign", ""))
     return StoredFacts(method, germs, analysis, seeds, None if copula is None else copula.summary(), kind, info)
+
+
+def _check_seed(check: Checker, text: str) -> None:
+    """The seed of the stored campaign text, which draws the report's runs: an integer >= 0 when the text
+    is a campaign mapping (a text that is not is the report's to say: it shows it as unreadable)."""
+    try:
+        data = yaml.load(text, Loader=schema.CampaignLoader)
+    except yaml.YAMLError:
+        return
+    if isinstance(data, dict) and "seed" in data:
+        check.integer(data["seed"], "campaign.seed", 0)
 
 
 def _design_info(check: Checker, info, kind: str, runs: int, d: int) -> dict:
