@@ -119,3 +119,15 @@ def test_a_pick_freeze_file_needs_its_base_rows(tmp_path, n_base):
         f.attrs["design_info"] = '{"n_base": %s}' % n_base
     refused(cli_in_process("report", path, "--out", tmp_path / "report"), path, "design_info",
             "n_base: expected the base rows n of the 64 runs, n (2 parameters + 2)")
+
+
+@pytest.mark.parametrize("text", [
+    DECAY_TWO_INPUTS.replace("simulator:", "simulator: 5\nwas:"), "{{{", "[1, 2]",
+    DECAY_TWO_INPUTS.replace('exp_decay"}', 'exp_decay", excitation: {start_s: abc}}')])
+def test_a_stored_campaign_text_that_is_no_campaign_is_shown_not_trusted(sound, tmp_path, text):
+    # the report shows the stored text and reads the excitation's start from it (where the coefficient decay
+    # is drawn from): a text whose simulator or start is no mapping or number was a traceback after the analysis
+    path = malformed(sound, tmp_path, "campaign", text)
+    done = cli_in_process("report", path, "--out", tmp_path / "report")
+    assert done.returncode == 0, done.stdout + done.stderr
+    assert (tmp_path / "report" / "report.html").is_file()

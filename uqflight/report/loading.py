@@ -75,6 +75,13 @@ def campaign_settings(campaign_text: str) -> dict:
     return copy.deepcopy(_read_settings(campaign_text))
 
 
+def campaign_simulator(campaign_text: str) -> dict:
+    """The campaign's `simulator:` mapping as written, {} when the text has none (an edited file's text is
+    shown, never trusted to be a campaign)."""
+    simulator = campaign_settings(campaign_text).get("simulator")
+    return simulator if isinstance(simulator, dict) else {}
+
+
 SAFE_LOADER = getattr(yaml, "CSafeLoader", yaml.SafeLoader)  # libyaml's, ten times faster, where PyYAML has it
 
 

@@ -13,7 +13,7 @@ from .formats import shown_path
 from ..forking import share_work
 from .sensitivity import NEGLIGIBLE, index_text, plot_sensitivity
 from ..campaign.reading import stored_parameters
-from .loading import Entry, _same_file, bounded, campaign_settings, flight_facts, method_label
+from .loading import Entry, _same_file, bounded, campaign_settings, campaign_simulator, flight_facts, method_label
 
 BELOW_FLOOR = "below reference resolution"
 UNRESOLVED = "unresolved"
@@ -113,8 +113,7 @@ def run_section(entries: list[Entry], out_dir: Path) -> Section:
     facts, parameter_rows = [], []
     for e in _files(entries):
         text = str(e.attrs.get("campaign", ""))
-        settings = campaign_settings(text)
-        simulator = settings.get("simulator") or {}
+        settings, simulator = campaign_settings(text), campaign_simulator(text)
         methods = ", ".join(dict.fromkeys(method_label(x.stats.method) for x in entries
                                           if (x.path or x.stats.path) == (e.path or e.stats.path)))
         versions = ", ".join(f"{k} {v}" for k, v in json.loads(e.attrs.get("versions", "{}")).items())
@@ -439,8 +438,10 @@ def decay_section(entries: list[Entry], out_dir: Path) -> Section:
     """The PCE coefficients' root-sum-square per total degree over time (convergence of the expansion)."""
     blocks = []
     for e in entries:
-        excitation = (campaign_settings(str(e.attrs.get("campaign", ""))).get("simulator") or {}).get("excitation")
+        excitation = campaign_simulator(str(e.attrs.get("campaign", ""))).get("excitation")
         start = excitation.get("start_s") if isinstance(excitation, dict) else None
+        if isinstance(start, bool) or not isinstance(start, (int, float)) or not np.isfinite(start):
+            start = None  # the stored text is shown, not trusted: a number or nothing
         path = plots.plot_coefficient_decay(e.outputs, out_dir / "plots" / bounded(f"coefficient_decay_{e.stem}.png"),
                                             f"PCE coefficients by total degree: {e.label}", start_s=start)
         blocks.append(Figure(_rel(path, out_dir), f"Root-sum-square of the PCE coefficients of each total degree "
