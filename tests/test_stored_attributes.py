@@ -131,3 +131,11 @@ def test_a_stored_campaign_text_that_is_no_campaign_is_shown_not_trusted(sound, 
     done = cli_in_process("report", path, "--out", tmp_path / "report")
     assert done.returncode == 0, done.stdout + done.stderr
     assert (tmp_path / "report" / "report.html").is_file()
+
+
+def test_the_export_names_the_file_and_the_field_of_a_stored_campaign_it_cannot_read(sound, tmp_path):
+    path = malformed(sound, tmp_path, "campaign", DECAY_TWO_INPUTS.replace("name: decay-people", "name: [1]"))
+    done = cli_in_process("surrogate", "export", path, "--out", tmp_path / "s.json")
+    assert done.returncode == 2 and not (tmp_path / "s.json").exists()
+    assert done.stderr == (f"error: {path}: cannot read the parameters' distributions from the campaign stored in "
+                           "the file: name: expected a non-empty string, got a list\n")

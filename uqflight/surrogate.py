@@ -99,7 +99,7 @@ def fit_surrogate(path, method: dict | None = None, partial: bool = False, allow
     with ResultStore.open(path) as store:
         facts = campaign_facts(store, path)
         stored, design_kind = normalised(facts.method), facts.design_kind
-        parameters, units, time = _parameters(store), dict(store.units), np.asarray(store.time, dtype=float)
+        parameters, units, time = _parameters(store, path), dict(store.units), np.asarray(store.time, dtype=float)
     override = dict(method or {})
     kind = override.get("kind", stored.get("kind"))
     if isinstance(kind, str) and kind in METHOD_KINDS:  # else analyse refuses
@@ -131,14 +131,21 @@ def _copula(dependence: dict | None):
         raise ValueError(str(exc) if str(exc).startswith("dependence") else f"dependence.{exc}") from None
 
 
-def _parameters(store) -> list[dict]:
-    """The parameters' laws from the stored campaign text (κ ↔ ξ), via the campaign parser."""
-    from .campaign.reading import stored_parameters
+def _parameters(store, path) -> list[dict]:
+    """The parameters' laws from the stored campaign text (κ ↔ ξ) of the results file `path`, via the campaign
+    parser; SurrogateError naming the file and why when they cannot be read."""
+    from .campaign import CampaignError
+    from .campaign.reading import parameter_rows, results_campaign
 
-    found = stored_parameters(store.attrs)
-    names = store.parameter_names
-    if found is None or [p["name"] for p in found] != names:
-        raise SurrogateError("cannot read the parameters' distributions from the campaign text in the results file")
+    try:
+        found = parameter_rows(results_campaign(store.attrs, str(path)).parameters)
+    except (CampaignError, OSError) as exc:
+        reason = str(exc).removeprefix(f"{path}: ")
+        raise SurrogateError(f"{path}: cannot read the parameters' distributions from the campaign stored in the "
+                             f"file: {reason}") from exc
+    if [p["name"] for p in found] != store.parameter_names:
+        raise SurrogateError(f"{path}: the parameters of the stored campaign ({', '.join(p['name'] for p in found)}) "
+                             f"are not the file's ({', '.join(store.parameter_names)})")
     return found
 
 
