@@ -22,7 +22,7 @@ from uqflight.simulators import models
 from uqflight.statistics import analyse, summary_json
 from uqflight.store import CorruptFile, ResultStore
 
-from conftest import UQFLIGHT, assert_same_results
+from conftest import UQFLIGHT, assert_same_results, cli_in_process
 
 RULES = ["genz_keister", "gauss_patterson", "clenshaw_curtis"]
 # downward closed, anisotropic, with a mixed index
@@ -155,6 +155,25 @@ def test_rounds_grow_one_results_file_whose_statistics_are_the_combination_quadr
         del f["design/old"]
     with pytest.raises(CorruptFile, match="/design/old is missing"):
         ResultStore.open(tmp_path / "a.h5")
+
+
+@pytest.mark.parametrize("damage", ["rounds", "eta", "indicator", "index_set"])
+def test_a_damaged_index_set_is_refused_by_every_reader_naming_design(tmp_path, damage):
+    run_campaign(parse_campaign(adaptive_text(budget=30), str(tmp_path / "a.yaml")), out=tmp_path / "a.h5")
+    with h5py.File(tmp_path / "a.h5", "r+") as f:  # present, as the layout check wants, but not a state
+        group = f["design"]
+        if damage in ("rounds", "eta"):
+            group.attrs[damage] = "many"
+        else:
+            size = group[damage].shape[0]
+            del group[damage]
+            group.create_dataset(damage, data=np.zeros((size + 1, 3) if damage == "index_set" else size + 1))
+    for command in (["report", tmp_path / "a.h5", "--out", tmp_path / "report"], ["info", tmp_path / "a.h5"],
+                    ["surrogate", "export", tmp_path / "a.h5", "--out", tmp_path / "s.json"]):
+        done = cli_in_process(*command)
+        assert done.returncode == 2, (command, done.stdout, done.stderr)
+        assert f"{tmp_path / 'a.h5'}: /design" in done.stderr and "the file is damaged" in done.stderr
+        assert len(done.stderr.strip().splitlines()) == 1 and "Traceback" not in done.stderr
 
 
 @pytest.mark.slow  # a whole report (the default suite checks the index set it draws, above)

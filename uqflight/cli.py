@@ -386,6 +386,9 @@ def info(results: Path = typer.Argument(..., metavar="RESULTS", help="Results fi
     with store:
         try:
             _describe_results(results, store, Status)
+        except CorruptFile as exc:  # a part read on the way (an adaptive grid's state)
+            echo(f"error: {exc}", err=True)
+            raise typer.Exit(2)
         except OSError as exc:
             echo(f"error: {results}: {read_error(exc)}", err=True)
             raise typer.Exit(2)

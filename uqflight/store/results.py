@@ -372,8 +372,18 @@ class ResultStore:
         self._flush(sync=True)
 
     def index_set(self):
-        """The adaptive grid's state (`designs.adaptive.IndexSet`) written by `write_index_set`, or None."""
-        return read_index_set(self._file)
+        """The adaptive grid's state (`designs.adaptive.IndexSet`) written by `write_index_set`, or None;
+        CorruptFile when /design is not such a state (a missing or mistyped part, lengths that differ)."""
+        try:
+            state = read_index_set(self._file)
+        except (KeyError, ValueError, TypeError, IndexError) as exc:
+            raise CorruptFile(f"{self._file.filename}: /design: the adaptive grid's recorded state cannot be read "
+                              f"({one_line(exc)}): the file is damaged or was not written by uqflight") from None
+        if state is not None and (not state.indices or len({len(state.indices), len(state.old), len(state.added),
+                                                             len(state.indicator)}) != 1):
+            raise CorruptFile(f"{self._file.filename}: /design: the adaptive grid's index_set, old, round and "
+                              "indicator differ in length: the file is damaged or was not written by uqflight")
+        return state
 
     def write_index_set(self, state) -> None:
         """Record an adaptive grid's state in /design (replaced whole, see `rounds`)."""
