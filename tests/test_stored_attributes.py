@@ -56,6 +56,8 @@ MALFORMED = {  # name: (attribute, value, what the message says after "FILE: att
                              "seed: expected an integer >= 0, got 'abc'"),  # it draws the report's runs
     "campaign seed a list": ("campaign", DECAY_TWO_INPUTS.replace("seed: 3", "seed: [1]"),
                              "seed: expected an integer >= 0, got a list"),
+    "campaign seed a word, a key twice": ("campaign", DECAY_TWO_INPUTS.replace("seed: 3", "seed: abc") + "name: x\n",
+                                          "seed: expected an integer >= 0, got 'abc'"),  # read as the report reads
 }
 
 

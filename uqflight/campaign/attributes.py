@@ -6,6 +6,7 @@ the field inside it, never a traceback or a number computed from it.
 """
 from __future__ import annotations
 
+import functools
 import json
 from dataclasses import dataclass
 
@@ -80,15 +81,26 @@ def stored_facts(attrs: dict, source: str, parameters: list[str], quantities: li
     return StoredFacts(method, germs, analysis, seeds, None if copula is None else copula.summary(), kind, info)
 
 
-def _check_seed(check: Checker, text: str) -> None:
-    """The seed of the stored campaign text, which draws the report's runs: an integer >= 0 when the text
-    is a campaign mapping (a text that is not is the report's to say: it shows it as unreadable)."""
+SAFE_LOADER = getattr(yaml, "CSafeLoader", yaml.SafeLoader)  # libyaml's, ten times faster, where PyYAML has it
+
+
+@functools.lru_cache(maxsize=8)
+def stored_settings(campaign_text: str) -> dict:
+    """The stored campaign text's mapping as written (YAML), {} when unreadable or not a mapping: what the
+    report shows and reads the seed and the excitation from (shared, not to be changed: the text read once)."""
     try:
-        data = yaml.load(text, Loader=schema.CampaignLoader)
-    except yaml.YAMLError:
-        return
-    if isinstance(data, dict) and "seed" in data:
-        check.integer(data["seed"], "campaign.seed", 0)
+        data = yaml.load(campaign_text, Loader=SAFE_LOADER)
+    except (yaml.YAMLError, ValueError, RecursionError):  # e.g. a date 2001-13-45, or nesting too deep
+        return {}
+    return data if isinstance(data, dict) else {}
+
+
+def _check_seed(check: Checker, text: str) -> None:
+    """The seed of the stored campaign text, read as the report reads it (it draws the report's runs): an
+    integer >= 0 when given (a text that is no mapping is the report's to show as unreadable)."""
+    settings = stored_settings(text)
+    if "seed" in settings:
+        check.integer(settings["seed"], "campaign.seed", 0)
 
 
 def _design_info(check: Checker, info, kind: str, runs: int, d: int) -> dict:

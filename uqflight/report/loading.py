@@ -2,15 +2,13 @@
 from __future__ import annotations
 
 import copy
-import functools
 import hashlib
 import os
 import re
 from dataclasses import dataclass, field
 from pathlib import Path
 
-import yaml
-
+from ..campaign.attributes import stored_settings
 from ..designs import REGISTRY as DESIGNS
 from ..methods import method_entry
 from ..statistics import Statistics, add_reference_errors, read_statistics
@@ -72,7 +70,7 @@ def input_distributions(campaign_text: str) -> str:
 
 def campaign_settings(campaign_text: str) -> dict:
     """The campaign's mapping as written (YAML), {} when unreadable: a copy, the text read once."""
-    return copy.deepcopy(_read_settings(campaign_text))
+    return copy.deepcopy(stored_settings(campaign_text))
 
 
 def campaign_simulator(campaign_text: str) -> dict:
@@ -80,18 +78,6 @@ def campaign_simulator(campaign_text: str) -> dict:
     shown, never trusted to be a campaign)."""
     simulator = campaign_settings(campaign_text).get("simulator")
     return simulator if isinstance(simulator, dict) else {}
-
-
-SAFE_LOADER = getattr(yaml, "CSafeLoader", yaml.SafeLoader)  # libyaml's, ten times faster, where PyYAML has it
-
-
-@functools.lru_cache(maxsize=8)
-def _read_settings(campaign_text: str) -> dict:
-    try:
-        data = yaml.load(campaign_text, Loader=SAFE_LOADER)
-    except (yaml.YAMLError, ValueError, RecursionError):  # e.g. a date 2001-13-45, or nesting too deep
-        return {}
-    return data if isinstance(data, dict) else {}
 
 
 def flight_facts(simulator: dict) -> dict[str, str]:
