@@ -47,7 +47,7 @@ from .analysis.sobol import pick_freeze_indices
 from .campaign.attributes import StoredFacts, stored_facts
 from .campaign.schema import CampaignError
 from .designs import REGISTRY as DESIGNS
-from .designs import is_sampled
+from .designs import is_rare, is_sampled
 from .designs.adaptive import index_set_summary
 from .methods import PCE, METHODS, failed_runs_note, fit, method_entry, method_settings, normalised
 from .methods.basis import orthonormal_basis
@@ -142,6 +142,8 @@ class Statistics:
     dependence: dict | None = None  # the inputs' Gaussian copula (parameters.dependence.summary), None: independent
     quantities: dict[str, QuantityStatistics] = field(default_factory=dict)
     index_set: dict | None = None  # an adaptive grid's refinement (designs.adaptive.index_set_summary)
+    rare_event: dict | None = None  # a rare-event design's estimate and rounds (analysis.rare_event)
+    rare_runs: dict | None = None  # its runs for the report's figures (not in summary.json)
     design_info: dict = field(default_factory=dict)  # the design's recorded facts (replicates, n_base, ...)
 
 
@@ -211,6 +213,11 @@ def analyse(path, reference: str | None = None, options: Options | None = None, 
         stats = Statistics(str(path), store.attrs.get("campaign_name", ""), method, design_kind,
                            store.parameter_names, int(status.size), int(ok.sum()), int(np.sum(status > 0)),
                            pending, {}, partial=pending > 0, design_info=facts.design_info)
+        if is_rare(design_kind):  # its runs are not draws of the input law: its event's probability only
+            from .analysis.rare_event import rare_statistics
+
+            rare_statistics(store, stats)
+            return stats
         _check_runs(store, stats, sampled, partial)
         state = store.index_set()
         stats.index_set = None if state is None else index_set_summary(state, store.parameter_names)
@@ -294,10 +301,7 @@ def _note_runs(store: ResultStore, stats: Statistics, sampled: bool, allow_alias
     else:
         stats.failure_probability = grid_failure_probability(failed, store.weights[done])
     if stats.failed:
-        kappa, reasons, names = store.kappa, store.reasons, store.parameter_names
-        stats.failures = [{"run": int(i), "status": Status(int(status[i])).name.lower(), "reason": reasons[i],
-                           "parameters": dict(zip(names, map(float, kappa[i])))}
-                          for i in np.flatnonzero(status > 0)]
+        stats.failures = failed_runs(store)
         stats.notes.append(failed_runs_note(stats.method["kind"], stats.failed, int(done.sum())))
         if not sampled:
             stats.notes.append("failure probability: " + _grid_failure_note(stats.failure_probability))
@@ -305,6 +309,13 @@ def _note_runs(store: ResultStore, stats: Statistics, sampled: bool, allow_alias
         stats.notes.append(f"partial: {stats.completed} of {stats.runs} runs")
     if allow_aliasing and not sampled and method_entry(stats.method["kind"]).rule == "projection":
         stats.notes.append("aliasing allowed: the projection's order may exceed what the grid integrates exactly")
+
+
+def failed_runs(store: ResultStore) -> list[dict]:
+    """summary.json's failures: every failed run with its status, reason and physical parameters."""
+    status, kappa, reasons, names = store.status, store.kappa, store.reasons, store.parameter_names
+    return [{"run": int(i), "status": Status(int(status[i])).name.lower(), "reason": reasons[i],
+             "parameters": dict(zip(names, map(float, kappa[i])))} for i in np.flatnonzero(status > 0)]
 
 
 def _grid_failure_note(probability: dict) -> str:
@@ -748,4 +759,5 @@ def summary_json(stats: Statistics) -> dict:
         **({"dependence": stats.dependence} if stats.dependence else {}),
         "outputs": outputs,
         "quantities": {name: _quantity_json(quantity, stats.seeds) for name, quantity in stats.quantities.items()},
-        **({"index_set": stats.index_set} if stats.index_set else {})})
+        **({"index_set": stats.index_set} if stats.index_set else {}),
+        **({"rare_event": stats.rare_event} if stats.rare_event else {})})

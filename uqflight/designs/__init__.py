@@ -8,6 +8,9 @@ Kinds (keys in braces):
 - pick_freeze {samples}: Saltelli's [A; B; AB_1; …; AB_d] for Sobol' index estimators.
 - adaptive_sparse_grid {rule, budget, tolerance}: Gerstner–Griebel's dimension-adaptive grid, built
   round by round from the results (`adaptive`; the runner refines it).
+- subset_simulation {event, budget, samples_per_level, p0}, importance_sampling {event, budget, samples},
+  active_learning {event, budget}: the probability of an event, the runs adapted to it round by round
+  (`rare`; the runner replays the algorithm over the stored runs).
 """
 from __future__ import annotations
 
@@ -21,6 +24,7 @@ from .adaptive import adaptive_design, adaptive_size
 from .montecarlo import (halton_design, latin_hypercube_design, monte_carlo_design, samples_size, sobol_design,
                          sobol_size)
 from .pickfreeze import pick_freeze_design, pick_freeze_size
+from .rare import active_learning_design, importance_sampling_design, rare_size, subset_simulation_design
 from .smolyak import sparse_grid_design, sparse_grid_size
 from .spec import is_integer
 from .tensor import tensor_grid_design, tensor_grid_size
@@ -35,7 +39,9 @@ class DesignKind:
     (analysis.proportions), or None for a quadrature grid (its weights are valid only all together);
     `sobol_from_runs`: its runs give Sobol' indices themselves (pick-freeze estimators), without a PCE;
     `adaptive`: the builder gives the first round only; the runner adds the others from the results
-    (designs.adaptive), up to `size` runs."""
+    (designs.adaptive), up to `size` runs; `rare`: an adaptive design that estimates the probability of its
+    `event` (designs.rare): its builder takes the `redrawn` columns (seed parameters), its runs are not draws
+    of the input law (the analysis gives the event's probability only) and `uqflight.rare_rounds` runs it."""
 
     build: Callable
     size: Callable
@@ -43,6 +49,7 @@ class DesignKind:
     example: dict  # a small `design:` mapping of this kind (help text and tests)
     sobol_from_runs: bool = False
     adaptive: bool = False
+    rare: bool = False
 
     @property
     def sampled(self) -> bool:
@@ -64,6 +71,15 @@ REGISTRY: dict[str, DesignKind] = {
     "adaptive_sparse_grid": DesignKind(adaptive_design, adaptive_size, None,
                                        {"kind": "adaptive_sparse_grid", "budget": 50, "tolerance": 1e-4},
                                        adaptive=True),
+    "subset_simulation": DesignKind(subset_simulation_design, rare_size, None,
+                                    {"kind": "subset_simulation", "event": {"of": "y", "above": 3.0},
+                                     "samples_per_level": 100, "p0": 0.1, "budget": 1000}, adaptive=True, rare=True),
+    "importance_sampling": DesignKind(importance_sampling_design, rare_size, None,
+                                      {"kind": "importance_sampling", "event": {"of": "y", "above": 3.0},
+                                       "samples": 100, "budget": 1000}, adaptive=True, rare=True),
+    "active_learning": DesignKind(active_learning_design, rare_size, None,
+                                  {"kind": "active_learning", "event": {"of": "y", "above": 3.0}, "budget": 100},
+                                  adaptive=True, rare=True),
 }
 DESIGN_KINDS = tuple(REGISTRY)
 SAMPLED_DESIGNS = tuple(kind for kind, entry in REGISTRY.items() if entry.sampled)
@@ -72,6 +88,11 @@ SAMPLED_DESIGNS = tuple(kind for kind, entry in REGISTRY.items() if entry.sample
 def is_adaptive(kind: str) -> bool:
     """Whether the design kind grows round by round from the results (see DesignKind)."""
     return REGISTRY[kind].adaptive
+
+
+def is_rare(kind: str) -> bool:
+    """Whether the design kind estimates the probability of its event (see DesignKind)."""
+    return REGISTRY[kind].rare
 
 
 def is_sampled(kind: str) -> bool:
@@ -98,8 +119,9 @@ def design_size(spec: dict, germs: list[str]) -> float | None:
     return REGISTRY[kind].size(spec, germs)
 
 
-def build_design(spec: dict, germs: list[str], seed: int) -> Design:
-    """The design a campaign's `design:` mapping asks for, over the given germs."""
+def build_design(spec: dict, germs: list[str], seed: int, redrawn: tuple[int, ...] = ()) -> Design:
+    """The design a campaign's `design:` mapping asks for, over the given germs; `redrawn`: the columns that
+    are random-stream seeds (a rare-event design treats them apart, see designs.rare)."""
     if not isinstance(spec, dict):
         raise ValueError(f"design: expected a mapping with a kind key, got {spec!r}")
     kind = spec.get("kind")
@@ -107,7 +129,9 @@ def build_design(spec: dict, germs: list[str], seed: int) -> Design:
         raise ValueError(f"design.kind: expected one of {', '.join(DESIGN_KINDS)}, got {kind!r}")
     if not is_integer(seed) or seed < 0:
         raise ValueError(f"seed: expected an integer >= 0, got {seed!r}")
-    xi, weights, info = REGISTRY[kind].build(spec, check_germs(germs), int(seed))
+    entry = REGISTRY[kind]
+    extra = {"redrawn": tuple(redrawn)} if entry.rare else {}
+    xi, weights, info = entry.build(spec, check_germs(germs), int(seed), **extra)
     return Design(kind, xi, weights, info)
 
 

@@ -75,4 +75,12 @@ def headline_section(entry: Entry, times: list[float]) -> Section:
             "Rounded to two digits of the std; in full in tables/headline.csv, as in summary.json.")
     if entry.stats.notes:
         text += " Read the notes below before these numbers."
-    return Section("Headline", "headline", text, [table], lead=True)
+    blocks = [table]
+    from .rare_event import headline_table
+
+    rare = headline_table(entry)
+    if rare is not None:  # a rare-event design: its estimate first; its runs have no mean or band of the law
+        blocks.insert(0, rare)
+        text = ("The probability of the event with its 95 % interval, c.o.v., runs and reliability index β "
+                "(−Φ⁻¹(p)); below, the other statistics, null: the runs are not draws of the input law. " + text)
+    return Section("Headline", "headline", text, blocks, lead=True)

@@ -51,11 +51,12 @@ def section_jobs(entries: list[Entry], ref: Entry | None, times: list[float],
             (0, "writing the notes", lambda: notes_section(entries)),
             (k, "drawing the design", lambda: run_section(entries, out_dir)),
             (0, "writing the inputs", lambda: inputs_section(entries, ref)),
-            (0, "writing the failures", lambda: failures_section(entries)),
-            ((outputs + 1) * k + (outputs if k >= 2 else 0), "drawing the statistics over time",
-             lambda: statistics_section(entries, ref, times, out_dir)),
-            (2 * outputs * k, "drawing the PDFs", lambda: draw_pdfs(entries, times, out_dir)),
-            ((outputs + inputs) * k, "drawing the runs", lambda: trajectories_section(entries, times, out_dir))]
+            (0, "writing the failures", lambda: failures_section(entries))]
+    if outputs:  # none: a rare-event design's runs are not draws of the input law (analysis.rare_event)
+        jobs += [((outputs + 1) * k + (outputs if k >= 2 else 0), "drawing the statistics over time",
+                  lambda: statistics_section(entries, ref, times, out_dir)),
+                 (2 * outputs * k, "drawing the PDFs", lambda: draw_pdfs(entries, times, out_dir))]
+    jobs.append(((outputs + inputs) * k, "drawing the runs", lambda: trajectories_section(entries, times, out_dir)))
     if any(e.has_errors for e in entries):
         jobs.append((2 * outputs + 2, "drawing the errors against the reference",
                      lambda: accuracy_section(entries, out_dir)))
@@ -69,6 +70,10 @@ def section_jobs(entries: list[Entry], ref: Entry | None, times: list[float],
         from .index_set import index_set_section
 
         jobs.append((k, "drawing the adaptive grid's index set", lambda: index_set_section(entries, out_dir)))
+    if any(getattr(e.stats, "rare_runs", None) for e in entries):
+        from .rare_event import rare_event_section
+
+        jobs.append((2 * k, "drawing the rare event's estimate", lambda: rare_event_section(entries, out_dir)))
     if any(e.stats.seeds for e in entries):
         from .variance_split import variance_split_section
 
