@@ -33,6 +33,7 @@ DEFAULT_BUDGET = {"subset_simulation": 12000, "importance_sampling": 5000, "acti
 OWN_KEYS = {"subset_simulation": ("samples_per_level", "p0"), "importance_sampling": ("samples",),
             "active_learning": ()}
 SIDES = ("above", "below")
+EVENT_KEYS = ("of", *SIDES)
 MAX_RUNS = 10**8  # a budget beyond this is no rare-event design's (and limits.max_runs bounds it first)
 
 
@@ -69,7 +70,7 @@ def _event(value) -> Event:
         raise ValueError(f"design.event: expected a mapping {{of: QUANTITY, above: X}} or {{of: QUANTITY, below: X}}, "
                          f"got {value!r}")
     for key in value:
-        if key not in ("of", *SIDES):
+        if key not in EVENT_KEYS:
             raise ValueError(f"design.event.{key}: unknown key; expected one of of, above, below")
     of = value.get("of")
     if not isinstance(of, str) or not of:
