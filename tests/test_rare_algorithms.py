@@ -1,0 +1,126 @@
+"""The rare-event algorithms (issue 46) against closed-form limit states (tests/reliability_problems.py).
+
+Fast tests: one or a few seeds on small problems, with tolerances of several standard deviations of the
+estimator (so that they fail on a wrong algorithm, not on an unlucky seed; each seed is fixed, so they are
+deterministic). Slow tests (-m slow): the issue's acceptance numbers over 20 seeds.
+"""
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+from scipy import special
+
+from uqflight.designs.rare.estimate import (Evaluations, RareEventEstimate, importance_shares, lognormal_interval,
+                                            zero_count_upper)
+from uqflight.designs.rare.subset import chain_correlation, subset_simulation
+
+sys.path.insert(0, str(Path(__file__).parent))
+from reliability_problems import PROBLEMS  # noqa: E402
+
+
+class Recorder:
+    """An evaluate that records every batch it is given (bit for bit) and its answers."""
+
+    def __init__(self, margin):
+        self.margin = margin
+        self.batches: list[np.ndarray] = []
+        self.answers: list[np.ndarray] = []
+
+    def __call__(self, u):
+        self.batches.append(u.copy())
+        self.answers.append(np.asarray(self.margin(u), dtype=float))
+        return self.answers[-1]
+
+
+def linear_margin(beta, dimension):
+    """g = Σu/√d − β: exact P = Φ(−β)."""
+    return lambda u: u.sum(axis=1) / np.sqrt(dimension) - beta
+
+
+# ---------------------------------------------------------------- estimate.py
+
+def test_beta_is_the_reliability_index():
+    estimate = RareEventEstimate("subset_simulation", float(special.ndtr(-3.0)), 0.0, 1.0, 0.1, 10, 0, None, (),
+                                 "converged", ())
+    assert estimate.beta == pytest.approx(3.0, rel=1e-12)
+    assert RareEventEstimate("subset_simulation", 0.0, 0.0, 1e-3, np.nan, 10, 0, None, (), "budget",
+                             ()).beta == np.inf
+
+
+def test_importance_shares_sum_to_one():
+    shares = importance_shares(np.array([3.0, -4.0, 0.0]))
+    np.testing.assert_allclose(shares, [0.36, 0.64, 0.0], rtol=1e-15)
+    with pytest.raises(ValueError):
+        importance_shares(np.zeros(2))
+
+
+def test_lognormal_interval_has_the_lognormal_quantiles():
+    # the log-normal law of mean p and c.o.v. 1 has σ² = ln 2; the interval is p exp(±1.96 σ)
+    lower, upper = lognormal_interval(1e-5, 1.0)
+    sigma = np.sqrt(np.log(2.0))
+    assert lower == pytest.approx(1e-5 * np.exp(-1.959964 * sigma), rel=1e-6)
+    assert upper == pytest.approx(1e-5 * np.exp(1.959964 * sigma), rel=1e-6)
+    assert lognormal_interval(1e-5, np.nan) == (0.0, 1.0)
+
+
+def test_zero_count_upper_is_clopper_pearson():
+    # 0 of n: 1 − 0.025^(1/n), about 3.69/n
+    assert zero_count_upper(1000) == pytest.approx(1 - 0.025 ** (1 / 1000), rel=1e-12)
+    assert zero_count_upper(1000) == pytest.approx(3.689 / 1000, rel=2e-3)
+    assert zero_count_upper(1000, largest_weight=20.0) == pytest.approx(20 * (1 - 0.025 ** (1 / 1000)))
+    assert zero_count_upper(0) == 1.0
+
+
+def test_evaluations_count_failed_runs_and_keep_the_design_point():
+    runs = Evaluations(lambda u: np.array([np.nan, 1.0, 2.0, -1.0]), 2, budget=6)
+    g = runs(np.array([[0.0, 0.1], [3.0, 4.0], [1.0, 1.0], [0.0, 0.0]]))
+    assert runs.failed == 1 and runs.runs == 4 and g[0] == -np.inf
+    np.testing.assert_array_equal(runs.design_point, [1.0, 1.0])   # the failing point nearest the origin
+    with pytest.raises(ValueError, match="budget"):
+        runs(np.zeros((4, 2)))
+
+
+def test_chain_correlation_of_independent_draws_is_zero_and_of_frozen_chains_is_large():
+    indicator = np.array([True, False] * 50)
+    singles = [np.array([i]) for i in range(100)]
+    assert chain_correlation(indicator, singles, 0.5) == 0.0
+    # 10 chains of 10 identical states: ρ_k = 1 at every lag, γ = 2 Σ_k (1 − k/10) = 9
+    frozen = np.repeat([True, False], 50)
+    chains = [np.arange(10 * c, 10 * c + 10) for c in range(10)]
+    assert chain_correlation(frozen, chains, 0.5) == pytest.approx(9.0, rel=1e-12)
+
+
+# ---------------------------------------------------------------- subset simulation
+
+def test_subset_simulation_linear_1e_minus_4():
+    # P = Φ(−3.719) = 1e-4 in 5 inputs: 4 levels of 1000 (3,700 runs). The estimator's c.o.v. is about
+    # 0.3 here; a factor 2.5 either way is 3 standard deviations on the log scale.
+    beta = float(-special.ndtri(1e-4))
+    estimate = subset_simulation(linear_margin(beta, 5), 5, seed=3, budget=5000)
+    assert estimate.stopped == "converged" and estimate.method == "subset_simulation"
+    assert 1e-4 / 2.5 < estimate.probability < 1e-4 * 2.5
+    assert estimate.lower < 1e-4 < estimate.upper
+    # 1000 + 3 × 900 runs, a few more when a stuck chain's repeated sample ties at a threshold
+    assert 3700 <= estimate.runs <= 3720 and estimate.rounds[-1].runs == estimate.runs
+    assert 0.1 < estimate.cov < 0.6
+    # the design point lies near the exact one, β/√5 (1, …, 1): its shares are about 1/5 each
+    np.testing.assert_allclose(importance_shares(estimate.design_point), 0.2, atol=0.15)
+
+
+def test_subset_simulation_budget_stop_is_an_honest_upper_bound():
+    # 1e-9 cannot be reached with 3 levels: the estimate is 0 and the upper bound is that of P[level 2]
+    beta = float(-special.ndtri(1e-9))
+    estimate = subset_simulation(linear_margin(beta, 3), 3, seed=1, budget=3000)
+    assert estimate.stopped == "budget" and estimate.probability == 0.0
+    assert 1e-9 < estimate.upper < 0.1 and estimate.runs <= 3000
+    assert any("upper bound" in note for note in estimate.notes)
+
+
+def test_subset_simulation_four_branch():
+    problem = PROBLEMS["four_branch"]
+    estimate = subset_simulation(problem.margin, 2, seed=0, budget=12000)
+    # c.o.v. about 0.2 (measured over 20 seeds): a factor 1.8 is 3 standard deviations
+    assert problem.exact / 1.8 < estimate.probability < problem.exact * 1.8
