@@ -127,8 +127,8 @@ def test_a_seed_parameter_is_redrawn_by_subset_simulation(tmp_path):
     ("event: {of: peak, over: 3.0}", "design.event.over", "unknown key"),
     ("event: {of: peak, above: 3.0}, p0: 0.7", "design.p0", "in (0, 0.5]"),
     ("event: {of: peak, above: 3.0}, p0: 0", "design.p0", "in (0, 0.5]"),
-    ("event: {of: peak, above: 3.0}, samples_per_level: 105, p0: 0.1", "design.samples_per_level",
-     "a whole number of chains"),
+    ("event: {of: peak, above: 3.0}, samples_per_level: 5, p0: 0.1", "design.samples_per_level",
+     "at least one chain"),
     ("event: {of: peak, above: 3.0}, samples_per_level: 1", "design.samples_per_level", "from 2"),
     ("event: {of: peak, above: 3.0}, budget: 0", "design.budget", "from 1"),
     ("event: {of: peak, above: 3.0}, samples: 100", "design.samples", "unknown key for kind subset_simulation"),
@@ -143,20 +143,20 @@ def test_bad_rare_event_designs_are_refused_naming_the_key(tmp_path, change, fie
 
 
 def test_the_command_line_refuses_an_event_of_no_quantity_in_one_line(tmp_path):
-    (tmp_path / "r.yaml").write_text(linear_text("importance_sampling").replace("{of: peak,", "{of: y,"))
+    (tmp_path / "r.yaml").write_text(linear_text("subset_simulation").replace("{of: peak,", "{of: y,"))
     done = cli_in_process("run", tmp_path / "r.yaml", "--out", tmp_path / "r.h5")
     assert done.returncode == 2 and "design.event.of: expected one of the campaign's quantities" in done.stderr
     assert len(done.stderr.strip().splitlines()) == 1 and not (tmp_path / "r.h5").exists()
 
 
 def test_analysis_exceedance_is_refused_beside_a_rare_event_design(tmp_path):
-    text = linear_text("importance_sampling") + "analysis: {exceedance: {peak: [{above: 2.0}]}}\n"
-    with pytest.raises(CampaignError, match="analysis.exceedance: a importance_sampling design's runs are not draws"):
+    text = linear_text("subset_simulation") + "analysis: {exceedance: {peak: [{above: 2.0}]}}\n"
+    with pytest.raises(CampaignError, match="analysis.exceedance: a subset_simulation design's runs are not draws"):
         parse_campaign(text, str(tmp_path / "r.yaml"))
 
 
 def test_an_unfinished_rare_event_file_is_refused_by_the_report(tmp_path):
-    out = fly(tmp_path, linear_text("importance_sampling"))
+    out = fly(tmp_path, linear_text("subset_simulation"))
     with h5py.File(out, "r+") as f:
         del f["rare_event"]
     done = cli_in_process("report", out, "--out", tmp_path / "report")
@@ -175,8 +175,8 @@ def test_one_worker_and_two_give_the_same_bits_and_another_seed_another_estimate
 
 
 def test_a_finished_rare_event_campaign_resumes_to_nothing(tmp_path):
-    out = fly(tmp_path, linear_text("importance_sampling"))
-    rerun = run_campaign(parse_campaign(linear_text("importance_sampling"), str(tmp_path / "r.yaml")), out=out)
+    out = fly(tmp_path, linear_text("subset_simulation"))
+    rerun = run_campaign(parse_campaign(linear_text("subset_simulation"), str(tmp_path / "r.yaml")), out=out)
     assert rerun.ran == 0
 
 
@@ -207,10 +207,10 @@ def test_a_sigkilled_rare_event_campaign_resumes_to_the_same_bits(tmp_path):
 
 
 def test_a_file_whose_runs_are_not_the_replay_is_refused(tmp_path):
-    out = fly(tmp_path, linear_text("importance_sampling"))
+    out = fly(tmp_path, linear_text("subset_simulation"))
     with h5py.File(out, "r+") as f:
         del f["rare_event"]
         f["samples/xi"][0, 0] += 1e-12
     done = cli_in_process("run", tmp_path / "r.yaml", "--out", out)
-    assert done.returncode == 2 and "are not the points this campaign's importance_sampling asks for" in done.stderr
+    assert done.returncode == 2 and "are not the points this campaign's subset_simulation asks for" in done.stderr
     assert json.dumps(done.stderr).count("\\n") <= 1

@@ -101,7 +101,7 @@ KEYS = {
     "design.event.of": "The quantity (a name under `quantities:`) the event is about.",
     "design.event.above": "The event is QUANTITY > above (give above or below, not both).",
     "design.event.below": "The event is QUANTITY < below.",
-    "design.samples_per_level": "subset_simulation: runs per level, >= 2; times p0 a whole number (the chains). "
+    "design.samples_per_level": "subset_simulation: runs per level, >= 2, times p0 at least 1 (the chains). "
                                 "Default 1000. `samples_per_level: 2000`",
     "design.p0": "subset_simulation: the conditional probability of each level, in (0, 0.5]. Default 0.1. "
                  "`p0: 0.1`",

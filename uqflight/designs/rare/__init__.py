@@ -112,10 +112,9 @@ def rare_settings(spec: dict) -> RareSettings:
         settings["p0"] = float(p0)
     if kind == "subset_simulation":
         samples = settings.get("samples_per_level", 1000)
-        seeds = samples * settings.get("p0", 0.1)
-        if abs(seeds - round(seeds)) > 1e-9 * samples or round(seeds) < 1:
-            raise ValueError(f"design.samples_per_level: times p0 must be a whole number of chains >= 1 "
-                             f"(samples_per_level {samples}, p0 {settings.get('p0', 0.1):g} give {seeds:g})")
+        if math.floor(samples * settings.get("p0", 0.1)) < 1:
+            raise ValueError(f"design.samples_per_level: times p0 must give at least one chain (samples_per_level "
+                             f"{samples}, p0 {settings.get('p0', 0.1):g})")
         if samples > budget:
             raise ValueError(f"design.budget: {budget} runs cannot hold one level of samples_per_level "
                              f"= {samples}")
