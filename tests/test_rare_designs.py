@@ -232,3 +232,12 @@ def test_a_file_whose_runs_are_not_the_replay_is_refused(quick, tmp_path):
     done = cli_in_process("run", source, "--out", out)
     assert done.returncode == 2 and "are not the points this campaign's subset_simulation asks for" in done.stderr
     assert len(done.stderr.strip().splitlines()) == 1
+
+
+def test_no_surrogate_is_exported_from_a_rare_event_design(quick, tmp_path):
+    _, out = copied(quick, tmp_path)
+    done = cli_in_process("surrogate", "export", out, "--out", tmp_path / "s.json")
+    assert done.returncode == 2 and "not draws of the input law" in done.stderr, done.stderr
+    assert len(done.stderr.strip().splitlines()) == 1 and not (tmp_path / "s.json").exists()
+    done = cli_in_process("info", out)
+    assert done.returncode == 0, done.stderr
