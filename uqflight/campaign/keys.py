@@ -88,7 +88,7 @@ KEYS = {
     # design
     "design.kind": "Required. The design kind (below).",
     "design.samples": "Number of points (`pick_freeze`: base rows n, N = n(d + 2) runs), >= 1; "
-                      "importance_sampling: runs per round, >= 2, default 1000. `samples: 1024`",
+                      "importance_sampling: runs per round, >= 2, default 500. `samples: 1024`",
     "design.scramble": "Scramble the QMC points with the seed. Default true. `scramble: false`",
     "design.replicates": "`sobol`: R independent scrambles of `samples` points (randomised QMC), giving every "
                          "statistic's standard error. Default 1. `replicates: 16`",
