@@ -59,6 +59,12 @@ def method_label(method: dict) -> str:
     return f"{name} order {method['order']}" + (" split" if method.get("split") else "")
 
 
+def estimator_label(stats) -> str:
+    """What gives a file's numbers: its method's label, or a rare-event design's kind (its runs are not the
+    method's draws: it estimates its event's probability only)."""
+    return stats.design_kind if getattr(stats, "rare_runs", None) else method_label(stats.method)
+
+
 def input_distributions(campaign_text: str) -> str:
     """The campaign's input distribution(s), e.g. "normal" or "normal, uniform"."""
     parameters = campaign_settings(campaign_text).get("parameters")
@@ -136,7 +142,7 @@ def _entry(path: Path, stats: Statistics, attrs: dict, stems: set[str], file_ste
     name = Path(path).stem + (f"_{stats.method['kind']}{stats.method.get('order', '')}" if with_method else "")
     stem = _unique(file_name(name), stems)
     runs = f"partial: {stats.completed} of {stats.runs} runs" if stats.partial else f"{stats.runs} runs"
-    label = f"{stats.campaign_name or stem}: {method_label(stats.method)}, {runs}"
+    label = f"{stats.campaign_name or stem}: {estimator_label(stats)}, {runs}"
     taken: set[str] = set()
     output_files = {name: _unique(file_name(name), taken) for name in stats.outputs}
     return Entry(stats, stem, label, str(attrs.get("campaign_hash", "")),

@@ -13,7 +13,8 @@ from .formats import shown_path
 from ..forking import share_work
 from .sensitivity import NEGLIGIBLE, index_text, plot_sensitivity
 from ..campaign.reading import stored_parameters
-from .loading import Entry, _same_file, bounded, campaign_settings, campaign_simulator, flight_facts, method_label
+from .loading import (Entry, _same_file, bounded, campaign_settings, campaign_simulator, estimator_label, flight_facts,
+                      method_label)
 
 BELOW_FLOOR = "below reference resolution"
 UNRESOLVED = "unresolved"
@@ -119,7 +120,7 @@ def run_section(entries: list[Entry], out_dir: Path) -> Section:
     for e in _files(entries):
         text = str(e.attrs.get("campaign", ""))
         settings, simulator = campaign_settings(text), campaign_simulator(text)
-        methods = ", ".join(dict.fromkeys(method_label(x.stats.method) for x in entries
+        methods = ", ".join(dict.fromkeys(estimator_label(x.stats) for x in entries
                                           if (x.path or x.stats.path) == (e.path or e.stats.path)))
         versions = ", ".join(f"{k} {v}" for k, v in json.loads(e.attrs.get("versions", "{}")).items())
         failed = getattr(e.stats, "failed", 0)
