@@ -224,7 +224,7 @@ def _load(path: Path):
 @app.command()
 def plan(campaign_file: Path = typer.Argument(..., metavar="CAMPAIGN", help="Campaign YAML file.")):
     """Validate a campaign and print its design, the number of runs and an estimated time."""
-    from .designs import describe, is_adaptive
+    from .designs import describe, is_adaptive, is_rare
 
     campaign = _load(campaign_file)
     design = campaign.design()
@@ -238,7 +238,10 @@ def plan(campaign_file: Path = typer.Argument(..., metavar="CAMPAIGN", help="Cam
              "Cholesky in this order)")
     echo(describe(design))
     kind = campaign.method["kind"]
-    echo(f"method: {kind}" + (f" (order {campaign.method['order']})" if _has_order(kind, design.kind) else ""))
+    if is_rare(design.kind):  # its own estimator: the runs are not draws of the input law
+        echo(f"method: none (the {design.kind} estimates the probability of its event only)")
+    else:
+        echo(f"method: {kind}" + (f" (order {campaign.method['order']})" if _has_order(kind, design.kind) else ""))
     runs = campaign.runs or len(design.xi)  # an adaptive grid's budget: its rounds are made from the results
     echo(f"runs: {runs}" + (" at most (design.budget)" if is_adaptive(design.kind) else ""))
     echo(f"results: {Path(campaign.storage['path']).resolve()} (storage.path, from the working directory; "
