@@ -241,3 +241,28 @@ def test_no_surrogate_is_exported_from_a_rare_event_design(quick, tmp_path):
     assert len(done.stderr.strip().splitlines()) == 1 and not (tmp_path / "s.json").exists()
     done = cli_in_process("info", out)
     assert done.returncode == 0, done.stderr
+
+
+FAILING_MODEL = '''
+import numpy as np
+
+
+def f(p):
+    if p["x1"] < -2.0:  # far from the event (y > 2.5): the estimate keeps its closed form
+        raise RuntimeError("stalled on the approach")
+    return {"y": (p["x1"] + p["x2"]) / np.sqrt(2.0)}
+'''
+
+
+def test_failed_runs_are_recorded_counted_outside_the_event_and_the_campaign_goes_on(tmp_path):
+    (tmp_path / "model.py").write_text(FAILING_MODEL)
+    text = linear_text("subset_simulation", threshold=2.5, settings=QUICK).replace(
+        '"uqflight.simulators.models:normal_sum"', '"model.py:f"')
+    summary = summary_json(analyse(fly(tmp_path, text)))
+    assert summary["failed"] > 0 and summary["failures"][0]["reason"].endswith("stalled on the approach")
+    assert all(run["parameters"]["x1"] < -2.0 for run in summary["failures"])
+    entry, = summary["quantities"]["peak"]["exceedance"]
+    assert entry["failed"] == summary["failed"] and entry["runs"] == summary["runs"]
+    exact = float(ndtr(-2.5))  # P(y > 2.5): the failed runs (x1 < -2) are all outside it
+    assert entry["lower"] <= exact <= entry["upper"], entry
+    assert any("counts them as outside the event" in note for note in summary["notes"])
