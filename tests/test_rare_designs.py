@@ -266,3 +266,16 @@ def test_failed_runs_are_recorded_counted_outside_the_event_and_the_campaign_goe
     exact = float(ndtr(-2.5))  # P(y > 2.5): the failed runs (x1 < -2) are all outside it
     assert entry["lower"] <= exact <= entry["upper"], entry
     assert any("counts them as outside the event" in note for note in summary["notes"])
+
+
+def test_the_shipped_hard_landing_campaign_loads_against_the_c172p():
+    from conftest import ROOT
+    from uqflight.campaign import load_campaign
+    from uqflight.simulators.validation_view import validation_view
+
+    campaign = load_campaign(ROOT / "campaigns" / "c172p-landing-rare.yaml", view=validation_view)
+    design = campaign.design()
+    assert design.kind == "subset_simulation" and campaign.runs == campaign.design_spec["budget"]
+    assert campaign.design_spec["event"] == {"of": "touchdown_sink_rate_fps", "below": -8.5}
+    assert [campaign.parameters[k].name for k in campaign.redrawn] == ["turbulence"]
+    assert design.xi.shape == (campaign.design_spec["samples_per_level"], 5)
