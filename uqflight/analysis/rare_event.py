@@ -8,6 +8,7 @@ import math
 
 import numpy as np
 
+from ..designs.rare import Event
 from ..store import ResultStore, Status
 
 
@@ -41,7 +42,7 @@ def rare_statistics(store: ResultStore, stats) -> None:
         raise BadInput(f"{path}: the {kind} design has not finished ({stats.completed} runs stored, no estimate "
                           f"in /rare_event yet): resume it with `uqflight run {campaign} --out {path}`")
     names, status = store.parameter_names, store.status
-    event = f"{record['of']} {'>' if record['side'] == 'above' else '<'} {record['threshold']:g}"
+    event = Event(record["of"], record["side"], record["threshold"]).text()
     stats.notes.append(f"the runs of this {kind} design were chosen to reach the event {event}: they are not draws of "
                        "the input law, so no mean, variance, band, density, Sobol' index or failure probability is "
                        f"computed from them (null); the event's probability is quantities.{record['of']}.exceedance")
@@ -59,7 +60,7 @@ def rare_statistics(store: ResultStore, stats) -> None:
         exceedance = [exceedance_entry(record, names)] if name == record["of"] else []
         stats.quantities[name] = QuantityStatistics(name, missing, None, exceedance)
         if name == record["of"]:
-            margin = values - record["threshold"] if record["side"] == "above" else record["threshold"] - values
+            margin = Event(name, record["side"], record["threshold"]).margin(values)
             margin[~ok] = np.nan
             if missing:
                 stats.notes.append(f"quantity {name} is undefined in {missing} successful runs: the {kind} counts them "

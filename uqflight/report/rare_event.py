@@ -71,6 +71,8 @@ def plot_convergence(record: dict, event: str, path: Path, title: str) -> Path:
         ax.errorbar([record["runs"]], [record["probability"]], yerr=[[record["probability"] - record["lower"]],
                                                                       [record["upper"] - record["probability"]]],
                     fmt="s", color="k", ms=5, capsize=4, label="final estimate, 95 % interval")
+    elif record["upper"] > 0:  # no run in the event: the estimate is 0, its upper bound is what the runs say
+        ax.plot([record["runs"]], [record["upper"]], "v", color="k", ms=7, label="upper bound (estimate 0)")
     if shown.any() or record["upper"] > 0:
         ax.set_yscale("log")
     ax.set_xlabel("runs so far", fontsize=9)
