@@ -34,8 +34,8 @@ quantities:
 design: {{kind: {kind}, event: {{of: peak, above: {threshold}}}{settings}}}
 execution: {{workers: 1, chunk: 25}}
 """
-SETTINGS = {"subset_simulation": ", samples_per_level: 400, p0: 0.1, budget: 2000",
-            "importance_sampling": ", samples: 400, budget: 2000",
+SETTINGS = {"subset_simulation": ", samples_per_level: 200, p0: 0.1, budget: 1000",
+            "importance_sampling": ", samples: 200, budget: 1000",
             "active_learning": ", budget: 300"}
 
 SEEDED = """
@@ -47,8 +47,8 @@ parameters:
   seed: {{distribution: seed}}
 quantities:
   peak: {{of: y, take: max}}
-design: {{kind: subset_simulation, event: {{of: peak, above: {threshold}}}, samples_per_level: 400, p0: 0.1,
-          budget: 2000}}
+design: {{kind: subset_simulation, event: {{of: peak, above: {threshold}}}, samples_per_level: 200, p0: 0.1,
+          budget: 1000}}
 execution: {{workers: 1, chunk: 25}}
 """
 
