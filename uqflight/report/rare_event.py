@@ -104,9 +104,14 @@ def plot_runs(runs: dict, names: list[str], path: Path, title: str) -> Path:
     pairs = input_pairs(record["importance"], d)
     panels = max(1, len(pairs))
     fig, axes = plots.plt.subplots(1, panels, figsize=(4.6 * panels + 0.6, 4.4), squeeze=False)
-    inside, failed = np.nan_to_num(margin, nan=-1.0) > 0, status > 0
-    outside = ~inside & ~failed
+    inside, failed = np.nan_to_num(margin, nan=-np.inf) > 0, status > 0
+    outside = ~inside & ~failed & np.isfinite(margin)
     point = record["design_point"]
+    nearest = None if inside.any() or not outside.any() else int(np.nanargmax(np.where(outside, margin, np.nan)))
+
+    def share(k: int) -> str:
+        return f" (share {_g(record['importance'][k], 2)})" if np.isfinite(record["importance"][k]) else ""
+
     for ax, pair in zip(axes[0], pairs or [None]):
         if pair is None:
             x, y, px, py = kappa[:, 0], margin, point[0], 0.0
@@ -115,10 +120,15 @@ def plot_runs(runs: dict, names: list[str], path: Path, title: str) -> Path:
         else:
             (i, j) = pair
             x, y, px, py = kappa[:, i], kappa[:, j], point[i], point[j]
-            ax.set_xlabel(f"{names[i]} (share {_g(record['importance'][i], 2)})", fontsize=9)
-            ax.set_ylabel(f"{names[j]} (share {_g(record['importance'][j], 2)})", fontsize=9)
-        ax.scatter(x[outside], y[outside], s=5, color="0.6", alpha=0.5, lw=0, label="outside the event")
+            ax.set_xlabel(names[i] + share(i), fontsize=9)
+            ax.set_ylabel(names[j] + share(j), fontsize=9)
+        order = np.flatnonzero(outside)[np.argsort(margin[outside], kind="stable")]  # nearest the event on top
+        ax.scatter(x[order], y[order], s=5, c=margin[order], cmap="Greys", alpha=0.7, lw=0,
+                           vmin=np.min(margin[order]) - 0.3 * np.ptp(margin[order]) if order.size else None,
+                           label="outside the event (darker: nearer)")
         ax.scatter(x[inside], y[inside], s=9, color="tab:red", alpha=0.8, lw=0, label="in the event")
+        if nearest is not None:
+            ax.plot([x[nearest]], [y[nearest]], "D", color="tab:blue", mec="k", ms=7, label="run nearest the event")
         if failed.any():
             ax.scatter(x[failed], y[failed], s=18, marker="x", color="k", lw=0.8, label="failed run")
         if np.isfinite(px) and np.isfinite(py):
@@ -151,12 +161,13 @@ def rare_event_section(entries: list[Entry], out_dir: Path) -> Section | None:
                          f"The runs in the inputs, {entry.label}")
         point = record["design_point"]
         where = ("; the design point (star): " + ", ".join(f"{n} = {_g(v, 5)}" for n, v in zip(names, point))
-                 if np.isfinite(point).all() else "; no run reached the event: no design point")
+                 if np.isfinite(point).all() else "; no run reached the event: no design point, the run nearest "
+                 "the event a diamond")
         blocks.append(Figure(_rel(path, out_dir), f"The {record['runs']} runs of {entry.label} in the physical "
                                                   "values of the inputs that weigh most in the design point (each "
                                                   "axis with its share α² of it): in the event red, outside grey, "
-                                                  f"failed runs crosses{where}. The runs were placed by the algorithm: "
-                                                  "their density is not the input law's."))
+                                                  f"failed runs crosses, the others shaded by their margin{where}. The runs were "
+                                                  "placed by the algorithm: their density is not the input law's."))
     if not facts:
         return None
     blocks.insert(0, Table("The estimate after each round", ["file", "round", "runs so far", "probability", "cov"],
