@@ -279,3 +279,11 @@ def test_the_shipped_hard_landing_campaign_loads_against_the_c172p():
     assert campaign.design_spec["event"] == {"of": "touchdown_sink_rate_fps", "below": -8.5}
     assert [campaign.parameters[k].name for k in campaign.redrawn] == ["turbulence"]
     assert design.xi.shape == (campaign.design_spec["samples_per_level"], 5)
+
+
+def test_a_rare_event_file_is_reported_alone(quick, tmp_path):
+    _, out = copied(quick, tmp_path)
+    for extra in (["--reference", out], [out]):  # another file or a reference: nothing to compare
+        done = cli_in_process("report", out, *extra, "--out", tmp_path / "report")
+        assert done.returncode == 2 and "is reported alone" in done.stderr, done.stderr
+        assert len(done.stderr.strip().splitlines()) == 1 and not (tmp_path / "report").exists()

@@ -11,7 +11,7 @@ from pathlib import Path
 from ..campaign.attributes import stored_settings
 from ..designs import REGISTRY as DESIGNS
 from ..methods import method_entry
-from ..statistics import Statistics, add_reference_errors, read_statistics
+from ..statistics import BadInput, Statistics, add_reference_errors, read_statistics
 
 
 @dataclass
@@ -122,7 +122,18 @@ def load_entries(paths: list[Path], reference: Path | None, method: dict | list[
             if ref is not None and not _same_file(path, reference):
                 add_reference_errors(stats, ref.stats)
             entries.append(_entry(path, stats, attrs, stems, file_stems, with_method=len(methods) > 1))
+    _rare_alone(entries, ref)
     return entries, ref
+
+
+def _rare_alone(entries: list[Entry], ref: Entry | None) -> None:
+    """A rare-event design's file is reported alone (BadInput otherwise): its runs are not draws of the input
+    law, so it has no statistics over time to overlay on another file's or to compare with a reference."""
+    rare = [e for e in entries + ([ref] if ref else []) if e.stats.rare_runs]
+    if rare and (len(entries) > 1 or ref is not None):
+        raise BadInput(f"{rare[0].stats.path}: a {rare[0].stats.design_kind} file is reported alone (no other "
+                       "results file, --method or --reference): its runs are not draws of the input law, it has "
+                       "only its event's probability; report it by itself")
 
 
 def _file_stems(paths: list[Path]) -> dict[Path, str]:
