@@ -1,4 +1,4 @@
-"""Rare-event designs as campaigns (designs.rare, rare_rounds, analysis.rare_event, report.rare_event): each
+"""Rare-event designs as campaigns (designs.rare, rare_rounds, rare_statistics, report.rare_event): each
 kind end to end through `run` and `report` on closed-form limit states (python models), the refusals of
 their keys, and reproducibility (a SIGKILLed run resumed, 1 worker against 2, another seed). The algorithms
 themselves are tested on their own in tests/test_rare_algorithms.py."""

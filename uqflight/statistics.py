@@ -142,7 +142,7 @@ class Statistics:
     dependence: dict | None = None  # the inputs' Gaussian copula (parameters.dependence.summary), None: independent
     quantities: dict[str, QuantityStatistics] = field(default_factory=dict)
     index_set: dict | None = None  # an adaptive grid's refinement (designs.adaptive.index_set_summary)
-    rare_event: dict | None = None  # a rare-event design's estimate and rounds (analysis.rare_event)
+    rare_event: dict | None = None  # a rare-event design's estimate and rounds (rare_statistics)
     rare_runs: dict | None = None  # its runs for the report's figures (not in summary.json)
     design_info: dict = field(default_factory=dict)  # the design's recorded facts (replicates, n_base, ...)
 
@@ -214,7 +214,7 @@ def analyse(path, reference: str | None = None, options: Options | None = None, 
                            store.parameter_names, int(status.size), int(ok.sum()), int(np.sum(status > 0)),
                            pending, {}, partial=pending > 0, design_info=facts.design_info)
         if is_rare(design_kind):  # its runs are not draws of the input law: its event's probability only
-            from .analysis.rare_event import rare_statistics
+            from .rare_statistics import rare_statistics
 
             rare_statistics(store, stats)
             return stats

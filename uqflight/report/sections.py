@@ -53,7 +53,7 @@ def section_jobs(entries: list[Entry], ref: Entry | None, times: list[float],
             (k, "drawing the design", lambda: run_section(entries, out_dir)),
             (0, "writing the inputs", lambda: inputs_section(entries, ref)),
             (0, "writing the failures", lambda: failures_section(entries))]
-    if outputs:  # none: a rare-event design's runs are not draws of the input law (analysis.rare_event)
+    if outputs:  # none: a rare-event design's runs are not draws of the input law (rare_statistics)
         jobs += [((outputs + 1) * k + (outputs if k >= 2 else 0), "drawing the statistics over time",
                   lambda: statistics_section(entries, ref, times, out_dir)),
                  (2 * outputs * k, "drawing the PDFs", lambda: draw_pdfs(entries, times, out_dir))]

@@ -14,7 +14,7 @@ The algorithms (`subset`, `importance`, `active`, `estimate`) work in standard-n
 u to the germs ξ (each germ's `from_normal`) and gives the first round's points (the design the results
 file is created with). The runner (`uqflight.rare_rounds`) replays the algorithm over the stored runs.
 The runs of such a design are not draws of the input law: the analysis gives the event's probability
-and refuses every other statistic (`uqflight.analysis.rare_event`).
+and refuses every other statistic (`uqflight.rare_statistics`).
 """
 from __future__ import annotations
 

@@ -8,8 +8,8 @@ import math
 
 import numpy as np
 
-from ..designs.rare import Event
-from ..store import ResultStore, Status
+from .designs.rare import Event
+from .store import ResultStore, Status
 
 
 def _number(value: float) -> float | None:
@@ -33,7 +33,7 @@ def rare_statistics(store: ResultStore, stats) -> None:
     """Fill `stats` (statistics.Statistics) of a rare-event design's file: the event's probability in its
     quantity's exceedance, the rounds (`rare_event`), the runs for the report's figures (`rare_runs`), every
     other statistic null with a note. BadInput when the file holds no estimate yet."""
-    from ..statistics import BadInput, QuantityStatistics, failed_runs
+    from .statistics import BadInput, QuantityStatistics, failed_runs
 
     record = store.rare_event()
     kind, path = stats.design_kind, stats.path
