@@ -19,10 +19,12 @@ draws, about 3.7/n, scaled by the largest weight the sampling density can give).
 """
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass
 
 import numpy as np
 from scipy import special
+from threadpoolctl import threadpool_limits
 
 CONFIDENCE = 0.95
 Z95 = float(special.ndtri(0.5 * (1.0 + CONFIDENCE)))
@@ -91,6 +93,17 @@ class RareEventEstimate:
     def beta(self) -> float:
         """The reliability index −Φ⁻¹(p): inf when p is 0, −inf when p is 1."""
         return float(-special.ndtri(self.probability))
+
+
+def single_threaded(algorithm):
+    """Run `algorithm` with one BLAS thread: a multi-threaded product may round differently with another
+    thread count, and the runs an algorithm asks for must not depend on the machine (nor, on 2 busy
+    cores, does a second thread pay)."""
+    @functools.wraps(algorithm)
+    def wrapper(*args, **kwargs):
+        with threadpool_limits(limits=1):
+            return algorithm(*args, **kwargs)
+    return wrapper
 
 
 def importance_shares(design_point) -> np.ndarray:

@@ -29,7 +29,8 @@ from __future__ import annotations
 import numpy as np
 from scipy import special
 
-from .estimate import Evaluations, RareEventEstimate, RoundRecord, lognormal_interval, standard_normal_logpdf
+from .estimate import (Evaluations, RareEventEstimate, RoundRecord, lognormal_interval, single_threaded,
+                       standard_normal_logpdf)
 
 QUANTILE = 0.1
 WIDENING = 1.5
@@ -104,16 +105,22 @@ def draw(density: KernelMixture | None, n: int, dimension: int, active: np.ndarr
     return u
 
 
-def weighted_mean(terms: list[np.ndarray]) -> tuple[float, float]:
-    """(P̂, c.o.v.) of rounds of unbiased terms pooled: P̂ = Σ terms / N, var = Σ_r N_r s_r² / N²."""
+def pooled_mean(terms: list[np.ndarray]) -> tuple[float, float]:
+    """(mean, its variance) of rounds of unbiased terms pooled: Σ terms / N and Σ_r N_r s_r² / N²."""
     total = sum(t.size for t in terms)
-    probability = float(sum(t.sum() for t in terms) / total)
+    mean = float(sum(t.sum() for t in terms) / total)
+    return mean, float(sum(t.size * t.var(ddof=1) for t in terms if t.size > 1) / total ** 2)
+
+
+def weighted_mean(terms: list[np.ndarray]) -> tuple[float, float]:
+    """(P̂, c.o.v.) of rounds of unbiased terms pooled (`pooled_mean`); the c.o.v. is nan when P̂ = 0."""
+    probability, variance = pooled_mean(terms)
     if probability <= 0.0:
         return 0.0, float("nan")
-    variance = sum(t.size * t.var(ddof=1) for t in terms if t.size > 1) / total ** 2
     return probability, float(np.sqrt(variance) / probability)
 
 
+@single_threaded
 def importance_sampling(evaluate, dimension, *, seed: int, budget: int, samples: int = 500,
                         redrawn: tuple[int, ...] = (), target_cov: float = 0.05) -> RareEventEstimate:
     """Estimate P[g(U) > 0], U ~ N(0, I_d), by nonparametric adaptive importance sampling.

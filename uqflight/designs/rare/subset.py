@@ -27,7 +27,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .estimate import Evaluations, RareEventEstimate, RoundRecord, lognormal_interval
+from .estimate import Evaluations, RareEventEstimate, RoundRecord, lognormal_interval, single_threaded
 
 TARGET_ACCEPTANCE = 0.44
 FIRST_SPREAD = 0.6
@@ -222,6 +222,7 @@ def _move_chains(evaluate, rng, u_seeds, g_seeds, threshold, n, mobile):
     return np.concatenate(path_u), np.concatenate(path_g), chains
 
 
+@single_threaded
 def subset_simulation(evaluate, dimension, *, seed: int, budget: int, samples_per_level: int = 1000,
                       p0: float = 0.1, redrawn: tuple[int, ...] = ()) -> RareEventEstimate:
     """Estimate P[g(U) > 0], U ~ N(0, I_d), by subset simulation.
