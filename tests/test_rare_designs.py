@@ -36,7 +36,7 @@ execution: {{workers: 1, chunk: 25}}
 """
 SETTINGS = {"subset_simulation": ", samples_per_level: 200, p0: 0.1, budget: 1000",
             "importance_sampling": ", samples: 200, budget: 1000",
-            "active_learning": ", budget: 300"}
+            "active_learning": ", budget: 500"}
 
 SEEDED = """
 name: rare-seeded

@@ -78,7 +78,7 @@ REGISTRY: dict[str, DesignKind] = {
                                       {"kind": "importance_sampling", "event": {"of": "y", "above": 3.0},
                                        "samples": 100, "budget": 1000}, adaptive=True, rare=True),
     "active_learning": DesignKind(active_learning_design, rare_size, None,
-                                  {"kind": "active_learning", "event": {"of": "y", "above": 3.0}, "budget": 100},
+                                  {"kind": "active_learning", "event": {"of": "y", "above": 3.0}, "budget": 500},
                                   adaptive=True, rare=True),
 }
 DESIGN_KINDS = tuple(REGISTRY)
