@@ -197,9 +197,14 @@ def test_a_finished_rare_event_campaign_resumes_to_nothing(quick, tmp_path):
     assert run_campaign(parse_campaign(source.read_text(), str(source)), out=out).ran == 0
 
 
-@pytest.mark.slow  # three subset simulations through the command line (the same replay: the tests above)
-def test_a_sigkilled_rare_event_campaign_resumes_to_the_same_bits(tmp_path):
-    (tmp_path / "c.yaml").write_text(linear_text("subset_simulation", threshold=2.5, settings=QUICK))
+KILLED = {"subset_simulation": QUICK, "importance_sampling": ", samples: 200, budget: 1000",
+          "active_learning": ", budget: 500"}
+
+
+@pytest.mark.slow  # three campaigns per kind through the command line (the same replay: the tests above)
+@pytest.mark.parametrize("kind", list(KILLED))
+def test_a_sigkilled_rare_event_campaign_resumes_to_the_same_bits(tmp_path, kind):
+    (tmp_path / "c.yaml").write_text(linear_text(kind, threshold=2.5, settings=KILLED[kind]))
     killed = tmp_path / "killed.h5"
     proc = subprocess.Popen([UQFLIGHT, "run", str(tmp_path / "c.yaml"), "--out", str(killed)],
                             stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True, start_new_session=True)
