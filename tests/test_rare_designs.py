@@ -292,3 +292,10 @@ def test_a_rare_event_file_is_reported_alone(quick, tmp_path):
         done = cli_in_process("report", out, *extra, "--out", tmp_path / "report")
         assert done.returncode == 2 and "is reported alone" in done.stderr, done.stderr
         assert len(done.stderr.strip().splitlines()) == 1 and not (tmp_path / "report").exists()
+
+
+def test_no_baseline_is_written_of_a_rare_event_file(quick, tmp_path):
+    _, out = copied(quick, tmp_path)
+    done = cli_in_process("report", out, "--out", tmp_path / "report", "--write-baseline", tmp_path / "b.json")
+    assert done.returncode == 2 and "--write-baseline" in done.stderr, done.stderr
+    assert not (tmp_path / "b.json").exists() and not (tmp_path / "report").exists()
