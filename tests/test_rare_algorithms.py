@@ -196,6 +196,12 @@ def test_active_learning_never_answers_a_silent_zero():
     assert any("no fresh run reached the event" in note for note in estimate.notes)
 
 
+def test_active_learning_whose_runs_all_fail_stops_with_no_bound():
+    estimate = active_learning(lambda u: np.full(u.shape[0], np.nan), 2, seed=0, budget=400)
+    assert estimate.stopped == "stalled" and estimate.failed == estimate.runs == 20
+    assert (estimate.probability, estimate.lower, estimate.upper) == (0.0, 0.0, 1.0)
+
+
 # ---------------------------------------------------------------- determinism, resume, failed runs
 
 SMALL = {
