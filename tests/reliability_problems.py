@@ -89,3 +89,43 @@ PROBLEMS = {
                       0.5 * (special.ndtr(SEEDED_C - SEEDED_BETA) + special.ndtr(-SEEDED_C - SEEDED_BETA)),
                       redrawn=(1,)),
 }
+
+
+@dataclass(frozen=True)
+class Repetitions:
+    """An algorithm's estimates of one problem over seeds 0 … n − 1, against the exact value."""
+
+    exact: float
+    probabilities: np.ndarray
+    lowers: np.ndarray
+    uppers: np.ndarray
+    runs: np.ndarray
+
+    @property
+    def cov(self) -> float:
+        """The c.o.v. of the estimates over the seeds (sample standard deviation / mean)."""
+        return float(self.probabilities.std(ddof=1) / self.probabilities.mean())
+
+    @property
+    def bias(self) -> float:
+        """The relative bias of their mean."""
+        return float(self.probabilities.mean() / self.exact - 1.0)
+
+    @property
+    def covered(self) -> int:
+        """How many of the 95 % intervals hold the exact value."""
+        return int(((self.lowers <= self.exact) & (self.exact <= self.uppers)).sum())
+
+    @property
+    def within_2(self) -> int:
+        """How many estimates lie within a factor 2 of the exact value."""
+        ratio = self.probabilities / self.exact
+        return int(((ratio >= 0.5) & (ratio <= 2.0)).sum())
+
+
+def repeat(algorithm, problem: Problem, seeds: int = 20, **settings) -> Repetitions:
+    """Run `algorithm` (one of uqflight.designs.rare's) on `problem` with seeds 0 … seeds − 1."""
+    estimates = [algorithm(problem.margin, problem.dimension, seed=seed, redrawn=problem.redrawn, **settings)
+                 for seed in range(seeds)]
+    return Repetitions(problem.exact, *(np.array([getattr(e, name) for e in estimates])
+                                        for name in ("probability", "lower", "upper", "runs")))

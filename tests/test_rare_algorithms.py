@@ -20,7 +20,7 @@ from uqflight.designs.rare.importance import KernelMixture, importance_sampling
 from uqflight.designs.rare.subset import chain_correlation, subset_simulation
 
 sys.path.insert(0, str(Path(__file__).parent))
-from reliability_problems import PROBLEMS  # noqa: E402
+from reliability_problems import PROBLEMS, repeat  # noqa: E402
 
 
 class Recorder:
@@ -196,6 +196,12 @@ def test_active_learning_never_answers_a_silent_zero():
     assert any("no fresh run reached the event" in note for note in estimate.notes)
 
 
+def test_active_learning_whose_runs_all_fail_stops_with_no_bound():
+    estimate = active_learning(lambda u: np.full(u.shape[0], np.nan), 2, seed=0, budget=400)
+    assert estimate.stopped == "stalled" and estimate.failed == estimate.runs == 20
+    assert (estimate.probability, estimate.lower, estimate.upper) == (0.0, 0.0, 1.0)
+
+
 # ---------------------------------------------------------------- determinism, resume, failed runs
 
 SMALL = {
@@ -273,3 +279,44 @@ def test_failed_runs_are_counted_outside_the_event(kind):
     assert estimate.failed == returned_nan > 0
     assert np.isfinite(estimate.probability) and np.isfinite(estimate.upper)
     assert any("failed" in note for note in estimate.notes)
+
+
+# ---------------------------------------------------------------- the acceptance numbers (slow)
+# Each over seeds 0..19. The thresholds are the issue's; an empirical c.o.v. from 20 seeds has a relative
+# standard error of about 16 %, so each setting was chosen with its measured c.o.v. well below the
+# threshold (benchmarks/rare_events.py prints them). "Within a factor 2 with its defaults" is read as:
+# the mean of the 20 estimates within a factor 2 of the exact value, and no estimate 0.
+
+DEFAULT_BUDGETS = {subset_simulation: 12000, importance_sampling: 5000, active_learning: 1500}
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("name", ["linear", "four_branch"])
+def test_active_learning_cov_and_bias_within_1000_runs(name):
+    result = repeat(active_learning, PROBLEMS[name], budget=1000)
+    assert result.runs.max() <= 1000 and (result.probabilities > 0).all()
+    assert result.cov <= 0.10 and abs(result.bias) <= 0.10
+    assert result.covered >= 16
+
+
+@pytest.mark.slow
+def test_importance_sampling_cov_within_4000_runs_on_linear():
+    result = repeat(importance_sampling, PROBLEMS["linear"], budget=4000)
+    assert result.runs.max() <= 4000 and result.cov <= 0.12 and result.covered >= 16
+
+
+@pytest.mark.slow
+def test_subset_simulation_cov_within_10000_runs_on_curved():
+    # 1,800 samples a level: 1,800 + 5 × 1,620 = 9,900 runs for the 6 levels of 9.2e-6
+    result = repeat(subset_simulation, PROBLEMS["curved"], budget=10000, samples_per_level=1800)
+    assert result.runs.max() <= 10000 and result.cov <= 0.4 and result.covered >= 16
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("algorithm", list(DEFAULT_BUDGETS), ids=lambda a: a.__name__)
+@pytest.mark.parametrize("name", list(PROBLEMS))
+def test_defaults_within_a_factor_2_and_intervals_cover(algorithm, name):
+    result = repeat(algorithm, PROBLEMS[name], budget=DEFAULT_BUDGETS[algorithm])
+    assert result.runs.max() <= DEFAULT_BUDGETS[algorithm] and (result.probabilities > 0).all()
+    assert 0.5 <= result.probabilities.mean() / result.exact <= 2.0
+    assert result.covered >= 16

@@ -185,6 +185,10 @@ def active_learning(evaluate, dimension, *, seed: int, budget: int, redrawn: tup
     while True:
         train_u, train_g = np.concatenate(seen_u), np.concatenate(seen_g)
         valid = np.isfinite(train_g)
+        if valid.sum() < k + 2:
+            notes.append(f"only {int(valid.sum())} of the first {train_g.size} runs gave a value: too few to learn "
+                         "a surrogate from")
+            return runs.estimate("active_learning", 0.0, float("nan"), rounds, "stalled", notes)
         surrogate = Surrogate(train_u[valid], train_g[valid], int(rng.integers(2 ** 31)), surrogate)
         candidates, _, reached = surrogate_levels(surrogate, k, rng)
         mu, sigma = surrogate.mean_and_std(candidates)
