@@ -4,7 +4,7 @@ estimated by an algorithm that adapts its runs to the event round by round.
 Kinds (keys in braces; every kind takes `event: {of: QUANTITY, above: X}` or `{of, below: X}` and an
 optional `budget`, the most runs):
 - subset_simulation {samples_per_level, p0}: Au & Beck's subset simulation, conditional levels by
-  modified Metropolis in standard-normal space (`subset`).
+  Markov chains in standard-normal space (`subset`).
 - importance_sampling {samples}: adaptive importance sampling, `samples` runs per round (`importance`).
 - active_learning {}: a Gaussian-process surrogate learnt where the event's boundary lies, then an
   importance-sampling correction on true runs (`active`).
@@ -197,8 +197,8 @@ def rare_design(spec: dict, germs: list[str], seed: int, redrawn=()):
 
 def subset_simulation_design(spec: dict, germs: list[str], seed: int, redrawn=()):
     """Subset simulation (Au & Beck 2001): the event's probability as a product of conditional probabilities
-    p0 of nested levels, each level's `samples_per_level` runs grown by modified Metropolis chains from the
-    p0 share of the runs beyond the previous level (keys `event`, `budget`, `samples_per_level`, `p0`)."""
+    p0 of nested levels, each level's `samples_per_level` runs grown by Markov chains (adaptive conditional
+    sampling) from the p0 share of the runs beyond the previous level, a seed parameter redrawn at each step (keys `event`, `budget`, `samples_per_level`, `p0`)."""
     return rare_design(spec, germs, seed, redrawn)
 
 
