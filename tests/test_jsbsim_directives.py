@@ -265,3 +265,15 @@ def test_the_step_count_is_bounded_where_it_is_computed(tmp_path):
     with pytest.raises(ScriptError, match=f"more than {MAX_STEPS}"):
         script.times()
     assert len(ScriptFile.read(jsbsim_scripts() / "ball_orbit.xml").times(10.0)) == 2001  # 10 s at dt = 0.005
+
+
+def test_a_parameter_setting_the_linearization_is_refused(tmp_path, home):
+    """The same property set by a campaign's parameter (a stored campaign flown again by `calibrate`)."""
+    path = tmp_path / "c.yaml"
+    path.write_text(yaml.safe_dump({
+        "name": "lin", "simulator": {"kind": "jsbsim", "aircraft": "c172p", "duration_s": 0.5, "flight": C172},
+        "parameters": {"lin": {"property": "simulation/do_linearization", "distribution": "uniform", "lower": 0,
+                               "upper": 1}}, "design": {"kind": "monte_carlo", "samples": 2}}))
+    line = refused(cli_in_process("plan", path, cwd=tmp_path))
+    assert "parameters.lin.property" in line and "simulation/do_linearization" in line
+    assert not list(tmp_path.glob("*_lin.sce"))
