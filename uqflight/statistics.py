@@ -33,22 +33,24 @@ from typing import Callable
 import numpy as np
 from threadpoolctl import threadpool_limits
 
+from .analysis.angles import angle_period, branch_shifts, unwrapped_runs
 from .analysis.density import pdf_over_time
 from .analysis.divergence import kl_divergence
 from .analysis.errors import error_summary, relative_errors
-from .analysis.exceedance import exceedance_from_pce, exceedance_from_runs
+from .analysis.exceedance import exceedance_from_pce, exceedance_from_runs, unit_slip
 from .analysis.failures import grid_failure_probability
 from .analysis.proportions import sampled_proportion
 from .analysis.floors import central_moments, floors_from_moments, kld_floor
 from .analysis.moments import (modified_cov, sorted_by_time, standardised_moments, weighted_moments,
                                weighted_quantiles)
 from .analysis.resolution import RESOLUTION_RTOL, resolved_variance
-from .analysis.sobol import pick_freeze_indices
-from .campaign.attributes import StoredFacts, stored_facts
+from .analysis.sobol import UNRESOLVED_WIDTH, complete_rows, pick_freeze_indices, unresolved
+from .campaign.attributes import StoredFacts, stored_facts, stored_settings
 from .campaign.schema import CampaignError
 from .designs import REGISTRY as DESIGNS
 from .designs import is_sampled
 from .designs.adaptive import index_set_summary
+from .labels import name_unit, quantity_unit
 from .methods import PCE, METHODS, failed_runs_note, fit, method_entry, method_settings, normalised
 from .methods.basis import orthonormal_basis
 from .methods.loo import relative_loo_error
@@ -113,6 +115,8 @@ class OutputStatistics:
     replicate_moments: tuple[np.ndarray, np.ndarray] | None = None  # (R, T) means and variances of RQMC replicates
     errors: dict = field(default_factory=dict)
     pce: PCE | None = None  # the expansion behind the statistics (None: statistics of the runs themselves)
+    flags: list[str] = field(default_factory=list)
+    unwrapped: bool = False  # an angle whose runs wrap, made continuous before any statistic (analysis.angles)
 
     @property
     def std(self) -> np.ndarray:
@@ -154,6 +158,8 @@ class QuantityStatistics:
     missing: int  # successful runs where the quantity is undefined
     output: OutputStatistics | None
     exceedance: list[dict] = field(default_factory=list)
+    units: str = ""  # its take's own, or its `of`'s (labels.quantity_unit)
+    flags: list[str] = field(default_factory=list)
 
 
 def campaign_facts(store: ResultStore, path) -> StoredFacts:
@@ -227,6 +233,10 @@ def analyse(path, reference: str | None = None, options: Options | None = None, 
             raise BadInput(f"{path}: method {method['kind']} order {method['order']}: {problem}")
         _note_runs(store, stats, sampled, allow_aliasing)
         stats.from_runs = method_entry(method["kind"]).runs_on_sampled and sampled
+        if stats.from_runs and DESIGNS[design_kind].sobol_from_runs:
+            note = pick_freeze_note(ok, len(store.parameter_names), "failed runs")
+            if note:
+                stats.notes.append(note)
         replicates = facts.design_info.get("replicates", 1)
         stats.replicates = replicates if stats.from_runs and ok.all() else 1
         if progress is not None:
@@ -242,6 +252,9 @@ def analyse(path, reference: str | None = None, options: Options | None = None, 
             def finish_oldest():
                 name, finish = in_flight.popleft()
                 out = stats.outputs[name] = finish()
+                if out.unwrapped:
+                    stats.notes.append(unwrapped_note(f"output {name}", out.units))
+                stats.notes.extend(f"output {name}: {flag}" for flag in out.flags)
                 if stats.replicates > 1:
                     out.replicate_moments = _replicate_moments(store, name, stats.replicates)
                 if progress is not None:
@@ -315,8 +328,11 @@ def _grid_failure_note(probability: dict) -> str:
             "(the nodes are not random draws); a sampled design gives one")
 
 
-def output_basis(store: ResultStore, name: str, ok: np.ndarray) -> tuple[np.ndarray, np.ndarray | None]:
-    """The ok runs of `name` as basis @ scale: raw (Y, None), or tSVD (V rows, diag(s) Uᵀ)."""
+def output_basis(store: ResultStore, name: str, ok: np.ndarray,
+                 unwrapped: list | None = None) -> tuple[np.ndarray, np.ndarray | None]:
+    """The ok runs of `name` as basis @ scale: raw (Y, None), or tSVD (V rows, diag(s) Uᵀ). An angle (deg or
+    rad) whose runs wrap is unwrapped (analysis.angles), raw, and its name appended to `unwrapped`."""
+    period = angle_period(store.units.get(name) or name_unit(name))
     factors = store.output_factors(name)
     if factors is None:
         runs = np.flatnonzero(ok)
@@ -325,13 +341,38 @@ def output_basis(store: ResultStore, name: str, ok: np.ndarray) -> tuple[np.ndar
         if bad.size:
             raise CorruptFile(f"output {name}: {bad.size} runs with status ok hold values that are not finite "
                               f"(e.g. run {bad[0]}): the file is damaged (`uqflight info` lists its problems)")
-        return histories, None
+        return _unwrapped(histories, period, name, unwrapped, histories), None
     U, s, V, columns = factors
     if not (np.isfinite(U).all() and np.isfinite(s).all() and np.isfinite(V).all()):
         raise CorruptFile(f"output {name}: its tSVD factors hold values that are not finite: the file is damaged")
     row_of = np.full(ok.size, -1)
     row_of[columns] = np.arange(columns.size)
-    return V[row_of[np.flatnonzero(ok)]], s[:, None] * U.T
+    basis, scale = V[row_of[np.flatnonzero(ok)]], s[:, None] * U.T
+    if period is None:
+        return basis, scale
+    histories = basis @ scale
+    found = _unwrapped(histories, period, name, unwrapped, None)
+    return (basis, scale) if found is None else (found, None)
+
+
+def unwrapped_note(what: str, units: str) -> str:
+    """The note of an angle made continuous before its statistics (analysis.angles)."""
+    turn = f"{angle_period(units):g} {units}" if units == "deg" else "2π rad"
+    return (f"{what} is an angle whose runs jump by about a turn ({turn}): unwrapped along each run and moved by "
+            "whole turns onto the first run's branch before any statistic")
+
+
+def _unwrapped(histories: np.ndarray, period: float | None, name: str, unwrapped: list | None, unchanged):
+    """`histories` unwrapped (analysis.angles) when `period` says it is an angle and its runs wrap, `name`
+    then appended to `unwrapped`; else `unchanged`."""
+    if period is None:
+        return unchanged
+    found, moved = unwrapped_runs(histories, period)
+    if not moved:
+        return unchanged
+    if unwrapped is not None:
+        unwrapped.append(name)
+    return found
 
 
 def _output_statistics(store: ResultStore, name: str, method: dict, germs: list[str], design_kind: str,
@@ -378,7 +419,8 @@ def _start_output(store: ResultStore, name: str, method: dict, germs: list[str],
     xi, weights = store.xi[ok], store.weights[ok]
     kind, order = method["kind"], method["order"]
     entry = method_entry(kind)
-    basis, scale = output_basis(store, name, ok)
+    unwrapped: list[str] = []
+    basis, scale = output_basis(store, name, ok, unwrapped)
     truncation = _tsvd_resolution(store, scale, int(ok.sum()))
     sampled = is_sampled(design_kind)
     x0 = None
@@ -398,10 +440,12 @@ def _start_output(store: ResultStore, name: str, method: dict, germs: list[str],
         rows, row_scale, band_weights = basis, scale, (None if entry.moments == "sample" else weights / weights.sum())
     else:
         rows, row_scale, band_weights = reused.band_rows(germs, pce.indices, options), pce.coefficients, None
-    pick_freeze = from_runs and DESIGNS[design_kind].sobol_from_runs and ok.all()
-    joined_blocks = _over_time_blocks(rows, row_scale, store.time.size, band_weights,
-                                      len(store.parameter_names) if pick_freeze else 0, options, from_runs, pool, pce,
-                                      reused)
+    d = len(store.parameter_names)
+    pick_rows = _pick_freeze_rows(ok, d) if from_runs and DESIGNS[design_kind].sobol_from_runs else None
+    pick_freeze = pick_rows is not None
+    joined_blocks = _over_time_blocks(rows, row_scale, store.time.size, band_weights, d if pick_freeze else 0,
+                                      options, from_runs, pool, pce, reused,
+                                      pick_rows=None if pick_freeze and ok.all() else pick_rows)
 
     def finish() -> OutputStatistics:
         blocks = joined_blocks()
@@ -412,11 +456,12 @@ def _start_output(store: ResultStore, name: str, method: dict, germs: list[str],
         resolved = resolved_variance(variance, mean, scale=magnitude, rtol=rtol, n=int(ok.sum()),
                                      weights=None if from_runs else weights, atol=atol)
         cov = modified_cov(mean, np.sqrt(np.maximum(variance, 0)))
-        stats = OutputStatistics(name, store.units.get(name, ""), store.time, mean, variance, blocks["band"],
-                                 blocks["support"], blocks["density"], cov, resolved,
+        stats = OutputStatistics(name, store.units.get(name) or name_unit(name), store.time, mean, variance,
+                                 blocks["band"], blocks["support"], blocks["density"], cov, resolved,
                                  quantiles=dict(zip(options.quantiles, blocks["quantiles"])),
                                  skewness=blocks["skewness"], kurtosis=blocks["kurtosis"],
-                                 final_samples=blocks["final"], fourth_central=blocks.get("fourth"))
+                                 final_samples=blocks["final"], fourth_central=blocks.get("fourth"),
+                                 unwrapped=bool(unwrapped))
         names = store.parameter_names
 
         def masked(indices):
@@ -437,9 +482,51 @@ def _start_output(store: ResultStore, name: str, method: dict, germs: list[str],
             stats.sobol_total = dict(zip(names, masked(blocks["total"])))
             stats.sobol_first_ci = dict(zip(names, np.moveaxis(blocks["first_ci"], 1, 0)))
             stats.sobol_total_ci = dict(zip(names, np.moveaxis(blocks["total_ci"], 1, 0)))
+            flag = unresolved_flag(stats)
+            if flag:
+                stats.flags.append(flag)
         return stats
 
     return finish
+
+
+def unresolved_flag(out: OutputStatistics) -> str | None:
+    """The flag of pick-freeze indices that resolve no share (analysis.sobol.unresolved), naming the
+    parameters and, over time, at how many times; None when every index is resolved."""
+    times: np.ndarray = np.zeros(out.time.size, dtype=bool)
+    named = []
+    for parameter in out.sobol_first:
+        where = (unresolved(out.sobol_first[parameter], out.sobol_first_ci[parameter])
+                 | unresolved(out.sobol_total[parameter], out.sobol_total_ci[parameter]))
+        if where.any():
+            named.append(parameter)
+            times |= where
+    if not named:
+        return None
+    at = f" at {int(times.sum())} of {times.size} times" if times.size > 1 else ""
+    return (f"Sobol' indices of {', '.join(named)} unresolved{at} (n too small): the 95 % interval is wider than "
+            f"{UNRESOLVED_WIDTH:g} or lies outside [0, 1]; run more base samples (design.samples)")
+
+
+def _pick_freeze_rows(ok: np.ndarray, d: int) -> np.ndarray | None:
+    """The ok runs' rows of a pick-freeze design's complete base rows (analysis.sobol.complete_rows), None when
+    fewer than 2 are complete (no index can be estimated)."""
+    rows = complete_rows(ok, d)
+    return rows if rows.size >= 2 * (d + 2) else None
+
+
+def pick_freeze_note(ok: np.ndarray, d: int, what: str) -> str | None:
+    """The note of a pick-freeze design whose runs `ok` miss some (failed, or `what` undefined in them):
+    the indices and the variance split come from the complete base rows, and how many were dropped."""
+    n = ok.size // (d + 2)
+    complete = complete_rows(ok, d).size // (d + 2)
+    if complete == n:
+        return None
+    if complete < 2:
+        return (f"{what}: no Sobol' indices: {complete} of the {n} base rows of the pick-freeze design are complete "
+                "(A, B and every AB_i ran), and the estimators need 2")
+    return (f"{what}: the pick-freeze Sobol' indices and the variance split are estimated on the {complete} complete "
+            f"base rows of {n} (A, B and every AB_i ran): {n - complete} rows dropped")
 
 
 def _replicate_moments(store: ResultStore, name: str, replicates: int) -> tuple[np.ndarray, np.ndarray]:
@@ -482,14 +569,16 @@ def _lower_order_difference(kind, xi, weights, basis, scale, germs, order, x0, p
 
 
 def _over_time_blocks(rows, scale, n_times: int, weights, pick_freeze_dimensions: int, options: Options,
-                      from_runs: bool, pool: Executor, pce: PCE | None, reused: Reused) -> Callable[[], dict]:
+                      from_runs: bool, pool: Executor, pce: PCE | None, reused: Reused,
+                      pick_rows: np.ndarray | None = None) -> Callable[[], dict]:
     """Quantiles, 99 % band, skewness and kurtosis, PDFs, final-time samples (the runs' fourth central
     moments, pick-freeze indices) of Y = rows @ scale (scale None: Y = rows), rebuilding Y for
     TIME_BLOCK times at once: the memory stays that of one block per thread whatever the number of runs or
     draws. Every statistic here is per time, so blocks change nothing. A `pce`'s skewness and kurtosis are
     its exact ones (methods.pce_moments), not those of its draws; the KDE's std comes from the factors.
     The blocks are handed to `pool`; returns what waits for them and joins them. `reused`: the triple
-    products of outputs before (Reused)."""
+    products of outputs before (Reused). `pick_rows`: the rows of the pick-freeze estimators (the complete
+    base rows', analysis.sobol.complete_rows), None for every row."""
     probabilities = (0.5 * (1 - BAND_LEVEL), 0.5 * (1 + BAND_LEVEL), *options.quantiles)
     exact = None if pce is None else pce_standardised_moments(pce.germs, pce.indices, pce.coefficients,
                                                               reused.triple_products)
@@ -512,7 +601,8 @@ def _over_time_blocks(rows, scale, n_times: int, weights, pick_freeze_dimensions
         if from_runs and weights is None:
             found["fourth"] = central_moments(Y)[2]
         if pick_freeze_dimensions:
-            found.update(pick_freeze_indices(Y, pick_freeze_dimensions, n_boot=options.bootstrap, seed=options.seed))
+            found.update(pick_freeze_indices(Y if pick_rows is None else Y[pick_rows], pick_freeze_dimensions,
+                                             n_boot=options.bootstrap, seed=options.seed))
         return found
 
     # blocks in the pool's threads (numpy's sort, FFTs and BLAS release the GIL); each block's numbers are
@@ -578,9 +668,9 @@ class _QuantityView:
     """A results file seen with one quantity as its only output, of one time point: what
     `_output_statistics` reads, so a quantity gets the outputs' methods, refusals and flags."""
 
-    def __init__(self, store: ResultStore, name: str, values: np.ndarray):
+    def __init__(self, store: ResultStore, name: str, values: np.ndarray, units: str):
         self._store, self._values = store, values
-        self.time, self.units = np.zeros(1), {name: ""}
+        self.time, self.units = np.zeros(1), {name: units}
 
     def __getattr__(self, attribute):  # the design, its weights, names and attributes: the file's
         return getattr(self._store, attribute)
@@ -601,7 +691,15 @@ def quantity_statistics(store: ResultStore, stats: Statistics, name: str, germs:
     a sampled design's statistics are conditional on the others (noted); a grid's are None (noted:
     a projection needs every run). Exceedance probabilities from the runs or from the PCE."""
     values = store.quantity(name)
+    specs = stored_settings(store.attrs.get("campaign", "")).get("quantities")
+    units = quantity_unit(specs.get(name) if isinstance(specs, dict) else None, store.units)
     defined = ok & np.isfinite(values)
+    period = angle_period(units)
+    if period is not None:
+        shifts = branch_shifts(np.where(defined, values, np.nan), period)
+        if shifts.any():
+            values = values + shifts
+            stats.notes.append(unwrapped_note(f"quantity {name}", units))
     missing = int(ok.sum() - defined.sum())
     sampled = is_sampled(stats.design_kind)
     why = None
@@ -621,22 +719,29 @@ def quantity_statistics(store: ResultStore, stats: Statistics, name: str, germs:
         stats.notes.append(why)
         nulls = [{**item, "probability": None, "lower": None, "upper": None, "method": None, "note": why}
                  for item in thresholds]
-        return QuantityStatistics(name, missing, None, nulls)
-    view = _QuantityView(store, name, values)
+        return QuantityStatistics(name, missing, None, nulls, units)
+    view = _QuantityView(store, name, values, units)
     out = _output_statistics(view, name, stats.method, germs, stats.design_kind, defined, options)
+    if missing and stats.from_runs and DESIGNS[stats.design_kind].sobol_from_runs:
+        note = pick_freeze_note(defined, len(store.parameter_names), f"quantity {name} (undefined in some runs)")
+        if note:
+            stats.notes.append(note)
     if out.pce is None:
         exceedance = exceedance_from_runs(values, defined, thresholds, DESIGNS[stats.design_kind].draws,
-                                          stats.design_info)
+                                          stats.design_info, units)
     else:
         exceedance = exceedance_from_pce(out.pce.sample(options.band_samples, options.seed)[:, 0],
-                                         int(defined.sum()), thresholds)
-    return QuantityStatistics(name, missing, out, exceedance)
+                                         int(defined.sum()), thresholds, values[defined], units)
+    flags = [slip for item in thresholds if (slip := unit_slip(values[defined], next(iter(item.values())), units))]
+    stats.notes.extend(f"quantity {name}: {flag}" for flag in (*out.flags, *flags))
+    return QuantityStatistics(name, missing, out, exceedance, units, flags)
 
 
 def _quantity_json(quantity: QuantityStatistics, seeds: list[str]) -> dict:
     """summary.json's quantities.NAME: numbers, not lists (null where undefined)."""
     out = quantity.output
-    entry = {"missing": quantity.missing, "exceedance": quantity.exceedance}
+    entry = {"units": quantity.units, "missing": quantity.missing, "exceedance": quantity.exceedance,
+             "flags": quantity.flags + (out.flags if out is not None else [])}
     if out is None:
         return {"mean": None, "variance": None, "std": None, "band99": {"lower": None, "upper": None},
                 "quantiles": {}, "skewness": None, "kurtosis": None, "sobol_first": {}, "sobol_total": {}, **entry}
@@ -715,7 +820,7 @@ def summary_json(stats: Statistics) -> dict:
     outputs = {}
     for name, out in stats.outputs.items():
         entry = {
-            "time": out.time, "units": out.units, "mean": out.mean, "variance": out.variance, "std": out.std,
+            "time": out.time, "units": out.units, "flags": out.flags, "mean": out.mean, "variance": out.variance, "std": out.std,
             "band99": {"lower": out.band99[0], "upper": out.band99[1]},
             "quantiles": {f"{p:g}": values for p, values in out.quantiles.items()},
             "skewness": out.skewness, "kurtosis": out.kurtosis, "cov": out.cov, "resolved": out.resolved,
