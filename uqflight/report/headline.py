@@ -41,7 +41,7 @@ def band_text(lower: float, upper: float, std: float) -> str:
 def _row(name: str, out, i: int, time) -> tuple[list, list]:
     """(CSV row, page row) of one output at time index i (or a quantity: time None)."""
     mean, std, lower, upper = (float(v[i]) for v in (out.mean, out.std, *out.band99))
-    top = top_contributors(out.sobol_first, i) if out.sobol_first else NO_INDICES
+    top = top_contributors(out.sobol_first, i, out.sobol_first_ci or None) if out.sobol_first else NO_INDICES
     csv = [name, out.units, "" if time is None else float(time), mean, std, lower, upper, top]
     page = [name, "" if time is None else f"{time:g}", mean_std_text(mean, std, out.units),
             band_text(lower, upper, std), top]
@@ -71,7 +71,9 @@ def headline_section(entry: Entry, times: list[float]) -> Section:
                   page=(["output or quantity", "time [s]", "mean ± std", "99 % band", contributors], page))
     text = ("Mean ± std, the 99 % band (0.5 % to 99.5 % quantiles) and the largest first-order Sobol' shares of "
             "the variance (up to three, each ≥ 1 %; 'interactions' = 1 − Σ S_i when ≥ 5 %; 'unresolved': a variance "
-            "at the simulator's noise), per output at the selected times (--times) and per quantity of interest. "
+            "at the simulator's noise; with a pick-freeze design each share carries its 95 % bootstrap interval, "
+            "and an index whose interval is wider than 0.5 or lies outside [0, 1] reads 'unresolved (its interval, n too small)'), "
+            "per output at the selected times (--times) and per quantity of interest. "
             "Rounded to two digits of the std; in full in tables/headline.csv, as in summary.json.")
     if entry.stats.notes:
         text += " Read the notes below before these numbers."

@@ -5,6 +5,7 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
+from matplotlib.patches import Patch
 
 from . import plots
 from .loading import Entry, bounded
@@ -29,31 +30,36 @@ def plot_quantity_pdfs(quantities: dict, path: Path, title: str) -> Path:
         for bound in out.band99:
             ax.axvline(bound[0], color="k", lw=0.9, ls="--")
         ax.set_title(name, fontsize=10)
-        ax.set_xlabel(name, fontsize=8)
-        ax.set_ylabel("probability density", fontsize=8)
+        ax.set_xlabel(plots.label(name, out.units), fontsize=8)
+        ax.set_ylabel(f"probability density [1/{out.units}]" if out.units else "probability density", fontsize=8)
         ax.tick_params(labelsize=8)
         ax.grid(alpha=0.3)
     return plots._save(fig, path)
 
 
 def plot_quantity_sobol(quantities: dict, path: Path, title: str) -> Path:
-    """One panel per quantity: first-order and total Sobol' indices per parameter, as bars (unresolved: none)."""
+    """One panel per quantity: first-order and total Sobol' indices per parameter, as bars (unresolved
+    variance: none), with their pick-freeze 95 % intervals unclipped and the indices those intervals do
+    not resolve hatched, "n too small" (plots.index_bars)."""
     fig, axes = plots._panels(len(quantities), title, row_height=2.7)
     for ax, (name, out) in zip(axes, quantities.items()):
         parameters = list(out.sobol_first)
         x = np.arange(len(parameters))
-        first = [float(out.sobol_first[p][0]) for p in parameters]
-        total = [float(out.sobol_total[p][0]) for p in parameters]
-        ax.bar(x - 0.2, np.nan_to_num(first), width=0.4, color=plots.COLORS[0], label="first order S_i")
-        ax.bar(x + 0.2, np.nan_to_num(total), width=0.4, color=plots.COLORS[1], label="total S_Ti")
+        drawn = []
+        for shift, color, indices, intervals in ((-0.2, plots.COLORS[0], out.sobol_first, out.sobol_first_ci),
+                                                 (0.2, plots.COLORS[1], out.sobol_total, out.sobol_total_ci)):
+            drawn += plots.index_bars(ax, x + shift, [indices[p] for p in parameters],
+                                      [intervals[p] for p in parameters] if intervals else None, color, 0.4)
         ax.set_xticks(x, parameters, fontsize=8, rotation=30 if max(map(len, parameters)) > 4 else 0)
-        ax.set_ylim(0, 1.05)
+        plots.index_axis(ax, drawn)
         ax.set_title(name, fontsize=10)
         ax.set_ylabel("Sobol' index [-]", fontsize=8)
         ax.tick_params(labelsize=8)
         ax.grid(alpha=0.3, axis="y")
     handles = [plots.Line2D([], [], color=plots.COLORS[k], lw=6) for k in (0, 1)]
-    return plots._save(fig, path, (handles, ["first order S_i", "total S_Ti"]), legend_columns=2)
+    handles.append(Patch(facecolor="white", edgecolor="k", hatch=plots.UNRESOLVED_HATCH))
+    return plots._save(fig, path, (handles, ["first order S_i", "total S_Ti", "95 % interval wider than 0.5 or "
+                                             "outside [0, 1]: n too small"]), legend_columns=3)
 
 
 def quantities_section(entries: list[Entry], out_dir: Path) -> Section:
@@ -84,7 +90,10 @@ def quantities_section(entries: list[Entry], out_dir: Path) -> Section:
             path = plot_quantity_sobol(with_sobol, out_dir / "plots" / bounded(f"quantity_sobol_{entry.stem}.png"),
                                        f"Sobol' indices of the quantities: {entry.label}")
             blocks.append(Figure(_rel(path, out_dir), f"First-order and total Sobol' indices of the quantities of "
-                                                      f"{entry.label}; an unresolved index is drawn as none."))
+                                                      f"{entry.label}, with their 95 % bootstrap intervals (pick-freeze) drawn "
+                                                      "unclipped; an index whose interval is wider than 0.5 or lies "
+                                                      "outside [0, 1] is hatched, 'n too small'; the index of an "
+                                                      "unresolved variance is drawn as none."))
     blocks.insert(0, Table("Quantities of interest: one number per run", [
         "file", "quantity", "missing runs", "mean", "std", "band99 lower", "band99 upper",
         "top total Sobol' index", "its value"], statistics, "tables/quantities.csv"))
