@@ -150,3 +150,22 @@ def test_a_smooth_model_is_not_flagged_and_a_unit_slip_is(flown):
     assert summary["outputs"]["y"]["flags"] == [] and summary["quantities"]["y_time"]["units"] == "s"
     assert summary["quantities"]["y_final"]["flags"] == quantity.flags
     assert any("unit slip" in note for note in summary["notes"])
+
+
+@pytest.mark.slow  # 9 JSBSim flights of 100 s (about 10 s): the wrapped models above are the fast check
+def test_the_737_turn_heading_is_continuous(tmp_path):
+    # JSBSim's 737_cruise_steady_turn starts at heading 0 and drifts below it before turning right:
+    # attitude/psi-deg jumps from 0 to 359.9 in every run. Unwrapped, the heading rises to about 136 deg at
+    # 100 s with a spread of tenths of a degree; wrapped, its std would be ~180 deg
+    text = (Path(__file__).parent.parent / "campaigns" / "737-turn.yaml").read_text()
+    text = (text.replace("level: 2}", "level: 1}").replace("order: 2}", "order: 1}")
+            .replace("workers: 2", "workers: 1")
+            .replace("quantities:\n", "quantities:\n  heading_change: {of: attitude/psi-deg, take: change}\n"))
+    stats = analyse(run_python_campaign(tmp_path, text, "turn737"))
+    psi = stats.outputs["attitude/psi-deg"]
+    assert psi.units == "deg" and psi.unwrapped and np.max(psi.std) < 1.0
+    assert 100 < psi.mean[-1] < 170 and np.all(np.diff(psi.mean[200:]) > 0)
+    change = stats.quantities["heading_change"]
+    assert change.units == "deg" and change.output.std[0] < 1.0
+    assert change.output.mean[0] == pytest.approx(psi.mean[-1] - psi.mean[0], abs=0.5)
+    assert stats.quantities["altitude_loss_ft"].units == "ft" and stats.quantities["peak_load_factor"].units == "g"

@@ -695,11 +695,10 @@ def quantity_statistics(store: ResultStore, stats: Statistics, name: str, germs:
     units = quantity_unit(specs.get(name) if isinstance(specs, dict) else None, store.units)
     defined = ok & np.isfinite(values)
     period = angle_period(units)
-    if period is not None:
-        shifts = branch_shifts(np.where(defined, values, np.nan), period)
-        if shifts.any():
-            values = values + shifts
-            stats.notes.append(unwrapped_note(f"quantity {name}", units))
+    shifts = None if period is None else branch_shifts(np.where(defined, values, np.nan), period)
+    if shifts is not None and shifts.any():
+        values = values + shifts
+        stats.notes.append(unwrapped_note(f"quantity {name}", units))
     missing = int(ok.sum() - defined.sum())
     sampled = is_sampled(stats.design_kind)
     why = None
@@ -722,6 +721,7 @@ def quantity_statistics(store: ResultStore, stats: Statistics, name: str, germs:
         return QuantityStatistics(name, missing, None, nulls, units)
     view = _QuantityView(store, name, values, units)
     out = _output_statistics(view, name, stats.method, germs, stats.design_kind, defined, options)
+    out.unwrapped = shifts is not None and bool(shifts.any())
     if missing and stats.from_runs and DESIGNS[stats.design_kind].sobol_from_runs:
         note = pick_freeze_note(defined, len(store.parameter_names), f"quantity {name} (undefined in some runs)")
         if note:

@@ -46,3 +46,11 @@ def unwrapped_runs(histories: np.ndarray, period: float) -> tuple[np.ndarray, bo
     if not shifts.any():
         return found, jumps
     return found + shifts[:, None], True
+
+
+def on_branch(histories: np.ndarray, start: float, period: float) -> np.ndarray:
+    """Runs of an angle (N, T; a quantity's (N, 1)) drawn as their statistics see them: unwrapped along time
+    and moved by whole turns to start within half a turn of `start` (the statistics' mean at the first time)."""
+    histories = np.asarray(histories, dtype=float)
+    found = np.unwrap(histories, period=period, axis=1) if histories.shape[1] > 1 else histories
+    return found - period * np.round((found[:, :1] - start) / period)
