@@ -7,14 +7,23 @@ from pathlib import Path
 import numpy as np
 from matplotlib.patches import Patch
 
+from ..analysis.sobol import unresolved
 from . import plots
+from .sensitivity import N_TOO_SMALL, UNRESOLVED
 from .loading import Entry, bounded
 from .blocks import Figure, Section, Table, _rel
 
 
-def _top_index(out) -> tuple[str, float] | tuple[None, None]:
-    """The parameter with the largest total Sobol' index and that index (None where there are none)."""
+def _top_index(out) -> tuple[str, float | str] | tuple[None, None]:
+    """The parameter with the largest total Sobol' index and that index (None where there are none); among
+    pick-freeze indices those their interval resolves (analysis.sobol.unresolved), the index text
+    "unresolved (n too small)" when none is."""
     finite = {p: float(v[0]) for p, v in (out.sobol_total or {}).items() if np.isfinite(v[0])}
+    if out.sobol_total_ci:
+        loose = {p for p in finite if unresolved(finite[p], out.sobol_total_ci[p][:, 0])}
+        if loose and len(loose) == len(finite):
+            return ", ".join(sorted(loose)), f"{UNRESOLVED} ({N_TOO_SMALL})"
+        finite = {p: v for p, v in finite.items() if p not in loose}
     if not finite:
         return None, None
     top = max(finite, key=finite.get)
