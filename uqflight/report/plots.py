@@ -580,7 +580,7 @@ def index_axis(ax, drawn: list[float]) -> None:
     finite = finite[np.isfinite(finite)]
     low, high = -0.05, 1.05
     if finite.size:
-        low, high = min(low, finite.min() - 0.1), max(high, finite.max() + 0.15)
+        low, high = min(low, finite.min() - 0.05), max(high, finite.max() + 0.15)
     ax.set_ylim(low, high)
     if high > 1.05 or low < -0.05:
         ax.axhspan(1.0, high, color="0.9", zorder=0)
