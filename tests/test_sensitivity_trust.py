@@ -143,6 +143,7 @@ def test_a_smooth_model_is_not_flagged_and_a_unit_slip_is(flown):
     assert out.flags == [] and out.units == ""
     quantity = stats.quantities["y_final"]
     assert quantity.output.flags == [] and len(quantity.flags) == 1 and "unit slip" in quantity.flags[0]
+    assert stats.quantities["y_time"].flags == []
     near, far = quantity.exceedance
     assert "unit slip" in far["note"] and "run more" not in far["note"] and "unit slip" not in near["note"]
     assert far["probability"] == 0.0

@@ -159,7 +159,7 @@ class QuantityStatistics:
     output: OutputStatistics | None
     exceedance: list[dict] = field(default_factory=list)
     units: str = ""  # its take's own, or its `of`'s (labels.quantity_unit)
-    flags: list[str] = field(default_factory=list)
+    flags: list[str] = field(default_factory=list)  # its statistics' (output.flags) and its thresholds' (unit slips)
 
 
 def campaign_facts(store: ResultStore, path) -> StoredFacts:
@@ -691,7 +691,8 @@ def quantity_statistics(store: ResultStore, stats: Statistics, name: str, germs:
     a sampled design's statistics are conditional on the others (noted); a grid's are None (noted:
     a projection needs every run). Exceedance probabilities from the runs or from the PCE."""
     values = store.quantity(name)
-    specs = stored_settings(store.attrs.get("campaign", "")).get("quantities")
+    text = store.attrs.get("campaign", "")  # the stored campaign text: its quantity's take and `of` give the unit
+    specs = stored_settings(text).get("quantities") if isinstance(text, str) else None
     units = quantity_unit(specs.get(name) if isinstance(specs, dict) else None, store.units)
     defined = ok & np.isfinite(values)
     period = angle_period(units)
@@ -732,8 +733,9 @@ def quantity_statistics(store: ResultStore, stats: Statistics, name: str, germs:
     else:
         exceedance = exceedance_from_pce(out.pce.sample(options.band_samples, options.seed)[:, 0],
                                          int(defined.sum()), thresholds, values[defined], units)
-    flags = [slip for item in thresholds if (slip := unit_slip(values[defined], next(iter(item.values())), units))]
-    stats.notes.extend(f"quantity {name}: {flag}" for flag in (*out.flags, *flags))
+    slips = [slip for item in thresholds if (slip := unit_slip(values[defined], next(iter(item.values())), units))]
+    flags = [*out.flags, *slips]
+    stats.notes.extend(f"quantity {name}: {flag}" for flag in flags)
     return QuantityStatistics(name, missing, out, exceedance, units, flags)
 
 
@@ -741,7 +743,7 @@ def _quantity_json(quantity: QuantityStatistics, seeds: list[str]) -> dict:
     """summary.json's quantities.NAME: numbers, not lists (null where undefined)."""
     out = quantity.output
     entry = {"units": quantity.units, "missing": quantity.missing, "exceedance": quantity.exceedance,
-             "flags": quantity.flags + (out.flags if out is not None else [])}
+             "flags": quantity.flags}
     if out is None:
         return {"mean": None, "variance": None, "std": None, "band99": {"lower": None, "upper": None},
                 "quantiles": {}, "skewness": None, "kurtosis": None, "sobol_first": {}, "sobol_total": {}, **entry}
@@ -820,7 +822,8 @@ def summary_json(stats: Statistics) -> dict:
     outputs = {}
     for name, out in stats.outputs.items():
         entry = {
-            "time": out.time, "units": out.units, "flags": out.flags, "mean": out.mean, "variance": out.variance, "std": out.std,
+            "time": out.time, "units": out.units, "flags": out.flags, "mean": out.mean, "variance": out.variance,
+            "std": out.std,
             "band99": {"lower": out.band99[0], "upper": out.band99[1]},
             "quantiles": {f"{p:g}": values for p, values in out.quantiles.items()},
             "skewness": out.skewness, "kurtosis": out.kurtosis, "cov": out.cov, "resolved": out.resolved,
