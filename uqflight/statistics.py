@@ -350,8 +350,12 @@ def output_basis(store: ResultStore, name: str, ok: np.ndarray,
     basis, scale = V[row_of[np.flatnonzero(ok)]], s[:, None] * U.T
     if period is None:
         return basis, scale
-    histories = basis @ scale
-    found = _unwrapped(histories, period, name, unwrapped, None)
+    # no step of any run can jump by half a turn when Σ_k max_i |V_ik| |Δ(s Uᵀ)_kt| stays below it, and the
+    # runs' first values need no turn: then nothing is rebuilt
+    steps = np.abs(basis).max(axis=0, initial=0.0) @ np.abs(np.diff(scale, axis=1))
+    if not (steps > 0.5 * period).any() and not branch_shifts(basis @ scale[:, 0], period).any():
+        return basis, scale
+    found = _unwrapped(basis @ scale, period, name, unwrapped, None)
     return (basis, scale) if found is None else (found, None)
 
 
