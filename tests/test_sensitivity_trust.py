@@ -181,3 +181,12 @@ def test_a_wrapped_heading_stored_as_tsvd_factors_is_unwrapped_as_the_raw_one(fl
     assert out.unwrapped
     np.testing.assert_allclose(out.mean, raw.mean, atol=1e-6)
     np.testing.assert_allclose(out.std, raw.std, atol=1e-6)
+
+
+def test_an_index_is_unresolved_by_its_interval_only():
+    from uqflight.analysis.sobol import unresolved
+
+    index = np.array([0.5, 0.5, 1.3, -0.2, 1.02, -0.01, np.nan])
+    lower = np.array([0.1, 0.2, 1.1, -0.3, 0.97, -0.01, np.nan])
+    upper = np.array([0.7, 0.6, 1.5, -0.1, 1.08, -0.01, np.nan])  # widths 0.6 0.4 0.4 0.2 0.11 0 -
+    assert unresolved(index, (lower, upper)).tolist() == [True, False, True, True, False, False, False]

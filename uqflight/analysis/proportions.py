@@ -10,11 +10,11 @@ How the points were drawn (`DesignKind.draws`, with the design's recorded info):
   of n independent draws (Owen 1997), so the Wilson interval of n − 1 draws is conservative.
 - net (sobol, halton): with R ≥ 2 scrambled replicates (randomised QMC), the mean of the R proportions
   and the hull of two intervals: the Wilson interval of the pooled runs and the Student-t interval of
-  the replicates' spread. The Student-t interval alone covers 0.92 at a few exceedances whatever R (the
-  replicates' proportions are then far from normal, and their spread often 0); the pooled Wilson
-  interval keeps the coverage at ≥ 0.95 there (benchmarks/rqmc_interval_coverage.py measures both), and
-  the t interval keeps a net's own spread in when it is wider than independent draws'. A single scrambled net: k/n and the Wilson interval of
-  independent draws, flagged (a scrambled net's variance is usually lower but not bounded by theirs for
+  the replicates' spread. The Student-t interval alone covers 0.90-0.94 at a few exceedances whatever R
+  (the replicates' proportions are then far from normal, and their spread often 0); the pooled Wilson
+  interval keeps the coverage at >= 0.95 there (benchmarks/rqmc_interval_coverage.py measures both), and
+  the t interval keeps a net's own spread in when it is wider than independent draws'.
+  A single scrambled net: k/n and the Wilson interval of independent draws, flagged (a scrambled net's variance is usually lower but not bounded by theirs for
   an indicator); unscrambled points are fixed, not random: k/n without an interval.
 """
 from __future__ import annotations

@@ -48,11 +48,13 @@ def complete_rows(ok, d: int) -> np.ndarray:
 
 def unresolved(index, ci) -> np.ndarray:
     """bool, shaped as `index`: the estimate is no share, its 95 % interval (`ci`: (lower, upper), each
-    shaped as `index`) being wider than UNRESOLVED_WIDTH or lying wholly outside [0, 1]."""
+    shaped as `index`) being wider than UNRESOLVED_WIDTH or lying wholly outside [0, 1]. An interval of no
+    width is none (`bootstrap: 0` gives the estimate twice): it resolves nothing and flags nothing."""
     index = np.asarray(index, dtype=float)
     lower, upper = (np.asarray(bound, dtype=float) for bound in ci)
     with np.errstate(invalid="ignore"):
-        return np.isfinite(index) & ((upper - lower > UNRESOLVED_WIDTH) | (lower > 1.0) | (upper < 0.0))
+        width = upper - lower
+        return np.isfinite(index) & ((width > UNRESOLVED_WIDTH) | ((width > 0) & ((lower > 1.0) | (upper < 0.0))))
 
 
 def pick_freeze_indices(Y, d: int, n_boot: int = 200, seed=0, confidence: float = 0.95) -> dict[str, np.ndarray]:

@@ -72,7 +72,8 @@ def headline_section(entry: Entry, times: list[float]) -> Section:
     text = ("Mean ± std, the 99 % band (0.5 % to 99.5 % quantiles) and the largest first-order Sobol' shares of "
             "the variance (up to three, each ≥ 1 %; 'interactions' = 1 − Σ S_i when ≥ 5 %; 'unresolved': a variance "
             "at the simulator's noise; with a pick-freeze design each share carries its 95 % bootstrap interval, "
-            "and an index whose interval is wider than 0.5 or lies outside [0, 1] reads 'unresolved (its interval, n too small)'), "
+            "and an index whose interval is wider than 0.5 or lies outside [0, 1] reads 'unresolved (its interval, "
+            "n too small)'), "
             "per output at the selected times (--times) and per quantity of interest. "
             "Rounded to two digits of the std; in full in tables/headline.csv, as in summary.json.")
     if entry.stats.notes:

@@ -80,7 +80,7 @@ def scatter_rows(results: Path, outputs: dict, quantities: dict, time: float, se
     """What `plot_scatter` draws, for a seeded subset of at most SCATTER_RUNS successful runs: their
     inputs in physical values ("kappa", "names"), and per row ("outputs": each output over time at the
     recorded time nearest `time`, labelled "NAME at T s [unit]", or its one value; "quantities": each
-    defined quantity)
+    defined quantity, labelled "NAME [unit]")
     (the runs' values, the total Sobol' indices {parameter: (T,)}, the time index)."""
     with ResultStore.open(results) as store:
         drawn = run_subset(store.status, SCATTER_RUNS, seed)
@@ -90,8 +90,8 @@ def scatter_rows(results: Path, outputs: dict, quantities: dict, time: float, se
             at = f" at {out.time[i]:g} s" if out.time.size > 1 else ""
             at_time[f"{plots.short_label(name)}{at}" + (f" [{out.units}]" if out.units else "")] = (
                 drawn_runs(store.output_matrix(name, drawn), out)[:, i], out.sobol_total, i)
-        of_quantities = {name: (drawn_runs(store.quantity(name)[drawn][:, None], q.output)[:, 0],
-                                q.output.sobol_total, 0)
+        of_quantities = {plots.label(name, q.units): (
+            drawn_runs(store.quantity(name)[drawn][:, None], q.output)[:, 0], q.output.sobol_total, 0)
                          for name, q in quantities.items() if q.output is not None}
         return {"kappa": store.kappa[drawn], "names": store.parameter_names, "outputs": at_time,
                 "quantities": of_quantities}
