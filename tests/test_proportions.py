@@ -56,7 +56,7 @@ def test_randomised_qmc_replicates_give_an_interval_that_covers():
 
 def test_randomised_qmc_covers_at_a_few_exceedances():
     # the disk of probability 6/512 (six exceedances expected over 8 replicates of 64 points): the
-    # replicates' Student-t interval alone covers 0.90-0.95 there (benchmarks/rqmc_interval_coverage.py);
+    # replicates' Student-t interval alone covers 0.93-0.96 there (benchmarks/rqmc_interval_coverage.py);
     # the reported hull must cover >= 0.95 over these 300 seeds (it gave 0.97-0.99 in the benchmark)
     radius = np.sqrt(4 * 6 / 512 / np.pi)
     covered = []
