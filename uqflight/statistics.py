@@ -697,7 +697,7 @@ def quantity_statistics(store: ResultStore, stats: Statistics, name: str, germs:
     values = store.quantity(name)
     text = store.attrs.get("campaign", "")  # the stored campaign text: its quantity's take and `of` give the unit
     specs = stored_settings(text).get("quantities") if isinstance(text, str) else None
-    units = quantity_unit(specs.get(name) if isinstance(specs, dict) else None, store.units)
+    units = quantity_unit(specs.get(name) if isinstance(specs, dict) else None, store.units) or name_unit(name)
     defined = ok & np.isfinite(values)
     period = angle_period(units)
     shifts = None if period is None else branch_shifts(np.where(defined, values, np.nan), period)
