@@ -207,3 +207,20 @@ def test_the_variance_split_survives_failed_runs(flown):
             interval = split[group][f"{order}_ci"]
             assert interval["lower"][0] <= share <= interval["upper"][0], (group, order)
     assert any("rows dropped" in note for note in stats.notes)
+
+
+def test_the_unresolved_flag_counts_the_times_of_non_negligible_variance_only():
+    from types import SimpleNamespace
+
+    from uqflight.statistics import unresolved_flag
+
+    wide, narrow = np.array([[0.0, 0.0, 0.1], [1.0, 1.0, 0.2]]), np.array([[0.0, 0.4, 0.1], [0.1, 0.5, 0.2]])
+    # t = 0: variance 1e-6 of the largest (negligible), its wide interval not counted; t = 1: wide, counted
+    out = SimpleNamespace(time=np.arange(3.0), variance=np.array([1e-6, 1.0, 1.0]),
+                          sobol_first={"a": np.array([0.5, 0.5, 0.15]), "b": np.array([0.05, 0.45, 0.15])},
+                          sobol_total={"a": np.array([0.5, 0.5, 0.15]), "b": np.array([0.05, 0.45, 0.15])},
+                          sobol_first_ci={"a": wide, "b": narrow}, sobol_total_ci={"a": wide, "b": narrow})
+    flag = unresolved_flag(out)
+    assert flag.startswith("Sobol' indices of a unresolved at 1 of 2 times of non-negligible variance (n too small)")
+    out.sobol_first_ci = out.sobol_total_ci = {"a": narrow, "b": narrow}
+    assert unresolved_flag(out) is None

@@ -44,7 +44,7 @@ from .analysis.floors import central_moments, floors_from_moments, kld_floor
 from .analysis.moments import (modified_cov, sorted_by_time, standardised_moments, weighted_moments,
                                weighted_quantiles)
 from .analysis.resolution import RESOLUTION_RTOL, resolved_variance
-from .analysis.sobol import UNRESOLVED_WIDTH, complete_rows, pick_freeze_indices, unresolved
+from .analysis.sobol import NEGLIGIBLE, UNRESOLVED_WIDTH, complete_rows, pick_freeze_indices, unresolved
 from .campaign.attributes import StoredFacts, stored_facts, stored_settings
 from .campaign.schema import CampaignError
 from .designs import REGISTRY as DESIGNS
@@ -496,18 +496,22 @@ def _start_output(store: ResultStore, name: str, method: dict, germs: list[str],
 
 def unresolved_flag(out: OutputStatistics) -> str | None:
     """The flag of pick-freeze indices that resolve no share (analysis.sobol.unresolved), naming the
-    parameters and, over time, at how many times; None when every index is resolved."""
+    parameters and, over time, at how many times; None when every index is resolved. Times where the
+    variance is negligible (below analysis.sobol.NEGLIGIBLE of its largest) are not counted: an index
+    there is the share of almost nothing, which the plots grey."""
     times: np.ndarray = np.zeros(out.time.size, dtype=bool)
+    variance = np.maximum(out.variance, 0.0)
+    counted = variance >= NEGLIGIBLE * (variance.max() if variance.size else 0.0)
     named = []
     for parameter in out.sobol_first:
-        where = (unresolved(out.sobol_first[parameter], out.sobol_first_ci[parameter])
-                 | unresolved(out.sobol_total[parameter], out.sobol_total_ci[parameter]))
+        where = counted & (unresolved(out.sobol_first[parameter], out.sobol_first_ci[parameter])
+                           | unresolved(out.sobol_total[parameter], out.sobol_total_ci[parameter]))
         if where.any():
             named.append(parameter)
             times |= where
     if not named:
         return None
-    at = f" at {int(times.sum())} of {times.size} times" if times.size > 1 else ""
+    at = f" at {int(times.sum())} of {int(counted.sum())} times of non-negligible variance" if times.size > 1 else ""
     return (f"Sobol' indices of {', '.join(named)} unresolved{at} (n too small): the 95 % interval is wider than "
             f"{UNRESOLVED_WIDTH:g} or lies outside [0, 1]; run more base samples (design.samples)")
 

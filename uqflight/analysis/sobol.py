@@ -31,6 +31,8 @@ def _split_design(Y, d: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
 
 
 UNRESOLVED_WIDTH = 0.5  # an interval wider than this (half of [0, 1]) does not resolve a share
+NEGLIGIBLE = 1e-4  # a variance below this share of its largest over time (std < 1 % of its largest) is negligible:
+#                    an index there is the share of almost nothing, and is not flagged
 
 
 def complete_rows(ok, d: int) -> np.ndarray:

@@ -8,10 +8,9 @@ from pathlib import Path
 import numpy as np
 from matplotlib.patches import Patch
 
-from ..analysis.sobol import unresolved
+from ..analysis.sobol import NEGLIGIBLE, unresolved  # noqa: F401 (NEGLIGIBLE: the report's too)
 from . import plots
 
-NEGLIGIBLE = 1e-4  # a variance below this share of its largest over time (std < 1 % of its largest) is negligible
 TINY_INDEX = 1e-3  # indices below this print as "<0.001"
 TOP = 3  # contributors the headline names
 SHOWN_SHARE = 0.01  # ... each with at least 1 % of the variance
