@@ -234,7 +234,8 @@ def analyse(path, reference: str | None = None, options: Options | None = None, 
         _note_runs(store, stats, sampled, allow_aliasing)
         stats.from_runs = method_entry(method["kind"]).runs_on_sampled and sampled
         if stats.from_runs and DESIGNS[design_kind].sobol_from_runs:
-            note = pick_freeze_note(ok, len(store.parameter_names), "failed runs")
+            note = pick_freeze_note(ok, len(store.parameter_names), "pending runs" if not stats.failed else
+                                    "failed and pending runs" if stats.pending else "failed runs")
             if note:
                 stats.notes.append(note)
         replicates = facts.design_info.get("replicates", 1)
