@@ -98,19 +98,24 @@ def analyse(results, method=None, reference=None, partial: bool = False, allow_a
 
 
 def write_report(results, out=None, reference=None, method=None, times=(10.0, 25.0, float("inf")),
-           baseline=None, partial: bool = False, allow_aliasing: bool = False) -> list:
+           baseline=None, partial: bool = False, allow_aliasing: bool = False, exceedance=None) -> list:
     """Write the report of one results file or a list of them into `out` (default RESULTS-report/ beside
     the first), as `uqflight report` does; returns the paths written. `method`: "KIND[:ORDER]", a mapping
     or a list of them (compared on the same runs); `times`: the tables' times (inf: the final one);
-    `baseline`: also write the baseline of `uqflight check`. Raises BadInput as `analyse`. An example:
-    docs/python.md."""
+    `baseline`: also write the baseline of `uqflight check`; `exceedance`: "NAME>X" / "NAME<X" strings (or
+    {NAME: [{above: X}]}) replacing the campaign's thresholds of NAME, as `report --exceedance`. Raises
+    BadInput as `analyse` (ValueError for a malformed threshold). An example: docs/python.md."""
     from pathlib import Path
 
     from .report import write_report as write
 
     paths = [Path(p) for p in (results if isinstance(results, (list, tuple)) else [results])]
+    if exceedance is not None and not isinstance(exceedance, dict):
+        from .quantities.spec import parse_exceedance_option
+
+        exceedance = parse_exceedance_option([exceedance] if isinstance(exceedance, str) else list(exceedance))
     return write(paths, out, reference=reference, times=times, baseline=baseline, method=_methods(method),
-                        partial=partial, allow_aliasing=allow_aliasing)
+                 partial=partial, allow_aliasing=allow_aliasing, exceedance=exceedance)
 
 
 def export_surrogate(results, out, method=None):

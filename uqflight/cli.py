@@ -454,6 +454,11 @@ def report(
     figure_format: str = typer.Option("png", "--format", metavar="png|svg|pdf",
                                       help="Format of plots/: png; svg (the page embeds the SVGs); pdf (beside "
                                            "PNGs of the same names, which the page embeds and links to the PDFs)."),
+    exceedance: List[str] = typer.Option([], "--exceedance", metavar="NAME>X|NAME<X",
+                                         help="P(NAME > X) or P(NAME < X) of a quantity of interest, repeatable: "
+                                              "replaces the campaign's analysis.exceedance thresholds of NAME, "
+                                              "computed from the stored runs (nothing is flown again); quote it "
+                                              "in the shell, e.g. --exceedance 'peak_nz>3.5'."),
 ):
     """Statistics, tables, plots and a report page of one or more results files.
 
@@ -482,8 +487,16 @@ def report(
         overrides = parse_methods(method, order)
     except ValueError as exc:
         raise typer.BadParameter(str(exc), param_hint="--method")
+    from .quantities.spec import parse_exceedance_option
+
+    try:
+        thresholds = parse_exceedance_option(exceedance)
+    except ValueError as exc:
+        raise typer.BadParameter(str(exc), param_hint="--exceedance")
     for path in [*results, *([reference] if reference else [])]:
         check_results_file(path)
+    if thresholds:
+        _check_quantities(thresholds, results)
     out = out if out is not None else default_out_dir(results[0])
     if not out.exists() and not out.is_symlink():  # an existing DIR is the report's to judge (check_replaceable)
         check_output(out, "--out", folder=True, create=True)
@@ -495,7 +508,7 @@ def report(
         with Progress(0, label="report") as progress:
             written = write_report(results, out, reference=reference, times=selected, baseline=write_baseline,
                                    method=overrides or None, progress=progress, partial=partial,
-                                   allow_aliasing=allow_aliasing, fmt=figure_format)
+                                   allow_aliasing=allow_aliasing, fmt=figure_format, exceedance=thresholds or None)
     except BadInput as exc:
         echo(f"error: {exc}", err=True)
         raise typer.Exit(2)
@@ -509,6 +522,24 @@ def report(
     echo(f"wrote {len(in_report)} files to {out}: open {out / 'report.html'}")
     if write_baseline:
         echo(f"wrote baseline {write_baseline}")
+
+
+def _check_quantities(thresholds: dict, results: list[Path]) -> None:
+    """Exit 2 naming --exceedance when a threshold names a quantity some results file does not have (an
+    unreadable file is the report's to refuse)."""
+    from .store import ResultStore
+
+    for path in results:
+        try:
+            with ResultStore.open(path) as store:
+                names = list(store.quantity_names)
+        except (OSError, KeyError, ValueError):
+            continue
+        unknown = [name for name in thresholds if name not in names]
+        if unknown:
+            echo(f"error: --exceedance: {path} has no quantity {unknown[0]!r}; its quantities: "
+                 f"{', '.join(names) or 'none (the campaign has no quantities: mapping)'}", err=True)
+            raise typer.Exit(2)
 
 
 def _check_times(text: str, selected: list[float], results: list[Path]) -> None:

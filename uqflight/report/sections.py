@@ -9,6 +9,7 @@ import numpy as np
 
 from . import plots
 from .blocks import Figure, Section, Table, _rel
+from ..labels import shown_time
 from .formats import shown_path
 from ..forking import share_work
 from .sensitivity import NEGLIGIBLE, index_text, plot_sensitivity
@@ -392,10 +393,12 @@ def sensitivity_section(entries: list[Entry], times: list[float], out_dir: Path)
                              "one colour per parameter, one line style per file and method."))
     parameters = list(dict.fromkeys(p for e in with_sobol for p in e.stats.parameter_names))
     for kind, what in (("sobol_first", "First-order"), ("sobol_total", "Total")):
+        at = [(out, i) for e in with_sobol for out in e.outputs.values() for i in plots.time_indices(out.time, times)]
         rows = [[e.label, name, out.time[i], *(_at(getattr(out, kind), p, i) for p in parameters)]
                 for e in with_sobol for name, out in e.outputs.items() for i in plots.time_indices(out.time, times)]
         caption = f"{what} Sobol' indices at the selected times" + (" (paper Table 3)" if kind == "sobol_first" else "")
-        page = [[label, name, f"{time:g}", *map(index_text, values)] for label, name, time, *values in rows]
+        page = [[label, name, f"{shown_time(out.time, i):g}", *map(index_text, values)]
+                for (label, name, _, *values), (out, i) in zip(rows, at)]
         blocks.append(Table(caption, ["file", "output", "time [s]", *parameters], rows, f"tables/{kind}.csv",
                             page=(["file", "output", "time [s]", *parameters], page), grouped=True))
     if any(e.pick_freeze for e in with_sobol) and any(not e.pick_freeze for e in with_sobol):

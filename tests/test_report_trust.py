@@ -1,0 +1,128 @@
+"""The engineer's number first (issue 45): exceedance probabilities with their intervals in the headline
+("—" where there is none), thresholds drawn on the quantity PDFs and changeable at report time
+(`report --exceedance`), recorded times shown as asked for, and a quantity's statistics as attributes."""
+import csv
+import json
+
+import numpy as np
+import pytest
+from conftest import cli_in_process
+from test_quantities import python_campaign
+
+import uqflight
+from uqflight.campaign import parse_campaign
+from uqflight.execution import run_campaign
+from uqflight.labels import shown_time
+from uqflight.quantities.spec import parse_exceedance_option
+from uqflight.report import write_report
+from uqflight.statistics import summary_json
+
+# final y = a + 4b with a ~ U(-1, 1), b ~ U(0.5, 1.5) (test_exceedance): P(final_y > 5) = 1/4
+QUANTITIES = "{final_y: {of: y, take: final}}"
+
+
+@pytest.fixture(scope="module")
+def campaigns(tmp_path_factory):
+    """A Monte Carlo file (Wilson intervals) and a grid with a PCE (no interval), both asking P(final_y > 5)."""
+    folder = tmp_path_factory.mktemp("trust")
+    files = {}
+    for name, design, method in (("mc", "{kind: monte_carlo, samples: 400}", "{kind: monte_carlo}"),
+                                 ("pce", "{kind: sparse_grid, rule: gauss_legendre, level: 2}",
+                                  "{kind: pseudo_galerkin, order: 2}")):
+        text = python_campaign(folder, QUANTITIES, design, method, name=name,
+                               analysis="{band_samples: 20000, exceedance: {final_y: [{above: 5}]}}")
+        files[name] = folder / f"{name}.h5"
+        run_campaign(parse_campaign(text, str(folder / f"{name}.yaml")), out=files[name])
+    return folder, files
+
+
+def _rows(path):
+    with open(path, newline="") as fh:
+        return list(csv.DictReader(fh))
+
+
+def test_the_headline_leads_with_the_exceedance_and_its_interval(campaigns):
+    folder, files = campaigns
+    report = folder / "mc-report"
+    write_report([files["mc"]], report, times=[float("inf")])
+    (row,) = _rows(report / "tables" / "headline_exceedance.csv")
+    summary = json.loads((report / "summary.json").read_text())["quantities"]["final_y"]["exceedance"][0]
+    assert row["event"] == "P(final_y > 5)" and float(row["probability"]) == summary["probability"]
+    assert float(row["lower"]) == summary["lower"] and float(row["upper"]) == summary["upper"]
+    page = (report / "report.html").read_text()
+    interval = f"{summary['lower']:.3g} to {summary['upper']:.3g}"
+    # before the key numbers, the contents and every figure
+    assert page.index("P(final_y &gt; 5)") < page.index("Key numbers of") < page.index("<h2>Contents</h2>")
+    assert page.index(interval) < page.index("<img")
+    assert "None" not in (report / "report.md").read_text()
+
+
+def test_a_pce_exceedance_has_a_dash_for_its_interval_never_none(campaigns):
+    folder, files = campaigns
+    report = folder / "pce-report"
+    write_report([files["pce"]], report, times=[float("inf")])
+    markdown = (report / "report.md").read_text()
+    headline = markdown[:markdown.index("## Contents")]
+    line = next(line for line in headline.splitlines() if "P(final\\_y \\> 5)" in line)
+    assert "| — |" in line and "pce" in line
+    assert "None" not in markdown
+
+
+def test_report_exceedance_replaces_the_thresholds_without_flying(campaigns):
+    folder, files = campaigns
+    report = folder / "changed"
+    before = files["mc"].stat().st_mtime_ns
+    done = cli_in_process("report", files["mc"], "--out", report, "--times", "end",
+                          "--exceedance", "final_y>6", "--exceedance", "final_y<1.1")
+    assert done.returncode == 0, done.stderr
+    assert files["mc"].stat().st_mtime_ns == before  # read, not written: nothing flown again
+    items = json.loads((report / "summary.json").read_text())["quantities"]["final_y"]["exceedance"]
+    assert [{k: item[k] for k in ("above", "below") if k in item} for item in items] == [{"above": 6.0},
+                                                                                         {"below": 1.1}]
+    assert [row["event"] for row in _rows(report / "tables" / "headline_exceedance.csv")] == [
+        "P(final_y > 6)", "P(final_y < 1.1)"]
+
+
+@pytest.mark.parametrize("value, words", [
+    ("nothing>3", ["--exceedance", "'nothing'", "final_y"]),
+    ("final_y>abc", ["--exceedance", "NAME>X"]),
+    ("final_y>inf", ["--exceedance", "finite"]),
+    ("final_y=3", ["--exceedance", "NAME>X"]),
+])
+def test_a_bad_exceedance_is_refused_naming_the_flag(campaigns, value, words):
+    folder, files = campaigns
+    done = cli_in_process("report", files["mc"], "--out", folder / "refused", "--exceedance", value)
+    assert done.returncode == 2
+    assert all(word in done.stderr for word in words), done.stderr
+    assert "Traceback" not in done.stderr and not (folder / "refused").exists()
+
+
+def test_parse_exceedance_option_keeps_the_order_per_quantity():
+    assert parse_exceedance_option(["a>1", " b < -2.5 ", "a<0"]) == {"a": [{"above": 1.0}, {"below": 0.0}],
+                                                                   "b": [{"below": -2.5}]}
+
+
+def test_a_quantitys_statistics_are_attributes_as_summary_json(campaigns):
+    _, files = campaigns
+    stats = uqflight.analyse(files["mc"])
+    q = stats.quantities["final_y"]
+    entry = json.loads(json.dumps(summary_json(stats)))["quantities"]["final_y"]
+    assert q.mean == entry["mean"] and q.std == entry["std"] and q.variance == entry["variance"]
+    assert q.band99 == (entry["band99"]["lower"], entry["band99"]["upper"])
+    assert {f"{p:g}": v for p, v in q.quantiles.items()} == entry["quantiles"]
+    assert q.skewness == entry["skewness"] and q.kurtosis == entry["kurtosis"]
+    assert q.exceedance[0]["probability"] == entry["exceedance"][0]["probability"]
+    assert q.flags == [] and isinstance(q.mean, float)
+    # final y = a + 4b: mean 0 + 4 = 4 exactly; 400 runs: its standard error is sqrt(1/3 + 16/12)/20 = 0.065
+    assert abs(q.mean - 4.0) < 4 * 0.065
+
+
+def test_recorded_times_show_as_asked():
+    # JSBSim's clock adds 1/120-s steps: 9.99996 s and 24.9999 s stand for 10 and 25 s at 20 Hz and at 120 Hz
+    grid = np.arange(1001) * 0.05
+    grid[200], grid[500], grid[-1] = 9.99996, 24.9999, 49.9998
+    assert [shown_time(grid, i) for i in (200, 500, 1000, 3)] == [10.0, 25.0, 50.0, 0.15]
+    fine = np.arange(3001) / 120 * (1 - 4e-6)
+    assert [shown_time(fine, i) for i in (1200, 3000)] == [10.0, 25.0]
+    assert shown_time(np.array([0.0, 0.3, 1.7, 2.0]), 2) == 1.7  # off any regular grid: as recorded
+    assert shown_time(np.array([3.0]), 0) == 3.0
