@@ -143,7 +143,7 @@ def simulate(settings: dict | None = None, *, aircraft: str = "bacm", altitude_f
     """Fly one flight as `uqflight simulate` does: trim in level flight (default: the aircraft's
     condition), excite the elevator and record the outputs (alpha_deg, theta_deg, h_ft, q_degps, vtas_kt
     and the JSBSim properties in `outputs`). `settings`: {property: value} set before the trim, e.g.
-    {"aero/uq/CL0": 0.22}. Returns a FlightResult (`.time`, `.outputs[NAME]`, `.trim`); raises FlightError
+    {"aero/uq/CL0": 0.22}. Returns a FlightResult (`.time`, `.outputs[NAME]`, `.trim`, `.warnings`); raises FlightError
     (`uqflight.simulators.base`) when the trim or the flight fails.
 
     >>> flight = simulate({"aero/uq/CL0": 0.22}, duration_s=2.0)
