@@ -78,3 +78,25 @@ def test_simulate_warns_on_the_command_line():
     assert "--amplitude-deg" in shown.stderr
     quiet = cli_in_process("simulate", "--duration-s", "3", "--no-files")  # bacm: the pulse moves it
     assert quiet.returncode == 0 and "warning" not in quiet.stderr
+
+
+def test_plan_warns_when_the_nominal_flights_pulse_leaves_the_elevator_unmoved(tmp_path):
+    text = """
+name: c172x-pulse
+simulator:
+  kind: jsbsim
+  aircraft: c172x
+  flight: {altitude_ft: 4000, airspeed_ktas: 100}
+  excitation: {kind: pulse, amplitude_deg: AMPLITUDE, start_s: 0.5, duration_s: 1.0}
+  duration_s: 3
+parameters:
+  CL: {function: aero/coefficient/CLwbh, perturbation: scale, distribution: normal, interval_pct: 10}
+design: {kind: sparse_grid, rule: gauss_hermite, level: 1}
+method: {kind: pseudo_galerkin, order: 1}
+storage: {path: c.h5}
+"""
+    for amplitude, warned in (("1.0", True), ("5.0", False)):
+        (tmp_path / "c.yaml").write_text(text.replace("AMPLITUDE", amplitude))
+        shown = cli_in_process("plan", tmp_path / "c.yaml", cwd=tmp_path)
+        assert shown.returncode == 0, shown.stderr
+        assert ("warning: the nominal flight: the pulse of 1 deg never moved the elevator" in shown.stderr) == warned
