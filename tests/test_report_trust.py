@@ -126,3 +126,36 @@ def test_recorded_times_show_as_asked():
     assert [shown_time(fine, i) for i in (1200, 3000)] == [10.0, 25.0]
     assert shown_time(np.array([0.0, 0.3, 1.7, 2.0]), 2) == 1.7  # off any regular grid: as recorded
     assert shown_time(np.array([3.0]), 0) == 3.0
+
+
+def test_a_changed_campaign_is_refused_naming_the_first_key_and_force(tmp_path):
+    text = python_campaign(tmp_path, QUANTITIES, "{kind: monte_carlo, samples: 8}", name="c",
+                           analysis="{exceedance: {final_y: [{above: 5}]}}")
+    out = tmp_path / "c.h5"
+    run_campaign(parse_campaign(text, str(tmp_path / "c.yaml")), out=out)
+    changed = text.replace("b: {distribution: uniform, lower: 0.5, upper: 1.5}",
+                           "b: {distribution: uniform, lower: 0.5, upper: 1.6}")
+    (tmp_path / "c.yaml").write_text(changed)
+    refused = cli_in_process("run", tmp_path / "c.yaml", "--out", out)
+    assert refused.returncode == 2
+    assert "its campaign differs first at parameters.b.upper" in refused.stderr and "--force" in refused.stderr
+    assert cli_in_process("run", tmp_path / "c.yaml", "--out", out, "--force").returncode == 0
+
+
+def test_a_change_of_analysis_alone_resumes_without_flying_again(tmp_path):
+    text = python_campaign(tmp_path, QUANTITIES, "{kind: monte_carlo, samples: 8}", name="c",
+                           analysis="{exceedance: {final_y: [{above: 5}]}}")
+    out = tmp_path / "c.h5"
+    run_campaign(parse_campaign(text, str(tmp_path / "c.yaml")), out=out)
+    from uqflight.store import ResultStore
+
+    with ResultStore.open(out) as store:
+        flown = store.quantity("final_y")
+    changed = text.replace("{exceedance: {final_y: [{above: 5}]}}", "{exceedance: {final_y: [{below: 3}]}}")
+    summary = run_campaign(parse_campaign(changed, str(tmp_path / "c.yaml")), out=out)
+    assert summary.ran == 0 and summary.skipped == 8  # nothing flown again
+    stats = uqflight.analyse(out)
+    assert list(stats.quantities["final_y"].exceedance[0])[0] == "below"  # the new threshold is read
+    with ResultStore.open(out) as store:
+        assert store.campaign_text == changed
+        np.testing.assert_array_equal(store.quantity("final_y"), flown)  # the runs of the first run
