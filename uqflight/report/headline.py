@@ -95,7 +95,15 @@ def exceedance_table(entry: Entry) -> Table | None:
     return Table(f"Exceedance probabilities of {entry.label}",
                  ["file", "quantity", "event", "probability", "lower", "upper", "method", "flags", "note"], rows,
                  "tables/headline_exceedance.csv",
-                 page=(["event", "probability", "95 % interval", "method", "flags", "note"], page))
+                 page=_without_empty_flags(["event", "probability", "95 % interval", "method", "flags", "note"], page))
+
+
+def _without_empty_flags(header: list[str], page: list[list]) -> tuple[list[str], list[list]]:
+    """The page's (header, rows) without the flags column when no row is flagged (the CSV keeps it)."""
+    k = header.index("flags")
+    if any(row[k] for row in page):
+        return header, page
+    return header[:k] + header[k + 1:], [row[:k] + row[k + 1:] for row in page]
 
 
 def headline_section(entry: Entry, times: list[float]) -> Section:
@@ -119,7 +127,8 @@ def headline_section(entry: Entry, times: list[float]) -> Section:
     header = ["file", "output or quantity", "unit", "time [s]", "mean", "std", "band99 lower", "band99 upper",
               contributors, "flags"]
     table = Table(f"Key numbers of {entry.label}", header, rows, "tables/headline.csv",
-                  page=(["output or quantity", "time [s]", "mean ± std", "99 % band", contributors, "flags"], page))
+                  page=_without_empty_flags(["output or quantity", "time [s]", "mean ± std", "99 % band", contributors,
+                                             "flags"], page))
     exceedance = exceedance_table(entry)
     text = ("Mean ± std, the 99 % band (0.5 % to 99.5 % quantiles) and the largest first-order Sobol' shares of "
             "the variance (up to three, each ≥ 1 %; 'interactions' = 1 − Σ S_i when ≥ 5 %; 'unresolved': a variance "

@@ -47,7 +47,7 @@ def plot_quantity_pdfs(quantities: dict, path: Path, title: str, thresholds: dic
             ax.axvline(value, color=THRESHOLD_COLOR, lw=1.3, ls=":")
             ax.annotate(threshold_label(item), (value, 1.0), xycoords=("data", "axes fraction"), xytext=(3, -3),
                         textcoords="offset points", ha="left", va="top", fontsize=7, color=THRESHOLD_COLOR,
-                        rotation=90)
+                        rotation=90, bbox={"facecolor": "white", "edgecolor": "none", "alpha": 0.8, "pad": 0.5})
         ax.set_title(name, fontsize=10)
         ax.set_xlabel(plots.label(name, out.units), fontsize=8)
         ax.set_ylabel(f"probability density [1/{out.units}]" if out.units else "probability density", fontsize=8)
