@@ -5,6 +5,7 @@ from __future__ import annotations
 from pathlib import Path
 
 import h5py
+import yaml
 
 from .file_end import extend_file, past_recorded_end
 from .results import READ_ERRORS, ResultStore, one_line, text_hash
@@ -100,17 +101,23 @@ def _stored_text(path: Path) -> str:
     return text.decode("utf-8", "replace") if isinstance(text, bytes) else str(text)
 
 
-def _settings(text: str) -> dict:
-    from ..campaign.attributes import stored_settings  # the campaign package imports the store
+SAFE_LOADER = getattr(yaml, "CSafeLoader", yaml.SafeLoader)  # libyaml's, ten times faster, where PyYAML has it
 
-    return stored_settings(text)
+
+def campaign_mapping(campaign_text: str) -> dict:
+    """A campaign text's mapping as written (YAML), {} when unreadable or not a mapping."""
+    try:
+        data = yaml.load(campaign_text, Loader=SAFE_LOADER)
+    except (yaml.YAMLError, ValueError, RecursionError):  # e.g. a date 2001-13-45, or nesting too deep
+        return {}
+    return data if isinstance(data, dict) else {}
 
 
 def first_difference(stored_text: str, campaign_text: str) -> str | None:
     """The first key (a dotted path such as analysis.exceedance.peak_nz[0].above, in the new campaign's
     order) where two campaign texts' mappings differ; None when they hold the same mapping (a comment or
     the layout differs) or when the stored text cannot be read."""
-    stored, ours = _settings(stored_text), _settings(campaign_text)
+    stored, ours = campaign_mapping(stored_text), campaign_mapping(campaign_text)
     if not stored:
         return None
     return _difference(stored, ours, "")
@@ -137,7 +144,7 @@ def _difference(old, new, path: str) -> str | None:
 
 def _only_read_keys_differ(stored_text: str, campaign_text: str) -> bool:
     """Whether the two campaigns' mappings differ in READ_ONLY_KEYS alone."""
-    stored, ours = _settings(stored_text), _settings(campaign_text)
+    stored, ours = campaign_mapping(stored_text), campaign_mapping(campaign_text)
     keys = set(stored) | set(ours)
     return bool(stored) and all(stored.get(k) == ours.get(k) for k in keys if k not in READ_ONLY_KEYS)
 
