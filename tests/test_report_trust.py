@@ -178,3 +178,14 @@ def test_a_flagged_quantity_is_marked_in_the_headline_and_an_unflagged_page_has_
     header, [(_, rows)] = page_view(exceedance)
     assert rows[0][0] == "⚠ P(final_y > 5)" and rows[0][header.index("flags")].startswith("band beyond")
     assert entry.stats.quantities["final_y"].flags == ["band beyond the runs: use least_squares"]
+
+
+def test_the_python_api_takes_thresholds_too(campaigns):
+    _, files = campaigns
+    stats = uqflight.analyse(files["mc"], exceedance=["final_y<2", "final_y>6"])
+    items = stats.quantities["final_y"].exceedance
+    assert [item.get("below", item.get("above")) for item in items] == [2.0, 6.0]
+    with pytest.raises(uqflight.statistics.BadInput, match="--exceedance nothing: no such quantity"):
+        uqflight.analyse(files["mc"], exceedance="nothing>1")
+    with pytest.raises(ValueError, match="NAME>X"):
+        uqflight.analyse(files["mc"], exceedance="final_y~1")

@@ -74,13 +74,24 @@ def _methods(method) -> list[dict] | None:
     return [m if isinstance(m, dict) else parse_methods([m])[0] for m in items]
 
 
-def analyse(results, method=None, reference=None, partial: bool = False, allow_aliasing: bool = False):
+def _thresholds(exceedance) -> dict | None:
+    """`exceedance` as analyse takes it: "NAME>X" strings (one or a list) parsed, a mapping as it is."""
+    if exceedance is None or isinstance(exceedance, dict):
+        return exceedance
+    from .quantities.spec import parse_exceedance_option
+
+    return parse_exceedance_option([exceedance] if isinstance(exceedance, str) else list(exceedance))
+
+
+def analyse(results, method=None, reference=None, partial: bool = False, allow_aliasing: bool = False,
+            exceedance=None):
     """The statistics (`uqflight.statistics.Statistics`) of a results file, as `uqflight report` computes
     them: `.outputs[NAME]` (mean, variance, std, band99, quantiles, sobol_first, sobol_total, ... over
     time), `.quantities[NAME]`, `.notes`, `.failure_probability`. `method`: "KIND[:ORDER]" or
     {"kind", "order"} instead of the campaign's; `reference`: a results file for the errors ε_m, ε_v and
-    the KLD; `partial`, `allow_aliasing`: as `report --partial`, `--allow-aliasing`. Never runs campaign
-    code. Raises `uqflight.statistics.BadInput` (one line naming the file and what to do) when the file
+    the KLD; `partial`, `allow_aliasing`: as `report --partial`, `--allow-aliasing`; `exceedance`: "NAME>X" /
+    "NAME<X" strings (or {NAME: [{above: X}]}) replacing the campaign's thresholds of NAME, as `report
+    --exceedance`. Never runs campaign code. Raises `uqflight.statistics.BadInput` (one line naming the file and what to do) when the file
     cannot give right numbers."""
     from .statistics import BadInput
     from .statistics import analyse as statistics
@@ -90,7 +101,7 @@ def analyse(results, method=None, reference=None, partial: bool = False, allow_a
         raise ValueError("analyse takes one method; report compares several")
     try:
         return statistics(results, reference=reference, method=methods[0] if methods else None, partial=partial,
-                          allow_aliasing=allow_aliasing)
+                          allow_aliasing=allow_aliasing, exceedance=_thresholds(exceedance))
     except BadInput:
         raise
     except (OSError, KeyError) as exc:
@@ -110,12 +121,8 @@ def write_report(results, out=None, reference=None, method=None, times=(10.0, 25
     from .report import write_report as write
 
     paths = [Path(p) for p in (results if isinstance(results, (list, tuple)) else [results])]
-    if exceedance is not None and not isinstance(exceedance, dict):
-        from .quantities.spec import parse_exceedance_option
-
-        exceedance = parse_exceedance_option([exceedance] if isinstance(exceedance, str) else list(exceedance))
     return write(paths, out, reference=reference, times=times, baseline=baseline, method=_methods(method),
-                 partial=partial, allow_aliasing=allow_aliasing, exceedance=exceedance)
+                 partial=partial, allow_aliasing=allow_aliasing, exceedance=_thresholds(exceedance))
 
 
 def export_surrogate(results, out, method=None):
