@@ -140,6 +140,10 @@ def test_a_changed_campaign_is_refused_naming_the_first_key_and_force(tmp_path):
     assert refused.returncode == 2
     assert "its campaign differs first at parameters.b.upper" in refused.stderr and "--force" in refused.stderr
     assert cli_in_process("run", tmp_path / "c.yaml", "--out", out, "--force").returncode == 0
+    (tmp_path / "c.yaml").write_text(changed.replace("take: final", "take: max"))
+    refused = cli_in_process("run", tmp_path / "c.yaml", "--out", out)
+    assert refused.returncode == 2 and "differs first at quantities.final_y.take" in refused.stderr
+    assert "finer than the stored histories" in refused.stderr
 
 
 def test_a_change_of_analysis_alone_resumes_without_flying_again(tmp_path):

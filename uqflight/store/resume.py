@@ -81,6 +81,9 @@ def open_for_campaign(path, *, campaign_text: str, force: bool = False, restart:
                                       "to start over")
             where = (f": its campaign differs first at {differs}" if differs else
                      f" (campaign_hash {stored})")
+            if differs and differs.startswith("quantities"):
+                where += (" (a quantity is computed in the worker at every integration step, finer than the "
+                          "stored histories: a changed one is flown again)")
             raise FileExistsError(f"{path} holds the results of another campaign{where}; choose another results "
                                   "file (--out), or --force (force=True in Python) to overwrite it and fly every "
                                   "run again (a change of analysis: alone resumes the file as it is; "
