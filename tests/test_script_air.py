@@ -52,7 +52,8 @@ def test_a_failed_script_trim_says_what_air_was_active():
     message = str(failed.value)
     assert "a trim in the script failed at t = 1.008 s" in message
     assert "the trim flew in still air" in message
-    assert "held for after the script's first trim: atmosphere/turb-type = 3, atmosphere/turbulence/milspec/severity = 4" in message
+    assert ("held for after the script's first trim: atmosphere/turb-type = 3, "
+            "atmosphere/turbulence/milspec/severity = 4") in message
 
 
 def test_a_trim_that_never_comes_before_the_end_is_said():

@@ -91,8 +91,8 @@ def analyse(results, method=None, reference=None, partial: bool = False, allow_a
     {"kind", "order"} instead of the campaign's; `reference`: a results file for the errors ε_m, ε_v and
     the KLD; `partial`, `allow_aliasing`: as `report --partial`, `--allow-aliasing`; `exceedance`: "NAME>X" /
     "NAME<X" strings (or {NAME: [{above: X}]}) replacing the campaign's thresholds of NAME, as `report
-    --exceedance`. Never runs campaign code. Raises `uqflight.statistics.BadInput` (one line naming the file and what to do) when the file
-    cannot give right numbers."""
+    --exceedance`. Never runs campaign code. Raises `uqflight.statistics.BadInput` (one line naming the file
+    and what to do) when the file cannot give right numbers."""
     from .statistics import BadInput
     from .statistics import analyse as statistics
 

@@ -459,9 +459,9 @@ class JSBSimFlight(PropertyAccess):
         self.surface_warning = None if not commanded or moved >= UNMOVED_FRACTION * commanded else (
             f"the {s.excitation.kind} of {s.excitation.amplitude_deg:g} deg never moved the elevator: {SURFACE} "
             f"went {moved:.3g} deg from its trimmed {trimmed_surface:.3g} deg while it was commanded (below "
-            f"{UNMOVED_FRACTION:.0%} of the amplitude; a dead band or hysteresis in the aircraft's actuator, e.g. "
-            "c172x's 2.9 deg); the runs then differ by the parameters alone: give a larger amplitude (excitation.amplitude_deg in a "
-            "campaign, --amplitude-deg on the command line)")
+            f"{UNMOVED_FRACTION:.0%} of the amplitude: a dead band or hysteresis in the aircraft's actuator, e.g. "
+            "c172x's 2.9 deg), so the flight is not excited: give a larger amplitude (excitation.amplitude_deg in "
+            "a campaign, --amplitude-deg on the command line)")
         data *= np.array([scale for _, scale in self._recorded])
         self._check_envelope(data)
         return FlightResult(time=time, outputs=dict(zip(s.outputs, data.T.copy())), trim=trim,

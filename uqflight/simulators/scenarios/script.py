@@ -431,7 +431,8 @@ class ScriptFlight(PropertyAccess):
         if not parts:
             parts.append("the trim flew in still air (no turbulence, gust or wind set)")
         if held and not applied:
-            parts.append("held for after the script's first trim: " + ", ".join(f"{k} = {v:g}" for k, v in held.items()))
+            parts.append("held for after the script's first trim: "
+                         + ", ".join(f"{k} = {v:g}" for k, v in held.items()))
         return "; ".join(parts)
 
     def _run(self, observers, held: dict | None = None) -> tuple[np.ndarray, np.ndarray]:
