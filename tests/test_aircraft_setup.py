@@ -100,3 +100,7 @@ storage: {path: c.h5}
         shown = cli_in_process("plan", tmp_path / "c.yaml", cwd=tmp_path)
         assert shown.returncode == 0, shown.stderr
         assert ("warning: the nominal flight: the pulse of 1 deg never moved the elevator" in shown.stderr) == warned
+    (tmp_path / "c.yaml").write_text(text.replace("AMPLITUDE", "1.0"))
+    ran = cli_in_process("run", tmp_path / "c.yaml", cwd=tmp_path)  # run says it too, in its summary
+    assert ran.returncode == 0, ran.stderr
+    assert "warning: the nominal flight: the pulse of 1 deg never moved the elevator" in ran.stdout
