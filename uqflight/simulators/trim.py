@@ -284,8 +284,8 @@ def lift_shortfall(flight) -> str | None:
             break
         best, best_alpha = lift, float(alpha)
     needed = weight / (qbar * area)
-    if not np.isfinite(best) or not needed > best:  # no α trimmed at all: not a stall (see speed_range_shortfall)
-        return None
+    if not (np.isfinite(best) and best > 0) or not needed > best:  # no α trimmed with lift: no stall to say
+        return None  # (speed_range_shortfall says what the speed is)
     slowest = flight.setup.airspeed_ktas * math.sqrt(needed / best)
     return (f"the stall: level flight needs a lift coefficient W/(qbar S) = {needed:.3f}, above the {best:.3f} "
             f"the aircraft reaches trimmed before it stalls (at alpha {best_alpha:.1f} deg); fly faster than "
