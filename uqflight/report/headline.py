@@ -53,7 +53,7 @@ def _row(name: str, out, i: int, time) -> tuple[list, list]:
     CSV keeps the recorded time."""
     mean, std, lower, upper = (float(v[i]) for v in (out.mean, out.std, *out.band99))
     top = top_contributors(out.sobol_first, i) if out.sobol_first else NO_INDICES
-    flags = list(getattr(out, "flags", None) or [])
+    flags = list(out.flags)
     csv = [name, out.units, "" if time is None else float(out.time[i]), mean, std, lower, upper, top, "; ".join(flags)]
     page = [flagged(name, flags), "" if time is None else f"{time:g}", mean_std_text(mean, std, out.units),
             band_text(lower, upper, std), top, "; ".join(flags)]
@@ -67,7 +67,8 @@ def event_text(name: str, item: dict) -> str:
 
 
 def probability_text(value) -> str:
-    return "null" if value is None or not np.isfinite(value) else f"{value:.3g}"
+    """The probability to 3 digits, "—" where it is undefined (its note says why)."""
+    return NO_INTERVAL if value is None or not np.isfinite(value) else f"{value:.3g}"
 
 
 def interval_text(lower, upper) -> str:
@@ -82,7 +83,7 @@ def exceedance_table(entry: Entry) -> Table | None:
     with their 95 % intervals, "—" for none; None when none was asked for."""
     rows, page = [], []
     for name, quantity in entry.stats.quantities.items():
-        flags = list(getattr(quantity.output, "flags", None) or [])
+        flags = quantity.flags
         for item in quantity.exceedance:
             event = event_text(name, item)
             rows.append([entry.label, name, event, item["probability"], item["lower"], item["upper"],
