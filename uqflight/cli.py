@@ -552,6 +552,7 @@ def _check_times(text: str, selected: list[float], results: list[Path]) -> None:
     """Exit 2 naming --times and the flight's time range when a time lies outside a file's recorded
     times (more than half a recording step); 'end' is always inside. An unreadable file is the
     report's to refuse."""
+    from .labels import shown_time
     from .store import ResultStore
 
     for path in results:
@@ -564,7 +565,8 @@ def _check_times(text: str, selected: list[float], results: list[Path]) -> None:
         outside = [t for t in selected if np.isfinite(t) and not time[0] - half <= t <= time[-1] + half]
         if outside:
             echo(f"error: --times {text}: {', '.join(f'{t:g}' for t in outside)} s outside the flight of {path}, "
-                 f"which records {time[0]:g} to {time[-1]:g} s; choose times in that range or 'end'", err=True)
+                 f"which records {shown_time(time, 0):g} to {shown_time(time, -1):g} s; choose times in that range "
+                 "or 'end'", err=True)
             raise typer.Exit(2)
 
 
