@@ -79,3 +79,19 @@ def parameter_label(name: str, prop: str) -> str:
     """A parameter's axis label with its unit when known, e.g. "CLalpha [1/rad]"."""
     unit = parameter_unit(prop)
     return f"{name} [{unit}]" if unit else name
+
+
+def shown_time(time, i: int) -> float:
+    """The recorded time `time[i]` as a reader asked for it: snapped to the recording grid t0 + k / rate
+    (the rate read from the grid to 4 digits) when within 10 % of a step of it, so that 9.99996 s (JSBSim's
+    clock adding 1/120 s steps) reads 10 s and 24.9999 s reads 25 s; a time off that grid keeps its
+    digits. Full precision stays in the time arrays."""
+    t = float(time[i])
+    if len(time) < 2:
+        return t
+    t0, step = float(time[0]), (float(time[-1]) - float(time[0])) / (len(time) - 1)
+    if not step > 0:
+        return t
+    rate = float(f"{1.0 / step:.4g}")
+    snapped = round(round(t0, 6) + round((t - t0) * rate) / rate, 9)
+    return snapped + 0.0 if abs(snapped - t) <= 0.1 * step else t  # + 0.0: no "-0"

@@ -161,6 +161,48 @@ class QuantityStatistics:
     units: str = ""  # its take's own, or its `of`'s (labels.quantity_unit)
     flags: list[str] = field(default_factory=list)  # its statistics' (output.flags) and its thresholds' (unit slips)
 
+    def _first(self, attribute: str):
+        """The output's `attribute` at its one time point (None when the statistics are undefined)."""
+        return None if self.output is None else _at_first_time(getattr(self.output, attribute))
+
+    @property
+    def mean(self) -> float | None:
+        """The mean (None where undefined), as summary.json's quantities.NAME.mean."""
+        return self._first("mean")
+
+    @property
+    def variance(self) -> float | None:
+        return self._first("variance")
+
+    @property
+    def std(self) -> float | None:
+        return self._first("std")
+
+    @property
+    def band99(self) -> tuple[float, float] | None:
+        """(lower, upper) of the 99 % band."""
+        return None if self.output is None else (float(self.output.band99[0][0]), float(self.output.band99[1][0]))
+
+    @property
+    def quantiles(self) -> dict[float, float]:
+        return {} if self.output is None else self._first("quantiles")
+
+    @property
+    def skewness(self) -> float | None:
+        return None if self.output is None or self.output.skewness is None else self._first("skewness")
+
+    @property
+    def kurtosis(self) -> float | None:
+        return None if self.output is None or self.output.kurtosis is None else self._first("kurtosis")
+
+    @property
+    def sobol_first(self) -> dict[str, float]:
+        return {} if self.output is None else self._first("sobol_first")
+
+    @property
+    def sobol_total(self) -> dict[str, float]:
+        return {} if self.output is None else self._first("sobol_total")
+
 
 def campaign_facts(store: ResultStore, path) -> StoredFacts:
     """The method, germs, analysis options, seeds and copula the results file `path` was made with, checked
@@ -172,16 +214,19 @@ def campaign_facts(store: ResultStore, path) -> StoredFacts:
 
 
 def read_statistics(path, method: dict | None = None, partial: bool = False,
-                    allow_aliasing: bool = False, progress=None) -> tuple[Statistics, dict]:
+                    allow_aliasing: bool = False, progress=None,
+                    exceedance: dict | None = None) -> tuple[Statistics, dict]:
     """The statistics of a results file (`method` overriding the campaign's) and its root attributes;
-    BadInput, one line naming the file, when it cannot give right numbers. `progress`: see analyse."""
+    BadInput, one line naming the file, when it cannot give right numbers. `progress`, `exceedance`: see
+    analyse."""
     path = Path(path)
     if not path.is_file():
         raise BadInput(f"{path}: no such results file")
     try:
         with ResultStore.open(path) as store:
             attrs = store.attrs
-        return analyse(path, method=method, partial=partial, allow_aliasing=allow_aliasing, progress=progress), attrs
+        return analyse(path, method=method, partial=partial, allow_aliasing=allow_aliasing, progress=progress,
+                       exceedance=exceedance), attrs
     except BadInput:
         raise
     except CorruptFile as exc:
@@ -191,13 +236,17 @@ def read_statistics(path, method: dict | None = None, partial: bool = False,
 
 
 def analyse(path, reference: str | None = None, options: Options | None = None, method: dict | None = None,
-            partial: bool = False, allow_aliasing: bool = False, progress=None) -> Statistics:
+            partial: bool = False, allow_aliasing: bool = False, progress=None,
+            exceedance: dict | None = None) -> Statistics:
     """All statistics of the results file `path` (and errors against `reference`).
 
     `method` ({"kind", "order", "split"}) overrides the campaign's: the runs of one grid serve every
     method, so methods and orders are compared on the same runs. `partial` analyses a file with pending
     runs where a subset of the runs is valid; `allow_aliasing` lets a projection exceed the grid's degree.
     `progress` (a uqflight.progress.Progress) gets a stage per file and counts its outputs and quantities.
+    `exceedance` ({quantity: [{above: X} | {below: X}]}) replaces the campaign's `analysis.exceedance` of the
+    quantities it names (`report --exceedance`: thresholds changed without flying again); BadInput when it
+    names a quantity the file does not have.
     """
     # one BLAS thread: the matrices are tall and thin (runs or draws × terms), where several threads are no
     # faster, and 10-20x slower on a loaded machine; the time blocks run in threads instead
@@ -268,9 +317,14 @@ def analyse(path, reference: str | None = None, options: Options | None = None, 
                     finish_oldest()
             while in_flight:
                 finish_oldest()
+        unknown = [name for name in exceedance or {} if name not in store.quantity_names]
+        if unknown:
+            raise BadInput(f"{path}: --exceedance {unknown[0]}: no such quantity in the file; its quantities: "
+                           + (", ".join(store.quantity_names) or "none"))
+        thresholds = {**analysis.get("exceedance", {}), **(exceedance or {})}
         for name in store.quantity_names:
             stats.quantities[name] = quantity_statistics(store, stats, name, germs, ok, options,
-                                                         analysis.get("exceedance", {}).get(name, []))
+                                                         thresholds.get(name, []))
             if progress is not None:
                 progress.advance()
     if reference:

@@ -25,7 +25,7 @@ from matplotlib.lines import Line2D  # noqa: E402
 from matplotlib.ticker import FixedLocator, FuncFormatter, LogLocator, MaxNLocator, NullFormatter  # noqa: E402
 
 from ..analysis.sobol import unresolved  # noqa: E402
-from ..labels import label, short_label  # noqa: E402,F401 (plots.label: the report's captions)
+from ..labels import label, short_label, shown_time  # noqa: E402,F401 (plots.label: the report's captions)
 from .formats import export_format, shown_path  # noqa: E402
 from .png import write_png  # noqa: E402
 
@@ -323,7 +323,7 @@ def plot_pdfs_over_time(figures: list, slice_times: list[float]) -> list[Path]:
             fig.colorbar(mesh, ax=top, label="density / peak density at that time")
         for color, index in zip(COLORS, time_indices(out.time, slice_times)):
             bottom.plot(out.pdf_support[index], out.pdf_density[index], color=color,
-                        label=f"t = {out.time[index]:g} s")
+                        label=f"t = {shown_time(out.time, index):g} s")
         bottom.set_xlabel(label(out.name, out.units), fontsize=9)
         bottom.set_ylabel(f"probability density [1/{out.units}]" if out.units else "probability density",
                           fontsize=9)

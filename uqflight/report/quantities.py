@@ -12,6 +12,7 @@ from . import plots
 from .sensitivity import N_TOO_SMALL, UNRESOLVED
 from .loading import Entry, bounded
 from .blocks import Figure, Section, Table, _rel
+from .headline import interval_text, probability_text
 
 
 def _top_index(out) -> tuple[str, float | str] | tuple[None, None]:
@@ -30,14 +31,33 @@ def _top_index(out) -> tuple[str, float | str] | tuple[None, None]:
     return top, finite[top]
 
 
-def plot_quantity_pdfs(quantities: dict, path: Path, title: str) -> Path:
-    """One panel per quantity: its PDF, the mean and the 99 % band marked."""
+THRESHOLD_COLOR = "#c0392b"
+
+
+def threshold_label(item: dict) -> str:
+    """A threshold's label on a PDF: "P(> 4.5) = 0.021" (its event and probability)."""
+    bound = "above" if "above" in item else "below"
+    p = item.get("probability")
+    shown = "null" if p is None or not np.isfinite(p) else f"{p:.3g}"
+    return f"P({'>' if bound == 'above' else '<'} {item[bound]:g}) = {shown}"
+
+
+def plot_quantity_pdfs(quantities: dict, path: Path, title: str, thresholds: dict | None = None) -> Path:
+    """One panel per quantity: its PDF, the mean and the 99 % band marked, and each exceedance threshold
+    (`thresholds`: {name: [exceedance items]}) as a labelled vertical line with its probability."""
+    thresholds = thresholds or {}
     fig, axes = plots._panels(len(quantities), title, row_height=2.7)
     for ax, (name, out) in zip(axes, quantities.items()):
         ax.plot(out.pdf_support[0], out.pdf_density[0], color=plots.COLORS[0], lw=1.3)
         ax.axvline(out.mean[0], color="k", lw=1.0, label="mean")
         for bound in out.band99:
             ax.axvline(bound[0], color="k", lw=0.9, ls="--")
+        for item in thresholds.get(name, []):
+            value = item["above" if "above" in item else "below"]
+            ax.axvline(value, color=THRESHOLD_COLOR, lw=1.3, ls=":")
+            ax.annotate(threshold_label(item), (value, 1.0), xycoords=("data", "axes fraction"), xytext=(3, -3),
+                        textcoords="offset points", ha="left", va="top", fontsize=7, color=THRESHOLD_COLOR,
+                        rotation=90, bbox={"facecolor": "white", "edgecolor": "none", "alpha": 0.8, "pad": 0.5})
         ax.set_title(name, fontsize=10)
         ax.set_xlabel(plots.label(name, out.units), fontsize=8)
         ax.set_ylabel(f"probability density [1/{out.units}]" if out.units else "probability density", fontsize=8)
@@ -90,10 +110,13 @@ def quantities_section(entries: list[Entry], out_dir: Path) -> Section:
                                    item["upper"], item["method"], item["note"]])
         defined = {name: q.output for name, q in quantities.items() if q.output is not None}
         if defined:
+            thresholds = {name: q.exceedance for name, q in quantities.items() if q.exceedance}
             path = plot_quantity_pdfs(defined, out_dir / "plots" / bounded(f"quantity_pdfs_{entry.stem}.png"),
-                                      f"Quantities of interest: {entry.label}")
+                                      f"Quantities of interest: {entry.label}", thresholds)
             blocks.append(Figure(_rel(path, out_dir), f"PDFs of the quantities of {entry.label} (kernel density "
-                                                      "estimate), the mean solid, the 99 % band dashed."))
+                                                      "estimate), the mean solid, the 99 % band dashed"
+                                 + (", each exceedance threshold dotted red with its probability." if thresholds
+                                    else ".")))
         with_sobol = {name: out for name, out in defined.items() if out.sobol_first}
         if with_sobol:
             path = plot_quantity_sobol(with_sobol, out_dir / "plots" / bounded(f"quantity_sobol_{entry.stem}.png"),
@@ -107,9 +130,12 @@ def quantities_section(entries: list[Entry], out_dir: Path) -> Section:
         "file", "quantity", "missing runs", "mean", "std", "band99 lower", "band99 upper",
         "top total Sobol' index", "its value"], statistics, "tables/quantities.csv"))
     if exceedance:
-        blocks.insert(1, Table("Exceedance probabilities (analysis.exceedance)", [
+        page = [[label, name, event, probability_text(p), interval_text(lower, upper), method or "", note]
+                for label, name, event, p, lower, upper, method, note in exceedance]
+        blocks.insert(1, Table("Exceedance probabilities (analysis.exceedance, report --exceedance)", [
             "file", "quantity", "event", "probability", "lower", "upper", "method", "note"],
-            exceedance, "tables/exceedance.csv"))
+            exceedance, "tables/exceedance.csv",
+            page=(["file", "quantity", "event", "probability", "95 % interval", "method", "note"], page)))
     return Section("Quantities of interest", "quantities",
                    "Computed in the worker at every integration step (or time point of a Python model); "
                    "their statistics are those of an output with one time point. Missing runs: successful runs "

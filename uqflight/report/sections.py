@@ -9,6 +9,7 @@ import numpy as np
 
 from . import plots
 from .blocks import Figure, Section, Table, _rel
+from ..labels import shown_time
 from .formats import shown_path
 from ..analysis.sobol import unresolved
 from ..forking import share_work
@@ -396,7 +397,7 @@ def sensitivity_section(entries: list[Entry], times: list[float], out_dir: Path)
         rows = [[e.label, name, out.time[i], *(_at(getattr(out, kind), p, i) for p in parameters)]
                 for e in with_sobol for name, out in e.outputs.items() for i in plots.time_indices(out.time, times)]
         caption = f"{what} Sobol' indices at the selected times" + (" (paper Table 3)" if kind == "sobol_first" else "")
-        page = [[e.label, name, f"{out.time[i]:g}", *(_shown(out, kind, p, i) for p in parameters)]
+        page = [[e.label, name, f"{shown_time(out.time, i):g}", *(_shown(out, kind, p, i) for p in parameters)]
                 for e in with_sobol for name, out in e.outputs.items() for i in plots.time_indices(out.time, times)]
         blocks.append(Table(caption, ["file", "output", "time [s]", *parameters], rows, f"tables/{kind}.csv",
                             page=(["file", "output", "time [s]", *parameters], page), grouped=True))

@@ -87,7 +87,7 @@ def scatter_rows(results: Path, outputs: dict, quantities: dict, time: float, se
         at_time = {}
         for name, out in outputs.items():
             i = plots.time_indices(out.time, [time])[0]
-            at = f" at {out.time[i]:g} s" if out.time.size > 1 else ""
+            at = f" at {plots.shown_time(out.time, i):g} s" if out.time.size > 1 else ""
             at_time[f"{plots.short_label(name)}{at}" + (f" [{out.units}]" if out.units else "")] = (
                 drawn_runs(store.output_matrix(name, drawn), out)[:, i], out.sobol_total, i)
         of_quantities = {plots.label(name, q.units): (
