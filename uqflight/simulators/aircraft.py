@@ -19,7 +19,6 @@ from __future__ import annotations
 
 import hashlib
 import os
-import re
 import shutil
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass, field
@@ -323,25 +322,12 @@ def aero_functions(xml: bytes) -> list[AeroFunction]:
     return found
 
 
-def engines(xml: bytes) -> list[tuple[str, str]]:
-    """(engine file, thruster file) per engine of the aircraft, in order."""
-    tree = ET.fromstring(xml)
-    result = []
-    for engine in tree.iter("engine"):
-        thruster = engine.find("thruster")
-        result.append((engine.get("file", ""), thruster.get("file", "") if thruster is not None else ""))
-    return result
-
-
-def safe_name(text: str) -> str:
-    return re.sub(r"[^A-Za-z0-9_.-]+", "_", text)
-
-
 # Flight condition used when a campaign or the command line states none: inside each tested
 # aircraft's envelope (measured: trims and holds level flight, see docs/own-aircraft.md).
 DEFAULT_CONDITIONS = {
     "bacm": {"altitude_ft": 15000.0, "airspeed_ktas": 200.0},
     "c172p": {"altitude_ft": 4000.0, "airspeed_ktas": 100.0},
+    "c172x": {"altitude_ft": 4000.0, "airspeed_ktas": 100.0},  # trims level from 45 to 125 KTAS there
     "737": {"altitude_ft": 10000.0, "airspeed_ktas": 280.0},
     "f16": {"altitude_ft": 15000.0, "airspeed_ktas": 400.0},
 }
