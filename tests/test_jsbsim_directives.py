@@ -149,14 +149,15 @@ def test_run_leaves_no_scratch_folder_in_the_temporary_directory(tmp_path, scrat
 # -- D03: sockets of the aircraft ----------------------------------------------------------------
 def test_an_aircraft_flies_without_its_output_socket_and_input_port(tmp_path, scratch, home):
     """JSBSim's 737 listens on an <input> port and its c310 sends <output type="SOCKET">: a copy doing both
-    on free ports flies a level flight that neither connects nor listens."""
+    on free ports (one input in a namespace, which JSBSim does not see) flies a level flight that neither
+    connects nor listens."""
     server = socket.create_server(("127.0.0.1", 0))
     server.setblocking(False)
     port, inbound = server.getsockname()[1], free_port()
     copied_aircraft(tmp_path, "talky", appended(
         f'<output name="127.0.0.1" type="SOCKET" port="{port}" rate="10">{PROBE}</output>\n'
         f'<output name="127.0.0.1" type="FLIGHTGEAR" port="{port}" protocol="TCP" rate="10"/>\n'
-        f'<input port="{inbound}"/>\n<input port="{free_port()}" type="QTJSBSIM"/>'))
+        f'<input xmlns="urn:x" port="{inbound}"/>\n<input port="{free_port()}" type="QTJSBSIM"/>'))
     simulator = make_simulator({"kind": "jsbsim", "aircraft": "planes/talky", "duration_s": 0.5, "flight": C172}, ["wind"],
                                ["atmosphere/wind-north-fps"], tmp_path)
     assert np.all(np.isfinite(simulator.evaluate(np.array([1.0]))["h_ft"]))
