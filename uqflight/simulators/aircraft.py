@@ -13,7 +13,9 @@ the engines, thrusters and systems it names that live in the root's shared folde
 `AircraftFiles` holds them as bytes (keyed by path), hashes them, and writes them out as a root
 of their own (the patched copies and the copies on remote workers are such roots). Every name in
 those files (`file=` attributes, output files, symbolic links) must stay in the folders JSBSim
-looks in: `AircraftUnsafe` otherwise, before anything is read or written.
+looks in, every file must be one Python's parser reads (JSBSim's may read more), and the main file
+names no `<child>` aircraft: `AircraftUnsafe` otherwise, before anything is read or written
+(directives.py says what JSBSim does with each name).
 """
 from __future__ import annotations
 
