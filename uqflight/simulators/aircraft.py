@@ -28,6 +28,7 @@ from pathlib import Path
 
 import jsbsim
 
+from ..console import one_line
 from .directives import checked, local_name, parsed, without_io
 from .safe_paths import is_inside, outside_links, relative_name, single_name
 
@@ -184,7 +185,7 @@ def _no_child(xml: bytes, file: Path) -> None:
     """Refuse a `<child>` aircraft in the main file: JSBSim would load it from the root, unchecked."""
     for element in ET.fromstring(xml):
         if local_name(element.tag) == "child":
-            raise AircraftUnsafe(f'{file}: <child name="{element.get("name", "")}">: JSBSim would load that aircraft '
+            raise AircraftUnsafe(f'{file}: <child name="{one_line(element.get("name", ""))}">: JSBSim would load that aircraft '
                                  "from the root's aircraft folder, files uqflight neither checks nor copies; "
                                  "uqflight flies one aircraft: remove the <child> element")
 

@@ -28,6 +28,7 @@ from __future__ import annotations
 
 import xml.etree.ElementTree as ET
 
+from ..console import one_line
 from .safe_paths import relative_name
 
 IO_DIRECTIVES = ("input", "output")
@@ -64,7 +65,7 @@ def checked(root: ET.Element, file, error: type[Exception], inside: str) -> list
         for attribute in attributes:
             value = element.get(attribute)
             if value is not None and relative_name(value) is None:
-                raise error(f'{file}: <{tag} {attribute}="{value}">: expected a path relative to {inside}, without '
+                raise error(f'{file}: <{tag} {attribute}="{one_line(value)}">: expected a path relative to {inside}, without '
                             "/ at the start, .. leading out of it, a drive or a backslash; uqflight neither reads "
                             "nor copies a file outside them, nor lets JSBSim write one")
         for text in (element.text, *element.attrib.values()):
