@@ -278,3 +278,13 @@ def test_a_parameter_setting_the_linearization_is_refused(tmp_path, home):
     line = refused(cli_in_process("plan", path, cwd=tmp_path))
     assert "parameters.lin.property" in line and "simulation/do_linearization" in line
     assert not list(tmp_path.glob("*_lin.sce"))
+
+
+def test_an_initialisation_file_beside_the_script_that_python_cannot_parse_is_refused(tmp_path, home):
+    """JSBSim reads the initialisation file beside the script (before the aircraft folder's): checked too."""
+    hostile_script(tmp_path)
+    doctype, body = HIDDEN["external entity"]
+    (tmp_path / "reset01.xml").write_text(f'<?xml version="1.0"?>\n{doctype.replace("output", "initialize")}'
+                                          f'<initialize name="r">{body}<altitude unit="FT">4000</altitude></initialize>\n')
+    line = refused(cli_in_process("plan", campaign(tmp_path, script_simulator())))
+    assert f"{tmp_path / 'reset01.xml'} is not well-formed XML" in line and "simulator.scenario.script" in line
