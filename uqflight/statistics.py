@@ -26,7 +26,7 @@ import math
 import os
 from collections import deque
 from concurrent.futures import Executor, ThreadPoolExecutor
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Callable
 
@@ -77,11 +77,13 @@ class BadInput(ValueError):
 
 @dataclass
 class Options:
-    """How the statistics are computed (from the campaign's `analysis:` mapping, or defaults)."""
+    """How the statistics are computed (from the campaign's `analysis:` mapping, or defaults). `seed` seeds
+    every draw of the analysis (band and PDF draws, bootstrap, exceedance draws, the KLD floor's splits);
+    None: the results file's campaign seed."""
 
     band_samples: int = 20000
     bootstrap: int = 200
-    seed: int = 0
+    seed: int | None = None
     quantiles: tuple[float, ...] = DEFAULT_QUANTILES
 
 
@@ -143,6 +145,7 @@ class Statistics:
     quantities: dict[str, QuantityStatistics] = field(default_factory=dict)
     index_set: dict | None = None  # an adaptive grid's refinement (designs.adaptive.index_set_summary)
     design_info: dict = field(default_factory=dict)  # the design's recorded facts (replicates, n_base, ...)
+    seed: int = 0  # what seeded the analysis's draws (the campaign's seed unless Options said otherwise)
 
 
 @dataclass
@@ -202,6 +205,8 @@ def analyse(path, reference: str | None = None, options: Options | None = None, 
         allow_aliasing = allow_aliasing or bool(method.get("allow_aliasing"))
         options = options or Options(**{k: (tuple(v) if k == "quantiles" else v) for k, v in analysis.items()
                                         if k in ("band_samples", "bootstrap", "quantiles")})
+        if options.seed is None:
+            options = replace(options, seed=facts.seed)
         status, design_kind = store.status, facts.design_kind
         if method["kind"] not in METHODS:
             raise BadInput(f"{path}: unknown method {method['kind']!r}: expected one of {', '.join(METHODS)}")
@@ -210,7 +215,7 @@ def analyse(path, reference: str | None = None, options: Options | None = None, 
         pending = int(np.sum(status == Status.PENDING))
         stats = Statistics(str(path), store.attrs.get("campaign_name", ""), method, design_kind,
                            store.parameter_names, int(status.size), int(ok.sum()), int(np.sum(status > 0)),
-                           pending, {}, partial=pending > 0, design_info=facts.design_info)
+                           pending, {}, partial=pending > 0, design_info=facts.design_info, seed=options.seed)
         _check_runs(store, stats, sampled, partial)
         state = store.index_set()
         stats.index_set = None if state is None else index_set_summary(state, store.parameter_names)
@@ -261,7 +266,7 @@ def analyse(path, reference: str | None = None, options: Options | None = None, 
                 progress.advance()
     if reference:
         add_reference_errors(stats, analyse(reference, options=Options(
-            band_samples=options.band_samples, bootstrap=0, seed=options.seed, quantiles=options.quantiles)))
+            band_samples=options.band_samples, bootstrap=0, quantiles=options.quantiles)))
     return stats
 
 
@@ -560,7 +565,9 @@ def _reference_floor(reference: Statistics, ref: OutputStatistics, out: OutputSt
         note = (f"reference: randomised QMC, {r} replicates of {reference.completed // r} scrambled Sobol' points; "
                 "floor = the standard errors of its mean and variance from the spread of the replicates")
         return {"eps_m_floor": se_mean / peak_mean, "eps_v_floor": se_variance / peak_variance,
-                "kld_floor": float(kld_floor(ref.final_samples, n_method=len(out.final_samples))), "floor_note": note}
+                "kld_floor": float(kld_floor(ref.final_samples, n_method=len(out.final_samples),
+                                               seed=reference.seed)),
+                "floor_note": note}
     if reference.from_runs and ref.fourth_central is not None:
         floors = floors_from_moments(ref.mean, ref.variance, ref.fourth_central, reference.completed)
         qmc = reference.design_kind != "monte_carlo"
@@ -568,7 +575,9 @@ def _reference_floor(reference: Statistics, ref: OutputStatistics, out: OutputSt
                 "(σ/√N for the mean, the distribution-free s.e. of the variance)"
                 + ("; QMC converges faster than this Monte Carlo floor, so it is an upper bound" if qmc else ""))
         return {"eps_m_floor": floors["eps_m_floor"], "eps_v_floor": floors["eps_v_floor"],
-                "kld_floor": float(kld_floor(ref.final_samples, n_method=len(out.final_samples))), "floor_note": note}
+                "kld_floor": float(kld_floor(ref.final_samples, n_method=len(out.final_samples),
+                                               seed=reference.seed)),
+                "floor_note": note}
     note = (f"reference: {reference.method['kind']} on a {reference.design_kind}, deterministic: it has no sampling "
             "floor; its own truncation error is not included (see its convergence estimate)")
     return {"eps_m_floor": None, "eps_v_floor": None, "kld_floor": None, "floor_note": note}
