@@ -115,6 +115,7 @@ class OutputStatistics:
     replicate_moments: tuple[np.ndarray, np.ndarray] | None = None  # (R, T) means and variances of RQMC replicates
     errors: dict = field(default_factory=dict)
     pce: PCE | None = None  # the expansion behind the statistics (None: statistics of the runs themselves)
+    flags: list[str] = field(default_factory=list)
 
     @property
     def std(self) -> np.ndarray:
@@ -264,10 +265,19 @@ def analyse(path, reference: str | None = None, options: Options | None = None, 
                                                          analysis.get("exceedance", {}).get(name, []))
             if progress is not None:
                 progress.advance()
+    note_flags(stats)
     if reference:
         add_reference_errors(stats, analyse(reference, options=Options(
             band_samples=options.band_samples, bootstrap=0, quantiles=options.quantiles)))
     return stats
+
+
+def note_flags(stats: Statistics) -> None:
+    """One line in the notes per flag of an output or a quantity ("output NAME: FLAG"): a flagged statistic
+    is in summary.json's `flags` of its output or quantity and in the notes every reader sees."""
+    flagged = [("output", name, out) for name, out in stats.outputs.items()]
+    flagged += [("quantity", name, q.output) for name, q in stats.quantities.items() if q.output is not None]
+    stats.notes.extend(f"{what} {name}: {text}" for what, name, out in flagged for text in out.flags)
 
 
 def _check_runs(store: ResultStore, stats: Statistics, sampled: bool, partial: bool) -> None:
@@ -645,7 +655,7 @@ def quantity_statistics(store: ResultStore, stats: Statistics, name: str, germs:
 def _quantity_json(quantity: QuantityStatistics, seeds: list[str]) -> dict:
     """summary.json's quantities.NAME: numbers, not lists (null where undefined)."""
     out = quantity.output
-    entry = {"missing": quantity.missing, "exceedance": quantity.exceedance}
+    entry = {"missing": quantity.missing, "exceedance": quantity.exceedance, "flags": [] if out is None else out.flags}
     if out is None:
         return {"mean": None, "variance": None, "std": None, "band99": {"lower": None, "upper": None},
                 "quantiles": {}, "skewness": None, "kurtosis": None, "sobol_first": {}, "sobol_total": {}, **entry}
@@ -728,7 +738,7 @@ def summary_json(stats: Statistics) -> dict:
             "band99": {"lower": out.band99[0], "upper": out.band99[1]},
             "quantiles": {f"{p:g}": values for p, values in out.quantiles.items()},
             "skewness": out.skewness, "kurtosis": out.kurtosis, "cov": out.cov, "resolved": out.resolved,
-            "sobol_first": out.sobol_first, "sobol_total": out.sobol_total,
+            "sobol_first": out.sobol_first, "sobol_total": out.sobol_total, "flags": out.flags,
         }
         if out.sobol_first_ci:
             entry["sobol_first_ci"] = {k: {"lower": v[0], "upper": v[1]} for k, v in out.sobol_first_ci.items()}
