@@ -53,6 +53,7 @@ from .methods import PCE, METHODS, failed_runs_note, fit, method_entry, method_s
 from .methods.basis import orthonormal_basis
 from .methods.loo import relative_loo_error
 from .methods.pce_moments import pce_standardised_moments, triple_products
+from .methods import validation
 from .methods.validity import method_problem
 from .parameters.distributions import SEED_REFUSAL
 from .parameters.germs import draw_germs
@@ -109,6 +110,7 @@ class OutputStatistics:
     loo_error: np.ndarray | None = None  # relative leave-one-out error of a fit, (T,)
     selection: dict | None = None  # what a selecting method (sparse) chose: terms, order, corrected LOO error
     convergence: dict | None = None  # difference to the next lower order of a projection
+    validation: dict | None = None  # the expansion checked on its own runs (methods.validation): error, band
     coefficient_decay: dict[int, np.ndarray] | None = None  # degree -> RSS of its PCE coefficients (T,)
     final_samples: np.ndarray | None = None  # runs or surrogate draws at the final time, for the KLD
     fourth_central: np.ndarray | None = None  # of the runs, for a sampled reference's noise floor
@@ -447,6 +449,8 @@ def _start_output(store: ResultStore, name: str, method: dict, germs: list[str],
                 stats.loo_error = _loo_error(entry, xi, weights, expand(basis), germs, pce.indices)
             elif entry.moments == "pce" and order >= 1:
                 stats.convergence = _lower_order_difference(kind, xi, weights, basis, scale, germs, order, x0, pce)
+            _validate(stats, entry.rule, f"{kind} order {order}", xi, weights, expand(basis), germs,
+                      None if isinstance(store, _QuantityView) else store.time)
         elif pick_freeze:
             stats.sobol_first = dict(zip(names, masked(blocks["first"])))
             stats.sobol_total = dict(zip(names, masked(blocks["total"])))
@@ -477,6 +481,20 @@ def _coefficient_decay(pce: PCE) -> dict[int, np.ndarray]:
     """Root-sum-square of the PCE coefficients of each total degree, over time: how fast they decay."""
     degrees = np.asarray(pce.indices).sum(axis=1)
     return {int(p): np.sqrt((pce.coefficients[degrees == p] ** 2).sum(axis=0)) for p in np.unique(degrees)}
+
+
+def _validate(out: OutputStatistics, rule: str, label: str, xi, weights, Y: np.ndarray, germs,
+              time: np.ndarray | None) -> None:
+    """Check `out`'s expansion on its own runs Y (methods.validation): its `validation` and its flags."""
+    edges = [*out.band99, *out.quantiles.values()]
+    found = validation.validate(rule, xi, weights, Y, germs, out.pce, out.loo_error, out.resolved, edges)
+    worst, excess = found.worst_error(), found.worst_excess()
+    out.validation = {"check": found.check, "threshold": validation.VALIDATION_THRESHOLD,
+                      "error": None if worst is None else worst[0],
+                      "time": None if worst is None or time is None else float(time[worst[1]]),
+                      "band_excess": None if excess is None else excess[0] + validation.BAND_MARGIN,
+                      "band_margin": validation.BAND_MARGIN, "validated": found.validates()}
+    out.flags.extend(validation.flags(found, rule, label, time))
 
 
 def _loo_error(entry, xi, weights, Y, germs, indices) -> np.ndarray:
@@ -678,6 +696,8 @@ def _quantity_json(quantity: QuantityStatistics, seeds: list[str]) -> dict:
     if out.convergence is not None:
         entry["convergence"] = {**out.convergence, "eps_m": out.convergence["eps_m"][0],
                                 "eps_v": out.convergence["eps_v"][0]}
+    if out.validation is not None:
+        entry["validation"] = out.validation
     return entry
 
 
@@ -751,6 +771,8 @@ def summary_json(stats: Statistics) -> dict:
             entry["selection"] = out.selection
         if out.convergence is not None:
             entry["convergence"] = out.convergence
+        if out.validation is not None:
+            entry["validation"] = out.validation
         if out.errors:
             errors = out.errors
             entry["errors"] = {"eps_m": errors["eps_m"], "eps_v": errors["eps_v"],

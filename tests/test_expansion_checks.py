@@ -1,0 +1,114 @@
+"""Every expansion is checked on its own runs (issue 45, methods.validation): an out-of-sample error and
+the band against the runs' range, a flag with its remedy beyond the stated thresholds, and no flag on
+smooth models and the shipped CI flight."""
+import numpy as np
+import pytest
+from conftest import DATA, ROOT, run_python_campaign, strict_json
+
+from uqflight.campaign import load_campaign
+from uqflight.execution import run_campaign
+from uqflight.methods.basis import orthonormal_basis, total_degree_indices
+from uqflight.methods.galerkin import pseudo_galerkin
+from uqflight.methods.pce import PCE
+from uqflight.methods.validation import BAND_MARGIN, VALIDATION_THRESHOLD, flags, validate
+from uqflight.simulators.validation_view import validation_view
+from uqflight.statistics import analyse, summary_json
+
+MODELS = DATA / "validation_models.py"
+NORMAL_3D = "".join(f"  x{k}: {{distribution: normal, lower: -3, upper: 3}}\n" for k in (1, 2, 3))
+GRID = "{kind: sparse_grid, rule: gauss_hermite, level: 2}"
+LHS = "{kind: latin_hypercube, samples: 60}"
+
+
+def campaign(function, design, method, quantities=""):
+    return (f"name: {function}\nseed: 5\nsimulator: {{kind: python, function: \"{MODELS}:{function}\"}}\n"
+            f"parameters:\n{NORMAL_3D}design: {design}\nmethod: {method}\n{quantities}"
+            "analysis: {band_samples: 2000, bootstrap: 0}\n")
+
+
+@pytest.fixture(scope="module")
+def files(tmp_path_factory):
+    root = tmp_path_factory.mktemp("checks")
+    specs = {"kink_grid": ("peak_bank", GRID, "{kind: pseudo_galerkin, order: 2}",
+                           "quantities: {peak: {of: phi, take: max}}\n"),
+             "step_lhs": ("step", LHS, "{kind: least_squares, order: 2}", ""),
+             "smooth_grid": ("smooth", GRID, "{kind: pseudo_galerkin, order: 2}",
+                             "quantities: {last: {of: y, take: final}}\n"),
+             "smooth_lhs": ("smooth", LHS, "{kind: least_squares, order: 2}",
+                            "quantities: {last: {of: y, take: final}}\n")}
+    return {name: run_python_campaign(root, campaign(*spec), name) for name, spec in specs.items()}
+
+
+def test_a_projection_of_a_kinked_bank_is_flagged_with_its_remedy(files):
+    # phi = 30 max(0, ·) sin t + 2 t on a level-2 Gauss-Hermite grid, projected at order 2 as the 737 rudder
+    # kick was: the projection misses its own nodes by more than the runs' variance (measured 2.2)
+    stats = analyse(files["kink_grid"])
+    summary = strict_json(summary_json(stats))
+    for entry in (summary["outputs"]["phi"], summary["quantities"]["peak"]):
+        assert entry["validation"]["error"] > 1.0 and not entry["validation"]["validated"]
+        assert any("misses its own runs" in text and "least squares" in text and "sampled design" in text
+                   for text in entry["flags"])
+    assert any(note.startswith("output phi: pseudo_galerkin order 2 misses its own runs") for note in summary["notes"])
+    assert any(note.startswith("quantity peak: ") for note in summary["notes"])
+    # the band reaches more than BAND_MARGIN ranges of the runs beyond what they span
+    assert summary["quantities"]["peak"]["validation"]["band_excess"] > BAND_MARGIN
+    assert any("extrapolates" in text for text in summary["quantities"]["peak"]["flags"])
+
+
+def test_a_fit_of_a_step_is_flagged_by_its_leave_one_out_error(files):
+    stats = analyse(files["step_lhs"])
+    out = stats.outputs["y"]
+    assert out.validation["check"] == "leave-one-out"
+    assert out.validation["error"] == pytest.approx(float(out.loo_error[0]))
+    assert out.validation["error"] > 0.3  # a step of an order-2 fit: measured 0.57
+    assert len(out.flags) == 1 and "sparse" in out.flags[0]
+
+
+@pytest.mark.parametrize("name", ["smooth_grid", "smooth_lhs"])
+def test_a_smooth_polynomial_is_not_flagged(files, name):
+    # degree 2 in the inputs: the order-2 expansions carry it to rounding; its band lies within the runs'
+    # range widened by their linear fit's band and the margin
+    summary = strict_json(summary_json(analyse(files[name])))
+    for entry in (summary["outputs"]["y"], summary["quantities"]["last"]):
+        assert entry["flags"] == [] and entry["validation"]["validated"]
+        assert entry["validation"]["error"] < 1e-20
+    assert not any("misses" in note or "extrapolates" in note for note in summary["notes"])
+
+
+def test_the_runs_own_statistics_carry_no_check(tmp_path):
+    path = run_python_campaign(tmp_path, campaign("step", LHS, "{kind: monte_carlo}"), "mc")
+    summary = strict_json(summary_json(analyse(path)))
+    assert summary["outputs"]["y"]["flags"] == [] and "validation" not in summary["outputs"]["y"]
+
+
+def test_validate_on_closed_forms():
+    rng = np.random.default_rng(0)
+    germs = ["normal", "normal"]
+    xi = rng.standard_normal((40, 2))
+    indices = total_degree_indices(2, 2)
+    exact = orthonormal_basis(germs, indices, xi) @ np.array([[1.0], [0.5], [0.2], [0.1], [0.0], [0.3]])
+    pce = pseudo_galerkin(xi, np.full(40, 1 / 40), exact, germs, 2)  # a projection with MC weights: not exact
+    fitted = PCE(germs, indices, np.linalg.lstsq(orthonormal_basis(germs, indices, xi), exact, rcond=None)[0])
+    resolved = np.array([True])
+    found = validate("projection", xi, None, exact, germs, fitted, None, resolved, [exact.min(0), exact.max(0)])
+    assert found.worst_error()[0] < 1e-25 and found.validates() and flags(found, "projection", "m", None) == []
+    # the same runs projected with 40 Monte Carlo weights: the residual at the runs is what the projection misses
+    residual = np.sum((exact - pce.evaluate(xi)) ** 2) / np.sum((exact - exact.mean()) ** 2)
+    found = validate("projection", xi, None, exact, germs, pce, None, resolved, [exact.min(0), exact.max(0)])
+    assert found.worst_error()[0] == pytest.approx(residual, rel=1e-12) and residual > VALIDATION_THRESHOLD
+    # a band edge 3 ranges above the runs, whose linear part is small: flagged as an extrapolation
+    span = float(np.ptp(exact))
+    high = exact.max(0) + 3 * span
+    found = validate("projection", xi, None, exact, germs, fitted, None, resolved, [exact.min(0), high])
+    assert found.worst_excess()[0] > 0 and any("extrapolates" in text for text in flags(found, "projection",
+                                                                                             "m", None))
+
+
+def test_the_shipped_ci_flight_is_not_flagged(tmp_path):
+    # the 15-run level-1 grid of tests/baselines/ci-tiny.yaml on JSBSim's c172p: the largest error measured is
+    # 0.021 (q at 8.8 s), the band within 0.04 ranges of the runs
+    run_campaign(load_campaign(ROOT / "tests" / "baselines" / "ci-tiny.yaml", validation_view),
+                 out=tmp_path / "ci.h5", workers=2)
+    summary = strict_json(summary_json(analyse(tmp_path / "ci.h5")))
+    assert all(entry["flags"] == [] for entry in summary["outputs"].values())
+    assert all(entry["validation"]["validated"] for entry in summary["outputs"].values())

@@ -1,0 +1,203 @@
+"""Every expansion checked on its own runs: an error estimated out of sample, and the band and quantiles
+against the range the runs themselves span. Beyond the thresholds below the output or quantity is flagged
+with the remedy that helps.
+
+The out-of-sample error is a share of the runs' own variance, per time, each run counting once:
+
+* a fit (least squares, regression): its leave-one-out error (`loo`, weighted as the fit);
+* a selection (sparse): its leave-one-out error on the basis it chose (optimistic: the choice saw every run);
+* a projection (pseudo-Galerkin, integration, interpolation on a grid): the larger of the projection's own
+  residual at the grid's runs, Σ(yᵢ − PCE(ξᵢ))² / Σ(yᵢ − ȳ)², and the leave-one-out error of a least-squares
+  fit of the same basis on the same runs (when the grid has more runs than terms). A projection does not
+  interpolate its nodes: where the runs hold what the basis cannot carry (a kink, a max(), a wrap) the
+  projection misses them at its own nodes, and the least-squares fit misses the left-out run.
+
+The band check: at each judged time the 99 % band's edges and the quantiles must lie within the runs'
+range [min, max] widened to take in the 99 % band of the runs' own linear least-squares fit (a smooth output
+over many inputs spreads beyond the few runs a grid puts on its axes, as its linear part says), plus
+BAND_MARGIN times the runs' range.
+
+A time is judged when its variance is resolved and the runs' std there is at least JUDGED_SPREAD of the
+output's largest: where the output hardly varies, a relative error of its rounding is no error of a
+statistic.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .basis import orthonormal_basis, total_degree_indices
+from .loo import relative_loo_error
+from .pce import PCE
+
+# An expansion that leaves more than 5 % of the runs' variance unexplained out of sample (an RMS error
+# above 22 % of their std) is flagged: the smooth flights and closed forms of the tests stay below 1e-2,
+# an output with a kink or a max() (a peak bank) is above 0.1.
+VALIDATION_THRESHOLD = 0.05
+# A band edge or quantile more than one range of the runs beyond their range (and their linear fit's band)
+# is flagged as an extrapolation (a χ² of two inputs on a level-2 grid reaches 0.8 of it).
+BAND_MARGIN = 1.0
+JUDGED_SPREAD = 1e-2
+Z_995 = 2.5758293035489004  # the 99.5 % quantile of N(0, 1): the linear fit's 99 % band is its mean ± Z σ
+
+
+@dataclass
+class Validation:
+    """What the check of an expansion on its own runs found.
+
+    Attributes
+    ----------
+    error : numpy.ndarray
+        (T,) out-of-sample error, a share of the runs' variance (NaN where undefined).
+    check : str
+        How the error was estimated, in words.
+    judged : numpy.ndarray
+        (T,) bool: the times the flags judge.
+    least_squares : numpy.ndarray or None
+        (T,) leave-one-out error of least squares of the same basis on the same runs (projections).
+    band_excess : numpy.ndarray
+        (T,) how far the band or a quantile lies beyond the allowed range, in ranges of the runs
+        (<= 0: within it).
+    allowed : tuple of numpy.ndarray
+        (lower, upper) of the allowed range per time.
+    """
+
+    error: np.ndarray
+    check: str
+    judged: np.ndarray
+    least_squares: np.ndarray | None
+    band_excess: np.ndarray
+    allowed: tuple[np.ndarray, np.ndarray]
+
+    def worst_error(self) -> tuple[float, int] | None:
+        """The largest error over the judged times and its time index; None when no time is judged or
+        the error is undefined at every judged one."""
+        error = np.where(self.judged, self.error, np.nan)
+        if not np.isfinite(error).any():
+            return None
+        at = int(np.nanargmax(error))
+        return float(error[at]), at
+
+    def worst_excess(self) -> tuple[float, int] | None:
+        """The largest band excess over the judged times and its time index (None: no time judged)."""
+        if not self.judged.any():
+            return None
+        excess = np.where(self.judged, self.band_excess, -np.inf)
+        at = int(np.argmax(excess))
+        return float(excess[at]), at
+
+    def validates(self) -> bool:
+        """The error is defined and below VALIDATION_THRESHOLD at every judged time, and the band within
+        its allowed range (no time judged: nothing varies, nothing to flag)."""
+        worst = self.worst_error()
+        excess = self.worst_excess()
+        if excess is None:
+            return True
+        return worst is not None and worst[0] <= VALIDATION_THRESHOLD and excess[0] <= 0.0
+
+
+def judged_times(Y: np.ndarray, resolved: np.ndarray) -> np.ndarray:
+    """(T,) bool: resolved times where the runs' std is at least JUDGED_SPREAD of its largest."""
+    std = Y.std(axis=0)
+    peak = std.max(initial=0.0)
+    return np.asarray(resolved, dtype=bool) & (std > 0) & (std >= JUDGED_SPREAD * peak)
+
+
+def out_of_sample_error(rule: str, xi, weights, Y: np.ndarray, germs, pce: PCE,
+                        loo_error: np.ndarray | None) -> tuple[np.ndarray, str, np.ndarray | None]:
+    """(error (T,), how it was estimated, least squares' LOO error of the same basis or None) of the
+    expansion `pce` built by a method of `rule` from the runs Y (N, T) at xi; `loo_error`: the fit's own."""
+    if rule in ("fit", "selection"):
+        how = "leave-one-out" + (" on the basis it selected" if rule == "selection" else "")
+        return (np.full(Y.shape[1], np.nan) if loo_error is None else loo_error), how, None
+    spread = np.sum((Y - Y.mean(axis=0)) ** 2, axis=0)
+    residual = np.sum((Y - pce.evaluate(xi)) ** 2, axis=0)
+    own = np.divide(residual, spread, out=np.full(Y.shape[1], np.nan), where=spread > 0)
+    matrix = orthonormal_basis(germs, pce.indices, xi)
+    least_squares = None
+    if matrix.shape[0] > matrix.shape[1]:
+        try:
+            least_squares = relative_loo_error(matrix, Y)
+        except ValueError:  # rank-deficient or interpolating: no out-of-sample error of the fit
+            least_squares = None
+    if least_squares is None:
+        return own, "the projection's residual at the grid's runs", None
+    return (np.fmax(own, least_squares),
+            "the projection's residual at the grid's runs and the leave-one-out error of least squares "
+            "of the same basis on them, the larger", least_squares)
+
+
+def allowed_range(xi, Y: np.ndarray, germs) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(lower, upper, range) per time: the runs' [min, max] widened to the 99 % band of their linear
+    least-squares fit, then by BAND_MARGIN ranges; range = max − min of the runs."""
+    low, high = Y.min(axis=0), Y.max(axis=0)
+    span = high - low
+    indices = total_degree_indices(len(germs), 1)
+    matrix = orthonormal_basis(germs, indices, xi)
+    if matrix.shape[0] > matrix.shape[1]:
+        coefficients, _, rank, _ = np.linalg.lstsq(matrix, Y, rcond=None)
+        if rank == matrix.shape[1]:
+            centre, std = coefficients[0], np.sqrt(np.sum(coefficients[1:] ** 2, axis=0))
+            low, high = np.minimum(low, centre - Z_995 * std), np.maximum(high, centre + Z_995 * std)
+    return low - BAND_MARGIN * span, high + BAND_MARGIN * span, span
+
+
+def validate(rule: str, xi, weights, Y: np.ndarray, germs, pce: PCE, loo_error, resolved,
+             edges: list[np.ndarray]) -> Validation:
+    """Check the expansion `pce` (of a method of `rule`) on its runs Y (N, T) at xi: its out-of-sample
+    error and its band edges and quantiles `edges` (each (T,)) against the runs' range."""
+    error, how, least_squares = out_of_sample_error(rule, xi, weights, Y, germs, pce, loo_error)
+    lower, upper, span = allowed_range(xi, Y, germs)
+    beyond = np.max([np.maximum(lower - edge, edge - upper) for edge in edges], axis=0)
+    excess = np.divide(beyond, span, out=np.zeros_like(beyond), where=span > 0)
+    return Validation(error, how, judged_times(Y, resolved), least_squares, excess, (lower, upper))
+
+
+def remedy(rule: str, least_squares_error: float | None) -> str:
+    """What helps an expansion of a method of `rule` that does not validate on its runs."""
+    sampled = ("or a sampled design (latin_hypercube, sobol, monte_carlo), whose runs' own statistics need "
+               "no expansion; `method: {kind: auto}` takes the method that validates")
+    if rule == "projection":
+        first = ("least squares of the same basis validates on these runs (`report --method least_squares`)"
+                 if least_squares_error is not None and least_squares_error <= VALIDATION_THRESHOLD else
+                 "use least squares or sparse on the same runs (`report --method least_squares`, "
+                 "`method: {kind: sparse}`)")
+        return f"{first}, {sampled}"
+    if rule == "fit":
+        return f"use sparse on the same runs (`method: {{kind: sparse}}`) or another order, {sampled}"
+    return f"use another max_order or more runs, {sampled}"
+
+
+def flags(validation: Validation, rule: str, label: str, time: np.ndarray | None,
+          band_of: str = "99 % band") -> list[str]:
+    """The flag texts of a check (empty when it validates); `label` names the method, `time` the output's
+    times (None: a quantity, one value)."""
+    found = []
+
+    def when(at: int) -> str:
+        return "" if time is None else f" at t = {time[at]:.6g} s"
+
+    worst = validation.worst_error()
+    excess = validation.worst_excess()
+    if excess is None:
+        return found
+    ls = validation.least_squares
+    ls_error = None if ls is None or not np.isfinite(ls[validation.judged]).any() else float(
+        np.nanmax(np.where(validation.judged, ls, np.nan)))
+    fix = remedy(rule, ls_error)
+    if worst is None:
+        found.append(f"{label}: no out-of-sample error could be estimated on these runs, so its statistics "
+                     f"are not validated; {fix}")
+    elif worst[0] > VALIDATION_THRESHOLD:
+        found.append(f"{label} misses its own runs: out-of-sample error {worst[0]:.3g} of their variance"
+                     f"{when(worst[1])} ({validation.check}), above {VALIDATION_THRESHOLD:g}: its mean, "
+                     f"spread, band and Sobol' indices are not to be trusted; {fix}")
+    if excess[0] > 0.0:
+        at = excess[1]
+        lower, upper = validation.allowed
+        found.append(f"{label} extrapolates: its {band_of} or a quantile{when(at)} lies "
+                     f"{excess[0] + BAND_MARGIN:.3g} ranges of the runs beyond what they span (more than "
+                     f"{BAND_MARGIN:g} beyond their range and their linear fit's band, [{lower[at]:.6g}, "
+                     f"{upper[at]:.6g}] with that margin); {fix}")
+    return found
