@@ -112,3 +112,39 @@ def test_the_shipped_ci_flight_is_not_flagged(tmp_path):
     summary = strict_json(summary_json(analyse(tmp_path / "ci.h5")))
     assert all(entry["flags"] == [] for entry in summary["outputs"].values())
     assert all(entry["validation"]["validated"] for entry in summary["outputs"].values())
+
+
+def test_auto_takes_the_validated_method_per_output_and_the_runs_when_none_validates(tmp_path):
+    # on a level-2 grid: the smooth polynomial validates with the projection (exact: the first candidate at
+    # equal error), the step with no expansion, so its statistics are the runs' own: the grid's weights
+    # are signed there, so the least-bad expansion stays, flagged; on Latin-hypercube runs the step falls back
+    # to monte_carlo, whose mean is the runs' own
+    grid = run_python_campaign(tmp_path, campaign("smooth", GRID, "{kind: auto, order: 2}",
+                                                  "quantities: {last: {of: y, take: final}}\n"), "grid")
+    summary = strict_json(summary_json(analyse(grid)))
+    assert summary["method"]["kind"] == "auto"
+    for entry in (summary["outputs"]["y"], summary["quantities"]["last"]):
+        assert entry["method"]["kind"] == "pseudo_galerkin" and entry["flags"] == []
+        assert set(entry["method"]["errors"]) == {"pseudo_galerkin", "least_squares", "sparse"}
+    assert any(note.startswith("auto took pseudo_galerkin for y, last") for note in summary["notes"])
+    lhs = run_python_campaign(tmp_path, campaign("step", LHS, "{kind: auto, order: 2}"), "lhs")
+    stats = analyse(lhs)
+    out = stats.outputs["y"]
+    assert out.method["kind"] == "monte_carlo" and out.pce is None and out.flags == []
+    assert out.method["errors"]["least_squares"] > VALIDATION_THRESHOLD
+    import h5py
+    with h5py.File(lhs) as f:
+        assert out.mean[0] == pytest.approx(float(np.mean(f["outputs/y"][:, 0])), rel=1e-12)
+    assert any("monte_carlo (the runs' own statistics) for y" in note for note in stats.notes)
+
+
+def test_auto_on_a_grid_of_positive_weights_falls_back_to_the_weighted_runs(tmp_path):
+    path = run_python_campaign(tmp_path, campaign("step", "{kind: tensor_grid, points: 4}", "{kind: auto, order: 2}"),
+                               "tensor")
+    stats = analyse(path)
+    out = stats.outputs["y"]
+    assert out.method["kind"] == "integration" and out.pce is None and out.flags == []
+    import h5py
+    with h5py.File(path) as f:
+        y, w = f["outputs/y"][:, 0], f["samples/weight"][:]
+    assert out.mean[0] == pytest.approx(float(w @ y / w.sum()), rel=1e-12)  # the grid's quadrature of the runs

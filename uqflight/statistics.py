@@ -51,7 +51,6 @@ from .designs import is_sampled
 from .designs.adaptive import index_set_summary
 from .methods import PCE, METHODS, failed_runs_note, fit, method_entry, method_settings, normalised
 from .methods.basis import orthonormal_basis
-from .methods.loo import relative_loo_error
 from .methods.pce_moments import pce_standardised_moments, triple_products
 from .methods import validation
 from .methods.validity import method_problem
@@ -111,6 +110,7 @@ class OutputStatistics:
     selection: dict | None = None  # what a selecting method (sparse) chose: terms, order, corrected LOO error
     convergence: dict | None = None  # difference to the next lower order of a projection
     validation: dict | None = None  # the expansion checked on its own runs (methods.validation): error, band
+    method: dict | None = None  # what `method: {kind: auto}` took for this output (auto_method), None otherwise
     coefficient_decay: dict[int, np.ndarray] | None = None  # degree -> RSS of its PCE coefficients (T,)
     final_samples: np.ndarray | None = None  # runs or surrogate draws at the final time, for the KLD
     fourth_central: np.ndarray | None = None  # of the runs, for a sampled reference's noise floor
@@ -256,8 +256,9 @@ def analyse(path, reference: str | None = None, options: Options | None = None, 
                     progress.advance()
 
             for name in store.output_names:
-                in_flight.append((name, _start_output(store, name, method, germs, design_kind, ok, options, pool,
-                                                      reused)))
+                chosen, runs_only, record = auto_method(store, name, method, germs, design_kind, ok)
+                in_flight.append((name, _with_method(record, _start_output(
+                    store, name, chosen, germs, design_kind, ok, options, pool, reused, runs_only))))
                 if len(in_flight) >= ANALYSIS_THREADS:
                     finish_oldest()
             while in_flight:
@@ -267,6 +268,7 @@ def analyse(path, reference: str | None = None, options: Options | None = None, 
                                                          analysis.get("exceedance", {}).get(name, []))
             if progress is not None:
                 progress.advance()
+    _note_auto(stats)
     note_flags(stats)
     if reference:
         add_reference_errors(stats, analyse(reference, options=Options(
@@ -354,8 +356,67 @@ def output_basis(store: ResultStore, name: str, ok: np.ndarray) -> tuple[np.ndar
 def _output_statistics(store: ResultStore, name: str, method: dict, germs: list[str], design_kind: str,
                        ok: np.ndarray, options: Options) -> OutputStatistics:
     """The statistics of output `name` over the `ok` runs, its time blocks in ANALYSIS_THREADS threads."""
+    chosen, runs_only, record = auto_method(store, name, method, germs, design_kind, ok)
     with ThreadPoolExecutor(ANALYSIS_THREADS) as pool:
-        return _start_output(store, name, method, germs, design_kind, ok, options, pool, Reused())()
+        return _with_method(record, _start_output(store, name, chosen, germs, design_kind, ok, options, pool,
+                                                  Reused(), runs_only))()
+
+
+def _with_method(record: dict | None, finish: Callable[[], OutputStatistics]) -> Callable[[], OutputStatistics]:
+    """`finish` whose statistics carry what auto took (`record`, None: the method was given)."""
+    def finished() -> OutputStatistics:
+        out = finish()
+        out.method = record
+        return out
+    return finished
+
+
+def auto_method(store: ResultStore, name: str, method: dict, germs: list[str], design_kind: str,
+                ok: np.ndarray) -> tuple[dict, bool, dict | None]:
+    """(the method for output `name`, whether its statistics are the runs' own, what auto took or None).
+
+    `method` other than auto is itself. For auto: among AUTO_CANDIDATES of its order that the design and its
+    runs allow (methods.validity), the one whose out-of-sample error (methods.validation, over the judged
+    times) is the lowest and below VALIDATION_THRESHOLD, ties (errors below 1e-12: exact fits) to the first;
+    when none validates, the runs' own statistics: monte_carlo on a sampled design, the weighted runs on a grid
+    of weights >= 0; a grid with signed weights has no statistics of its runs alone, so it keeps the expansion
+    of lowest error, flagged by its own check."""
+    if method["kind"] != "auto":
+        return method, False, None
+    xi, weights, order = store.xi[ok], store.weights[ok], method["order"]
+    sampled, missing = is_sampled(design_kind), int(ok.size - ok.sum())
+    basis, scale = output_basis(store, name, ok)
+    taken, errors = validation.auto_choice(xi, weights, basis, scale, germs, order, sampled, missing)
+    record = {"chosen_by": "auto", "order": order, "errors": errors, "threshold": validation.VALIDATION_THRESHOLD}
+    if taken is not None:
+        return ({**method, "kind": taken, "order": order}, False,
+                {**record, "kind": taken, "why": f"the lowest validated error, {errors[taken]:.3g}"})
+    why = "no expansion validates on these runs"
+    if sampled:
+        return ({**method, "kind": "monte_carlo", "order": order}, False,
+                {**record, "kind": "monte_carlo", "why": f"{why}: the runs' own statistics"})
+    if (weights >= 0).all() or not [e for e in errors.values() if e is not None]:
+        return ({**method, "kind": "integration", "order": order}, True,
+                {**record, "kind": "integration", "why": f"{why}: the runs' own statistics, weighted by the grid"})
+    kind = min((e, i, k) for i, (k, e) in enumerate(errors.items()) if e is not None)[2]
+    return ({**method, "kind": kind, "order": order}, False,
+            {**record, "kind": kind, "why": f"{why}, and a grid with negative weights has no statistics of its runs "
+                                            "alone: the expansion of lowest error, flagged; run a sampled design"})
+
+
+def _note_auto(stats: Statistics) -> None:
+    """One note of what `method: {kind: auto}` took for each output and quantity."""
+    taken: dict[str, list[str]] = {}
+    entries = [(name, out) for name, out in stats.outputs.items()]
+    entries += [(name, q.output) for name, q in stats.quantities.items() if q.output is not None]
+    for name, out in entries:
+        if out.method is not None:
+            how = out.method["kind"] + (" (the runs' own statistics)" if out.method["kind"] in ("monte_carlo",
+                                                                                               "integration") else "")
+            taken.setdefault(how, []).append(name)
+    if taken:
+        stats.notes.append("auto took " + "; ".join(f"{how} for {', '.join(names)}" for how, names in taken.items())
+                           + " (each output's method in summary.json)")
 
 
 class Reused:
@@ -389,15 +450,17 @@ class Reused:
 
 
 def _start_output(store: ResultStore, name: str, method: dict, germs: list[str], design_kind: str,
-                  ok: np.ndarray, options: Options, pool: Executor, reused: Reused) -> Callable[[], OutputStatistics]:
+                  ok: np.ndarray, options: Options, pool: Executor, reused: Reused,
+                  runs_only: bool = False) -> Callable[[], OutputStatistics]:
     """Read and fit output `name` here and hand its time blocks to `pool`; returns what waits for them
-    and gives the output's statistics. `reused`: what the outputs of one analysis share (Reused)."""
+    and gives the output's statistics. `reused`: what the outputs of one analysis share (Reused).
+    `runs_only`: the statistics of the (weighted) runs themselves, as on a sampled design (auto_method)."""
     xi, weights = store.xi[ok], store.weights[ok]
     kind, order = method["kind"], method["order"]
     entry = method_entry(kind)
     basis, scale = output_basis(store, name, ok)
     truncation = _tsvd_resolution(store, scale, int(ok.sum()))
-    sampled = is_sampled(design_kind)
+    sampled = is_sampled(design_kind) or runs_only
     x0 = None
     # x = x0 + S with each run's initial value (needs the runs themselves); only the projections use
     # it: the other kinds fit the constant term themselves, where the split would change nothing
@@ -499,11 +562,7 @@ def _validate(out: OutputStatistics, rule: str, label: str, xi, weights, Y: np.n
 
 def _loo_error(entry, xi, weights, Y, germs, indices) -> np.ndarray:
     """The relative leave-one-out error of the fit over time (methods.loo), weighted as the fit is."""
-    matrix = orthonormal_basis(germs, indices, xi)
-    try:
-        return relative_loo_error(matrix, Y, np.abs(weights) if entry.weighted else None)
-    except ValueError:  # a point the fit interpolates: leaving it out is undefined
-        return np.full(Y.shape[1], np.nan)
+    return validation.leave_one_out(entry.weighted, xi, weights, Y, germs, indices)
 
 
 def _lower_order_difference(kind, xi, weights, basis, scale, germs, order, x0, pce: PCE) -> dict:
@@ -661,13 +720,30 @@ def quantity_statistics(store: ResultStore, stats: Statistics, name: str, germs:
         return QuantityStatistics(name, missing, None, nulls)
     view = _QuantityView(store, name, values)
     out = _output_statistics(view, name, stats.method, germs, stats.design_kind, defined, options)
-    if out.pce is None:
+    if out.pce is None and not sampled:  # auto's runs' own statistics on a grid: the weighted runs
+        exceedance = _grid_exceedance(values, defined, store.weights, thresholds)
+    elif out.pce is None:
         exceedance = exceedance_from_runs(values, defined, thresholds, DESIGNS[stats.design_kind].draws,
                                           stats.design_info)
     else:
         exceedance = exceedance_from_pce(out.pce.sample(options.band_samples, options.seed)[:, 0],
                                          int(defined.sum()), thresholds)
     return QuantityStatistics(name, missing, out, exceedance)
+
+
+def _grid_exceedance(values: np.ndarray, defined: np.ndarray, weights: np.ndarray,
+                     thresholds: list[dict]) -> list[dict]:
+    """Exceedance probabilities of a grid's weighted runs (weights >= 0): the quadrature of the indicator,
+    without an interval (analysis.failures: the nodes are not random draws)."""
+    found = []
+    for item in thresholds:
+        (bound, threshold), = item.items()
+        beyond = values[defined] > threshold if bound == "above" else values[defined] < threshold
+        p = grid_failure_probability(beyond, weights[defined])
+        found.append({bound: threshold, "probability": p["estimate"], "lower": None, "upper": None, "method": "grid",
+                      "note": f"the grid's quadrature of the indicator {bound} {threshold:g}, without an interval "
+                              "(the nodes are not random draws); a sampled design gives one"})
+    return found
 
 
 def _quantity_json(quantity: QuantityStatistics, seeds: list[str]) -> dict:
@@ -698,6 +774,8 @@ def _quantity_json(quantity: QuantityStatistics, seeds: list[str]) -> dict:
                                 "eps_v": out.convergence["eps_v"][0]}
     if out.validation is not None:
         entry["validation"] = out.validation
+    if out.method is not None:
+        entry["method"] = out.method
     return entry
 
 
@@ -773,6 +851,8 @@ def summary_json(stats: Statistics) -> dict:
             entry["convergence"] = out.convergence
         if out.validation is not None:
             entry["validation"] = out.validation
+        if out.method is not None:
+            entry["method"] = out.method
         if out.errors:
             errors = out.errors
             entry["errors"] = {"eps_m": errors["eps_m"], "eps_v": errors["eps_v"],

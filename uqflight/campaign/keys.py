@@ -200,7 +200,10 @@ VALUES = {
         "interpolation": "Moments from the weights (Eq. 32–34), PCE by projection.",
         "regression": "Least-squares fit of the PCE, weights ignored (Eq. 35–37).",
         "least_squares": "Weighted least-squares fit of the PCE (Eq. 43–48).",
-        "monte_carlo": "Sample moments of the runs; sampled designs only."},
+        "monte_carlo": "Sample moments of the runs; sampled designs only.",
+        "auto": "Per output and quantity, among pseudo_galerkin (grids), least_squares and sparse of `order`, the "
+                "one with the lowest error validated on the runs; the runs' own statistics when none validates. "
+                "Each output's `method` in summary.json says which it took (see [methods](../methods.md))."},
     "design.rule": {
         "gauss_hermite": "Gauss–Hermite (normal inputs; nested: Genz–Keister).",
         "genz_keister": "Genz–Keister, nested (normal inputs).",

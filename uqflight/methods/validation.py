@@ -30,6 +30,7 @@ import numpy as np
 from .basis import orthonormal_basis, total_degree_indices
 from .loo import relative_loo_error
 from .pce import PCE
+from .validity import method_problem
 
 # An expansion that leaves more than 5 % of the runs' variance unexplained out of sample (an RMS error
 # above 22 % of their std) is flagged: the smooth flights and closed forms of the tests stay below 1e-2,
@@ -201,3 +202,43 @@ def flags(validation: Validation, rule: str, label: str, time: np.ndarray | None
                      f"{BAND_MARGIN:g} beyond their range and their linear fit's band, [{lower[at]:.6g}, "
                      f"{upper[at]:.6g}] with that margin); {fix}")
     return found
+
+
+def leave_one_out(weighted: bool, xi, weights, Y: np.ndarray, germs, indices) -> np.ndarray:
+    """The relative leave-one-out error over time (`loo`) of the fit of basis `indices`, weighted by |w|
+    when the fit is; NaN where undefined (a point the fit interpolates)."""
+    matrix = orthonormal_basis(germs, indices, xi)
+    try:
+        return relative_loo_error(matrix, Y, np.abs(weights) if weighted else None)
+    except ValueError:  # a point the fit interpolates: leaving it out is undefined
+        return np.full(Y.shape[1], np.nan)
+
+
+def auto_choice(xi, weights, basis, scale, germs, order: int, sampled: bool,
+                missing: int = 0) -> tuple[str | None, dict[str, float | None]]:
+    """What `method: {kind: auto}` takes on the runs Y = basis @ scale (scale None: Y = basis) at xi: (the kind
+    of AUTO_CANDIDATES with the lowest out-of-sample error over the judged times, at most VALIDATION_THRESHOLD,
+    ties (below 1e-12: exact) to the first; None when none validates, {kind: its error, None: undefined}).
+    Candidates the design and its runs refuse (methods.validity) are left out."""
+    from . import AUTO_CANDIDATES, fit, method_entry, method_settings
+
+    Y = basis if scale is None else basis @ scale
+    judged = judged_times(Y, np.ones(Y.shape[1], dtype=bool))
+    errors: dict[str, float | None] = {}
+    for kind in AUTO_CANDIDATES:
+        entry = method_entry(kind)
+        if (entry.rule == "projection" and sampled) or method_problem(kind, order, xi, weights, germs, sampled,
+                                                                       missing=missing):
+            continue
+        try:
+            pce = fit(kind, xi, weights, basis, germs, order, scale=scale, sampled=sampled,
+                      settings=method_settings({"kind": kind})).pce
+        except ValueError:  # e.g. sparse with no basis of a defined leave-one-out error
+            continue
+        loo = None if entry.rule == "projection" else leave_one_out(entry.weighted, xi, weights, Y, germs,
+                                                                    pce.indices)
+        error = np.where(judged, out_of_sample_error(entry.rule, xi, weights, Y, germs, pce, loo)[0], np.nan)
+        errors[kind] = 0.0 if not judged.any() else (float(np.nanmax(error)) if np.isfinite(error).any() else None)
+    valid = [(max(e, 1e-12), i, k) for i, (k, e) in enumerate(errors.items())
+             if e is not None and e <= VALIDATION_THRESHOLD]
+    return (min(valid)[2] if valid else None), errors
