@@ -256,7 +256,7 @@ def analyse(path, reference: str | None = None, options: Options | None = None, 
                     progress.advance()
 
             for name in store.output_names:
-                chosen, runs_only, record = auto_method(store, name, method, germs, design_kind, ok)
+                chosen, runs_only, record = auto_method(store, name, method, germs, design_kind, ok, options.seed)
                 in_flight.append((name, _with_method(record, _start_output(
                     store, name, chosen, germs, design_kind, ok, options, pool, reused, runs_only))))
                 if len(in_flight) >= ANALYSIS_THREADS:
@@ -356,7 +356,7 @@ def output_basis(store: ResultStore, name: str, ok: np.ndarray) -> tuple[np.ndar
 def _output_statistics(store: ResultStore, name: str, method: dict, germs: list[str], design_kind: str,
                        ok: np.ndarray, options: Options) -> OutputStatistics:
     """The statistics of output `name` over the `ok` runs, its time blocks in ANALYSIS_THREADS threads."""
-    chosen, runs_only, record = auto_method(store, name, method, germs, design_kind, ok)
+    chosen, runs_only, record = auto_method(store, name, method, germs, design_kind, ok, options.seed)
     with ThreadPoolExecutor(ANALYSIS_THREADS) as pool:
         return _with_method(record, _start_output(store, name, chosen, germs, design_kind, ok, options, pool,
                                                   Reused(), runs_only))()
@@ -372,12 +372,13 @@ def _with_method(record: dict | None, finish: Callable[[], OutputStatistics]) ->
 
 
 def auto_method(store: ResultStore, name: str, method: dict, germs: list[str], design_kind: str,
-                ok: np.ndarray) -> tuple[dict, bool, dict | None]:
+                ok: np.ndarray, seed: int = 0) -> tuple[dict, bool, dict | None]:
     """(the method for output `name`, whether its statistics are the runs' own, what auto took or None).
 
     `method` other than auto is itself. For auto: among AUTO_CANDIDATES of its order that the design and its
     runs allow (methods.validity), the one whose out-of-sample error (methods.validation, over the judged
-    times) is the lowest and below VALIDATION_THRESHOLD, ties (errors below 1e-12: exact fits) to the first;
+    times) is the lowest and below VALIDATION_THRESHOLD and whose band stays within the runs' allowed range (its
+    draws seeded by `seed`), ties (errors below 1e-12: exact fits) to the first;
     when none validates, the runs' own statistics: monte_carlo on a sampled design, the weighted runs on a grid
     of weights >= 0; a grid with signed weights has no statistics of its runs alone, so it keeps the expansion
     of lowest error, flagged by its own check."""
@@ -386,11 +387,14 @@ def auto_method(store: ResultStore, name: str, method: dict, germs: list[str], d
     xi, weights, order = store.xi[ok], store.weights[ok], method["order"]
     sampled, missing = is_sampled(design_kind), int(ok.size - ok.sum())
     basis, scale = output_basis(store, name, ok)
-    taken, errors = validation.auto_choice(xi, weights, basis, scale, germs, order, sampled, missing)
-    record = {"chosen_by": "auto", "order": order, "errors": errors, "threshold": validation.VALIDATION_THRESHOLD}
+    taken, errors, band_outside = validation.auto_choice(xi, weights, basis, scale, germs, order, sampled, missing,
+                                                         seed)
+    record = {"chosen_by": "auto", "order": order, "errors": errors, "threshold": validation.VALIDATION_THRESHOLD,
+              "band_beyond_runs": band_outside}
     if taken is not None:
         return ({**method, "kind": taken, "order": order}, False,
-                {**record, "kind": taken, "why": f"the lowest validated error, {errors[taken]:.3g}"})
+                {**record, "kind": taken, "why": f"the lowest validated error, {errors[taken]:.3g}, its band "
+                                                 "within the runs' range"})
     why = "no expansion validates on these runs"
     if sampled:
         return ({**method, "kind": "monte_carlo", "order": order}, False,
@@ -513,7 +517,7 @@ def _start_output(store: ResultStore, name: str, method: dict, germs: list[str],
             elif entry.moments == "pce" and order >= 1:
                 stats.convergence = _lower_order_difference(kind, xi, weights, basis, scale, germs, order, x0, pce)
             _validate(stats, entry.rule, f"{kind} order {order}", xi, weights, expand(basis), germs,
-                      None if isinstance(store, _QuantityView) else store.time)
+                      None if isinstance(store, _QuantityView) else store.time, options.seed)
         elif pick_freeze:
             stats.sobol_first = dict(zip(names, masked(blocks["first"])))
             stats.sobol_total = dict(zip(names, masked(blocks["total"])))
@@ -547,10 +551,10 @@ def _coefficient_decay(pce: PCE) -> dict[int, np.ndarray]:
 
 
 def _validate(out: OutputStatistics, rule: str, label: str, xi, weights, Y: np.ndarray, germs,
-              time: np.ndarray | None) -> None:
+              time: np.ndarray | None, seed: int) -> None:
     """Check `out`'s expansion on its own runs Y (methods.validation): its `validation` and its flags."""
     edges = [*out.band99, *out.quantiles.values()]
-    found = validation.validate(rule, xi, weights, Y, germs, out.pce, out.loo_error, out.resolved, edges)
+    found = validation.validate(rule, xi, weights, Y, germs, out.pce, out.loo_error, out.resolved, edges, seed)
     worst, excess = found.worst_error(), found.worst_excess()
     out.validation = {"check": found.check, "threshold": validation.VALIDATION_THRESHOLD,
                       "error": None if worst is None else worst[0],

@@ -162,7 +162,7 @@ def fit(kind: str, xi, weights, Y, germs, order: int = 2, x0=None, *, scale=None
         from .validation import auto_choice
 
         Y = as_runs_by_time(Y)
-        taken, _ = auto_choice(xi, weights, Y, scale, germs, order, sampled)
+        taken = auto_choice(xi, weights, Y, scale, germs, order, sampled)[0]
         fallback = "monte_carlo" if sampled else "integration"
         return fit(taken or fallback, xi, weights, Y, germs, order, scale=scale, sampled=sampled or taken is None,
                    settings=method_settings({"kind": taken}) if taken else None)
