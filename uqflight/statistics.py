@@ -516,8 +516,10 @@ def _start_output(store: ResultStore, name: str, method: dict, germs: list[str],
                 stats.loo_error = _loo_error(entry, xi, weights, expand(basis), germs, pce.indices)
             elif entry.moments == "pce" and order >= 1:
                 stats.convergence = _lower_order_difference(kind, xi, weights, basis, scale, germs, order, x0, pce)
+            refit = (validation.refitting(kind, xi, weights, basis, scale, germs, order, sampled,
+                                          method_settings(method)) if entry.rule == "selection" else None)
             _validate(stats, entry.rule, f"{kind} order {order}", xi, weights, expand(basis), germs,
-                      None if isinstance(store, _QuantityView) else store.time, options.seed)
+                      None if isinstance(store, _QuantityView) else store.time, options.seed, refit)
         elif pick_freeze:
             stats.sobol_first = dict(zip(names, masked(blocks["first"])))
             stats.sobol_total = dict(zip(names, masked(blocks["total"])))
@@ -551,10 +553,11 @@ def _coefficient_decay(pce: PCE) -> dict[int, np.ndarray]:
 
 
 def _validate(out: OutputStatistics, rule: str, label: str, xi, weights, Y: np.ndarray, germs,
-              time: np.ndarray | None, seed: int) -> None:
+              time: np.ndarray | None, seed: int, refit=None) -> None:
     """Check `out`'s expansion on its own runs Y (methods.validation): its `validation` and its flags."""
     edges = [*out.band99, *out.quantiles.values()]
-    found = validation.validate(rule, xi, weights, Y, germs, out.pce, out.loo_error, out.resolved, edges, seed)
+    found = validation.validate(rule, xi, weights, Y, germs, out.pce, out.loo_error, out.resolved, edges, seed,
+                                refit)
     worst, excess = found.worst_error(), found.worst_excess()
     out.validation = {"check": found.check, "threshold": validation.VALIDATION_THRESHOLD,
                       "error": None if worst is None else worst[0],
