@@ -180,3 +180,12 @@ def test_the_statistics_of_sparse_say_their_cross_validated_error(tmp_path):
     out = analyse(path).outputs["y"]
     assert out.validation["check"] == "5-fold cross-validation, the selection redone in each fold"
     assert out.validation["error"] > VALIDATION_THRESHOLD and out.flags
+
+
+def test_auto_on_a_signed_grid_with_no_valid_method_keeps_the_least_bad_flagged(files):
+    # the kinked bank on a level-2 Gauss-Hermite grid (signed weights): no candidate validates its peak, and the
+    # grid's runs alone give no statistics, so auto keeps the lowest error and its flag says to sample
+    stats = analyse(files["kink_grid"], method={"kind": "auto", "order": 2})
+    peak = stats.quantities["peak"].output
+    assert peak.method["kind"] in ("least_squares", "sparse") and "negative weights" in peak.method["why"]
+    assert peak.flags and all("(taken by auto)" in text and "run a sampled design" in text for text in peak.flags)

@@ -257,8 +257,9 @@ def analyse(path, reference: str | None = None, options: Options | None = None, 
 
             for name in store.output_names:
                 chosen, runs_only, record = auto_method(store, name, method, germs, design_kind, ok, options.seed)
-                in_flight.append((name, _with_method(record, _start_output(
-                    store, name, chosen, germs, design_kind, ok, options, pool, reused, runs_only))))
+                start = _start_output(store, name, chosen, germs, design_kind, ok, options, pool, reused, runs_only,
+                                      record is not None)
+                in_flight.append((name, _with_method(record, start)))
                 if len(in_flight) >= ANALYSIS_THREADS:
                     finish_oldest()
             while in_flight:
@@ -359,7 +360,7 @@ def _output_statistics(store: ResultStore, name: str, method: dict, germs: list[
     chosen, runs_only, record = auto_method(store, name, method, germs, design_kind, ok, options.seed)
     with ThreadPoolExecutor(ANALYSIS_THREADS) as pool:
         return _with_method(record, _start_output(store, name, chosen, germs, design_kind, ok, options, pool,
-                                                  Reused(), runs_only))()
+                                                  Reused(), runs_only, record is not None))()
 
 
 def _with_method(record: dict | None, finish: Callable[[], OutputStatistics]) -> Callable[[], OutputStatistics]:
@@ -455,10 +456,11 @@ class Reused:
 
 def _start_output(store: ResultStore, name: str, method: dict, germs: list[str], design_kind: str,
                   ok: np.ndarray, options: Options, pool: Executor, reused: Reused,
-                  runs_only: bool = False) -> Callable[[], OutputStatistics]:
+                  runs_only: bool = False, auto: bool = False) -> Callable[[], OutputStatistics]:
     """Read and fit output `name` here and hand its time blocks to `pool`; returns what waits for them
     and gives the output's statistics. `reused`: what the outputs of one analysis share (Reused).
-    `runs_only`: the statistics of the (weighted) runs themselves, as on a sampled design (auto_method)."""
+    `runs_only`: the statistics of the (weighted) runs themselves, as on a sampled design; `auto`: `method`
+    is what auto took (auto_method)."""
     xi, weights = store.xi[ok], store.weights[ok]
     kind, order = method["kind"], method["order"]
     entry = method_entry(kind)
@@ -518,8 +520,9 @@ def _start_output(store: ResultStore, name: str, method: dict, germs: list[str],
                 stats.convergence = _lower_order_difference(kind, xi, weights, basis, scale, germs, order, x0, pce)
             refit = (validation.refitting(kind, xi, weights, basis, scale, germs, order, sampled,
                                           method_settings(method)) if entry.rule == "selection" else None)
-            _validate(stats, entry.rule, f"{kind} order {order}", xi, weights, expand(basis), germs,
-                      None if isinstance(store, _QuantityView) else store.time, options.seed, refit)
+            _validate(stats, entry.rule, f"{kind} order {order}" + (" (taken by auto)" if auto else ""), xi, weights,
+                      expand(basis), germs, None if isinstance(store, _QuantityView) else store.time, options.seed,
+                      refit, auto)
         elif pick_freeze:
             stats.sobol_first = dict(zip(names, masked(blocks["first"])))
             stats.sobol_total = dict(zip(names, masked(blocks["total"])))
@@ -553,7 +556,7 @@ def _coefficient_decay(pce: PCE) -> dict[int, np.ndarray]:
 
 
 def _validate(out: OutputStatistics, rule: str, label: str, xi, weights, Y: np.ndarray, germs,
-              time: np.ndarray | None, seed: int, refit=None) -> None:
+              time: np.ndarray | None, seed: int, refit=None, auto: bool = False) -> None:
     """Check `out`'s expansion on its own runs Y (methods.validation): its `validation` and its flags."""
     edges = [*out.band99, *out.quantiles.values()]
     found = validation.validate(rule, xi, weights, Y, germs, out.pce, out.loo_error, out.resolved, edges, seed,
@@ -564,7 +567,7 @@ def _validate(out: OutputStatistics, rule: str, label: str, xi, weights, Y: np.n
                       "time": None if worst is None or time is None else float(time[worst[1]]),
                       "band_excess": None if excess is None else excess[0] + validation.BAND_MARGIN,
                       "band_margin": validation.BAND_MARGIN, "validated": found.validates()}
-    out.flags.extend(validation.flags(found, rule, label, time))
+    out.flags.extend(validation.flags(found, rule, label, time, auto))
 
 
 def _loo_error(entry, xi, weights, Y, germs, indices) -> np.ndarray:

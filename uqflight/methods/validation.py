@@ -193,8 +193,12 @@ def validate(rule: str, xi, weights, Y: np.ndarray, germs, pce: PCE, loo_error, 
     return Validation(error, how, judged_times(Y, resolved), least_squares, excess, (lower, upper))
 
 
-def remedy(rule: str, least_squares_error: float | None) -> str:
-    """What helps an expansion of a method of `rule` that does not validate on its runs."""
+def remedy(rule: str, least_squares_error: float | None, auto: bool = False) -> str:
+    """What helps an expansion of a method of `rule` that does not validate on its runs (`auto`: the method
+    `method: {kind: auto}` took, the lowest error among those the runs allow)."""
+    if auto:
+        return ("auto took the lowest error among the methods these runs allow: run a sampled design "
+                "(latin_hypercube, sobol, monte_carlo), whose runs' own statistics need no expansion")
     sampled = ("or a sampled design (latin_hypercube, sobol, monte_carlo), whose runs' own statistics need "
                "no expansion; `method: {kind: auto}` takes the method that validates")
     if rule == "projection":
@@ -208,7 +212,7 @@ def remedy(rule: str, least_squares_error: float | None) -> str:
     return f"use another max_order or more runs, {sampled}"
 
 
-def flags(validation: Validation, rule: str, label: str, time: np.ndarray | None,
+def flags(validation: Validation, rule: str, label: str, time: np.ndarray | None, auto: bool = False,
           band_of: str = "99 % band") -> list[str]:
     """The flag texts of a check (empty when it validates); `label` names the method, `time` the output's
     times (None: a quantity, one value)."""
@@ -224,7 +228,7 @@ def flags(validation: Validation, rule: str, label: str, time: np.ndarray | None
     ls = validation.least_squares
     ls_error = None if ls is None or not np.isfinite(ls[validation.judged]).any() else float(
         np.nanmax(np.where(validation.judged, ls, np.nan)))
-    fix = remedy(rule, ls_error)
+    fix = remedy(rule, ls_error, auto)
     if worst is None:
         found.append(f"{label}: no out-of-sample error could be estimated on these runs, so its statistics "
                      f"are not validated; {fix}")
