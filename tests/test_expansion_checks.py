@@ -101,11 +101,14 @@ def test_validate_on_closed_forms():
                                                                                              "m", None))
 
 
-def test_the_shipped_ci_flight_is_not_flagged(tmp_path):
-    # the 15-run level-1 grid of tests/baselines/ci-tiny.yaml on JSBSim's c172p: the largest error measured is
-    # 0.021 (q at 8.8 s), the band within 0.12 ranges of the runs
-    run_campaign(load_campaign(ROOT / "tests" / "baselines" / "ci-tiny.yaml", validation_view),
-                 out=tmp_path / "ci.h5", workers=2)
+@pytest.mark.parametrize("campaign_file", [
+    pytest.param(ROOT / "tests" / "baselines" / "ci-tiny.yaml", id="ci-tiny"),
+    pytest.param(ROOT / "campaigns" / "paper-pg2-l2.yaml", id="paper-pg2-l2", marks=pytest.mark.slow)])
+def test_the_shipped_flights_are_not_flagged(tmp_path, campaign_file):
+    # ci-tiny, the 15-run level-1 grid on JSBSim's c172p: the largest error measured is 0.021 (q at 8.8 s), the
+    # band within 0.12 ranges of the runs; paper-pg2-l2, the paper's 113-run level-2 grid at order 2: errors
+    # below 1e-7, bands within 0.1 ranges
+    run_campaign(load_campaign(campaign_file, validation_view), out=tmp_path / "ci.h5", workers=2)
     summary = strict_json(summary_json(analyse(tmp_path / "ci.h5")))
     assert all(entry["flags"] == [] for entry in summary["outputs"].values())
     assert all(entry["validation"]["validated"] for entry in summary["outputs"].values())
