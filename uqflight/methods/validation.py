@@ -161,23 +161,28 @@ def out_of_sample_error(rule: str, xi, weights, Y: np.ndarray, germs, pce: PCE, 
             "of the same basis on them, the larger", least_squares)
 
 
-def allowed_range(xi, Y: np.ndarray, germs, seed: int = 0) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def allowed_range(xi, Y: np.ndarray, germs, edges: list[np.ndarray],
+                  seed: int = 0) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """(lower, upper, range) per time: the runs' [min, max] widened to the 99 % band of their additive quadratic
     least-squares fit (its linear fit when the runs are too few; ALLOWANCE_DRAWS draws seeded by `seed`), then
-    by BAND_MARGIN ranges; range = max − min."""
+    by BAND_MARGIN ranges; range = max − min. The fit's band is drawn only at the times where one of `edges`
+    (each (T,)) lies beyond the runs' range and the margin: elsewhere it could only widen what already holds."""
     low, high = Y.min(axis=0), Y.max(axis=0)
     span = high - low
+    outside = np.max([np.maximum(low - BAND_MARGIN * span - edge, edge - high - BAND_MARGIN * span)
+                      for edge in edges], axis=0) > 0
     d = len(germs)
     indices = np.vstack([np.zeros((1, d), dtype=int), np.eye(d, dtype=int), 2 * np.eye(d, dtype=int)])
     if len(Y) <= len(indices):  # too few runs for the quadratic terms (a level-1 grid): the linear fit
         indices = indices[:d + 1]
     matrix = orthonormal_basis(germs, indices, xi)
-    if matrix.shape[0] > matrix.shape[1]:
-        coefficients, _, rank, _ = np.linalg.lstsq(matrix, Y, rcond=None)
+    if outside.any() and matrix.shape[0] > matrix.shape[1]:
+        coefficients, _, rank, _ = np.linalg.lstsq(matrix, Y[:, outside], rcond=None)
         if rank == matrix.shape[1]:
             draws = orthonormal_basis(germs, indices, draw_germs(germs, ALLOWANCE_DRAWS, seed)) @ coefficients
-            edges = np.quantile(draws, [0.005, 0.995], axis=0)
-            low, high = np.minimum(low, edges[0]), np.maximum(high, edges[1])
+            band = np.quantile(draws, [0.005, 0.995], axis=0)
+            low, high = low.copy(), high.copy()
+            low[outside], high[outside] = np.minimum(low[outside], band[0]), np.maximum(high[outside], band[1])
     return low - BAND_MARGIN * span, high + BAND_MARGIN * span, span
 
 
@@ -187,7 +192,7 @@ def validate(rule: str, xi, weights, Y: np.ndarray, germs, pce: PCE, loo_error, 
     """Check the expansion `pce` (of a method of `rule`) on its runs Y (N, T) at xi: its out-of-sample
     error and its band edges and quantiles `edges` (each (T,)) against the runs' range (`seed`: allowed_range)."""
     error, how, least_squares = out_of_sample_error(rule, xi, weights, Y, germs, pce, loo_error, refit)
-    lower, upper, span = allowed_range(xi, Y, germs, seed)
+    lower, upper, span = allowed_range(xi, Y, germs, edges, seed)
     beyond = np.max([np.maximum(lower - edge, edge - upper) for edge in edges], axis=0)
     excess = np.divide(beyond, span, out=np.zeros_like(beyond), where=span > 0)
     return Validation(error, how, judged_times(Y, resolved), least_squares, excess, (lower, upper))
@@ -288,7 +293,7 @@ def auto_choice(xi, weights, basis, scale, germs, order: int, sampled: bool, mis
         if errors[kind] is not None and errors[kind] <= VALIDATION_THRESHOLD and judged.any():
             draws = pce.sample(AUTO_BAND_DRAWS, seed)
             edges = list(np.quantile(draws, [0.005, 0.995], axis=0))
-            lower, upper, span = allowed_range(xi, Y, germs, seed)
+            lower, upper, span = allowed_range(xi, Y, germs, edges, seed)
             beyond = np.max([np.maximum(lower - edge, edge - upper) for edge in edges], axis=0)
             if np.any(judged & (beyond > 0)):
                 band_outside.add(kind)
