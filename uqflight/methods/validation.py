@@ -247,7 +247,8 @@ def flags(validation: Validation, rule: str, label: str, time: np.ndarray | None
         found.append(f"{label} extrapolates: its {band_of} or a quantile{when(at)} lies "
                      f"{excess[0] + BAND_MARGIN:.3g} ranges of the runs beyond what they span (more than "
                      f"{BAND_MARGIN:g} beyond their range and their additive quadratic fit's band, [{lower[at]:.6g}, "
-                     f"{upper[at]:.6g}] with that margin); {fix}")
+                     f"{upper[at]:.6g}] with that margin): an extrapolation these runs can neither confirm nor "
+                     f"refute; {fix}")
     return found
 
 
