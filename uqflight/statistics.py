@@ -49,7 +49,8 @@ from .campaign.schema import CampaignError
 from .designs import REGISTRY as DESIGNS
 from .designs import is_sampled
 from .designs.adaptive import index_set_summary
-from .methods import PCE, METHODS, failed_runs_note, fit, method_entry, method_settings, normalised
+from .methods import (AUTO_CANDIDATES, PCE, METHODS, failed_runs_note, fit, method_entry, method_settings,
+                      normalised)
 from .methods.basis import orthonormal_basis
 from .methods.pce_moments import pce_standardised_moments, triple_products
 from .methods import validation
@@ -400,9 +401,13 @@ def auto_method(store: ResultStore, name: str, method: dict, germs: list[str], d
     if sampled:
         return ({**method, "kind": "monte_carlo", "order": order}, False,
                 {**record, "kind": "monte_carlo", "why": f"{why}: the runs' own statistics"})
-    if (weights >= 0).all() or not [e for e in errors.values() if e is not None]:
+    if (weights >= 0).all():
         return ({**method, "kind": "integration", "order": order}, True,
                 {**record, "kind": "integration", "why": f"{why}: the runs' own statistics, weighted by the grid"})
+    if not [e for e in errors.values() if e is not None]:
+        raise ValueError(f"method auto: for {name}, no candidate ({', '.join(AUTO_CANDIDATES)}) of order "
+                         f"{order} can be applied to these runs, and a grid with negative weights gives no statistics "
+                         "of its runs alone: run a sampled design, or choose a method and order")
     kind = min((e, i, k) for i, (k, e) in enumerate(errors.items()) if e is not None)[2]
     return ({**method, "kind": kind, "order": order}, False,
             {**record, "kind": kind, "why": f"{why}, and a grid with negative weights has no statistics of its runs "
