@@ -26,7 +26,7 @@ import math
 import os
 from collections import deque
 from concurrent.futures import Executor, ThreadPoolExecutor
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Callable
 
@@ -40,7 +40,7 @@ from .analysis.errors import error_summary, relative_errors
 from .analysis.exceedance import exceedance_from_pce, exceedance_from_runs, unit_slip
 from .analysis.failures import grid_failure_probability
 from .analysis.proportions import sampled_proportion
-from .analysis.floors import central_moments, floors_from_moments, kld_floor
+from .analysis.floors import central_moments, floors_from_moments, kld_estimator_bias, kld_floor
 from .analysis.moments import (modified_cov, sorted_by_time, standardised_moments, weighted_moments,
                                weighted_quantiles)
 from .analysis.resolution import RESOLUTION_RTOL, resolved_variance
@@ -51,10 +51,11 @@ from .designs import REGISTRY as DESIGNS
 from .designs import is_sampled
 from .designs.adaptive import index_set_summary
 from .labels import name_unit, quantity_unit
-from .methods import PCE, METHODS, failed_runs_note, fit, method_entry, method_settings, normalised
+from .methods import (AUTO_CANDIDATES, PCE, METHODS, failed_runs_note, fit, method_entry, method_settings,
+                      normalised)
 from .methods.basis import orthonormal_basis
-from .methods.loo import relative_loo_error
 from .methods.pce_moments import pce_standardised_moments, triple_products
+from .methods import validation
 from .methods.validity import method_problem
 from .parameters.distributions import SEED_REFUSAL
 from .parameters.germs import draw_germs
@@ -79,11 +80,13 @@ class BadInput(ValueError):
 
 @dataclass
 class Options:
-    """How the statistics are computed (from the campaign's `analysis:` mapping, or defaults)."""
+    """How the statistics are computed (from the campaign's `analysis:` mapping, or defaults). `seed` seeds
+    every draw of the analysis (band and PDF draws, bootstrap, exceedance draws, the KLD floor's splits);
+    None: the results file's campaign seed."""
 
     band_samples: int = 20000
     bootstrap: int = 200
-    seed: int = 0
+    seed: int | None = None
     quantiles: tuple[float, ...] = DEFAULT_QUANTILES
 
 
@@ -109,6 +112,8 @@ class OutputStatistics:
     loo_error: np.ndarray | None = None  # relative leave-one-out error of a fit, (T,)
     selection: dict | None = None  # what a selecting method (sparse) chose: terms, order, corrected LOO error
     convergence: dict | None = None  # difference to the next lower order of a projection
+    validation: dict | None = None  # the expansion checked on its own runs (methods.validation): error, band
+    method: dict | None = None  # what `method: {kind: auto}` took for this output (auto_method), None otherwise
     coefficient_decay: dict[int, np.ndarray] | None = None  # degree -> RSS of its PCE coefficients (T,)
     final_samples: np.ndarray | None = None  # runs or surrogate draws at the final time, for the KLD
     fourth_central: np.ndarray | None = None  # of the runs, for a sampled reference's noise floor
@@ -147,6 +152,7 @@ class Statistics:
     quantities: dict[str, QuantityStatistics] = field(default_factory=dict)
     index_set: dict | None = None  # an adaptive grid's refinement (designs.adaptive.index_set_summary)
     design_info: dict = field(default_factory=dict)  # the design's recorded facts (replicates, n_base, ...)
+    seed: int = 0  # what seeded the analysis's draws (the campaign's seed unless Options said otherwise)
 
 
 @dataclass
@@ -257,6 +263,8 @@ def analyse(path, reference: str | None = None, options: Options | None = None, 
         allow_aliasing = allow_aliasing or bool(method.get("allow_aliasing"))
         options = options or Options(**{k: (tuple(v) if k == "quantiles" else v) for k, v in analysis.items()
                                         if k in ("band_samples", "bootstrap", "quantiles")})
+        if options.seed is None:
+            options = replace(options, seed=facts.seed)
         status, design_kind = store.status, facts.design_kind
         if method["kind"] not in METHODS:
             raise BadInput(f"{path}: unknown method {method['kind']!r}: expected one of {', '.join(METHODS)}")
@@ -265,7 +273,7 @@ def analyse(path, reference: str | None = None, options: Options | None = None, 
         pending = int(np.sum(status == Status.PENDING))
         stats = Statistics(str(path), store.attrs.get("campaign_name", ""), method, design_kind,
                            store.parameter_names, int(status.size), int(ok.sum()), int(np.sum(status > 0)),
-                           pending, {}, partial=pending > 0, design_info=facts.design_info)
+                           pending, {}, partial=pending > 0, design_info=facts.design_info, seed=options.seed)
         _check_runs(store, stats, sampled, partial)
         state = store.index_set()
         stats.index_set = None if state is None else index_set_summary(state, store.parameter_names)
@@ -311,8 +319,10 @@ def analyse(path, reference: str | None = None, options: Options | None = None, 
                     progress.advance()
 
             for name in store.output_names:
-                in_flight.append((name, _start_output(store, name, method, germs, design_kind, ok, options, pool,
-                                                      reused)))
+                chosen, runs_only, record = auto_method(store, name, method, germs, design_kind, ok, options.seed)
+                start = _start_output(store, name, chosen, germs, design_kind, ok, options, pool, reused, runs_only,
+                                      record is not None)
+                in_flight.append((name, _with_method(record, start)))
                 if len(in_flight) >= ANALYSIS_THREADS:
                     finish_oldest()
             while in_flight:
@@ -327,9 +337,10 @@ def analyse(path, reference: str | None = None, options: Options | None = None, 
                                                          thresholds.get(name, []))
             if progress is not None:
                 progress.advance()
+    _note_auto(stats)
     if reference:
         add_reference_errors(stats, analyse(reference, options=Options(
-            band_samples=options.band_samples, bootstrap=0, seed=options.seed, quantiles=options.quantiles)))
+            band_samples=options.band_samples, bootstrap=0, quantiles=options.quantiles)))
     return stats
 
 
@@ -437,8 +448,75 @@ def _unwrapped(histories: np.ndarray, period: float | None, name: str, unwrapped
 def _output_statistics(store: ResultStore, name: str, method: dict, germs: list[str], design_kind: str,
                        ok: np.ndarray, options: Options) -> OutputStatistics:
     """The statistics of output `name` over the `ok` runs, its time blocks in ANALYSIS_THREADS threads."""
+    chosen, runs_only, record = auto_method(store, name, method, germs, design_kind, ok, options.seed)
     with ThreadPoolExecutor(ANALYSIS_THREADS) as pool:
-        return _start_output(store, name, method, germs, design_kind, ok, options, pool, Reused())()
+        return _with_method(record, _start_output(store, name, chosen, germs, design_kind, ok, options, pool,
+                                                  Reused(), runs_only, record is not None))()
+
+
+def _with_method(record: dict | None, finish: Callable[[], OutputStatistics]) -> Callable[[], OutputStatistics]:
+    """`finish` whose statistics carry what auto took (`record`, None: the method was given)."""
+    def finished() -> OutputStatistics:
+        out = finish()
+        out.method = record
+        return out
+    return finished
+
+
+def auto_method(store: ResultStore, name: str, method: dict, germs: list[str], design_kind: str,
+                ok: np.ndarray, seed: int = 0) -> tuple[dict, bool, dict | None]:
+    """(the method for output `name`, whether its statistics are the runs' own, what auto took or None).
+
+    `method` other than auto is itself. For auto: among AUTO_CANDIDATES of its order that the design and its
+    runs allow (methods.validity), the one whose out-of-sample error (methods.validation, over the judged
+    times) is the lowest and below VALIDATION_THRESHOLD and whose band stays within the runs' allowed range (its
+    draws seeded by `seed`), ties (errors below 1e-12: exact fits) to the first;
+    when none validates, the runs' own statistics: monte_carlo on a sampled design, the weighted runs on a grid
+    of weights >= 0; a grid with signed weights has no statistics of its runs alone, so it keeps the expansion
+    of lowest error, flagged by its own check."""
+    if method["kind"] != "auto":
+        return method, False, None
+    xi, weights, order = store.xi[ok], store.weights[ok], method["order"]
+    sampled, missing = is_sampled(design_kind), int(ok.size - ok.sum())
+    basis, scale = output_basis(store, name, ok)
+    taken, errors, band_outside = validation.auto_choice(xi, weights, basis, scale, germs, order, sampled, missing,
+                                                         seed)
+    record = {"chosen_by": "auto", "order": order, "errors": errors, "threshold": validation.VALIDATION_THRESHOLD,
+              "band_beyond_runs": band_outside}
+    if taken is not None:
+        return ({**method, "kind": taken, "order": order}, False,
+                {**record, "kind": taken, "why": f"the lowest validated error, {errors[taken]:.3g}, its band "
+                                                 "within the runs' range"})
+    why = "no expansion validates on these runs"
+    if sampled:
+        return ({**method, "kind": "monte_carlo", "order": order}, False,
+                {**record, "kind": "monte_carlo", "why": f"{why}: the runs' own statistics"})
+    if (weights >= 0).all():
+        return ({**method, "kind": "integration", "order": order}, True,
+                {**record, "kind": "integration", "why": f"{why}: the runs' own statistics, weighted by the grid"})
+    if not [e for e in errors.values() if e is not None]:
+        raise ValueError(f"method auto: for {name}, no candidate ({', '.join(AUTO_CANDIDATES)}) of order "
+                         f"{order} can be applied to these runs, and a grid with negative weights gives no statistics "
+                         "of its runs alone: run a sampled design, or choose a method and order")
+    kind = min((e, i, k) for i, (k, e) in enumerate(errors.items()) if e is not None)[2]
+    return ({**method, "kind": kind, "order": order}, False,
+            {**record, "kind": kind, "why": f"{why}, and a grid with negative weights has no statistics of its runs "
+                                            "alone: the expansion of lowest error, flagged; run a sampled design"})
+
+
+def _note_auto(stats: Statistics) -> None:
+    """One note of what `method: {kind: auto}` took for each output and quantity."""
+    taken: dict[str, list[str]] = {}
+    entries = [(name, out) for name, out in stats.outputs.items()]
+    entries += [(name, q.output) for name, q in stats.quantities.items() if q.output is not None]
+    for name, out in entries:
+        if out.method is not None:
+            how = out.method["kind"] + (" (the runs' own statistics)" if out.method["kind"] in ("monte_carlo",
+                                                                                               "integration") else "")
+            taken.setdefault(how, []).append(name)
+    if taken:
+        stats.notes.append("auto took " + "; ".join(f"{how} for {', '.join(names)}" for how, names in taken.items())
+                           + " (each output's method in summary.json)")
 
 
 class Reused:
@@ -472,16 +550,19 @@ class Reused:
 
 
 def _start_output(store: ResultStore, name: str, method: dict, germs: list[str], design_kind: str,
-                  ok: np.ndarray, options: Options, pool: Executor, reused: Reused) -> Callable[[], OutputStatistics]:
+                  ok: np.ndarray, options: Options, pool: Executor, reused: Reused,
+                  runs_only: bool = False, auto: bool = False) -> Callable[[], OutputStatistics]:
     """Read and fit output `name` here and hand its time blocks to `pool`; returns what waits for them
-    and gives the output's statistics. `reused`: what the outputs of one analysis share (Reused)."""
+    and gives the output's statistics. `reused`: what the outputs of one analysis share (Reused).
+    `runs_only`: the statistics of the (weighted) runs themselves, as on a sampled design; `auto`: `method`
+    is what auto took (auto_method)."""
     xi, weights = store.xi[ok], store.weights[ok]
     kind, order = method["kind"], method["order"]
     entry = method_entry(kind)
     unwrapped: list[str] = []
     basis, scale = output_basis(store, name, ok, unwrapped)
     truncation = _tsvd_resolution(store, scale, int(ok.sum()))
-    sampled = is_sampled(design_kind)
+    sampled = is_sampled(design_kind) or runs_only
     x0 = None
     # x = x0 + S with each run's initial value (needs the runs themselves); only the projections use
     # it: the other kinds fit the constant term themselves, where the split would change nothing
@@ -536,6 +617,11 @@ def _start_output(store: ResultStore, name: str, method: dict, germs: list[str],
                 stats.loo_error = _loo_error(entry, xi, weights, expand(basis), germs, pce.indices)
             elif entry.moments == "pce" and order >= 1:
                 stats.convergence = _lower_order_difference(kind, xi, weights, basis, scale, germs, order, x0, pce)
+            refit = (validation.refitting(kind, xi, weights, basis, scale, germs, order, sampled,
+                                          method_settings(method)) if entry.rule == "selection" else None)
+            _validate(stats, entry.rule, f"{kind} order {order}" + (" (taken by auto)" if auto else ""), xi, weights,
+                      expand(basis), germs, None if isinstance(store, _QuantityView) else store.time, options.seed,
+                      refit, auto)
         elif pick_freeze:
             stats.sobol_first = dict(zip(names, masked(blocks["first"])))
             stats.sobol_total = dict(zip(names, masked(blocks["total"])))
@@ -614,13 +700,24 @@ def _coefficient_decay(pce: PCE) -> dict[int, np.ndarray]:
     return {int(p): np.sqrt((pce.coefficients[degrees == p] ** 2).sum(axis=0)) for p in np.unique(degrees)}
 
 
+def _validate(out: OutputStatistics, rule: str, label: str, xi, weights, Y: np.ndarray, germs,
+              time: np.ndarray | None, seed: int, refit=None, auto: bool = False) -> None:
+    """Check `out`'s expansion on its own runs Y (methods.validation): its `validation` and its flags."""
+    edges = [*out.band99, *out.quantiles.values()]
+    found = validation.validate(rule, xi, weights, Y, germs, out.pce, out.loo_error, out.resolved, edges, seed,
+                                refit)
+    worst, excess = found.worst_error(), found.worst_excess()
+    out.validation = {"check": found.check, "threshold": validation.VALIDATION_THRESHOLD,
+                      "error": None if worst is None else worst[0],
+                      "time": None if worst is None or time is None else float(time[worst[1]]),
+                      "band_excess": None if excess is None else excess[0] + validation.BAND_MARGIN,
+                      "band_margin": validation.BAND_MARGIN, "validated": found.validates()}
+    out.flags.extend(validation.flags(found, rule, label, time, auto))
+
+
 def _loo_error(entry, xi, weights, Y, germs, indices) -> np.ndarray:
     """The relative leave-one-out error of the fit over time (methods.loo), weighted as the fit is."""
-    matrix = orthonormal_basis(germs, indices, xi)
-    try:
-        return relative_loo_error(matrix, Y, np.abs(weights) if entry.weighted else None)
-    except ValueError:  # a point the fit interpolates: leaving it out is undefined
-        return np.full(Y.shape[1], np.nan)
+    return validation.leave_one_out(entry.weighted, xi, weights, Y, germs, indices)
 
 
 def _lower_order_difference(kind, xi, weights, basis, scale, germs, order, x0, pce: PCE) -> dict:
@@ -703,6 +800,18 @@ def add_reference_errors(stats: Statistics, reference: Statistics) -> None:
                       "eps_v_summary": error_summary(eps_v), "kld_final": kld, **_reference_floor(reference, ref, out)}
 
 
+KLD_FLOOR_NOTE = ("; KLD floor = the KLD of two disjoint parts of the reference plus the estimator's bias for normal "
+                  "laws of the method's and the reference's means and spreads")
+
+
+def _kld_floor(reference: Statistics, ref: OutputStatistics, out: OutputStatistics) -> float:
+    """The KLD the reference's sampling noise (analysis.floors.kld_floor) and the estimator's bias
+    (kld_estimator_bias: a method's law wider than the reference's is overstated) give, seeded by the reference's
+    seed."""
+    split = kld_floor(ref.final_samples, n_method=len(out.final_samples), seed=reference.seed)
+    return float(split + kld_estimator_bias(out.final_samples, ref.final_samples, seed=reference.seed))
+
+
 def _reference_floor(reference: Statistics, ref: OutputStatistics, out: OutputStatistics) -> dict:
     """The errors a reference's own noise alone would show, and which floor that is."""
     if ref.replicate_moments is not None:
@@ -713,7 +822,7 @@ def _reference_floor(reference: Statistics, ref: OutputStatistics, out: OutputSt
         note = (f"reference: randomised QMC, {r} replicates of {reference.completed // r} scrambled Sobol' points; "
                 "floor = the standard errors of its mean and variance from the spread of the replicates")
         return {"eps_m_floor": se_mean / peak_mean, "eps_v_floor": se_variance / peak_variance,
-                "kld_floor": float(kld_floor(ref.final_samples, n_method=len(out.final_samples))), "floor_note": note}
+                "kld_floor": _kld_floor(reference, ref, out), "floor_note": note + KLD_FLOOR_NOTE}
     if reference.from_runs and ref.fourth_central is not None:
         floors = floors_from_moments(ref.mean, ref.variance, ref.fourth_central, reference.completed)
         qmc = reference.design_kind != "monte_carlo"
@@ -721,7 +830,7 @@ def _reference_floor(reference: Statistics, ref: OutputStatistics, out: OutputSt
                 "(σ/√N for the mean, the distribution-free s.e. of the variance)"
                 + ("; QMC converges faster than this Monte Carlo floor, so it is an upper bound" if qmc else ""))
         return {"eps_m_floor": floors["eps_m_floor"], "eps_v_floor": floors["eps_v_floor"],
-                "kld_floor": float(kld_floor(ref.final_samples, n_method=len(out.final_samples))), "floor_note": note}
+                "kld_floor": _kld_floor(reference, ref, out), "floor_note": note + KLD_FLOOR_NOTE}
     note = (f"reference: {reference.method['kind']} on a {reference.design_kind}, deterministic: it has no sampling "
             "floor; its own truncation error is not included (see its convergence estimate)")
     return {"eps_m_floor": None, "eps_v_floor": None, "kld_floor": None, "floor_note": note}
@@ -790,7 +899,9 @@ def quantity_statistics(store: ResultStore, stats: Statistics, name: str, germs:
         note = pick_freeze_note(defined, len(store.parameter_names), f"quantity {name} (undefined in some runs)")
         if note:
             stats.notes.append(note)
-    if out.pce is None:
+    if out.pce is None and not sampled:  # auto's runs' own statistics on a grid: the weighted runs
+        exceedance = _grid_exceedance(values, defined, store.weights, thresholds)
+    elif out.pce is None:
         exceedance = exceedance_from_runs(values, defined, thresholds, DESIGNS[stats.design_kind].draws,
                                           stats.design_info, units)
     else:
@@ -800,6 +911,21 @@ def quantity_statistics(store: ResultStore, stats: Statistics, name: str, germs:
     flags = [*out.flags, *slips]
     stats.notes.extend(f"quantity {name}: {flag}" for flag in flags)
     return QuantityStatistics(name, missing, out, exceedance, units, flags)
+
+
+def _grid_exceedance(values: np.ndarray, defined: np.ndarray, weights: np.ndarray,
+                     thresholds: list[dict]) -> list[dict]:
+    """Exceedance probabilities of a grid's weighted runs (weights >= 0): the quadrature of the indicator,
+    without an interval (analysis.failures: the nodes are not random draws)."""
+    found = []
+    for item in thresholds:
+        (bound, threshold), = item.items()
+        beyond = values[defined] > threshold if bound == "above" else values[defined] < threshold
+        p = grid_failure_probability(beyond, weights[defined])
+        found.append({bound: threshold, "probability": p["estimate"], "lower": None, "upper": None, "method": "grid",
+                      "note": f"the grid's quadrature of the indicator {bound} {threshold:g}, without an interval "
+                              "(the nodes are not random draws); a sampled design gives one"})
+    return found
 
 
 def _quantity_json(quantity: QuantityStatistics, seeds: list[str]) -> dict:
@@ -829,6 +955,10 @@ def _quantity_json(quantity: QuantityStatistics, seeds: list[str]) -> dict:
     if out.convergence is not None:
         entry["convergence"] = {**out.convergence, "eps_m": out.convergence["eps_m"][0],
                                 "eps_v": out.convergence["eps_v"][0]}
+    if out.validation is not None:
+        entry["validation"] = out.validation
+    if out.method is not None:
+        entry["method"] = out.method
     return entry
 
 
@@ -903,6 +1033,10 @@ def summary_json(stats: Statistics) -> dict:
             entry["selection"] = out.selection
         if out.convergence is not None:
             entry["convergence"] = out.convergence
+        if out.validation is not None:
+            entry["validation"] = out.validation
+        if out.method is not None:
+            entry["method"] = out.method
         if out.errors:
             errors = out.errors
             entry["errors"] = {"eps_m": errors["eps_m"], "eps_v": errors["eps_v"],
