@@ -33,7 +33,7 @@ def rare_statistics(store: ResultStore, stats) -> None:
     """Fill `stats` (statistics.Statistics) of a rare-event design's file: the event's probability in its
     quantity's exceedance, the rounds (`rare_event`), the runs for the report's figures (`rare_runs`), every
     other statistic null with a note. BadInput when the file holds no estimate yet."""
-    from .statistics import BadInput, QuantityStatistics, failed_runs
+    from .statistics import BadInput, QuantityStatistics, failed_runs, quantity_units
 
     record = store.rare_event()
     kind, path = stats.design_kind, stats.path
@@ -58,7 +58,7 @@ def rare_statistics(store: ResultStore, stats) -> None:
         values = store.quantity(name)
         missing = int(np.count_nonzero(ok & ~np.isfinite(values)))
         exceedance = [exceedance_entry(record, names)] if name == record["of"] else []
-        stats.quantities[name] = QuantityStatistics(name, missing, None, exceedance)
+        stats.quantities[name] = QuantityStatistics(name, missing, None, exceedance, quantity_units(store, name))
         if name == record["of"]:
             margin = Event(name, record["side"], record["threshold"]).margin(values)
             margin[~ok] = np.nan
