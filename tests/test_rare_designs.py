@@ -299,3 +299,10 @@ def test_no_baseline_is_written_of_a_rare_event_file(quick, tmp_path):
     done = cli_in_process("report", out, "--out", tmp_path / "report", "--write-baseline", tmp_path / "b.json")
     assert done.returncode == 2 and "--write-baseline" in done.stderr, done.stderr
     assert not (tmp_path / "b.json").exists() and not (tmp_path / "report").exists()
+
+
+def test_report_exceedance_is_refused_for_a_rare_event_file(quick, tmp_path):
+    _, out = copied(quick, tmp_path)
+    done = cli_in_process("report", out, "--out", tmp_path / "report", "--exceedance", "peak>2")
+    assert done.returncode == 2 and "--exceedance" in done.stderr, done.stderr
+    assert not (tmp_path / "report").exists()
