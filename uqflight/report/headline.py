@@ -147,8 +147,10 @@ def headline_section(entry: Entry, times: list[float]) -> Section:
     from .rare_event import headline_table
 
     rare = headline_table(entry)
-    if rare is not None:  # a rare-event design: its estimate (c.o.v., runs, β) first, in place of the exceedance
-        exceedance = rare  # table; its runs have no mean or band of the law
-        text = ("The probability of the event with its 95 % interval, c.o.v., runs and reliability index β "
-                "(−Φ⁻¹(p)); below, the other statistics, null: the runs are not draws of the input law. " + text)
+    if rare is not None:  # a rare-event design: its estimate (c.o.v., runs, β) in place of the exceedance table;
+        exceedance = rare  # its runs have no mean or band of the law
+        text = ("The probability of the design's event with its 95 % interval, c.o.v., runs and reliability index "
+                "β = −Φ⁻¹(p) (in full in tables/rare_event.csv, as in summary.json); below, the quantities' other "
+                "statistics, undefined: the runs were chosen to reach the event, they are not draws of the input "
+                "law. Read the notes below before these numbers.")
     return Section("Headline", "headline", text, [b for b in (exceedance, table) if b is not None], lead=True)
