@@ -306,3 +306,12 @@ def test_report_exceedance_is_refused_for_a_rare_event_file(quick, tmp_path):
     done = cli_in_process("report", out, "--out", tmp_path / "report", "--exceedance", "peak>2")
     assert done.returncode == 2 and "--exceedance" in done.stderr, done.stderr
     assert not (tmp_path / "report").exists()
+
+
+@pytest.mark.slow  # a Dask LocalCluster starts for each round's runs
+def test_dask_gives_the_bits_of_the_local_workers(quick, tmp_path):
+    folder, text, local = quick
+    source = tmp_path / "r.yaml"
+    source.write_text(text)
+    run_campaign(parse_campaign(text, str(source)), out=tmp_path / "dask.h5", executor="dask", workers=2)
+    assert_same_results(local, tmp_path / "dask.h5")
