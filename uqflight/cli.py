@@ -1,9 +1,28 @@
 """The `uqflight` command line: simulate, plan, run, report, check, info, demo."""
 from __future__ import annotations
 
-import csv
-import io
 import os
+import signal
+import threading
+
+
+def _interrupted_while_starting(signum, frame):
+    """Ctrl-C while the command line is still importing (NumPy, typer, ...): one line and exit 130, as an
+    interrupted command says, not a KeyboardInterrupt traceback from inside an import. Nothing has
+    been done yet, so nothing is left to clean up."""
+    os.write(2, b"\ninterrupted: uqflight was starting, nothing was done\n")
+    os._exit(130)
+
+
+# only where Python's own Ctrl-C handler is in place (an ignored SIGINT stays ignored, a program's own
+# handler stays its own), until the module is imported; the commands handle Ctrl-C from then on
+_STARTING = (threading.current_thread() is threading.main_thread()
+             and signal.getsignal(signal.SIGINT) is signal.default_int_handler)
+if _STARTING:
+    signal.signal(signal.SIGINT, _interrupted_while_starting)
+
+import csv  # noqa: E402 (the imports below are what Ctrl-C may interrupt)
+import io
 from collections import Counter
 from pathlib import Path
 from typing import List, Optional
@@ -19,7 +38,7 @@ from .leaving import leave
 from .progress import Progress
 
 from .methods import METHOD_KINDS
-from .simulators.base import FlightError, NominalFailed
+from .simulators.base import FlightError
 from .simulators.aircraft import default_condition
 from .simulators.jsbsim import DEFAULT_OUTPUTS, Excitation, FlightSetup, JSBSimFlight
 
@@ -225,6 +244,8 @@ def _load(path: Path):
 def plan(campaign_file: Path = typer.Argument(..., metavar="CAMPAIGN", help="Campaign YAML file.")):
     """Validate a campaign and print its design, the number of runs and an estimated time."""
     from .designs import describe, is_adaptive
+    from .execution import WorkerError, timed_nominal
+    from .methods import method_entry
 
     campaign = _load(campaign_file)
     design = campaign.design()
@@ -238,18 +259,16 @@ def plan(campaign_file: Path = typer.Argument(..., metavar="CAMPAIGN", help="Cam
              "Cholesky in this order)")
     echo(describe(design))
     kind = campaign.method["kind"]
-    echo(f"method: {kind}" + (f" (order {campaign.method['order']})" if _has_order(kind, design.kind) else ""))
+    order = campaign.method.get(method_entry(kind).order_key)  # sparse's is max_order
+    echo(f"method: {kind}" + (f" (order {order})" if _has_order(kind, design.kind) else ""))
     runs = campaign.runs or len(design.xi)  # an adaptive grid's budget: its rounds are made from the results
     echo(f"runs: {runs}" + (" at most (design.budget)" if is_adaptive(design.kind) else ""))
     echo(f"results: {Path(campaign.storage['path']).resolve()} (storage.path, from the working directory; "
          "--out to choose)")
     try:
-        seconds = _seconds_per_run(campaign)
-    except NominalFailed as exc:  # its message says it all
+        seconds = timed_nominal(campaign)
+    except WorkerError as exc:  # its message says it all (a hang, a crash, a build or nominal failure), as `run`'s
         echo(f"error: {campaign_file}: {exc}", err=True)
-        raise typer.Exit(2)
-    except Exception as exc:  # the simulator's own code (a python model) failed to build or to fly: as `run` says
-        echo(f"error: {campaign_file}: {type(exc).__name__}: {exc}", err=True)
         raise typer.Exit(2)
     workers = min(campaign.execution["workers"], CORES)
     echo(f"estimated time: {runs * seconds / workers:.0f} s with {workers} worker(s) "
@@ -266,29 +285,6 @@ def _has_order(kind: str, design_kind: str) -> bool:
 
     entry = method_entry(kind)
     return entry.pce is not None and not (entry.runs_on_sampled and is_sampled(design_kind))
-
-
-def _seconds_per_run(campaign) -> float:
-    """One nominal run of the campaign's simulator, timed here (after a first, warming run)."""
-    import time
-
-    from .execution import nominal_kappa, worker_spec
-
-    from .quantities.recorder import QuantityRecorder
-
-    simulator = worker_spec(campaign).build()
-    nominal = nominal_kappa(campaign)  # the sample `run` flies first, the centre of every law (ξ = 0)
-    simulator.layout(nominal)  # as `run` learns the outputs first: NominalFailed says what to do when it fails
-    # the timed run computes the quantities too: a linearisation costs more than the flight
-    observers = (QuantityRecorder(campaign.quantities, simulator.source),) if campaign.quantities else ()
-    for timed in (False, True):  # the first run loads what every later one reuses (the Newton trim's nominal)
-        simulator.restart()
-        started = time.perf_counter()
-        try:
-            simulator.evaluate(nominal, observers if timed else ())
-        except FlightError:
-            pass
-    return time.perf_counter() - started
 
 
 @app.command()
@@ -701,3 +697,7 @@ def aircraft_command(
         raise typer.Exit(1)
     echo("reference factors at the trim (an offset ΔC adds ΔC times its function's): " + ", ".join(
         f"{symbol} = {number:.6g} {unit}" for symbol, number, unit in factor_values(flight.property_value)))
+
+
+if _STARTING:  # imported: Ctrl-C is a KeyboardInterrupt again, which each command handles
+    signal.signal(signal.SIGINT, signal.default_int_handler)

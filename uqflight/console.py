@@ -33,6 +33,7 @@ LINE_BREAK = re.compile("[\n\u2028\u2029]")  # what `clean` keeps that starts a 
 def one_line(text: str) -> str:
     """Text from a file that is not a name (a failure reason) on one line: as it is when it holds no line
     break (echo strips its control characters), else quoted as repr shows it (a newline as \\n)."""
+    text = str(text)  # a NumPy string read from a file shows as np.str_('...') in its own repr
     return repr(text) if LINE_BREAK.search(text) else text
 
 

@@ -99,7 +99,7 @@ class RunSummary:
                  f"{self.skipped} already done, {sum(self.failures.values())} failed"]
         if self.nominal_failure:
             lines.append(f"  warning: the nominal flight (every parameter at its law's centre) failed: "
-                         f"{self.nominal_failure}; runs near it fail the same way: check the campaign's flight with "
+                         f"{one_line(self.nominal_failure)}; runs near it fail the same way: check the campaign's flight with "
                          "`uqflight simulate` and its --set")
         lines += [f"  failed ({n}): {one_line(reason)}" for reason, n in self.failures.most_common(10)]
         return "\n".join(lines)
@@ -226,6 +226,22 @@ def worker_spec(campaign: Campaign) -> WorkerSpec:
                       properties=properties, base=base,
                       bundle=make_bundle(campaign.simulator, properties, base),  # files travel with the task
                       quantities=campaign.quantities or None)
+
+
+def timed_nominal(campaign: Campaign) -> float:
+    """The seconds one nominal flight of the campaign takes on this machine (`uqflight plan`'s estimate),
+    flown as `run` flies it: in a supervised worker process, under the campaign's time limit
+    (execution.timeout_s, else NOMINAL_TIMEOUT_S, plus STARTUP_GRACE_S for the worker's start), a
+    first flight warming what every later one reuses (the Newton trim's nominal), the second timed.
+    Raises WorkerError when the worker dies, runs past the limit or cannot build the simulator (the
+    message says which), as `run` does."""
+    pool = WorkerPool(worker_spec(campaign), 1, campaign.execution.get("timeout_s") or NOMINAL_TIMEOUT_S)
+    kappa = nominal_kappa(campaign)
+    try:
+        pool.nominal_flight(kappa, measure_resolution=False)
+        return pool.nominal_flight(kappa, measure_resolution=False).seconds
+    finally:
+        pool.close()
 
 
 def local_workers(campaign: Campaign, workers: int, chunk: int) -> int:
@@ -522,23 +538,24 @@ class WorkerPool:
         self.spec, self.workers, self.timeout = spec, max(1, int(workers)), float(timeout)
         self.slots: list[WorkerProcess] = []
 
-    def nominal_flight(self, kappa: np.ndarray) -> NominalFlight:
+    def nominal_flight(self, kappa: np.ndarray, measure_resolution: bool = True) -> NominalFlight:
         """The NominalFlight at `kappa` (worker.nominal_flight), from a worker:
         `start_warmup`, then `warmup_result`."""
-        self.start_warmup(kappa)
+        self.start_warmup(kappa, measure_resolution)
         return self.warmup_result()
 
-    def start_warmup(self, kappa: np.ndarray) -> None:
+    def start_warmup(self, kappa: np.ndarray, measure_resolution: bool = True) -> None:
         """Start every worker of the pool and ask each to fly the nominal `kappa`, so that all are warm
         (imports, aircraft, the Newton trim's nominal) when the chunks start. Returns at once: the
-        caller may work meanwhile, then call `warmup_result`."""
+        caller may work meanwhile, then call `warmup_result`. `measure_resolution` false: the first
+        worker does not measure the simulator's resolution either (a second flight for JSBSim)."""
         slot = self._slot()
         while len(self.slots) < self.workers:
             self.slots.append(WorkerProcess())
         for other in self.slots[1:]:  # a warm-up only: the trims' drift is measured once, by the first
             if not other.send(("nominal", self.spec, kappa, False)):
                 self._drop(other)
-        if not slot.send(("nominal", self.spec, kappa)):
+        if not slot.send(("nominal", self.spec, kappa, measure_resolution)):
             raise WorkerError(death_reason(self._drop(slot)))
 
     def warmup_result(self) -> NominalFlight:

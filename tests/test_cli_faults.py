@@ -1,0 +1,111 @@
+"""The commands under a model's faults: plan flies its nominal in a supervised worker under the campaign's
+time limit (a hang or a crash there is one line, exit 2), plans every method and design kind, a reason on
+several lines is shown on one, and Ctrl-C while uqflight starts is one line with exit 130. Real worker
+processes, real python models (tests/data/hostile_model.py)."""
+import os
+import signal
+import subprocess
+import sys
+
+import pytest
+from conftest import DATA, ROOT, UQFLIGHT, cli_in_process, hostile_campaign_text
+
+import uqflight.execution
+from uqflight.designs import REGISTRY as DESIGNS
+from uqflight.methods import METHODS
+
+
+def write(tmp_path, function, **kwargs):
+    path = tmp_path / "c.yaml"
+    path.write_text(hostile_campaign_text(function, **kwargs))
+    return path
+
+
+def test_plan_flies_its_nominal_under_the_campaigns_time_limit(tmp_path, monkeypatch):
+    # the model never returns at the nominal: plan ran for ever; now it gives up as run does, after
+    # execution.timeout_s plus the worker's start (shortened here from 60 s to 2 s: the same code path)
+    monkeypatch.setattr(uqflight.execution, "STARTUP_GRACE_S", 2.0)
+    campaign = write(tmp_path, "hanging_at_centre", extra=", timeout_s: 1")
+    planned = cli_in_process("plan", campaign)
+    assert planned.returncode == 2, planned.stderr
+    assert planned.stderr.count("\n") == 1 and "Traceback" not in planned.stderr, planned.stderr
+    assert planned.stderr.startswith(f"error: {campaign}: the nominal flight did not finish within 3 s "
+                                     "(execution.timeout_s 1 s plus 2 s for the worker's start)"), planned.stderr
+
+
+def test_plan_reports_a_model_that_kills_its_process_at_the_nominal_as_run_does(tmp_path):
+    campaign = write(tmp_path, "segfault_at_centre")
+    planned = cli_in_process("plan", campaign)
+    ran = cli_in_process("run", campaign, "--out", tmp_path / "c.h5")
+    for done in (planned, ran):
+        assert done.returncode == 2, done.stderr
+        assert done.stderr.count("\n") == 1 and "Traceback" not in done.stderr, done.stderr
+        assert done.stderr.startswith(f"error: {campaign}: worker process died: signal 11 (SIGSEGV)"), done.stderr
+
+
+def test_plan_in_a_process_of_its_own_does_not_die_with_the_model(tmp_path):
+    # as a user runs it: the uqflight process itself, not the test's (exit 139 before)
+    done = subprocess.run([UQFLIGHT, "plan", str(write(tmp_path, "segfault_at_centre"))], capture_output=True,
+                          text=True, timeout=300, env={**os.environ, "PYTHONPATH": str(ROOT)})
+    assert done.returncode == 2 and "SIGSEGV" in done.stderr, (done.returncode, done.stderr)
+
+
+def _method_design_cases():
+    """Every method kind on a design that carries it, and every design kind with a method it carries."""
+    cases = [(kind, "monte_carlo" if m.sampled_only else "tensor_grid") for kind, m in METHODS.items()]
+    cases += [("least_squares" if DESIGNS[kind].sampled else "pseudo_galerkin", kind) for kind in DESIGNS]
+    return sorted(set(cases))
+
+
+@pytest.mark.parametrize("method, design", _method_design_cases())
+def test_plan_plans_every_method_and_design_kind(tmp_path, method, design):
+    entry, spec = METHODS[method], dict(DESIGNS[design].example)
+    settings = f", {entry.order_key}: 1" if entry.pce is not None else ""
+    body = ", ".join(f"{k}: {v}" for k, v in spec.items())
+    (tmp_path / "c.yaml").write_text(
+        f"name: every\nseed: 5\nsimulator: {{kind: python, function: \"{DATA / 'trust_models.py'}:sum_of_squares\"}}\n"
+        "parameters:\n  x1: {distribution: normal, lower: -3, upper: 3}\n"
+        "  x2: {distribution: normal, lower: -3, upper: 3}\n"
+        f"design: {{{body}}}\nmethod: {{kind: {method}{settings}}}\n")
+    planned = cli_in_process("plan", tmp_path / "c.yaml")
+    assert planned.returncode == 0, planned.stderr
+    assert "Traceback" not in planned.stderr
+    assert f"method: {method}" in planned.stdout and "estimated time: " in planned.stdout
+
+
+def test_a_reason_on_several_lines_is_summarised_on_one_as_plain_text(tmp_path):
+    campaign = write(tmp_path, "multi_line_failure", samples=20)
+    ran = cli_in_process("run", campaign, "--out", tmp_path / "c.h5")
+    assert ran.returncode == 0, ran.stderr
+    failed = [line for line in ran.stdout.splitlines() if "failed (" in line]
+    assert failed and all("np.str_" not in line for line in failed), ran.stdout
+    assert "): 'ValueError: first line\\nerror: a forged second line'" in failed[0]
+    assert not any(line.startswith("error: a forged") for line in ran.stdout.splitlines())
+
+
+SITE_INTERRUPT = '''
+import os, signal, sys
+
+
+class InterruptOnImport:
+    """Ctrl-C (a real SIGINT to this process) as uqflight's command line imports numpy."""
+
+    def find_spec(self, name, path=None, target=None):
+        if name == "numpy" and "uqflight.cli" in sys.modules:
+            sys.meta_path.remove(self)
+            os.kill(os.getpid(), signal.SIGINT)
+        return None
+
+
+sys.meta_path.insert(0, InterruptOnImport())
+'''
+
+
+def test_ctrl_c_while_uqflight_starts_is_one_line_and_exit_130(tmp_path):
+    (tmp_path / "sitecustomize.py").write_text(SITE_INTERRUPT)
+    done = subprocess.run([UQFLIGHT, "--version"], capture_output=True, text=True, timeout=120,
+                          env={**os.environ, "PYTHONPATH": f"{tmp_path}{os.pathsep}{ROOT}"},
+                          preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
+    assert done.returncode == 130, (done.returncode, done.stderr)
+    assert "Traceback" not in done.stderr and "KeyboardInterrupt" not in done.stderr, done.stderr
+    assert done.stderr.strip() == "interrupted: uqflight was starting, nothing was done" and done.stdout == ""
