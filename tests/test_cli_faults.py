@@ -109,3 +109,18 @@ def test_ctrl_c_while_uqflight_starts_is_one_line_and_exit_130(tmp_path):
     assert done.returncode == 130, (done.returncode, done.stderr)
     assert "Traceback" not in done.stderr and "KeyboardInterrupt" not in done.stderr, done.stderr
     assert done.stderr.strip() == "interrupted: uqflight was starting, nothing was done" and done.stdout == ""
+
+
+def test_a_run_whose_times_differ_from_the_nominals_fails_and_is_not_stored_against_them(tmp_path):
+    # shifted_time returns times 5, 6 (not 0, 1) where x > 1, with values of the same length
+    from uqflight.store import ResultStore, Status
+
+    ran = cli_in_process("run", write(tmp_path, "shifted_time", samples=20), "--out", tmp_path / "c.h5")
+    assert ran.returncode == 0, ran.stderr
+    with ResultStore.open(tmp_path / "c.h5") as store:
+        x, status, reasons = store.kappa[:, 0], store.status, list(store.reasons)
+        assert store.time.tolist() == [0.0, 1.0]
+    shifted = x > 1.0
+    assert shifted.any() and (~shifted).any()
+    assert (status[shifted] == Status.SIMULATOR_ERROR).all() and (status[~shifted] == Status.OK).all()
+    assert all("'time' differs from the nominal run's" in str(reasons[j]) for j in range(len(x)) if shifted[j])

@@ -34,7 +34,7 @@ import subprocess
 import sys
 import time
 from collections import Counter, deque
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from importlib import metadata
 from multiprocessing.connection import Connection
 from multiprocessing.connection import wait as wait_connections
@@ -341,6 +341,8 @@ def run_campaign(campaign: Campaign, out: Path | None = None, workers: int | Non
         design = campaign.design()  # built while the workers start
         nominal = pool.warmup_result()
         seconds = nominal.seconds
+        # every run is stored against the nominal's times: a model giving other times fails the run
+        pool.spec = spec = replace(spec, time=tuple(map(float, nominal.time)))
         timeout = execution.get("timeout_s") or default_timeout(seconds)
         pool.timeout = timeout
         # One BLAS thread here, for the folds on opening too: the workers keep every core busy, a
@@ -687,7 +689,7 @@ def supervised_chunk(spec: WorkerSpec, indices, kappa, n_times: int, outputs: li
     pool = _DASK_POOLS.get(spec.key)
     if pool is None:
         pool = _DASK_POOLS[spec.key] = WorkerPool(spec, 1, timeout)
-    pool.timeout = timeout
+    pool.spec, pool.timeout = spec, timeout  # this campaign's nominal times (WorkerSpec.time)
     return next(iter(pool.run([Task(np.asarray(indices), np.asarray(kappa))], n_times, outputs)))
 
 

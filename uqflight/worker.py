@@ -40,6 +40,7 @@ class WorkerSpec:
     base: str
     bundle: dict | None = None  # the aircraft's (or file.py's) files as bytes + hash (simulators/bundle.py)
     quantities: dict | None = None  # the campaign's quantities of interest, {name: spec} (uqflight.quantities)
+    time: tuple[float, ...] | None = None  # the nominal flight's times, which every run's values are stored against
 
     @property
     def key(self) -> str:
@@ -72,6 +73,9 @@ def run_chunk(spec: WorkerSpec, indices: np.ndarray, kappa: np.ndarray, n_times:
     (NaN where undefined or failed)."""
     simulator = worker_simulator(spec)
     simulator.restart()
+    expect_time = getattr(simulator, "expect_time", None)  # a model that gives its own times (python)
+    if expect_time is not None and spec.time is not None:
+        expect_time(np.asarray(spec.time, dtype=float))
     n = len(indices)
     status = np.zeros(n, dtype=np.int8)
     reasons = [""] * n
