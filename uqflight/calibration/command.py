@@ -10,7 +10,7 @@ from typing import List, Optional
 import typer
 
 from ..arguments import check_campaign_file, check_output, check_results_file
-from ..console import echo
+from ..console import echo, one_line
 from ..progress import Progress
 
 EXIT_BAD_INPUT = 2
@@ -141,6 +141,10 @@ def calibrate_command(
     if _page[0] is not None:
         written.append(_page[0](out).name)
     echo(f"wrote {', '.join(written)} to {out} ({summary['seconds']['total']:.1f} s)")
+    refused = summary.get("calibrated_campaign", {}).get("refused")
+    if refused:
+        echo(f"warning: calibrated.yaml not written: {one_line(refused)}; the calibration is kept (posterior.h5, "
+             "summary.json, the plots): write the campaign from summary.json's posterior", err=True)
 
 
 def _truth(items: list[str], results: Path) -> dict[str, float] | None:
