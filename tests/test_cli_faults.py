@@ -124,3 +124,69 @@ def test_a_run_whose_times_differ_from_the_nominals_fails_and_is_not_stored_agai
     assert shifted.any() and (~shifted).any()
     assert (status[shifted] == Status.SIMULATOR_ERROR).all() and (status[~shifted] == Status.OK).all()
     assert all("'time' differs from the nominal run's" in str(reasons[j]) for j in range(len(x)) if shifted[j])
+
+
+FORGED = """
+name: forged
+seed: 5
+simulator: {kind: python, function: "hostile_model.py:forged_names"}
+parameters:
+  "x\\nerror: a forged parameter line": {distribution: uniform, lower: -2, upper: 2}
+design: {kind: tensor_grid, points: 5}
+method: {kind: pseudo_galerkin, order: 2}
+"""
+
+
+@pytest.fixture(scope="module")
+def forged(tmp_path_factory):
+    """A results file whose parameter and output names hold a newline and a line of uqflight's after it,
+    its python model beside it (as calibrate wants it)."""
+    import shutil
+
+    folder = tmp_path_factory.mktemp("forged")
+    shutil.copy(DATA / "hostile_model.py", folder / "hostile_model.py")
+    (folder / "c.yaml").write_text(FORGED)
+    ran = cli_in_process("run", folder / "c.yaml", "--out", folder / "c.h5")
+    assert ran.returncode == 0, ran.stderr
+    return folder
+
+
+def forged_lines(done):
+    """The lines of a command's output that a name forged (each starts 'error: a forged' or 'error: forged')."""
+    return [line for line in (done.stdout + done.stderr).splitlines() if line.startswith(("error: forged",
+                                                                                          "error: a forged"))]
+
+
+def test_names_from_a_results_file_are_quoted_in_check_calibrate_and_plan(forged, tmp_path):
+    import json
+
+    results = forged / "c.h5"
+    assert cli_in_process("report", results, "--out", tmp_path / "r", "--write-baseline", tmp_path / "b.json"
+                          ).returncode == 0
+    baseline = json.loads((tmp_path / "b.json").read_text())
+    baseline["outputs"]["q"] = baseline["outputs"].pop("z")
+    (tmp_path / "b.json").write_text(json.dumps(baseline))
+    checked = cli_in_process("check", results, "--baseline", tmp_path / "b.json")
+    assert checked.returncode == 2 and checked.stderr.count("\n") == 1, checked.stderr
+    assert "'y\\nerror: forged'" in checked.stderr
+    data = tmp_path / "d.csv"
+    data.write_text("time_s,q\n0,1\n1,2\n")
+    calibrations = [("--out", tmp_path / "cal"), ("--out", tmp_path / "cal", "--output", "zz"),
+                    ("--out", tmp_path / "cal", "--output", "z", "--truth", "zz=1")]
+    for args in calibrations:
+        refused = cli_in_process("calibrate", results, "--data", data, *args)
+        assert refused.returncode == 2 and "Traceback" not in refused.stderr, refused.stderr
+        assert refused.stderr.splitlines()[-1].startswith("error: ") and not forged_lines(refused), refused.stderr
+    planned = cli_in_process("plan", forged / "c.yaml")
+    assert planned.returncode == 0 and not forged_lines(planned), planned.stdout
+    assert "'x\\nerror: a forged parameter line'" in planned.stdout
+
+
+def test_a_nominal_failure_on_several_lines_is_one_line_at_plan_and_run(tmp_path):
+    # multi_line_failure fails at x > 1 with a two-line reason: the nominal of U(1.5, 2.5) is 2
+    campaign = tmp_path / "c.yaml"
+    campaign.write_text(hostile_campaign_text("multi_line_failure").replace("lower: -2, upper: 2",
+                                                                            "lower: 1.5, upper: 2.5"))
+    for done in (cli_in_process("plan", campaign), cli_in_process("run", campaign, "--out", tmp_path / "c.h5")):
+        assert done.returncode == 2 and done.stderr.count("\n") == 1, done.stderr
+        assert "the nominal sample failed" in done.stderr and not forged_lines(done), done.stderr

@@ -32,7 +32,7 @@ import typer
 
 from .arguments import check_campaign_file, check_output, check_results_file
 from .calibration.command import register as register_calibrate
-from .console import echo, one_line, shown
+from .console import echo, listed, one_line, shown
 from . import stopping
 from .leaving import leave
 from .progress import Progress
@@ -252,10 +252,10 @@ def plan(campaign_file: Path = typer.Argument(..., metavar="CAMPAIGN", help="Cam
     echo(f"campaign: {campaign.name} ({campaign_file})")
     echo("parameters:")
     for p in campaign.parameters:
-        echo(f"  {p.name:<10} {p.property:<18} {p.distribution:<16} nominal {p.nominal:<10.6g} "
+        echo(f"  {shown(p.name):<10} {shown(p.property):<18} {p.distribution:<16} nominal {p.nominal:<10.6g} "
              f"interval [{p.lower:.6g}, {p.upper:.6g}]")
     if campaign.dependence is not None:
-        echo(f"dependence: {campaign.dependence.kind} over {', '.join(campaign.dependence.names)} (standard-normal germs, "
+        echo(f"dependence: {campaign.dependence.kind} over {listed(campaign.dependence.names)} (standard-normal germs, "
              "Cholesky in this order)")
     echo(describe(design))
     kind = campaign.method["kind"]
@@ -400,8 +400,8 @@ def _describe_results(results, store, Status) -> None:
     if state is not None:
         echo(f"index set: {len(state.indices)} multi-indices, {state.rounds} rounds, "
              f"{'stopped by ' + state.stopped if state.stopped else 'refining (resume to go on)'}")
-    echo(f"parameters: {', '.join(map(shown, store.parameter_names))}")
-    echo(f"outputs: {', '.join(map(shown, store.output_names))} ({store.time.size} times, "
+    echo(f"parameters: {listed(store.parameter_names)}")
+    echo(f"outputs: {listed(store.output_names)} ({store.time.size} times, "
          f"{store.time[0]:g} to {store.time[-1]:g} s)")
     counts = {s.name.lower(): int(np.sum(status == s)) for s in Status}
     echo("runs: " + ", ".join(f"{v} {k}" for k, v in counts.items()) + f" (of {status.size})")
@@ -558,7 +558,7 @@ def design(
             echo(f"error: cannot write {csv_path}: {exc.strerror}", err=True)
             raise typer.Exit(2)
     echo(f"wrote {'the design' if to_stdout else csv_path}: {len(points.xi)} points of a {points.kind} design in "
-         f"{len(names)} parameters ({', '.join(names)})", err=to_stdout)
+         f"{len(names)} parameters ({listed(names)})", err=to_stdout)
 
 
 @surrogate_app.command("export")

@@ -22,6 +22,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .console import one_line
 from .forking import die_with_parent
 from .quantities import quantity_key
 from .quantities.recorder import QuantityRecorder
@@ -174,8 +175,8 @@ def main(argv=None) -> None:
             os._exit(0)
         except NominalFailed as exc:  # its message says it all
             conn.send(("error", str(exc)))
-        except Exception as exc:  # building the simulator failed: the runner reports it
-            conn.send(("error", f"{type(exc).__name__}: {exc}"))
+        except Exception as exc:  # building the simulator failed: the runner reports it, on one line
+            conn.send(("error", f"{type(exc).__name__}: {one_line(str(exc))}"))
 
 
 if __name__ == "__main__":  # `python -m uqflight.worker`: the imported module's main, so that the

@@ -72,6 +72,7 @@ def shifted_time(p):
 
 
 def forged_names(p):
-    """An output whose name holds a newline and a forged line of uqflight's."""
-    x = p["x"]
+    """An output whose name holds a newline and a forged line of uqflight's (of the one parameter, whatever
+    its name)."""
+    (x,) = p.values()
     return {"y\nerror: forged": np.array([x, x * x]), "z": np.array([1.0 + x, 2.0])}
