@@ -48,7 +48,6 @@ from .campaign.reading import parameters_attribute
 from .campaign.schema import WORKER_BYTES
 from .console import one_line
 from .designs import Design, is_adaptive
-from .forking import FORKS, Child, ChildFailed, wait_all
 from .parameters import seed_names
 from .stopping import check as check_stop
 from .progress import Progress
@@ -153,63 +152,40 @@ def prepare_store(campaign: Campaign, design: Design, out: Path, force: bool, no
 
 
 def simulate(campaign: Campaign, kappa: np.ndarray, outputs: list[str], processes: int = 1, meanwhile=None):
-    """Fly (or call) the campaign's simulator at every row of kappa (M, d), as a worker of `uqflight run`
-    does (e.g. the calibration's posterior-predictive runs): in this process, or split over `processes`
-    forked children (where the system forks). Each run starts from a fresh simulator state, so the
-    numbers do not depend on the split. `meanwhile` (no arguments) is called here while the children fly,
-    e.g. an import the caller needs next.
+    """Fly (or call) the campaign's simulator at every row of kappa (M, d) as `uqflight run` flies its
+    samples (e.g. the calibration's posterior-predictive runs): in `processes` supervised worker processes,
+    each run from a fresh simulator state (the numbers do not depend on the split) and under the campaign's
+    per-run limit (execution.timeout_s, else max(60 s, 50 flights at the nominal, measured first). A run
+    that fails, kills its worker or runs past the limit is a failed run with its reason; the others stand.
+    `meanwhile` (no arguments) is called here while the workers start, e.g. an import the caller needs next.
 
-    Returns (time (T,), {output: (M, T)} with NaN rows for failed runs, [failure reasons]).
-    """
+    Returns (time (T,), {output: (M, T)} with NaN rows for failed runs, [failure reasons in row order]).
+    Raises WorkerError when no simulator can be built (the message says why)."""
     kappa = np.asarray(kappa, dtype=float)
-    chunks = np.array_split(np.arange(len(kappa)), max(1, min(processes, len(kappa))))
-    if len(chunks) == 1 or not FORKS:
-        found = _simulate_rows(campaign, kappa, outputs)
-        if meanwhile is not None:
-            meanwhile()
-        return found
-    children = [Child(lambda rows=rows: _simulate_rows(campaign, kappa[rows], outputs)) for rows in chunks]
+    spec = replace(worker_spec(campaign), quantities=None)  # the outputs only
+    timeout = campaign.execution.get("timeout_s")
+    pool = WorkerPool(spec, max(1, min(processes, len(kappa))), timeout or NOMINAL_TIMEOUT_S)
     try:
+        pool.start_warmup(nominal_kappa(campaign), measure_resolution=False)  # the time grid, a run's cost
         if meanwhile is not None:
             meanwhile()
+        nominal = pool.warmup_result()
+        pool.timeout = timeout or default_timeout(nominal.seconds)
+        pool.spec = replace(spec, time=tuple(map(float, nominal.time)))  # every run on the nominal's times
+        time = np.asarray(nominal.time, dtype=float)
+        values = {name: np.full((len(kappa), time.size), np.nan) for name in outputs}
+        failures = {}
+        tasks = [Task(np.array([row]), kappa[row:row + 1]) for row in range(len(kappa))]  # a fresh state each
+        for indices, status, reasons, flown in pool.run(tasks, time.size, list(outputs)):
+            row = int(indices[0])
+            if status[0] != Status.OK:
+                failures[row] = str(reasons[0])
+                continue
+            for name in outputs:
+                values[name][row] = flown[name][0]
     finally:
-        found = wait_all(children)
-    time = next((f[0] for f in found if not isinstance(f, ChildFailed)), None)
-    if time is None:  # every child died: the time grid from the simulator here
-        time = _simulate_rows(campaign, kappa[:0], outputs)[0]
-    values = {name: np.full((len(kappa), len(time)), np.nan) for name in outputs}
-    failures = []
-    for rows, f in zip(chunks, found):
-        if isinstance(f, ChildFailed):  # a child that died: its runs failed, with how
-            failures += [f"the process flying this run {f}"] * len(rows)
-            continue
-        failures += f[2]
-        for name in outputs:
-            values[name][rows] = f[1][name]
-    return time, values, failures
-
-
-def _simulate_rows(campaign: Campaign, kappa: np.ndarray, outputs: list[str]):
-    """`simulate` of every row in this process."""
-    from .simulators import make_simulator
-    from .simulators.base import FlightError
-
-    names = [p.name for p in campaign.parameters]
-    properties = [p.property for p in campaign.parameters]
-    simulator = make_simulator(campaign.simulator, names, properties, Path(campaign.source).resolve().parent)
-    time, _ = simulator.layout(kappa[0] if len(kappa) else nominal_kappa(campaign))
-    values = {name: np.full((len(kappa), len(time)), np.nan) for name in outputs}
-    failures = []
-    for row, k in enumerate(kappa):
-        simulator.restart()  # each run as from a fresh worker: independent of the order of the draws
-        try:
-            result = simulator.evaluate(k)
-        except FlightError as exc:
-            failures.append(str(exc))
-            continue
-        for name in outputs:
-            values[name][row] = result[name]
-    return np.asarray(time, dtype=float), values, failures
+        pool.close()
+    return time, values, [failures[row] for row in sorted(failures)]
 
 
 def nominal_kappa(campaign: Campaign) -> np.ndarray:

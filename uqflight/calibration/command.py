@@ -90,6 +90,7 @@ def calibrate_command(
         echo(f"error: {exc}", err=True)
         raise typer.Exit(EXIT_BAD_INPUT)
     known = _truth(truth, results)
+    from ..execution import WorkerError
     from .run import NotConverged, SurrogateError, calibrate
 
     streams, previous = (sys.stdout, sys.stderr), signal.signal(signal.SIGINT, _interrupted)
@@ -104,6 +105,9 @@ def calibrate_command(
         raise typer.Exit(EXIT_INTERRUPTED)
     except (DataError, SurrogateError, ValueError) as exc:
         echo(f"error: {exc}", err=True)
+        raise typer.Exit(EXIT_BAD_INPUT)
+    except WorkerError as exc:  # no simulator for the predictive runs (the model cannot be built or hangs)
+        echo(f"error: {results}: the posterior predictive runs cannot be flown: {exc}", err=True)
         raise typer.Exit(EXIT_BAD_INPUT)
     except NotConverged as exc:
         echo("not converged: no posterior is reported.", err=True)
