@@ -190,3 +190,20 @@ def test_a_nominal_failure_on_several_lines_is_one_line_at_plan_and_run(tmp_path
     for done in (cli_in_process("plan", campaign), cli_in_process("run", campaign, "--out", tmp_path / "c.h5")):
         assert done.returncode == 2 and done.stderr.count("\n") == 1, done.stderr
         assert "the nominal sample failed" in done.stderr and not forged_lines(done), done.stderr
+
+
+def test_an_aircrafts_function_names_are_quoted_by_the_aircraft_command(tmp_path):
+    # `&#10;` in an XML attribute is a newline in the name Python reads; JSBSim itself refuses the name later
+    import shutil
+
+    folder = tmp_path / "root" / "aircraft" / "odd"
+    shutil.copytree(ROOT / "uqflight" / "aircraft" / "bacm", folder)
+    xml = (folder / "bacm.xml").read_text()
+    (folder / "bacm.xml").unlink()
+    forged = xml.replace('<function name="aero/force/drag-beta">',
+                         '<function name="aero/force/drag-beta&#10;error: forged">')
+    assert forged != xml
+    (folder / "odd.xml").write_text(forged)
+    listed = cli_in_process("aircraft", folder)
+    assert "'aero/force/drag-beta\\nerror: forged'" in listed.stdout, listed.stdout
+    assert not forged_lines(listed), listed.stdout + listed.stderr

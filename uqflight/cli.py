@@ -675,7 +675,8 @@ def aircraft_command(
     for f in functions:
         ref = refs[f.name]
         factor = f"ΔC x {ref.symbol}" if not ref.refusal else "offset_value only"
-        echo(f"  {f.axis or '-':<6} {f.name:<40} {ref.unit or 'own':<6} {factor:<17} {f.description[:60]}")
+        echo(f"  {shown(f.axis) if f.axis else '-':<6} {shown(f.name):<40} {ref.unit or 'own':<6} {factor:<17} "
+             f"{one_line(f.description[:60])}")
     condition = default_condition(located.name)
     condition.update({k: v for k, v in (("altitude_ft", altitude_ft), ("airspeed_ktas", airspeed_ktas)) if v is not None})
     setup = FlightSetup(aircraft=located.name, root=located.root, excitation=Excitation(kind="none"), **condition)
@@ -686,7 +687,7 @@ def aircraft_command(
         raise typer.Exit(2)
     echo("engines:")
     for i, (name, kind, thruster) in enumerate(engine_kinds(flight.fdm)):
-        echo(f"  {i}: {name:<24} {kind:<10} thruster: {thruster}")
+        echo(f"  {i}: {shown(name):<24} {shown(kind):<10} thruster: {shown(thruster)}")
     echo(f"elevator travel: {flight.elevator_travel_deg[0]:.1f} deg down, {flight.elevator_travel_deg[1]:.1f} deg up"
          + ("" if not flight.has_property("fcs/elevator-excitation-deg") else " (fcs/elevator-excitation-deg used)"))
     echo(f"nominal trim at {setup.altitude_ft:g} ft, {setup.airspeed_ktas:g} KTAS:")
