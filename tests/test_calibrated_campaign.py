@@ -4,8 +4,10 @@ the real aircraft (JSBSim) checking it; and a calibrated campaign that still fai
 the finished calibration."""
 import csv
 import json
+import shutil
 
 import numpy as np
+import pytest
 import yaml
 from conftest import cli_in_process
 
@@ -25,10 +27,18 @@ execution: {workers: 1}
 """
 
 
-def _calibrated(tmp_path, *args):
-    (tmp_path / "c.yaml").write_text(CAMPAIGN)
-    ran = cli_in_process("run", tmp_path / "c.yaml", "--out", tmp_path / "c.h5")
+@pytest.fixture(scope="module")
+def flown(tmp_path_factory):
+    """The campaign's results file (4 JSBSim runs), flown once for the module."""
+    folder = tmp_path_factory.mktemp("perturbed")
+    (folder / "c.yaml").write_text(CAMPAIGN)
+    ran = cli_in_process("run", folder / "c.yaml", "--out", folder / "c.h5")
     assert ran.returncode == 0, ran.stderr
+    return folder / "c.h5"
+
+
+def _calibrated(flown, tmp_path, *args):
+    shutil.copy(flown, tmp_path / "c.h5")
     with ResultStore.open(tmp_path / "c.h5") as store:  # the data: the run at the grid's last node
         time, alpha = store.time, store.output_matrix("alpha_deg")[-1]
     with open(tmp_path / "flight.csv", "w", newline="") as fh:
@@ -40,8 +50,8 @@ def _calibrated(tmp_path, *args):
                           *args)
 
 
-def test_a_calibrated_campaign_keeps_function_and_perturbation_and_plans(tmp_path):
-    done = _calibrated(tmp_path)
+def test_a_calibrated_campaign_keeps_function_and_perturbation_and_plans(flown, tmp_path):
+    done = _calibrated(flown, tmp_path)
     assert done.returncode == 0, done.stderr
     calibrated = yaml.safe_load((tmp_path / "cal" / "calibrated.yaml").read_text())
     lift = calibrated["parameters"]["lift"]
@@ -54,7 +64,7 @@ def test_a_calibrated_campaign_keeps_function_and_perturbation_and_plans(tmp_pat
     assert planned.returncode == 0, planned.stderr
 
 
-def test_a_calibrated_campaign_that_fails_its_check_keeps_the_calibration_and_says_so(tmp_path, monkeypatch):
+def test_a_calibrated_campaign_that_fails_its_check_keeps_the_calibration_and_says_so(flown, tmp_path, monkeypatch):
     # a calibrated text the campaign check refuses (here a parameter given a key no campaign takes): the
     # posterior, the summary and the plots are kept, calibrated.yaml is not written, one warning says why
     written = outputs_module.calibrated_campaign
@@ -63,7 +73,7 @@ def test_a_calibrated_campaign_that_fails_its_check_keeps_the_calibration_and_sa
         return written(*args, **kwargs).replace("perturbation: scale", "perturbation: scale, bogus: 1")
 
     monkeypatch.setattr("uqflight.calibration.run.calibrated_campaign", refused)
-    done = _calibrated(tmp_path)
+    done = _calibrated(flown, tmp_path)
     assert done.returncode == 0, done.stderr
     out = tmp_path / "cal"
     assert (out / "posterior.h5").is_file() and (out / "summary.json").is_file()

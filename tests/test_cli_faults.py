@@ -160,10 +160,12 @@ def forged_lines(done):
 def test_names_from_a_results_file_are_quoted_in_check_calibrate_and_plan(forged, tmp_path):
     import json
 
+    from uqflight.check import baseline_json
+    from uqflight.statistics import read_statistics
+
     results = forged / "c.h5"
-    assert cli_in_process("report", results, "--out", tmp_path / "r", "--write-baseline", tmp_path / "b.json"
-                          ).returncode == 0
-    baseline = json.loads((tmp_path / "b.json").read_text())
+    stats, attrs = read_statistics(results)  # the baseline `report --write-baseline` writes
+    baseline = json.loads(json.dumps(baseline_json(stats, attrs["campaign_hash"])))
     baseline["outputs"]["q"] = baseline["outputs"].pop("z")
     (tmp_path / "b.json").write_text(json.dumps(baseline))
     checked = cli_in_process("check", results, "--baseline", tmp_path / "b.json")
