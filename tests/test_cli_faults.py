@@ -209,3 +209,21 @@ def test_an_aircrafts_function_names_are_quoted_by_the_aircraft_command(tmp_path
     listed = cli_in_process("aircraft", folder)
     assert "'aero/force/drag-beta\\nerror: forged'" in listed.stdout, listed.stdout
     assert not forged_lines(listed), listed.stdout + listed.stderr
+
+
+def test_info_prints_a_results_files_texts_on_their_own_lines(forged, tmp_path):
+    # the attributes info shows as they are (the design's facts, the versions, the aircraft's hash), edited
+    # to hold newlines followed by lines of uqflight's
+    import shutil
+
+    import h5py
+
+    shutil.copy(forged / "c.h5", tmp_path / "c.h5")
+    with h5py.File(tmp_path / "c.h5", "a") as f:
+        f.attrs["design_info"] = f.attrs["design_info"].replace(", ", ",\nerror: forged\n")
+        f.attrs["versions"] = f.attrs["versions"].replace(", ", ",\nerror: forged\n", 1)
+        f.attrs["aircraft_hash"] = "abc\nerror: forged"
+    shown = cli_in_process("info", tmp_path / "c.h5")
+    assert shown.returncode == 0, shown.stderr
+    assert not forged_lines(shown), shown.stdout
+    assert "aircraft sha256: 'abc\\nerror: forged'" in shown.stdout

@@ -394,8 +394,8 @@ def _describe_results(results, store, Status) -> None:
     status = store.status
     attrs = store.attrs
     echo(f"file: {results}")
-    echo(f"campaign: {shown(str(attrs.get('campaign_name', '?')))} (sha256 {store.campaign_hash[:12]})")
-    echo(f"design: {attrs.get('design_kind', '?')} {attrs.get('design_info', '')}")
+    echo(f"campaign: {shown(str(attrs.get('campaign_name', '?')))} (sha256 {one_line(str(store.campaign_hash[:12]))})")
+    echo(f"design: {shown(str(attrs.get('design_kind', '?')))} {one_line(str(attrs.get('design_info', '')))}")
     state = store.index_set()  # an adaptive grid's refinement (/design)
     if state is not None:
         echo(f"index set: {len(state.indices)} multi-indices, {state.rounds} rounds, "
@@ -412,11 +412,11 @@ def _describe_results(results, store, Status) -> None:
         echo(f"  failed ({n}): {one_line(reason)}")
     problems = store.verify()  # reads every checksummed chunk: a flipped byte is reported
     for problem in problems:
-        echo(f"  problem: {problem}")
+        echo(f"  problem: {one_line(str(problem))}")
     echo(f"storage: {store.storage_description}")
-    echo(f"versions: {attrs.get('versions', '?')}")
+    echo(f"versions: {one_line(str(attrs.get('versions', '?')))}")  # text of the file's: one line whatever it holds
     if "aircraft_hash" in attrs:
-        echo(f"aircraft sha256: {attrs['aircraft_hash']}")
+        echo(f"aircraft sha256: {one_line(str(attrs['aircraft_hash']))}")
     if problems:
         raise typer.Exit(2)
 
