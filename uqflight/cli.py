@@ -631,7 +631,7 @@ def check(
         echo(f"error: {exc}", err=True)
         raise typer.Exit(2)
     if expected.get("campaign_hash") and expected["campaign_hash"] != attrs.get("campaign_hash"):
-        echo(f"error: {results} comes from another campaign (sha256 {str(attrs.get('campaign_hash'))[:12]}) "
+        echo(f"error: {results} comes from another campaign (sha256 {one_line(str(attrs.get('campaign_hash'))[:12])}) "
              f"than the baseline {baseline} ({str(expected['campaign_hash'])[:12]}): compare a results file "
              "with the baseline of its own campaign", err=True)
         raise typer.Exit(2)
