@@ -227,3 +227,36 @@ def test_info_prints_a_results_files_texts_on_their_own_lines(forged, tmp_path):
     assert shown.returncode == 0, shown.stderr
     assert not forged_lines(shown), shown.stdout
     assert "aircraft sha256: 'abc\\nerror: forged'" in shown.stdout
+
+
+def test_ctrl_c_while_plan_flies_its_nominal_is_one_line_and_exit_130_and_ends_its_worker(tmp_path):
+    import time
+    from pathlib import Path
+
+    from test_run_faults import alive, children
+
+    campaign = write(tmp_path, "hanging_at_centre")
+    planner = subprocess.Popen([UQFLIGHT, "plan", str(campaign)], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                               text=True, env={**os.environ, "PYTHONPATH": str(ROOT)},
+                               preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
+    try:
+        for _ in range(600):  # its worker started (a bound, not a speed test)
+            workers = [pid for pid in children(planner.pid)
+                       if b"uqflight.worker" in Path(f"/proc/{pid}/cmdline").read_bytes()]
+            if workers:
+                break
+            time.sleep(0.1)
+        assert workers
+        time.sleep(1.0)  # flying the nominal, which never returns
+        planner.send_signal(signal.SIGINT)
+        _, stderr = planner.communicate(timeout=120)
+    finally:
+        if planner.poll() is None:
+            planner.kill()
+    assert planner.returncode == 130, stderr
+    assert stderr.strip() == "interrupted" and "Traceback" not in stderr, stderr
+    for _ in range(100):
+        if not any(alive(pid) for pid in workers):
+            break
+        time.sleep(0.1)
+    assert not any(alive(pid) for pid in workers)

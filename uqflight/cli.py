@@ -59,6 +59,8 @@ def main() -> None:
     try:
         app()
     except SystemExit as done:
+        if done.code == 130 and isinstance(getattr(done.__context__, "__cause__", None), KeyboardInterrupt):
+            echo("\ninterrupted", err=True)  # a Ctrl-C no command caught (typer exits 130 silently): say so
         leave(done.code)
     leave(0)
 
