@@ -260,3 +260,16 @@ def test_ctrl_c_while_plan_flies_its_nominal_is_one_line_and_exit_130_and_ends_i
             break
         time.sleep(0.1)
     assert not any(alive(pid) for pid in workers)
+
+
+def test_run_quotes_the_campaign_hash_of_another_campaigns_file_it_refuses(forged, tmp_path):
+    import shutil
+
+    import h5py
+
+    shutil.copy(forged / "c.h5", tmp_path / "c.h5")
+    with h5py.File(tmp_path / "c.h5", "a") as f:
+        f.attrs["campaign_hash"] = "abc\nerror: forged"
+    refused = cli_in_process("run", write(tmp_path, "slow", samples=2), "--out", tmp_path / "c.h5")
+    assert refused.returncode == 2 and refused.stderr.count("\n") == 1, refused.stderr
+    assert "(campaign_hash 'abc\\nerror: forged')" in refused.stderr and not forged_lines(refused)

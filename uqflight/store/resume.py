@@ -6,6 +6,7 @@ from pathlib import Path
 
 import h5py
 
+from ..console import shown
 from .file_end import extend_file, past_recorded_end
 from .results import READ_ERRORS, ResultStore, one_line, text_hash
 
@@ -60,10 +61,10 @@ def open_for_campaign(path, *, campaign_text: str, force: bool = False, restart:
             if stored == text_hash(campaign_text):
                 key = next(key for key in FLOWN if stored_flown.get(key) != flown[key])
                 what = {"aircraft_hash": "aircraft files (sha256", "scenario": "script files ("}[key]
-                raise FileExistsError(f"{path} was made with other {what} {str(stored_flown.get(key))[:80]}); "
+                raise FileExistsError(f"{path} was made with other {what} {shown(str(stored_flown.get(key))[:80])}); "
                                       "resuming would mix two models: choose another results file, or force "
                                       "to start over")
-            raise FileExistsError(f"{path} holds the results of another campaign (campaign_hash {stored}); "
+            raise FileExistsError(f"{path} holds the results of another campaign (campaign_hash {shown(str(stored))}); "
                                   "choose another results file, or force to overwrite it")
         path.unlink()
     try:
