@@ -91,6 +91,7 @@ class RunSummary:
     failures: Counter = field(default_factory=Counter)
     timeout_s: float = float("nan")
     nominal_failure: str | None = None  # why the nominal flight (ξ = 0) failed, when it did
+    nominal_warnings: list[str] = field(default_factory=list)  # what it warned of (an unmoved surface)
 
     def describe(self) -> str:
         rate = self.ran / self.seconds if self.seconds > 0 else float("nan")
@@ -100,6 +101,7 @@ class RunSummary:
             lines.append(f"  warning: the nominal flight (every parameter at its law's centre) failed: "
                          f"{one_line(self.nominal_failure)}; runs near it fail the same way: check the campaign's flight with "
                          "`uqflight simulate` and its --set")
+        lines += [f"  warning: the nominal flight: {one_line(warning)}" for warning in self.nominal_warnings]
         lines += [f"  failed ({n}): {one_line(reason)}" for reason, n in self.failures.most_common(10)]
         return "\n".join(lines)
 
@@ -204,18 +206,18 @@ def worker_spec(campaign: Campaign) -> WorkerSpec:
                       quantities=campaign.quantities or None)
 
 
-def timed_nominal(campaign: Campaign) -> float:
-    """The seconds one nominal flight of the campaign takes on this machine (`uqflight plan`'s estimate),
-    flown as `run` flies it: in a supervised worker process, under the campaign's time limit
-    (execution.timeout_s, else NOMINAL_TIMEOUT_S, plus STARTUP_GRACE_S for the worker's start), a
-    first flight warming what every later one reuses (the Newton trim's nominal), the second timed.
-    Raises WorkerError when the worker dies, runs past the limit or cannot build the simulator (the
-    message says which), as `run` does."""
+def timed_nominal(campaign: Campaign) -> NominalFlight:
+    """One nominal flight of the campaign timed on this machine (`uqflight plan`'s estimate: its
+    `seconds`, and its `warnings`), flown as `run` flies it: in a supervised worker process, under the
+    campaign's time limit (execution.timeout_s, else NOMINAL_TIMEOUT_S, plus STARTUP_GRACE_S for the
+    worker's start), a first flight warming what every later one reuses (the Newton trim's nominal),
+    the second timed. Raises WorkerError when the worker dies, runs past the limit or cannot build the
+    simulator (the message says which), as `run` does."""
     pool = WorkerPool(worker_spec(campaign), 1, campaign.execution.get("timeout_s") or NOMINAL_TIMEOUT_S)
     kappa = nominal_kappa(campaign)
     try:
         pool.nominal_flight(kappa, measure_resolution=False)
-        return pool.nominal_flight(kappa, measure_resolution=False).seconds
+        return pool.nominal_flight(kappa, measure_resolution=False)
     finally:
         pool.close()
 
@@ -357,6 +359,7 @@ def run_campaign(campaign: Campaign, out: Path | None = None, workers: int | Non
     summary.seconds = time.perf_counter() - started
     summary.timeout_s = timeout
     summary.nominal_failure = nominal.failure
+    summary.nominal_warnings = list(getattr(nominal, "warnings", []))
     return summary
 
 
