@@ -262,14 +262,21 @@ def test_ctrl_c_while_plan_flies_its_nominal_is_one_line_and_exit_130_and_ends_i
     assert not any(alive(pid) for pid in workers)
 
 
-def test_run_quotes_the_campaign_hash_of_another_campaigns_file_it_refuses(forged, tmp_path):
+def test_run_quotes_what_it_read_from_another_campaigns_file_it_refuses(forged, tmp_path):
+    # the key where the stored campaign differs first (a parameter's name holding a newline), and the
+    # stored campaign hash when the stored text cannot be read (edited to hold a newline)
     import shutil
 
     import h5py
 
     shutil.copy(forged / "c.h5", tmp_path / "c.h5")
+    shutil.copy(forged / "hostile_model.py", tmp_path / "hostile_model.py")
+    (tmp_path / "other.yaml").write_text(FORGED.replace("upper: 2", "upper: 3"))
+    refused = cli_in_process("run", tmp_path / "other.yaml", "--out", tmp_path / "c.h5")
+    assert refused.returncode == 2 and refused.stderr.count("\n") == 1, refused.stderr
+    assert "differs first at 'parameters.x\\nerror: a forged parameter line.upper'" in refused.stderr
     with h5py.File(tmp_path / "c.h5", "a") as f:
-        f.attrs["campaign_hash"] = "abc\nerror: forged"
+        f.attrs["campaign_hash"], f.attrs["campaign"] = "abc\nerror: forged", ""
     refused = cli_in_process("run", write(tmp_path, "slow", samples=2), "--out", tmp_path / "c.h5")
     assert refused.returncode == 2 and refused.stderr.count("\n") == 1, refused.stderr
     assert "(campaign_hash 'abc\\nerror: forged')" in refused.stderr and not forged_lines(refused)
