@@ -188,7 +188,7 @@ def _compare_section(what: str, fresh: dict, expected: dict, rtol: float, atol: 
         plural = {"output": "outputs", "quantity": "quantities"}[what]
         raise BadInput(f"the baseline is for {plural} {listed(expected) or '-'}; the results have "
                        f"{listed(fresh) or '-'}")
-    label = (lambda name: shown_name(name)) if what == "output" else (lambda name: f"quantity {shown_name(name)}")
+    label = shown_name if what == "output" else (lambda name: f"quantity {shown_name(name)}")
     compared, drifts = 0, []
     for name, entry in expected.items():
         if entry is None or fresh[name] is None:

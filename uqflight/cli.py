@@ -253,7 +253,7 @@ def plan(campaign_file: Path = typer.Argument(..., metavar="CAMPAIGN", help="Cam
 
     campaign = _load(campaign_file)
     design = campaign.design()
-    echo(f"campaign: {campaign.name} ({campaign_file})")
+    echo(f"campaign: {shown(str(campaign.name))} ({campaign_file})")
     echo("parameters:")
     for p in campaign.parameters:
         echo(f"  {shown(p.name):<10} {shown(p.property):<18} {p.distribution:<16} nominal {p.nominal:<10.6g} "

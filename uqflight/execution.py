@@ -157,7 +157,7 @@ def simulate(campaign: Campaign, kappa: np.ndarray, outputs: list[str], processe
     """Fly (or call) the campaign's simulator at every row of kappa (M, d) as `uqflight run` flies its
     samples (e.g. the calibration's posterior-predictive runs): in `processes` supervised worker processes,
     each run from a fresh simulator state (the numbers do not depend on the split) and under the campaign's
-    per-run limit (execution.timeout_s, else max(60 s, 50 flights at the nominal, measured first). A run
+    per-run limit (execution.timeout_s, else max(60 s, 50 flights at the nominal), the nominal flown first). A run
     that fails, kills its worker or runs past the limit is a failed run with its reason; the others stand.
     `meanwhile` (no arguments) is called here while the workers start, e.g. an import the caller needs next.
 
