@@ -203,8 +203,8 @@ def _compare_section(what: str, fresh: dict, expected: dict, rtol: float, atol: 
         if set(values) != set(reference):
             only_baseline = listed(sorted(set(reference) - set(values))) or "-"
             only_results = listed(sorted(set(values) - set(reference))) or "-"
-            raise BadInput(f"{what} {shown_name(name)}: the baseline has statistics {only_baseline} that the results lack, the "
-                           f"results {only_results} that the baseline lacks (another method or parameters?)")
+            raise BadInput(f"{what} {shown_name(name)}: the baseline has statistics {only_baseline} that the results "
+                           f"lack, the results {only_results} that the baseline lacks (another method or parameters?)")
         for statistic, baseline_values in reference.items():
             value = np.asarray(values[statistic], dtype=float)
             base = np.asarray(baseline_values, dtype=float)

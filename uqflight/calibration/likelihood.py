@@ -77,7 +77,8 @@ def read_flight_csv(path, outputs: list[str] | None, available: list[str]) -> Fl
                 try:
                     table[i - 2, j] = float(cell)
                 except ValueError:
-                    raise DataError(f"{path}: line {i}, column {shown(header[j])}: expected a number, got {cell!r}") from None
+                    raise DataError(f"{path}: line {i}, column {shown(header[j])}: expected a number, "
+                                    f"got {cell!r}") from None
     time = table[:, header.index("time_s")]
     if not np.all(np.isfinite(time)) or np.any(np.diff(time) <= 0):
         raise DataError(f"{path}: time_s must be finite and strictly increasing")
