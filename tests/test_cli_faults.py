@@ -280,3 +280,21 @@ def test_run_quotes_what_it_read_from_another_campaigns_file_it_refuses(forged, 
     refused = cli_in_process("run", write(tmp_path, "slow", samples=2), "--out", tmp_path / "c.h5")
     assert refused.returncode == 2 and refused.stderr.count("\n") == 1, refused.stderr
     assert "(campaign_hash 'abc\\nerror: forged')" in refused.stderr and not forged_lines(refused)
+
+
+def test_a_damaged_outputs_name_is_quoted_by_surrogate_export_and_report(forged, tmp_path):
+    import shutil
+
+    import h5py
+
+    shutil.copy(forged / "c.h5", tmp_path / "c.h5")
+    with h5py.File(tmp_path / "c.h5", "a") as f:  # a run with status ok holding NaN: refused as damaged
+        values = f["outputs"]["y\nerror: forged"]
+        edited = values[...]
+        edited[1, 0] = float("nan")
+        values[...] = edited
+    for args in (("surrogate", "export", tmp_path / "c.h5", "--out", tmp_path / "s.json"),
+                 ("report", tmp_path / "c.h5", "--out", tmp_path / "r")):
+        refused = cli_in_process(*args)
+        assert refused.returncode == 2 and refused.stderr.count("\n") == 1, refused.stderr
+        assert "output 'y\\nerror: forged': 1 runs with status ok" in refused.stderr and not forged_lines(refused)
