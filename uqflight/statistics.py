@@ -47,6 +47,7 @@ from .analysis.resolution import RESOLUTION_RTOL, resolved_variance
 from .analysis.sobol import NEGLIGIBLE, UNRESOLVED_WIDTH, complete_rows, pick_freeze_indices, unresolved
 from .campaign.attributes import StoredFacts, stored_facts, stored_settings
 from .campaign.schema import CampaignError
+from .console import shown
 from .designs import REGISTRY as DESIGNS
 from .designs import is_sampled
 from .designs.adaptive import index_set_summary
@@ -405,12 +406,12 @@ def output_basis(store: ResultStore, name: str, ok: np.ndarray,
         histories = store.output_matrix(name, runs)
         bad = runs[~np.isfinite(histories).all(axis=1)]
         if bad.size:
-            raise CorruptFile(f"output {name}: {bad.size} runs with status ok hold values that are not finite "
+            raise CorruptFile(f"output {shown(name)}: {bad.size} runs with status ok hold values that are not finite "
                               f"(e.g. run {bad[0]}): the file is damaged (`uqflight info` lists its problems)")
         return _unwrapped(histories, period, name, unwrapped, histories), None
     U, s, V, columns = factors
     if not (np.isfinite(U).all() and np.isfinite(s).all() and np.isfinite(V).all()):
-        raise CorruptFile(f"output {name}: its tSVD factors hold values that are not finite: the file is damaged")
+        raise CorruptFile(f"output {shown(name)}: its tSVD factors hold values that are not finite: the file is damaged")
     row_of = np.full(ok.size, -1)
     row_of[columns] = np.arange(columns.size)
     basis, scale = V[row_of[np.flatnonzero(ok)]], s[:, None] * U.T

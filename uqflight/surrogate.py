@@ -22,6 +22,9 @@ from pathlib import Path
 
 import numpy as np
 
+from .console import listed
+from .console import shown as shown_name
+
 FORMAT = "uqflight-pce"
 VERSION = 1
 MAX_FILE_BYTES = 64 << 20  # 64 MiB of JSON (about 3 million coefficients); parsing takes about 10 times that
@@ -58,7 +61,7 @@ class Surrogate:
         kappa = np.atleast_2d(np.asarray(kappa, dtype=float))
         if kappa.shape[1] != len(self.parameters):
             raise ValueError(f"expected {len(self.parameters)} values per point "
-                             f"({', '.join(p['name'] for p in self.parameters)}), got {kappa.shape[1]}")
+                             f"({listed(p['name'] for p in self.parameters)}), got {kappa.shape[1]}")
         laws = [Parameter(p["name"], p.get("property", p["name"]), p["distribution"], p["nominal"], p["lower"],
                           p["upper"]) for p in self.parameters]
         return to_standard(laws, kappa, _copula(self.dependence))
@@ -145,8 +148,8 @@ def _parameters(store, path) -> list[dict]:
         raise SurrogateError(f"{path}: cannot read the parameters' distributions from the campaign stored in the "
                              f"file: {reason}") from exc
     if [p["name"] for p in found] != store.parameter_names:
-        raise SurrogateError(f"{path}: the parameters of the stored campaign ({', '.join(p['name'] for p in found)}) "
-                             f"are not the file's ({', '.join(store.parameter_names)})")
+        raise SurrogateError(f"{path}: the parameters of the stored campaign ({listed(p['name'] for p in found)}) "
+                             f"are not the file's ({listed(store.parameter_names)})")
     return found
 
 
@@ -252,7 +255,7 @@ def _checked(data: dict) -> Surrogate:
                         p["upper"])
         germ = "normal" if copula is not None and law.name in copula.names else law.germ
         if germ != germs[j]:
-            raise ValueError(f"parameters[{j}] ({p['name']}): a {p['distribution']} law is driven by a {germ} "
+            raise ValueError(f"parameters[{j}] ({shown_name(p['name'])}): a {p['distribution']} law is driven by a {germ} "
                              f"germ{' (dependence:)' if germ != law.germ else ''}, but germs[{j}] is {germs[j]}")
     unknown = set(copula.names) - {p["name"] for p in parameters} if copula is not None else set()
     if unknown:
@@ -270,13 +273,13 @@ def _checked(data: dict) -> Surrogate:
     coefficients, indices = {}, {}
     for name, output in outputs.items():
         if shared is None or "multi_indices" in output:
-            indices[name] = _multi_indices(output["multi_indices"], f"outputs.{name}.multi_indices", d, order)
+            indices[name] = _multi_indices(output["multi_indices"], f"outputs.{shown_name(name)}.multi_indices", d, order)
         else:
             indices[name] = shared
-        coefficients[name] = _array(output["coefficients"], f"outputs.{name}.coefficients",
+        coefficients[name] = _array(output["coefficients"], f"outputs.{shown_name(name)}.coefficients",
                                     (len(indices[name]), time.size))
         if not isinstance(output.get("units", ""), str):
-            raise ValueError(f"outputs.{name}.units: expected a string, got {_shown(output['units'])}")
+            raise ValueError(f"outputs.{shown_name(name)}.units: expected a string, got {_shown(output['units'])}")
     for key, kind in (("method", str), ("split", bool), ("campaign", str)):
         if key in data and not isinstance(data[key], kind):
             raise ValueError(f"{key}: expected a {kind.__name__}, got {_shown(data[key])}")

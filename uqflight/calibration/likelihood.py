@@ -21,6 +21,7 @@ from typing import Callable
 
 import numpy as np
 
+from ..console import listed, shown
 from ..parameters.germs import GERMS, germ_columns
 
 
@@ -55,17 +56,17 @@ def read_flight_csv(path, outputs: list[str] | None, available: list[str]) -> Fl
         raise DataError(f"{path}: expected a header (time_s, outputs...) and at least one row of data")
     header = [cell.strip() for cell in rows[0]]
     if "time_s" not in header:
-        raise DataError(f"{path}: no time_s column (header: {', '.join(header)})")
+        raise DataError(f"{path}: no time_s column (header: {listed(header)})")
     if outputs is None:
         outputs = [name for name in header if name in available]
         if not outputs:
-            raise DataError(f"{path}: none of the columns {', '.join(h for h in header if h != 'time_s')} is an "
-                            f"output of the campaign ({', '.join(available)})")
+            raise DataError(f"{path}: none of the columns {listed(h for h in header if h != 'time_s')} is an "
+                            f"output of the campaign ({listed(available)})")
     for name in outputs:
         if name not in available:
-            raise DataError(f"--output {name}: not an output of the campaign ({', '.join(available)})")
+            raise DataError(f"--output {shown(name)}: not an output of the campaign ({listed(available)})")
         if name not in header:
-            raise DataError(f"{path}: no column {name!r} (header: {', '.join(header)})")
+            raise DataError(f"{path}: no column {name!r} (header: {listed(header)})")
     table = np.full((len(rows) - 1, len(header)), np.nan)
     for i, row in enumerate(rows[1:], start=2):
         if len(row) != len(header):
@@ -76,7 +77,8 @@ def read_flight_csv(path, outputs: list[str] | None, available: list[str]) -> Fl
                 try:
                     table[i - 2, j] = float(cell)
                 except ValueError:
-                    raise DataError(f"{path}: line {i}, column {header[j]}: expected a number, got {cell!r}") from None
+                    raise DataError(f"{path}: line {i}, column {shown(header[j])}: expected a number, "
+                                    f"got {cell!r}") from None
     time = table[:, header.index("time_s")]
     if not np.all(np.isfinite(time)) or np.any(np.diff(time) <= 0):
         raise DataError(f"{path}: time_s must be finite and strictly increasing")
@@ -109,9 +111,9 @@ def name_values(pairs: list[str], option: str, form: str, names: list[str], amon
         if not sep or not name or not math.isfinite(value) or (positive and not value > 0):
             raise DataError(f"{option}: expected {form}, got {pair!r}")
         if name not in names:
-            raise DataError(f"{option} {name}: not one of {among} ({', '.join(names)})")
+            raise DataError(f"{option} {shown(name)}: not one of {among} ({listed(names)})")
         if name in values:
-            raise DataError(f"{option} {name}: given twice ({values[name]:g} and {value:g}); give it once")
+            raise DataError(f"{option} {shown(name)}: given twice ({values[name]:g} and {value:g}); give it once")
         values[name] = value
     return values
 

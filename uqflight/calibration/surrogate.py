@@ -16,6 +16,7 @@ import numpy as np
 
 from ..campaign import Campaign, CampaignError, load_campaign
 from ..campaign.reading import campaign_folder, check_campaign_text, portable_mapping, results_campaign
+from ..console import listed
 from ..designs import is_sampled
 from ..execution import simulate
 from ..methods import METHOD_KINDS, normalised
@@ -159,7 +160,7 @@ def calibration_surrogate(results, method: str | None = None, order: int | None 
         missing = [name for name in names if name not in store.output_names]
         if missing:
             raise SurrogateError(f"{results} has no output {', '.join(map(repr, missing))} "
-                                 f"(it has {', '.join(store.output_names)})")
+                                 f"(it has {listed(store.output_names)})")
         try:  # the statistics' own PCE, after their checks (pending or failed runs, aliasing, rank)
             fitted = fit_surrogate(results, {"kind": kind, "order": order},
                                    options=Options(band_samples=200, bootstrap=0))

@@ -26,6 +26,7 @@ EXECUTORS = ("local", "dask")
 TOP_KEYS = ("name", "description", "seed", "simulator", "parameters", "design", "method",
             "execution", "storage", "analysis", "limits", "quantities", "dependence")
 PARAMETER_KEYS = ("property", "function", "perturbation", "distribution", "nominal", "interval_pct", "lower", "upper")
+LAW_KEYS = ("distribution", "nominal", "interval_pct", "lower", "upper")  # a parameter's law; the rest say what it sets
 PERTURBATIONS = ("scale", "offset", "offset_value")
 METHOD_KEYS = ("kind", "order", "split", "allow_aliasing")
 EXECUTION_KEYS = ("workers", "executor", "scheduler", "chunk", "timeout_s")

@@ -7,6 +7,7 @@ from pathlib import Path
 import h5py
 import yaml
 
+from ..console import shown
 from .file_end import extend_file, past_recorded_end
 from .results import READ_ERRORS, ResultStore, one_line, text_hash
 
@@ -76,11 +77,11 @@ def open_for_campaign(path, *, campaign_text: str, force: bool = False, restart:
             if stored == text_hash(campaign_text):
                 key = next(key for key in FLOWN if stored_flown.get(key) != flown[key])
                 what = {"aircraft_hash": "aircraft files (sha256", "scenario": "script files ("}[key]
-                raise FileExistsError(f"{path} was made with other {what} {str(stored_flown.get(key))[:80]}); "
+                raise FileExistsError(f"{path} was made with other {what} {shown(str(stored_flown.get(key))[:80])}); "
                                       "resuming would mix two models: choose another results file, or force "
                                       "to start over")
-            where = (f": its campaign differs first at {differs}" if differs else
-                     f" (campaign_hash {stored})")
+            where = (f": its campaign differs first at {shown(differs)}" if differs else
+                     f" (campaign_hash {shown(str(stored))})")
             if differs and differs.startswith("quantities"):
                 where += (" (a quantity is computed in the worker at every integration step, finer than the "
                           "stored histories: a changed one is flown again)")
