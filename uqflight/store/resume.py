@@ -7,6 +7,7 @@ from pathlib import Path
 import h5py
 
 from .file_end import extend_file, past_recorded_end
+from .lock import LockHeld, held_message, is_lock_error, open_elsewhere
 from .results import READ_ERRORS, ResultStore, one_line, text_hash
 
 
@@ -23,6 +24,9 @@ def open_for_campaign(path, *, campaign_text: str, force: bool = False, restart:
     never deletes what is not a uqflight results file (a directory, a text file, another HDF5 file):
     those are refused, with how to remove them. (The caller holds the file's lock: `force` never
     touches a file another run writes.) `restart` starts a results file of this same campaign over.
+    A file another process holds open (HDF5's file lock: a reader, or a writer without our lock) is
+    refused with LockHeld naming that process, before anything is read: it is in use, not damaged,
+    and neither `force` nor `restart` replaces it.
     """
     path = Path(path)
     flown = {key: (create_args.get("attrs") or {}).get(key) for key in FLOWN}
@@ -40,6 +44,8 @@ def open_for_campaign(path, *, campaign_text: str, force: bool = False, restart:
         try:
             stored, stored_flown, ours = _stored_campaign(path)
         except READ_ERRORS as exc:  # e.g. killed while the file was being created: nothing to resume
+            if is_lock_error(exc):  # opened by another process since the check above
+                raise LockHeld(held_message(path)) from None
             if not force:
                 reason = one_line(exc)[:200]
                 if past_recorded_end(reason):  # and _stored_campaign could not move that end
@@ -53,7 +59,12 @@ def open_for_campaign(path, *, campaign_text: str, force: bool = False, restart:
                                   "or /samples/status); uqflight never overwrites it, even with --force: "
                                   f"remove it yourself (rm {path}) or choose another results file")
         if stored == text_hash(campaign_text) and stored_flown == flown and not restart:
-            return ResultStore.open(path, "a")
+            try:
+                return ResultStore.open(path, "a")
+            except OSError as exc:
+                if is_lock_error(exc):
+                    raise LockHeld(held_message(path)) from None
+                raise
         if restart and stored == text_hash(campaign_text):
             force = True
         if not force:
@@ -65,6 +76,8 @@ def open_for_campaign(path, *, campaign_text: str, force: bool = False, restart:
                                       "to start over")
             raise FileExistsError(f"{path} holds the results of another campaign (campaign_hash {stored}); "
                                   "choose another results file, or force to overwrite it")
+        if open_elsewhere(path):  # opened meanwhile: it is in use, and stays
+            raise LockHeld(held_message(path))
         path.unlink()
     try:
         return ResultStore.create(path, campaign_text=campaign_text, **create_args)
