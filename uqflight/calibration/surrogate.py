@@ -146,8 +146,8 @@ def calibration_surrogate(results, method: str | None = None, order: int | None 
     results = Path(results)
     try:
         store = ResultStore.open(results)
-    except (OSError, ValueError) as exc:
-        raise SurrogateError(f"{results}: {exc}") from exc
+    except (OSError, ValueError) as exc:  # CorruptFile's message names the file already
+        raise SurrogateError(str(exc) if str(exc).startswith(f"{results}:") else f"{results}: {exc}") from exc
     with store:
         campaign = _campaign_of(store, results, Path(campaign_path) if campaign_path else None)
         try:
