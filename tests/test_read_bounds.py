@@ -4,6 +4,8 @@ runs, times, outputs and quantities; a baseline's bytes (`check --baseline`); a 
 limit (RLIMIT_AS), so that a reader that does allocate from a declared size fails there, not on the machine."""
 from __future__ import annotations
 
+import os
+import re
 import resource
 import shutil
 import subprocess
@@ -21,9 +23,9 @@ def _limited():
     resource.setrlimit(resource.RLIMIT_AS, (MEMORY_LIMIT, MEMORY_LIMIT))
 
 
-def limited_cli(*args, cwd=None) -> subprocess.CompletedProcess:
+def limited_cli(*args, cwd=None, timeout: float = 300) -> subprocess.CompletedProcess:
     """`uqflight ARGS...` in a process whose address space is MEMORY_LIMIT."""
-    return subprocess.run([UQFLIGHT, *map(str, args)], cwd=cwd, capture_output=True, text=True, timeout=300,
+    return subprocess.run([UQFLIGHT, *map(str, args)], cwd=cwd, capture_output=True, text=True, timeout=timeout,
                           preexec_fn=_limited)
 
 
@@ -102,3 +104,42 @@ def test_a_tsvd_buffer_declaring_runs_x_times_beyond_the_bound_is_refused(decay_
             part.create_dataset("buffer_index", shape=(1000,), dtype="i8", fillvalue=-1)
     with pytest.raises(CorruptFile, match=r"declares buffered runs 1000 \(at most 250\)"):
         ResultStore.open(out)
+
+
+def unbounded_inputs(tmp_path) -> dict:
+    """A 4 GiB file of one line (sparse: no disk taken), /dev/zero (never ends), a FIFO nobody writes (its
+    reader waits for ever): what each one is called in the refusal."""
+    huge = tmp_path / "huge"
+    with open(huge, "wb") as fh:
+        fh.truncate(4 * 2**30)
+    fifo = tmp_path / "fifo"
+    os.mkfifo(fifo)
+    return {huge: "4096.0 MiB, more than the", "/dev/zero": "a character device, not a regular file",
+            fifo: "a FIFO (named pipe), not a regular file"}
+
+
+def test_a_baseline_is_bounded_before_it_is_read(decay_results, tmp_path):
+    """D14: `check --baseline` read a baseline of any size whole (a 4 GiB file: MemoryError); /dev/zero and
+    a FIFO never ended."""
+    for baseline, said in unbounded_inputs(tmp_path).items():
+        done = limited_cli("check", decay_results, "--baseline", baseline, timeout=60)
+        one_line_refusal(done, f"error: {baseline}: {said}", "--write-baseline FILE")
+
+
+def test_flight_data_is_bounded_in_bytes_and_a_regular_file(decay_results, tmp_path):
+    """D15: `calibrate --data` sized the data by its lines: a 4 GiB single line passed (MemoryError), and
+    /dev/zero never ended."""
+    for data, said in unbounded_inputs(tmp_path).items():
+        done = limited_cli("calibrate", decay_results, "--data", data, "--out", tmp_path / "cal", timeout=60)
+        one_line_refusal(done, f"error: {data}: {said}", "as `uqflight simulate --out` writes it")
+    assert not (tmp_path / "cal").exists() or not any((tmp_path / "cal").iterdir())
+
+
+def test_a_surrogate_is_loaded_only_from_a_bounded_regular_file(tmp_path):
+    """The sibling in `uqflight.surrogate.load`: a FIFO made its open wait for a writer for ever, /dev/zero was
+    read up to the bound. Each is refused before a byte is read, naming the file."""
+    from uqflight.surrogate import SurrogateError, load
+
+    for path, said in unbounded_inputs(tmp_path).items():
+        with pytest.raises(SurrogateError, match=re.escape(f"{path}: cannot read the surrogate (") + ".*" + re.escape(said)):
+            load(path)
