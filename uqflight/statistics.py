@@ -62,6 +62,7 @@ from .store.results import one_line
 PDF_POINTS = 120
 TIME_BLOCK = 100  # recorded times whose runs or surrogate draws are rebuilt at once
 ANALYSIS_THREADS = min(2, os.cpu_count() or 1)  # time blocks analysed at once (each with one BLAS thread)
+MAX_MAGNITUDE = 1e100  # an output's or quantity's values beyond: squares of 1e200, room for sums over 10^8 runs
 BAND_LEVEL = 0.99
 DEFAULT_QUANTILES = (0.005, 0.995)
 # The relative spread a JSBSim output can resolve: the same sample flown on a reused model and on a
@@ -315,8 +316,18 @@ def _grid_failure_note(probability: dict) -> str:
             "(the nodes are not random draws); a sampled design gives one")
 
 
+def too_large(kind: str, name: str, peak: float) -> str | None:
+    """Why the values of output or quantity (`kind`) `name`, of magnitude up to `peak`, give no statistics
+    (their squares leave float64), or None."""
+    if peak <= MAX_MAGNITUDE:
+        return None
+    return (f"{kind} {name if name.isprintable() else repr(name)} holds values up to {peak:.3g}, beyond the {MAX_MAGNITUDE:.0e} its statistics take in "
+            "float64 (their squares, the variance and a PCE's projections, would overflow): record it in larger units")
+
+
 def output_basis(store: ResultStore, name: str, ok: np.ndarray) -> tuple[np.ndarray, np.ndarray | None]:
-    """The ok runs of `name` as basis @ scale: raw (Y, None), or tSVD (V rows, diag(s) Uᵀ)."""
+    """The ok runs of `name` as basis @ scale: raw (Y, None), or tSVD (V rows, diag(s) Uᵀ). BadInput, one
+    line, for values whose statistics would overflow (`too_large`)."""
     factors = store.output_factors(name)
     if factors is None:
         runs = np.flatnonzero(ok)
@@ -325,13 +336,22 @@ def output_basis(store: ResultStore, name: str, ok: np.ndarray) -> tuple[np.ndar
         if bad.size:
             raise CorruptFile(f"output {name}: {bad.size} runs with status ok hold values that are not finite "
                               f"(e.g. run {bad[0]}): the file is damaged (`uqflight info` lists its problems)")
+        problem = too_large("output", name, float(np.abs(histories).max(initial=0.0)))
+        if problem:
+            raise BadInput(f"{store.path}: {problem}")
         return histories, None
     U, s, V, columns = factors
     if not (np.isfinite(U).all() and np.isfinite(s).all() and np.isfinite(V).all()):
         raise CorruptFile(f"output {name}: its tSVD factors hold values that are not finite: the file is damaged")
     row_of = np.full(ok.size, -1)
     row_of[columns] = np.arange(columns.size)
-    return V[row_of[np.flatnonzero(ok)]], s[:, None] * U.T
+    basis, scale = V[row_of[np.flatnonzero(ok)]], s[:, None] * U.T
+    with np.errstate(over="ignore"):  # a bound of every value: sum over the rank of |V| |diag(s) Uᵀ|
+        peak = float((np.abs(basis).max(axis=0, initial=0.0) @ np.abs(scale)).max(initial=0.0))
+    problem = too_large("output", name, peak)
+    if problem:
+        raise BadInput(f"{store.path}: {problem}")
+    return basis, scale
 
 
 def _output_statistics(store: ResultStore, name: str, method: dict, germs: list[str], design_kind: str,
@@ -605,7 +625,10 @@ def quantity_statistics(store: ResultStore, stats: Statistics, name: str, germs:
     missing = int(ok.sum() - defined.sum())
     sampled = is_sampled(stats.design_kind)
     why = None
-    if not defined.any():
+    huge = too_large("quantity", name, float(np.abs(values[defined]).max(initial=0.0)))
+    if huge:
+        why = f"{huge}; its statistics are null"
+    elif not defined.any():
         why = f"quantity {name} is undefined in every successful run: its statistics are null"
     elif missing and not sampled:
         why = (f"quantity {name} is undefined in {missing} of {int(ok.sum())} successful runs: a projection on "

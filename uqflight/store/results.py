@@ -306,6 +306,11 @@ class ResultStore:
                 storage.settle(status)
         return store
 
+    @property
+    def path(self) -> str:
+        """The file's path, as it was opened."""
+        return self._file.filename
+
     def close(self) -> None:
         self._file.close()
 

