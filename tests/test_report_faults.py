@@ -4,6 +4,7 @@ closed-form moments; a full disk while the plots are drawn is "cannot write the 
 old report intact. Real campaigns of a python model, real processes, a real full disk."""
 from __future__ import annotations
 
+import shutil
 import subprocess
 
 import numpy as np
@@ -55,3 +56,31 @@ def test_large_outputs_below_the_bound_give_their_closed_form_moments(tmp_path):
     t = np.asarray(x["time"])
     np.testing.assert_allclose(x["mean"], 1e90 * (2 + t), rtol=1e-12)
     np.testing.assert_allclose(x["variance"], 1e180 * (1 + t) ** 2 / 12, rtol=1e-12)
+
+
+def _snapshot(folder):
+    return {path.relative_to(folder): path.read_bytes() for path in sorted(folder.rglob("*")) if path.is_file()}
+
+
+def test_a_disk_that_fills_while_the_plots_are_drawn_leaves_the_old_report(decay_results, tmp_path):
+    """D10: a full disk in a drawing child gave its traceback and RuntimeError "a process drawing them failed"
+    (exit 1). A real full disk (a 2 MiB tmpfs holding the old report, filled but for 200 to 400 KiB, where the
+    plots are drawn): "cannot write the report" in one line (exit 2), the old report byte for byte, no
+    staging folder left."""
+    with mounted_tmpfs(tmp_path, "2m") as disk:
+        report = disk / "rep"
+        first = subprocess.run([UQFLIGHT, "report", str(decay_results), "--out", str(report)], capture_output=True,
+                               text=True, timeout=300)
+        assert first.returncode == 0, first.stderr
+        old = _snapshot(report)
+        for free in (200, 300, 400):
+            (disk / "filler").unlink(missing_ok=True)
+            with open(disk / "filler", "wb") as fh:
+                fh.write(b"\0" * max(shutil.disk_usage(disk).free - free * 1024, 0))
+            done = subprocess.run([UQFLIGHT, "report", str(decay_results), "--out", str(report)], capture_output=True,
+                                  text=True, timeout=300)
+            assert done.returncode == 2, (free, done.stderr)
+            errors = [line for line in done.stderr.splitlines() if "rror" in line or "Traceback" in line]
+            assert errors == ["error: cannot write the report: [Errno 28] No space left on device"], (free, done.stderr)
+            assert _snapshot(report) == old
+            assert sorted(p.name for p in disk.iterdir()) == ["filler", "rep"]

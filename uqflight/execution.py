@@ -174,14 +174,14 @@ def simulate(campaign: Campaign, kappa: np.ndarray, outputs: list[str], processe
             meanwhile()
     finally:
         found = wait_all(children)
-    time = next((f[0] for f in found if not isinstance(f, ChildFailed)), None)
+    time = next((f[0] for f in found if not isinstance(f, (ChildFailed, OSError))), None)
     if time is None:  # every child died: the time grid from the simulator here
         time = _simulate_rows(campaign, kappa[:0], outputs)[0]
     values = {name: np.full((len(kappa), len(time)), np.nan) for name in outputs}
     failures = []
     for rows, f in zip(chunks, found):
-        if isinstance(f, ChildFailed):  # a child that died: its runs failed, with how
-            failures += [f"the process flying this run {f}"] * len(rows)
+        if isinstance(f, (ChildFailed, OSError)):  # a child that died or raised: its runs failed, with how
+            failures += [f"the process flying this run {f if isinstance(f, ChildFailed) else f'raised {f}'}"] * len(rows)
             continue
         failures += f[2]
         for name in outputs:
