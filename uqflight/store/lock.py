@@ -178,7 +178,8 @@ def holders(path) -> list[str]:
                         break
             if held:
                 try:
-                    command = Path(f"/proc/{entry.name}/cmdline").read_bytes()[:200].replace(b"\0", b" ")
+                    with open(f"/proc/{entry.name}/cmdline", "rb") as fh:
+                        command = fh.read(200).replace(b"\0", b" ")
                 except OSError:
                     command = b""
                 text = " ".join(command.decode("utf-8", "replace").split())
