@@ -85,12 +85,6 @@ class CalibrationSurrogate:
             self._basis = Basis(self.germs, self.indices)
         return self._basis(xi)
 
-    def prior_mean_variance(self, output: str) -> tuple[np.ndarray, np.ndarray]:
-        """Mean and variance over time of the surrogate under the prior (orthonormal basis)."""
-        c = self.coefficients[output]
-        constant = ~self.indices.any(axis=1)
-        return c[constant].sum(axis=0), (c[~constant] ** 2).sum(axis=0)
-
 
 def to_physical(parameters, xi, dependence=None) -> np.ndarray:
     """κ (M, d) from ξ (M, d) (by the Nataf transform of the campaign's `dependence`, if any)."""

@@ -19,7 +19,6 @@ from __future__ import annotations
 
 import hashlib
 import os
-import re
 import shutil
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass, field
@@ -323,20 +322,6 @@ def aero_functions(xml: bytes) -> list[AeroFunction]:
                 found.append(AeroFunction(axis, child.get("name").strip(), " ".join(desc.split())))
     walk(aero, "")
     return found
-
-
-def engines(xml: bytes) -> list[tuple[str, str]]:
-    """(engine file, thruster file) per engine of the aircraft, in order."""
-    tree = ET.fromstring(xml)
-    result = []
-    for engine in tree.iter("engine"):
-        thruster = engine.find("thruster")
-        result.append((engine.get("file", ""), thruster.get("file", "") if thruster is not None else ""))
-    return result
-
-
-def safe_name(text: str) -> str:
-    return re.sub(r"[^A-Za-z0-9_.-]+", "_", text)
 
 
 # Flight condition used when a campaign or the command line states none: inside each tested

@@ -182,7 +182,6 @@ class PreparedAircraft:
         own = declared_properties(original.main)
         self.patches = sorted(set(patches) | set(patches_from_properties(
             properties, self.functions, existing=lambda p: p in own)))
-        self.original_hash = original.hash()
         self.files = patched_files(original, self.patches)
         self.name = self.location.name
         if self.patches or not self.location.loadable_from_root:

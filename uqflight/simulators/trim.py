@@ -86,7 +86,6 @@ class LevelTrim:
         self.nominal_alpha = 0.0                    # alpha [rad] of the thrust table
         self.dthrust_dalpha = 0.0                   # its steady thrust's slope in alpha [lbf/rad]
         self.fallbacks = 0
-        self.last_steady_states = 0
 
     # -- evaluations at dt = 0 ---------------------------------------------------------------
     def _set(self, alpha: float, pitch: float, throttle: float | None = None) -> None:
@@ -107,7 +106,6 @@ class LevelTrim:
         self._set(alpha, pitch, throttle)
         self.fdm.run_ic()                   # the throttle and the air data reach the engines
         self._prop.get_steady_state()
-        self.last_steady_states += 1
         return self._evaluate()
 
     def _model(self, alpha: float, pitch: float, thrust: float) -> np.ndarray:
@@ -172,7 +170,6 @@ class LevelTrim:
         aircraft is left in the trimmed state, evaluated at dt = 0, and the engines run once
         more to their steady state, as after JSBSim's trim: three steady states in all.
         """
-        self.last_steady_states = 0
         alpha, throttle, pitch = (float(v) for v in start)
         wanted = float(np.interp(throttle, THROTTLE_GRID, self.thrust_grid))
         tol = JSBSIM_TOLERANCE * FRACTION
@@ -193,7 +190,6 @@ class LevelTrim:
                 return None
             if np.all(np.abs(r) <= tol):
                 self._prop.get_steady_state()   # leave the turboprops in their run phase
-                self.last_steady_states += 1
                 return np.array([alpha, throttle, pitch])
             offset = thrust - float(np.interp(throttle, THROTTLE_GRID, self.thrust_grid))
         return None
