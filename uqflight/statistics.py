@@ -62,7 +62,7 @@ from .store.results import one_line
 PDF_POINTS = 120
 TIME_BLOCK = 100  # recorded times whose runs or surrogate draws are rebuilt at once
 ANALYSIS_THREADS = min(2, os.cpu_count() or 1)  # time blocks analysed at once (each with one BLAS thread)
-MAX_MAGNITUDE = 1e100  # an output's or quantity's values beyond: squares of 1e200, room for sums over 10^8 runs
+MAX_MAGNITUDE = 1e75  # an output's or quantity's values beyond: their fourth powers (kurtosis) leave float64
 BAND_LEVEL = 0.99
 DEFAULT_QUANTILES = (0.005, 0.995)
 # The relative spread a JSBSim output can resolve: the same sample flown on a reused model and on a
@@ -318,11 +318,12 @@ def _grid_failure_note(probability: dict) -> str:
 
 def too_large(kind: str, name: str, peak: float) -> str | None:
     """Why the values of output or quantity (`kind`) `name`, of magnitude up to `peak`, give no statistics
-    (their squares leave float64), or None."""
+    (their powers up to the fourth, the variance and the kurtosis, leave float64), or None."""
     if peak <= MAX_MAGNITUDE:
         return None
-    return (f"{kind} {name if name.isprintable() else repr(name)} holds values up to {peak:.3g}, beyond the {MAX_MAGNITUDE:.0e} its statistics take in "
-            "float64 (their squares, the variance and a PCE's projections, would overflow): record it in larger units")
+    return (f"{kind} {name if name.isprintable() else repr(name)} holds values up to {peak:.3g}, beyond the "
+            f"{MAX_MAGNITUDE:.0e} its statistics take in float64 (their powers, up to the fourth in the kurtosis, "
+            "would overflow): record it in larger units")
 
 
 def output_basis(store: ResultStore, name: str, ok: np.ndarray) -> tuple[np.ndarray, np.ndarray | None]:
