@@ -8,6 +8,7 @@ import shutil
 import subprocess
 
 import numpy as np
+import pytest
 
 from conftest import UQFLIGHT, cli_in_process, mounted_tmpfs, read_summary, run_python_campaign
 
@@ -89,3 +90,22 @@ def test_a_disk_that_fills_while_the_plots_are_drawn_leaves_the_old_report(decay
             assert errors == ["error: cannot write the report: [Errno 28] No space left on device"], (free, done.stderr)
             assert _snapshot(report) == old
             assert sorted(p.name for p in disk.iterdir()) == ["filler", "rep"]
+
+
+def test_a_quantity_whose_powers_overflow_is_null_with_a_note(tmp_path):
+    """D09 for a quantity of interest (one number per run, edited to 1e200 with h5py): its statistics are null in
+    summary.json and a note says why; the outputs' report goes on."""
+    import h5py
+
+    (tmp_path / "model.py").write_text(MODEL.format(scale="1.0"))
+    out = run_python_campaign(tmp_path, CAMPAIGN + "quantities: {final_x: {of: x, take: final}}\n")
+    with h5py.File(out, "a") as f:
+        f["quantities/final_x"][...] = 1e200 * f["quantities/final_x"][()]
+    done = cli_in_process("report", out, "--out", tmp_path / "rep")
+    assert done.returncode == 0, done.stderr
+    summary = read_summary(tmp_path / "rep" / "summary.json")
+    q = summary["quantities"]["final_x"]
+    assert q["mean"] is None and q["variance"] is None, q
+    assert any(note.startswith("quantity final_x holds values up to ") and "its statistics are null" in note
+               for note in summary["notes"]), summary["notes"]
+    assert summary["outputs"]["x"]["mean"][0] == pytest.approx(2.0, rel=1e-12)
