@@ -62,3 +62,23 @@ def test_resuming_a_file_another_process_reads_is_one_line_naming_it(decay_resul
     out, _ = _copy(decay_results, tmp_path)  # resuming opens the file to write, even when every run is done
     with held_open(out, "r") as pid:
         _refused_as_held(cli("run", tmp_path / "decay.yaml", "--out", out, "--workers", 1), pid)
+
+
+def test_reading_a_file_another_process_writes_names_that_process(decay_results, tmp_path):
+    """D20's sibling for the readers: `report` and `check` of a file a writer without uqflight's lock holds
+    said "cannot analyse the results file ([Errno 11] Unable to synchronously open file (unable to lock
+    file...))"; `info` reads it as it is now."""
+    out, _ = _copy(decay_results, tmp_path)
+    baseline = tmp_path / "baseline.json"
+    assert cli("report", out, "--out", tmp_path / "first", "--write-baseline", baseline).returncode == 0
+    with held_open(out, "a") as pid:
+        for args in (("report", out, "--out", tmp_path / "rep"), ("check", out, "--baseline", baseline)):
+            done = cli(*args)
+            assert done.returncode == 2, done.stderr
+            errors = [line for line in done.stderr.splitlines() if "error" in line]
+            assert errors == [f"error: {out} is open in pid {pid} ({sys.executable} -c import h5py, sys f = h5py.File("
+                              f"'{out}', 'a') print('held', flush=True) sys.stdin.read()) (HDF5's file lock), so it "
+                              "cannot be read now: wait until that process closes it, or stop it, then run again"], \
+                done.stderr
+        shown = cli("info", out)
+        assert shown.returncode == 0 and "locked by another process" in shown.stdout, shown.stderr

@@ -114,7 +114,7 @@ def unbounded_inputs(tmp_path) -> dict:
         fh.truncate(4 * 2**30)
     fifo = tmp_path / "fifo"
     os.mkfifo(fifo)
-    return {huge: "4096.0 MiB, more than the", "/dev/zero": "a character device, not a regular file",
+    return {huge: "4096 MiB, more than the", "/dev/zero": "a character device, not a regular file",
             fifo: "a FIFO (named pipe), not a regular file"}
 
 

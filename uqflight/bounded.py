@@ -28,7 +28,7 @@ def open_bounded(path, limit: int, what: str) -> BinaryIO:
             kind = next((name for test, name in KINDS if test(info.st_mode)), "not a regular file")
             raise Refused(f"{kind}, not a regular file: {what} is read from a file")
         if info.st_size > limit:
-            raise Refused(f"{info.st_size / 2**20:.1f} MiB, more than the {limit / 2**20:g} MiB {what} may take")
+            raise Refused(f"{info.st_size / 2**20:.0f} MiB, more than the {limit / 2**20:g} MiB {what} may take")
         os.set_blocking(fd, True)
         return os.fdopen(fd, "rb")
     except BaseException:

@@ -56,7 +56,7 @@ from .methods.pce_moments import pce_standardised_moments, triple_products
 from .methods.validity import method_problem
 from .parameters.distributions import SEED_REFUSAL
 from .parameters.germs import draw_germs
-from .store import CorruptFile, ResultStore, Status
+from .store import CorruptFile, LockHeld, ResultStore, Status
 from .store.results import one_line
 
 PDF_POINTS = 120
@@ -181,6 +181,8 @@ def read_statistics(path, method: dict | None = None, partial: bool = False,
         raise
     except CorruptFile as exc:
         raise BadInput(str(exc) if str(exc).startswith(f"{path}:") else f"{path}: {exc}") from exc
+    except LockHeld as exc:  # names the file and the process holding it
+        raise BadInput(str(exc)) from exc
     except (OSError, ValueError, KeyError) as exc:
         raise BadInput(f"{path}: cannot analyse the results file ({one_line(exc)})") from exc
 

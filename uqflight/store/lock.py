@@ -187,12 +187,12 @@ def holders(path) -> list[str]:
     return found
 
 
-def held_message(path) -> str:
-    """Why `path` cannot be opened to write: another process holds it open (which says nothing of its
-    contents: never a reason to replace it)."""
+def held_message(path, to: str = "written") -> str:
+    """Why `path` cannot be opened (`to` be "written", or "read" while another process writes it): another
+    process holds it open (which says nothing of its contents: never a reason to replace it)."""
     who = holders(path)
     named = ", ".join(repr(w) if not w.isprintable() else w for w in who) or "another process"
-    return (f"{path} is open in {named} (HDF5's file lock), so it cannot be written now: wait until that "
+    return (f"{path} is open in {named} (HDF5's file lock), so it cannot be {to} now: wait until that "
             "process closes it, or stop it, then run again")
 
 

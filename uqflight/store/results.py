@@ -61,6 +61,7 @@ from .compressed import TsvdStorage
 from .file_end import HINT as END_HINT
 from .file_end import extend_to_file_end, past_recorded_end
 from .layout import is_time_grid, layout_problems
+from .lock import LockHeld, held_message, is_lock_error
 from .raw import RawStorage
 from .rounds import read_index_set, write_index_set
 from .storage import OutputStorage, key_of, name_of
@@ -260,11 +261,17 @@ class ResultStore:
     def open(cls, path, mode: str = "r", while_written: bool = False) -> ResultStore:
         """An existing file, read-only ("r") or to resume ("a": half-done steps of a killed writer are mended).
         `while_written`: read a file that a live run is writing (HDF5's file lock off; the writer flushes
-        whole batches, so what is read is a consistent earlier state, or an OSError to retry)."""
+        whole batches, so what is read is a consistent earlier state, or an OSError to retry). LockHeld
+        (an OSError) naming the process when another one holds the file under HDF5's lock."""
         if mode not in ("r", "a"):
             raise ValueError(f"mode must be 'r' or 'a', got {mode!r}")
-        f = h5py.File(path, "r", locking=False) if while_written and mode == "r" else \
-            h5py.File(path, "r" if mode == "r" else "r+")
+        try:
+            f = h5py.File(path, "r", locking=False) if while_written and mode == "r" else \
+                h5py.File(path, "r" if mode == "r" else "r+")
+        except OSError as exc:  # held by another process: in use, not damaged
+            if is_lock_error(exc):
+                raise LockHeld(held_message(path, "read" if mode == "r" else "written")) from None
+            raise
         # before anything is written: space past the recorded end is not free (file_end)
         extended = mode == "a" and extend_to_file_end(f)
         try:

@@ -59,12 +59,7 @@ def open_for_campaign(path, *, campaign_text: str, force: bool = False, restart:
                                   "or /samples/status); uqflight never overwrites it, even with --force: "
                                   f"remove it yourself (rm {path}) or choose another results file")
         if stored == text_hash(campaign_text) and stored_flown == flown and not restart:
-            try:
-                return ResultStore.open(path, "a")
-            except OSError as exc:
-                if is_lock_error(exc):
-                    raise LockHeld(held_message(path)) from None
-                raise
+            return ResultStore.open(path, "a")  # LockHeld when another process opened it since the check
         if restart and stored == text_hash(campaign_text):
             force = True
         if not force:
