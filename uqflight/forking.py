@@ -40,7 +40,9 @@ class Child:
                 try:
                     payload = pickle.dumps((True, work()), protocol=pickle.HIGHEST_PROTOCOL)
                 except OSError as exc:  # a file it could not write (a full disk): the parent's error, no traceback
-                    payload = pickle.dumps((False, OSError(exc.errno, exc.strerror or str(exc), exc.filename)))
+                    error = OSError(exc.errno, exc.strerror, exc.filename) if exc.errno is not None and exc.strerror \
+                        else OSError(" ".join(str(exc).split()))
+                    payload = pickle.dumps((False, error))
                 with os.fdopen(write, "wb") as pipe:
                     pipe.write(payload)
             except BaseException:
