@@ -73,6 +73,7 @@ def test_a_worker_imports_only_what_flying_needs():
             "if m.startswith(('uqflight', 'scipy', 'h5py', 'yaml', 'matplotlib', 'dask')))))")
     loaded = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout.split()
     # the quantities' recorder is part of flying: it sees every integration step; forking (the standard
-    # library only) makes it die with its runner
+    # library only) makes it die with its runner; labels (no imports) gives the unit a property's name ends
+    # in, which tells the recorder an angle to unwrap
     assert all(m.startswith(("uqflight.simulators", "uqflight.worker", "uqflight.quantities"))
-               or m in ("uqflight", "uqflight.forking") for m in loaded), loaded
+               or m in ("uqflight", "uqflight.forking", "uqflight.labels") for m in loaded), loaded

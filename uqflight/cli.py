@@ -148,6 +148,8 @@ def simulate(
         echo(f"error: {exc.args[0]}", err=True)
         raise typer.Exit(2)
     echo(result.trim.describe())
+    if flight.surface_warning:
+        echo(f"warning: {flight.surface_warning}", err=True)
     for line in _offset_lines(located, flight):
         echo(line)
     if sigmas:
@@ -244,13 +246,16 @@ def plan(campaign_file: Path = typer.Argument(..., metavar="CAMPAIGN", help="Cam
     echo(f"results: {Path(campaign.storage['path']).resolve()} (storage.path, from the working directory; "
          "--out to choose)")
     try:
-        seconds = _seconds_per_run(campaign)
+        seconds, simulator_of_plan = _seconds_per_run(campaign)
     except NominalFailed as exc:  # its message says it all
         echo(f"error: {campaign_file}: {exc}", err=True)
         raise typer.Exit(2)
     except Exception as exc:  # the simulator's own code (a python model) failed to build or to fly: as `run` says
         echo(f"error: {campaign_file}: {type(exc).__name__}: {exc}", err=True)
         raise typer.Exit(2)
+    warning = getattr(getattr(simulator_of_plan, "flight", None), "surface_warning", None)
+    if warning:
+        echo(f"warning: the nominal flight: {warning}", err=True)
     workers = min(campaign.execution["workers"], CORES)
     echo(f"estimated time: {runs * seconds / workers:.0f} s with {workers} worker(s) "
          f"({seconds * 1e3:.0f} ms per run, one nominal run timed now on this machine)")
@@ -268,8 +273,9 @@ def _has_order(kind: str, design_kind: str) -> bool:
     return entry.pce is not None and not (entry.runs_on_sampled and is_sampled(design_kind))
 
 
-def _seconds_per_run(campaign) -> float:
-    """One nominal run of the campaign's simulator, timed here (after a first, warming run)."""
+def _seconds_per_run(campaign) -> tuple[float, object]:
+    """One nominal run of the campaign's simulator, timed here (after a first, warming run), and the simulator
+    that flew it (its flight's surface_warning: the excitation left the elevator unmoved)."""
     import time
 
     from .execution import nominal_kappa, worker_spec
@@ -288,7 +294,7 @@ def _seconds_per_run(campaign) -> float:
             simulator.evaluate(nominal, observers if timed else ())
         except FlightError:
             pass
-    return time.perf_counter() - started
+    return time.perf_counter() - started, simulator
 
 
 @app.command()
@@ -454,6 +460,11 @@ def report(
     figure_format: str = typer.Option("png", "--format", metavar="png|svg|pdf",
                                       help="Format of plots/: png; svg (the page embeds the SVGs); pdf (beside "
                                            "PNGs of the same names, which the page embeds and links to the PDFs)."),
+    exceedance: List[str] = typer.Option([], "--exceedance", metavar="NAME>X|NAME<X",
+                                         help="P(NAME > X) or P(NAME < X) of a quantity of interest, repeatable: "
+                                              "replaces the campaign's analysis.exceedance thresholds of NAME, "
+                                              "computed from the stored runs (nothing is flown again); quote it "
+                                              "in the shell, e.g. --exceedance 'peak_nz>3.5'."),
 ):
     """Statistics, tables, plots and a report page of one or more results files.
 
@@ -482,8 +493,16 @@ def report(
         overrides = parse_methods(method, order)
     except ValueError as exc:
         raise typer.BadParameter(str(exc), param_hint="--method")
+    from .quantities.spec import parse_exceedance_option
+
+    try:
+        thresholds = parse_exceedance_option(exceedance)
+    except ValueError as exc:
+        raise typer.BadParameter(str(exc), param_hint="--exceedance")
     for path in [*results, *([reference] if reference else [])]:
         check_results_file(path)
+    if thresholds:
+        _check_quantities(thresholds, results)
     out = out if out is not None else default_out_dir(results[0])
     if not out.exists() and not out.is_symlink():  # an existing DIR is the report's to judge (check_replaceable)
         check_output(out, "--out", folder=True, create=True)
@@ -495,7 +514,7 @@ def report(
         with Progress(0, label="report") as progress:
             written = write_report(results, out, reference=reference, times=selected, baseline=write_baseline,
                                    method=overrides or None, progress=progress, partial=partial,
-                                   allow_aliasing=allow_aliasing, fmt=figure_format)
+                                   allow_aliasing=allow_aliasing, fmt=figure_format, exceedance=thresholds or None)
     except BadInput as exc:
         echo(f"error: {exc}", err=True)
         raise typer.Exit(2)
@@ -511,10 +530,29 @@ def report(
         echo(f"wrote baseline {write_baseline}")
 
 
+def _check_quantities(thresholds: dict, results: list[Path]) -> None:
+    """Exit 2 naming --exceedance when a threshold names a quantity some results file does not have (an
+    unreadable file is the report's to refuse)."""
+    from .store import ResultStore
+
+    for path in results:
+        try:
+            with ResultStore.open(path) as store:
+                names = list(store.quantity_names)
+        except (OSError, KeyError, ValueError):
+            continue
+        unknown = [name for name in thresholds if name not in names]
+        if unknown:
+            echo(f"error: --exceedance: {path} has no quantity {unknown[0]!r}; its quantities: "
+                 f"{', '.join(names) or 'none (the campaign has no quantities: mapping)'}", err=True)
+            raise typer.Exit(2)
+
+
 def _check_times(text: str, selected: list[float], results: list[Path]) -> None:
     """Exit 2 naming --times and the flight's time range when a time lies outside a file's recorded
     times (more than half a recording step); 'end' is always inside. An unreadable file is the
     report's to refuse."""
+    from .labels import shown_time
     from .store import ResultStore
 
     for path in results:
@@ -527,7 +565,8 @@ def _check_times(text: str, selected: list[float], results: list[Path]) -> None:
         outside = [t for t in selected if np.isfinite(t) and not time[0] - half <= t <= time[-1] + half]
         if outside:
             echo(f"error: --times {text}: {', '.join(f'{t:g}' for t in outside)} s outside the flight of {path}, "
-                 f"which records {time[0]:g} to {time[-1]:g} s; choose times in that range or 'end'", err=True)
+                 f"which records {shown_time(time, 0):g} to {shown_time(time, -1):g} s; choose times in that range "
+                 "or 'end'", err=True)
             raise typer.Exit(2)
 
 
@@ -654,8 +693,11 @@ def aircraft_command(
     altitude_ft: Optional[float] = typer.Option(None, help="Trim altitude [ft] (default: the aircraft's)."),
     airspeed_ktas: Optional[float] = typer.Option(None, help="Trim true airspeed [kt] (default: the aircraft's)."),
     list_: bool = typer.Option(False, "--list", help="List the project's and JSBSim's aircraft."),
+    trim: bool = typer.Option(False, "--trim", help="Also trim the aircraft in level flight at the altitude and "
+                                                    "airspeed (exit 1 when it cannot, saying why and what to do)."),
 ):
-    """An aircraft's aerodynamic functions (axis, name, description), engines and nominal trim."""
+    """An aircraft's aerodynamic functions (axis, name, description), engines and elevator travel, without
+    flying it; with --trim its nominal trim too."""
     from .simulators.aircraft import AircraftFiles, aero_functions, known_aircraft
     from .simulators.engines import engine_kinds
     from .simulators.reference import factor_values, references
@@ -693,11 +735,19 @@ def aircraft_command(
         echo(f"  {i}: {name:<24} {kind:<10} thruster: {thruster}")
     echo(f"elevator travel: {flight.elevator_travel_deg[0]:.1f} deg down, {flight.elevator_travel_deg[1]:.1f} deg up"
          + ("" if not flight.has_property("fcs/elevator-excitation-deg") else " (fcs/elevator-excitation-deg used)"))
-    echo(f"nominal trim at {setup.altitude_ft:g} ft, {setup.airspeed_ktas:g} KTAS:")
-    try:
-        echo(flight.trim({}).describe())
-    except FlightError as exc:
-        echo(f"trim failed: {exc}")
-        raise typer.Exit(1)
-    echo("reference factors at the trim (an offset ΔC adds ΔC times its function's): " + ", ".join(
+    if trim:
+        echo(f"nominal trim at {setup.altitude_ft:g} ft, {setup.airspeed_ktas:g} KTAS:")
+        try:
+            echo(flight.trim({}).describe())
+        except FlightError as exc:
+            echo(f"trim failed: {exc}", err=True)
+            raise typer.Exit(1)
+        where = "at the trim"
+    else:  # qbar = ρ V² / 2 at the condition's altitude and airspeed: the trim's, without trimming
+        flight.prepare_validation_view()
+        flight.fdm.run_ic()
+        where = f"at {setup.altitude_ft:g} ft, {setup.airspeed_ktas:g} KTAS"
+        echo(f"not trimmed: `uqflight aircraft {aircraft} --trim` trims it at {setup.altitude_ft:g} ft, "
+             f"{setup.airspeed_ktas:g} KTAS (--altitude-ft, --airspeed-ktas)")
+    echo(f"reference factors {where} (an offset ΔC adds ΔC times its function's): " + ", ".join(
         f"{symbol} = {number:.6g} {unit}" for symbol, number, unit in factor_values(flight.property_value)))

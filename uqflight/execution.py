@@ -92,6 +92,7 @@ class RunSummary:
     failures: Counter = field(default_factory=Counter)
     timeout_s: float = float("nan")
     nominal_failure: str | None = None  # why the nominal flight (ξ = 0) failed, when it did
+    nominal_warnings: list[str] = field(default_factory=list)  # what it warned of (an unmoved surface)
 
     def describe(self) -> str:
         rate = self.ran / self.seconds if self.seconds > 0 else float("nan")
@@ -101,6 +102,7 @@ class RunSummary:
             lines.append(f"  warning: the nominal flight (every parameter at its law's centre) failed: "
                          f"{self.nominal_failure}; runs near it fail the same way: check the campaign's flight with "
                          "`uqflight simulate` and its --set")
+        lines += [f"  warning: the nominal flight: {warning}" for warning in self.nominal_warnings]
         lines += [f"  failed ({n}): {one_line(reason)}" for reason, n in self.failures.most_common(10)]
         return "\n".join(lines)
 
@@ -363,6 +365,7 @@ def run_campaign(campaign: Campaign, out: Path | None = None, workers: int | Non
     summary.seconds = time.perf_counter() - started
     summary.timeout_s = timeout
     summary.nominal_failure = nominal.failure
+    summary.nominal_warnings = list(getattr(nominal, "warnings", []))
     return summary
 
 

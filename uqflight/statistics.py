@@ -33,22 +33,24 @@ from typing import Callable
 import numpy as np
 from threadpoolctl import threadpool_limits
 
+from .analysis.angles import angle_period, branch_shifts, unwrapped_runs
 from .analysis.density import pdf_over_time
 from .analysis.divergence import kl_divergence
 from .analysis.errors import error_summary, relative_errors
-from .analysis.exceedance import exceedance_from_pce, exceedance_from_runs
+from .analysis.exceedance import exceedance_from_pce, exceedance_from_runs, unit_slip
 from .analysis.failures import grid_failure_probability
 from .analysis.proportions import sampled_proportion
 from .analysis.floors import central_moments, floors_from_moments, kld_floor
 from .analysis.moments import (modified_cov, sorted_by_time, standardised_moments, weighted_moments,
                                weighted_quantiles)
 from .analysis.resolution import RESOLUTION_RTOL, resolved_variance
-from .analysis.sobol import pick_freeze_indices
-from .campaign.attributes import StoredFacts, stored_facts
+from .analysis.sobol import NEGLIGIBLE, UNRESOLVED_WIDTH, complete_rows, pick_freeze_indices, unresolved
+from .campaign.attributes import StoredFacts, stored_facts, stored_settings
 from .campaign.schema import CampaignError
 from .designs import REGISTRY as DESIGNS
 from .designs import is_sampled
 from .designs.adaptive import index_set_summary
+from .labels import name_unit, quantity_unit
 from .methods import PCE, METHODS, failed_runs_note, fit, method_entry, method_settings, normalised
 from .methods.basis import orthonormal_basis
 from .methods.loo import relative_loo_error
@@ -114,6 +116,8 @@ class OutputStatistics:
     replicate_moments: tuple[np.ndarray, np.ndarray] | None = None  # (R, T) means and variances of RQMC replicates
     errors: dict = field(default_factory=dict)
     pce: PCE | None = None  # the expansion behind the statistics (None: statistics of the runs themselves)
+    flags: list[str] = field(default_factory=list)
+    unwrapped: bool = False  # an angle whose runs wrap, made continuous before any statistic (analysis.angles)
 
     @property
     def std(self) -> np.ndarray:
@@ -155,6 +159,50 @@ class QuantityStatistics:
     missing: int  # successful runs where the quantity is undefined
     output: OutputStatistics | None
     exceedance: list[dict] = field(default_factory=list)
+    units: str = ""  # its take's own, or its `of`'s (labels.quantity_unit)
+    flags: list[str] = field(default_factory=list)  # its statistics' (output.flags) and its thresholds' (unit slips)
+
+    def _first(self, attribute: str):
+        """The output's `attribute` at its one time point (None when the statistics are undefined)."""
+        return None if self.output is None else _at_first_time(getattr(self.output, attribute))
+
+    @property
+    def mean(self) -> float | None:
+        """The mean (None where undefined), as summary.json's quantities.NAME.mean."""
+        return self._first("mean")
+
+    @property
+    def variance(self) -> float | None:
+        return self._first("variance")
+
+    @property
+    def std(self) -> float | None:
+        return self._first("std")
+
+    @property
+    def band99(self) -> tuple[float, float] | None:
+        """(lower, upper) of the 99 % band."""
+        return None if self.output is None else (float(self.output.band99[0][0]), float(self.output.band99[1][0]))
+
+    @property
+    def quantiles(self) -> dict[float, float]:
+        return {} if self.output is None else self._first("quantiles")
+
+    @property
+    def skewness(self) -> float | None:
+        return None if self.output is None or self.output.skewness is None else self._first("skewness")
+
+    @property
+    def kurtosis(self) -> float | None:
+        return None if self.output is None or self.output.kurtosis is None else self._first("kurtosis")
+
+    @property
+    def sobol_first(self) -> dict[str, float]:
+        return {} if self.output is None else self._first("sobol_first")
+
+    @property
+    def sobol_total(self) -> dict[str, float]:
+        return {} if self.output is None else self._first("sobol_total")
 
 
 def campaign_facts(store: ResultStore, path) -> StoredFacts:
@@ -167,16 +215,19 @@ def campaign_facts(store: ResultStore, path) -> StoredFacts:
 
 
 def read_statistics(path, method: dict | None = None, partial: bool = False,
-                    allow_aliasing: bool = False, progress=None) -> tuple[Statistics, dict]:
+                    allow_aliasing: bool = False, progress=None,
+                    exceedance: dict | None = None) -> tuple[Statistics, dict]:
     """The statistics of a results file (`method` overriding the campaign's) and its root attributes;
-    BadInput, one line naming the file, when it cannot give right numbers. `progress`: see analyse."""
+    BadInput, one line naming the file, when it cannot give right numbers. `progress`, `exceedance`: see
+    analyse."""
     path = Path(path)
     if not path.is_file():
         raise BadInput(f"{path}: no such results file")
     try:
         with ResultStore.open(path) as store:
             attrs = store.attrs
-        return analyse(path, method=method, partial=partial, allow_aliasing=allow_aliasing, progress=progress), attrs
+        return analyse(path, method=method, partial=partial, allow_aliasing=allow_aliasing, progress=progress,
+                       exceedance=exceedance), attrs
     except BadInput:
         raise
     except CorruptFile as exc:
@@ -188,13 +239,17 @@ def read_statistics(path, method: dict | None = None, partial: bool = False,
 
 
 def analyse(path, reference: str | None = None, options: Options | None = None, method: dict | None = None,
-            partial: bool = False, allow_aliasing: bool = False, progress=None) -> Statistics:
+            partial: bool = False, allow_aliasing: bool = False, progress=None,
+            exceedance: dict | None = None) -> Statistics:
     """All statistics of the results file `path` (and errors against `reference`).
 
     `method` ({"kind", "order", "split"}) overrides the campaign's: the runs of one grid serve every
     method, so methods and orders are compared on the same runs. `partial` analyses a file with pending
     runs where a subset of the runs is valid; `allow_aliasing` lets a projection exceed the grid's degree.
     `progress` (a uqflight.progress.Progress) gets a stage per file and counts its outputs and quantities.
+    `exceedance` ({quantity: [{above: X} | {below: X}]}) replaces the campaign's `analysis.exceedance` of the
+    quantities it names (`report --exceedance`: thresholds changed without flying again); BadInput when it
+    names a quantity the file does not have.
     """
     # one BLAS thread: the matrices are tall and thin (runs or draws × terms), where several threads are no
     # faster, and 10-20x slower on a loaded machine; the time blocks run in threads instead
@@ -230,6 +285,11 @@ def analyse(path, reference: str | None = None, options: Options | None = None, 
             raise BadInput(f"{path}: method {method['kind']} order {method['order']}: {problem}")
         _note_runs(store, stats, sampled, allow_aliasing)
         stats.from_runs = method_entry(method["kind"]).runs_on_sampled and sampled
+        if stats.from_runs and DESIGNS[design_kind].sobol_from_runs:
+            note = pick_freeze_note(ok, len(store.parameter_names), "pending runs" if not stats.failed else
+                                    "failed and pending runs" if stats.pending else "failed runs")
+            if note:
+                stats.notes.append(note)
         replicates = facts.design_info.get("replicates", 1)
         stats.replicates = replicates if stats.from_runs and ok.all() else 1
         if progress is not None:
@@ -245,6 +305,9 @@ def analyse(path, reference: str | None = None, options: Options | None = None, 
             def finish_oldest():
                 name, finish = in_flight.popleft()
                 out = stats.outputs[name] = finish()
+                if out.unwrapped:
+                    stats.notes.append(unwrapped_note(f"output {name}", out.units))
+                stats.notes.extend(f"output {name}: {flag}" for flag in out.flags)
                 if stats.replicates > 1:
                     out.replicate_moments = _replicate_moments(store, name, stats.replicates)
                 if progress is not None:
@@ -257,9 +320,14 @@ def analyse(path, reference: str | None = None, options: Options | None = None, 
                     finish_oldest()
             while in_flight:
                 finish_oldest()
+        unknown = [name for name in exceedance or {} if name not in store.quantity_names]
+        if unknown:
+            raise BadInput(f"{path}: --exceedance {unknown[0]}: no such quantity in the file; its quantities: "
+                           + (", ".join(store.quantity_names) or "none"))
+        thresholds = {**analysis.get("exceedance", {}), **(exceedance or {})}
         for name in store.quantity_names:
             stats.quantities[name] = quantity_statistics(store, stats, name, germs, ok, options,
-                                                         analysis.get("exceedance", {}).get(name, []))
+                                                         thresholds.get(name, []))
             if progress is not None:
                 progress.advance()
     if reference:
@@ -328,9 +396,12 @@ def too_large(kind: str, name: str, peak: float) -> str | None:
             "would overflow): record it in larger units")
 
 
-def output_basis(store: ResultStore, name: str, ok: np.ndarray) -> tuple[np.ndarray, np.ndarray | None]:
-    """The ok runs of `name` as basis @ scale: raw (Y, None), or tSVD (V rows, diag(s) Uᵀ). BadInput, one
-    line, for values whose statistics would overflow (`too_large`)."""
+def output_basis(store: ResultStore, name: str, ok: np.ndarray,
+                 unwrapped: list | None = None) -> tuple[np.ndarray, np.ndarray | None]:
+    """The ok runs of `name` as basis @ scale: raw (Y, None), or tSVD (V rows, diag(s) Uᵀ). An angle (deg or
+    rad) whose runs wrap is unwrapped (analysis.angles), raw, and its name appended to `unwrapped`. BadInput,
+    one line, for values whose statistics would overflow (`too_large`)."""
+    period = angle_period(store.units.get(name) or name_unit(name))
     factors = store.output_factors(name)
     if factors is None:
         runs = np.flatnonzero(ok)
@@ -342,7 +413,7 @@ def output_basis(store: ResultStore, name: str, ok: np.ndarray) -> tuple[np.ndar
         problem = too_large("output", name, float(np.abs(histories).max(initial=0.0)))
         if problem:
             raise BadInput(f"{store.path}: {problem}")
-        return histories, None
+        return _unwrapped(histories, period, name, unwrapped, histories), None
     U, s, V, columns = factors
     if not (np.isfinite(U).all() and np.isfinite(s).all() and np.isfinite(V).all()):
         raise CorruptFile(f"output {name}: its tSVD factors hold values that are not finite: the file is damaged")
@@ -354,7 +425,35 @@ def output_basis(store: ResultStore, name: str, ok: np.ndarray) -> tuple[np.ndar
     problem = too_large("output", name, peak)
     if problem:
         raise BadInput(f"{store.path}: {problem}")
-    return basis, scale
+    if period is None:
+        return basis, scale
+    # no step of any run can jump by half a turn when Σ_k max_i |V_ik| |Δ(s Uᵀ)_kt| stays below it, and the
+    # runs' first values need no turn: then nothing is rebuilt
+    steps = np.abs(basis).max(axis=0, initial=0.0) @ np.abs(np.diff(scale, axis=1))
+    if not (steps > 0.5 * period).any() and not branch_shifts(basis @ scale[:, 0], period).any():
+        return basis, scale
+    found = _unwrapped(basis @ scale, period, name, unwrapped, None)
+    return (basis, scale) if found is None else (found, None)
+
+
+def unwrapped_note(what: str, units: str) -> str:
+    """The note of an angle made continuous before its statistics (analysis.angles)."""
+    turn = f"{angle_period(units):g} {units}" if units == "deg" else "2π rad"
+    return (f"{what} is an angle whose runs jump by about a turn ({turn}): unwrapped along each run and moved by "
+            "whole turns onto the first run's branch before any statistic")
+
+
+def _unwrapped(histories: np.ndarray, period: float | None, name: str, unwrapped: list | None, unchanged):
+    """`histories` unwrapped (analysis.angles) when `period` says it is an angle and its runs wrap, `name`
+    then appended to `unwrapped`; else `unchanged`."""
+    if period is None:
+        return unchanged
+    found, moved = unwrapped_runs(histories, period)
+    if not moved:
+        return unchanged
+    if unwrapped is not None:
+        unwrapped.append(name)
+    return found
 
 
 def _output_statistics(store: ResultStore, name: str, method: dict, germs: list[str], design_kind: str,
@@ -401,7 +500,8 @@ def _start_output(store: ResultStore, name: str, method: dict, germs: list[str],
     xi, weights = store.xi[ok], store.weights[ok]
     kind, order = method["kind"], method["order"]
     entry = method_entry(kind)
-    basis, scale = output_basis(store, name, ok)
+    unwrapped: list[str] = []
+    basis, scale = output_basis(store, name, ok, unwrapped)
     truncation = _tsvd_resolution(store, scale, int(ok.sum()))
     sampled = is_sampled(design_kind)
     x0 = None
@@ -421,10 +521,12 @@ def _start_output(store: ResultStore, name: str, method: dict, germs: list[str],
         rows, row_scale, band_weights = basis, scale, (None if entry.moments == "sample" else weights / weights.sum())
     else:
         rows, row_scale, band_weights = reused.band_rows(germs, pce.indices, options), pce.coefficients, None
-    pick_freeze = from_runs and DESIGNS[design_kind].sobol_from_runs and ok.all()
-    joined_blocks = _over_time_blocks(rows, row_scale, store.time.size, band_weights,
-                                      len(store.parameter_names) if pick_freeze else 0, options, from_runs, pool, pce,
-                                      reused)
+    d = len(store.parameter_names)
+    pick_rows = _pick_freeze_rows(ok, d) if from_runs and DESIGNS[design_kind].sobol_from_runs else None
+    pick_freeze = pick_rows is not None
+    joined_blocks = _over_time_blocks(rows, row_scale, store.time.size, band_weights, d if pick_freeze else 0,
+                                      options, from_runs, pool, pce, reused,
+                                      pick_rows=None if pick_freeze and ok.all() else pick_rows)
 
     def finish() -> OutputStatistics:
         blocks = joined_blocks()
@@ -435,11 +537,12 @@ def _start_output(store: ResultStore, name: str, method: dict, germs: list[str],
         resolved = resolved_variance(variance, mean, scale=magnitude, rtol=rtol, n=int(ok.sum()),
                                      weights=None if from_runs else weights, atol=atol)
         cov = modified_cov(mean, np.sqrt(np.maximum(variance, 0)))
-        stats = OutputStatistics(name, store.units.get(name, ""), store.time, mean, variance, blocks["band"],
-                                 blocks["support"], blocks["density"], cov, resolved,
+        stats = OutputStatistics(name, store.units.get(name) or name_unit(name), store.time, mean, variance,
+                                 blocks["band"], blocks["support"], blocks["density"], cov, resolved,
                                  quantiles=dict(zip(options.quantiles, blocks["quantiles"])),
                                  skewness=blocks["skewness"], kurtosis=blocks["kurtosis"],
-                                 final_samples=blocks["final"], fourth_central=blocks.get("fourth"))
+                                 final_samples=blocks["final"], fourth_central=blocks.get("fourth"),
+                                 unwrapped=bool(unwrapped))
         names = store.parameter_names
 
         def masked(indices):
@@ -460,9 +563,55 @@ def _start_output(store: ResultStore, name: str, method: dict, germs: list[str],
             stats.sobol_total = dict(zip(names, masked(blocks["total"])))
             stats.sobol_first_ci = dict(zip(names, np.moveaxis(blocks["first_ci"], 1, 0)))
             stats.sobol_total_ci = dict(zip(names, np.moveaxis(blocks["total_ci"], 1, 0)))
+            flag = unresolved_flag(stats)
+            if flag:
+                stats.flags.append(flag)
         return stats
 
     return finish
+
+
+def unresolved_flag(out: OutputStatistics) -> str | None:
+    """The flag of pick-freeze indices that resolve no share (analysis.sobol.unresolved), naming the
+    parameters and, over time, at how many times; None when every index is resolved. Times where the
+    variance is negligible (below analysis.sobol.NEGLIGIBLE of its largest) are not counted: an index
+    there is the share of almost nothing, which the plots grey."""
+    times: np.ndarray = np.zeros(out.time.size, dtype=bool)
+    variance = np.maximum(out.variance, 0.0)
+    counted = variance >= NEGLIGIBLE * (variance.max() if variance.size else 0.0)
+    named = []
+    for parameter in out.sobol_first:
+        where = counted & (unresolved(out.sobol_first[parameter], out.sobol_first_ci[parameter])
+                           | unresolved(out.sobol_total[parameter], out.sobol_total_ci[parameter]))
+        if where.any():
+            named.append(parameter)
+            times |= where
+    if not named:
+        return None
+    at = f" at {int(times.sum())} of {int(counted.sum())} times of non-negligible variance" if times.size > 1 else ""
+    return (f"Sobol' indices of {', '.join(named)} unresolved{at} (n too small): the 95 % interval is wider than "
+            f"{UNRESOLVED_WIDTH:g} or lies outside [0, 1]; run more base samples (design.samples)")
+
+
+def _pick_freeze_rows(ok: np.ndarray, d: int) -> np.ndarray | None:
+    """The ok runs' rows of a pick-freeze design's complete base rows (analysis.sobol.complete_rows), None when
+    fewer than 2 are complete (no index can be estimated)."""
+    rows = complete_rows(ok, d)
+    return rows if rows.size >= 2 * (d + 2) else None
+
+
+def pick_freeze_note(ok: np.ndarray, d: int, what: str) -> str | None:
+    """The note of a pick-freeze design whose runs `ok` miss some (failed, or `what` undefined in them):
+    the indices and the variance split come from the complete base rows, and how many were dropped."""
+    n = ok.size // (d + 2)
+    complete = complete_rows(ok, d).size // (d + 2)
+    if complete == n:
+        return None
+    if complete < 2:
+        return (f"{what}: no Sobol' indices: {complete} of the {n} base rows of the pick-freeze design are complete "
+                "(A, B and every AB_i ran), and the estimators need 2")
+    return (f"{what}: the pick-freeze Sobol' indices and the variance split are estimated on the {complete} complete "
+            f"base rows of {n} (A, B and every AB_i ran): {n - complete} rows dropped")
 
 
 def _replicate_moments(store: ResultStore, name: str, replicates: int) -> tuple[np.ndarray, np.ndarray]:
@@ -505,14 +654,16 @@ def _lower_order_difference(kind, xi, weights, basis, scale, germs, order, x0, p
 
 
 def _over_time_blocks(rows, scale, n_times: int, weights, pick_freeze_dimensions: int, options: Options,
-                      from_runs: bool, pool: Executor, pce: PCE | None, reused: Reused) -> Callable[[], dict]:
+                      from_runs: bool, pool: Executor, pce: PCE | None, reused: Reused,
+                      pick_rows: np.ndarray | None = None) -> Callable[[], dict]:
     """Quantiles, 99 % band, skewness and kurtosis, PDFs, final-time samples (the runs' fourth central
     moments, pick-freeze indices) of Y = rows @ scale (scale None: Y = rows), rebuilding Y for
     TIME_BLOCK times at once: the memory stays that of one block per thread whatever the number of runs or
     draws. Every statistic here is per time, so blocks change nothing. A `pce`'s skewness and kurtosis are
     its exact ones (methods.pce_moments), not those of its draws; the KDE's std comes from the factors.
     The blocks are handed to `pool`; returns what waits for them and joins them. `reused`: the triple
-    products of outputs before (Reused)."""
+    products of outputs before (Reused). `pick_rows`: the rows of the pick-freeze estimators (the complete
+    base rows', analysis.sobol.complete_rows), None for every row."""
     probabilities = (0.5 * (1 - BAND_LEVEL), 0.5 * (1 + BAND_LEVEL), *options.quantiles)
     exact = None if pce is None else pce_standardised_moments(pce.germs, pce.indices, pce.coefficients,
                                                               reused.triple_products)
@@ -535,7 +686,8 @@ def _over_time_blocks(rows, scale, n_times: int, weights, pick_freeze_dimensions
         if from_runs and weights is None:
             found["fourth"] = central_moments(Y)[2]
         if pick_freeze_dimensions:
-            found.update(pick_freeze_indices(Y, pick_freeze_dimensions, n_boot=options.bootstrap, seed=options.seed))
+            found.update(pick_freeze_indices(Y if pick_rows is None else Y[pick_rows], pick_freeze_dimensions,
+                                             n_boot=options.bootstrap, seed=options.seed))
         return found
 
     # blocks in the pool's threads (numpy's sort, FFTs and BLAS release the GIL); each block's numbers are
@@ -601,9 +753,9 @@ class _QuantityView:
     """A results file seen with one quantity as its only output, of one time point: what
     `_output_statistics` reads, so a quantity gets the outputs' methods, refusals and flags."""
 
-    def __init__(self, store: ResultStore, name: str, values: np.ndarray):
+    def __init__(self, store: ResultStore, name: str, values: np.ndarray, units: str):
         self._store, self._values = store, values
-        self.time, self.units = np.zeros(1), {name: ""}
+        self.time, self.units = np.zeros(1), {name: units}
 
     def __getattr__(self, attribute):  # the design, its weights, names and attributes: the file's
         return getattr(self._store, attribute)
@@ -624,7 +776,15 @@ def quantity_statistics(store: ResultStore, stats: Statistics, name: str, germs:
     a sampled design's statistics are conditional on the others (noted); a grid's are None (noted:
     a projection needs every run). Exceedance probabilities from the runs or from the PCE."""
     values = store.quantity(name)
+    text = store.attrs.get("campaign", "")  # the stored campaign text: its quantity's take and `of` give the unit
+    specs = stored_settings(text).get("quantities") if isinstance(text, str) else None
+    units = quantity_unit(specs.get(name) if isinstance(specs, dict) else None, store.units) or name_unit(name)
     defined = ok & np.isfinite(values)
+    period = angle_period(units)
+    shifts = None if period is None else branch_shifts(np.where(defined, values, np.nan), period)
+    if shifts is not None and shifts.any():
+        values = values + shifts
+        stats.notes.append(unwrapped_note(f"quantity {name}", units))
     missing = int(ok.sum() - defined.sum())
     sampled = is_sampled(stats.design_kind)
     why = None
@@ -647,22 +807,31 @@ def quantity_statistics(store: ResultStore, stats: Statistics, name: str, germs:
         stats.notes.append(why)
         nulls = [{**item, "probability": None, "lower": None, "upper": None, "method": None, "note": why}
                  for item in thresholds]
-        return QuantityStatistics(name, missing, None, nulls)
-    view = _QuantityView(store, name, values)
+        return QuantityStatistics(name, missing, None, nulls, units)
+    view = _QuantityView(store, name, values, units)
     out = _output_statistics(view, name, stats.method, germs, stats.design_kind, defined, options)
+    out.unwrapped = shifts is not None and bool(shifts.any())
+    if missing and stats.from_runs and DESIGNS[stats.design_kind].sobol_from_runs:
+        note = pick_freeze_note(defined, len(store.parameter_names), f"quantity {name} (undefined in some runs)")
+        if note:
+            stats.notes.append(note)
     if out.pce is None:
         exceedance = exceedance_from_runs(values, defined, thresholds, DESIGNS[stats.design_kind].draws,
-                                          stats.design_info)
+                                          stats.design_info, units)
     else:
         exceedance = exceedance_from_pce(out.pce.sample(options.band_samples, options.seed)[:, 0],
-                                         int(defined.sum()), thresholds)
-    return QuantityStatistics(name, missing, out, exceedance)
+                                         int(defined.sum()), thresholds, values[defined], units)
+    slips = [slip for item in thresholds if (slip := unit_slip(values[defined], next(iter(item.values())), units))]
+    flags = [*out.flags, *slips]
+    stats.notes.extend(f"quantity {name}: {flag}" for flag in flags)
+    return QuantityStatistics(name, missing, out, exceedance, units, flags)
 
 
 def _quantity_json(quantity: QuantityStatistics, seeds: list[str]) -> dict:
     """summary.json's quantities.NAME: numbers, not lists (null where undefined)."""
     out = quantity.output
-    entry = {"missing": quantity.missing, "exceedance": quantity.exceedance}
+    entry = {"units": quantity.units, "missing": quantity.missing, "exceedance": quantity.exceedance,
+             "flags": quantity.flags}
     if out is None:
         return {"mean": None, "variance": None, "std": None, "band99": {"lower": None, "upper": None},
                 "quantiles": {}, "skewness": None, "kurtosis": None, "sobol_first": {}, "sobol_total": {}, **entry}
@@ -741,7 +910,8 @@ def summary_json(stats: Statistics) -> dict:
     outputs = {}
     for name, out in stats.outputs.items():
         entry = {
-            "time": out.time, "units": out.units, "mean": out.mean, "variance": out.variance, "std": out.std,
+            "time": out.time, "units": out.units, "flags": out.flags, "mean": out.mean, "variance": out.variance,
+            "std": out.std,
             "band99": {"lower": out.band99[0], "upper": out.band99[1]},
             "quantiles": {f"{p:g}": values for p, values in out.quantiles.items()},
             "skewness": out.skewness, "kurtosis": out.kurtosis, "cov": out.cov, "resolved": out.resolved,

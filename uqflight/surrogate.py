@@ -101,7 +101,7 @@ def fit_surrogate(path, method: dict | None = None, partial: bool = False, allow
     with ResultStore.open(path) as store:
         facts = campaign_facts(store, path)
         stored, design_kind = normalised(facts.method), facts.design_kind
-        parameters, units, time = _parameters(store, path), dict(store.units), np.asarray(store.time, dtype=float)
+        parameters, time = _parameters(store, path), np.asarray(store.time, dtype=float)
     override = dict(method or {})
     kind = override.get("kind", stored.get("kind"))
     if isinstance(kind, str) and kind in METHOD_KINDS:  # else analyse refuses
@@ -109,6 +109,7 @@ def fit_surrogate(path, method: dict | None = None, partial: bool = False, allow
     stats = analyse(path, method=override, partial=partial, allow_aliasing=allow_aliasing,
                     options=options or Options(band_samples=200, bootstrap=0), progress=progress)
     pces = {name: out.pce for name, out in stats.outputs.items()}
+    units = {name: out.units for name, out in stats.outputs.items()}  # the simulator's, else from the name
     dependence = {k: v for k, v in stats.dependence.items() if k != "sobol_of"} if stats.dependence else None
     return Surrogate(parameters, list(next(iter(pces.values())).germs),
                      {name: np.asarray(pce.indices, dtype=int) for name, pce in pces.items()}, time,

@@ -17,7 +17,7 @@ import os
 import signal
 import sys
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
@@ -111,8 +111,8 @@ def run_chunk(spec: WorkerSpec, indices: np.ndarray, kappa: np.ndarray, n_times:
 class NominalFlight:
     """What the runner needs to create the results file and derive the default per-run time limit,
     measured in a worker: the recorded times, the output names and units, the seconds one flight at the
-    nominal took, the simulator's resolution there ({output: (T,)}, or None), and why that flight
-    failed (None when it flew)."""
+    nominal took, the simulator's resolution there ({output: (T,)}, or None), why that flight
+    failed (None when it flew), and what its flight warned of (an excitation that left its surface unmoved)."""
 
     time: np.ndarray
     outputs: list[str]
@@ -120,6 +120,7 @@ class NominalFlight:
     seconds: float
     resolution: dict[str, np.ndarray] | None
     failure: str | None = None
+    warnings: list[str] = field(default_factory=list)
 
 
 def nominal_flight(spec: WorkerSpec, kappa: np.ndarray, measure_resolution: bool = True) -> NominalFlight:
@@ -137,9 +138,10 @@ def nominal_flight(spec: WorkerSpec, kappa: np.ndarray, measure_resolution: bool
         failure = None
     seconds = time.perf_counter() - started
     resolution = getattr(simulator, "resolution", None)
+    warning = getattr(getattr(simulator, "flight", None), "surface_warning", None) if flown is not None else None
     return NominalFlight(np.asarray(time_grid, dtype=float), list(outputs), dict(getattr(simulator, "units", {}) or {}),
                          seconds, resolution(kappa, flown) if measure_resolution and resolution and flown is not None
-                         else None, failure)
+                         else None, failure, [warning] if warning else [])
 
 
 def main(argv=None) -> None:

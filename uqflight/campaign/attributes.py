@@ -10,11 +10,10 @@ import functools
 import json
 from dataclasses import dataclass
 
-import yaml
-
 from ..designs import DESIGN_KINDS
 from ..designs.spec import is_integer
 from ..parameters.germs import GERMS
+from ..store.resume import campaign_mapping
 from . import schema
 from .schema import CampaignError, Checker, shown
 
@@ -81,18 +80,11 @@ def stored_facts(attrs: dict, source: str, parameters: list[str], quantities: li
     return StoredFacts(method, germs, analysis, seeds, None if copula is None else copula.summary(), kind, info)
 
 
-SAFE_LOADER = getattr(yaml, "CSafeLoader", yaml.SafeLoader)  # libyaml's, ten times faster, where PyYAML has it
-
-
 @functools.lru_cache(maxsize=8)
 def stored_settings(campaign_text: str) -> dict:
     """The stored campaign text's mapping as written (YAML), {} when unreadable or not a mapping: what the
     report shows and reads the seed and the excitation from (shared, not to be changed: the text read once)."""
-    try:
-        data = yaml.load(campaign_text, Loader=SAFE_LOADER)
-    except (yaml.YAMLError, ValueError, RecursionError):  # e.g. a date 2001-13-45, or nesting too deep
-        return {}
-    return data if isinstance(data, dict) else {}
+    return campaign_mapping(campaign_text)
 
 
 def _check_seed(check: Checker, text: str) -> None:

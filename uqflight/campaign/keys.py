@@ -212,6 +212,9 @@ VALUES = {
         "final": "The last step's value.",
         "drop": "How far `of` falls below its value at the window's first step (first − min, 0 if it never "
                 "falls): `{of: h_ft, take: drop}` is an altitude loss.",
+        "change": "The last step's value minus the window's first (last − first): `{of: attitude/psi-deg, take: "
+                  "change}` is the heading change of a turn, continuous across 360° (an angle `of` is unwrapped "
+                  "along the run).",
         "mean": "Time average by the trapezoid rule over the window.",
         "at": "Linear interpolation at `at_s`.",
         "at_first": "The value of `of` at the first step meeting `when`, no interpolation: the touchdown sink "

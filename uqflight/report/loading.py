@@ -100,10 +100,12 @@ def flight_facts(simulator: dict) -> dict[str, str]:
 
 
 def load_entries(paths: list[Path], reference: Path | None, method: dict | list[dict] | None = None,
-                 progress=None, partial: bool = False, allow_aliasing: bool = False) -> tuple[list[Entry], Entry | None]:
+                 progress=None, partial: bool = False, allow_aliasing: bool = False,
+                 exceedance: dict | None = None) -> tuple[list[Entry], Entry | None]:
     """Every file analysed once per method (`method`: one override, several, or None for the
     campaigns' own; the reference keeps its own), with errors against the reference unless it is
-    the reference itself, and the reference. `progress` (a Progress) counts each file's outputs."""
+    the reference itself, and the reference. `progress` (a Progress) counts each file's outputs.
+    `exceedance`: thresholds replacing the campaigns' (statistics.analyse)."""
     methods = method if isinstance(method, list) else [method]
     methods = methods or [None]
     stems: set[str] = set()
@@ -115,7 +117,7 @@ def load_entries(paths: list[Path], reference: Path | None, method: dict | list[
     for path in paths:
         for override in methods:
             stats, attrs = read_statistics(path, override, partial=partial, allow_aliasing=allow_aliasing,
-                                           progress=progress)
+                                           progress=progress, exceedance=exceedance)
             if ref is not None and not _same_file(path, reference):
                 add_reference_errors(stats, ref.stats)
             entries.append(_entry(path, stats, attrs, stems, file_stems, with_method=len(methods) > 1))

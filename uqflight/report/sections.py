@@ -9,9 +9,11 @@ import numpy as np
 
 from . import plots
 from .blocks import Figure, Section, Table, _rel
+from ..labels import shown_time
 from .formats import shown_path
+from ..analysis.sobol import unresolved
 from ..forking import share_work
-from .sensitivity import NEGLIGIBLE, index_text, plot_sensitivity
+from .sensitivity import N_TOO_SMALL, NEGLIGIBLE, index_text, plot_sensitivity
 from .loading import Entry, _same_file, bounded, campaign_settings, campaign_simulator, flight_facts, method_label
 
 BELOW_FLOOR = "below reference resolution"
@@ -392,7 +394,8 @@ def sensitivity_section(entries: list[Entry], times: list[float], out_dir: Path)
         rows = [[e.label, name, out.time[i], *(_at(getattr(out, kind), p, i) for p in parameters)]
                 for e in with_sobol for name, out in e.outputs.items() for i in plots.time_indices(out.time, times)]
         caption = f"{what} Sobol' indices at the selected times" + (" (paper Table 3)" if kind == "sobol_first" else "")
-        page = [[label, name, f"{time:g}", *map(index_text, values)] for label, name, time, *values in rows]
+        page = [[e.label, name, f"{shown_time(out.time, i):g}", *(_shown(out, kind, p, i) for p in parameters)]
+                for e in with_sobol for name, out in e.outputs.items() for i in plots.time_indices(out.time, times)]
         blocks.append(Table(caption, ["file", "output", "time [s]", *parameters], rows, f"tables/{kind}.csv",
                             page=(["file", "output", "time [s]", *parameters], page), grouped=True))
     if any(e.pick_freeze for e in with_sobol) and any(not e.pick_freeze for e in with_sobol):
@@ -421,6 +424,16 @@ def pce_vs_mc_table(entries: list[Entry], parameters: list[str]) -> Table:
     page = [[name, f"{time:g}", parameter, *map(index_text, values)] for name, time, parameter, *values in rows]
     return Table("First-order Sobol' indices at the final time: PCE against Monte Carlo pick-freeze (paper Table 4)",
                  header, rows, "tables/sobol_pce_vs_mc.csv", page=(header, page))
+
+
+def _shown(out, kind: str, parameter: str, i: int) -> str:
+    """An index as the page shows it (index_text), "… (n too small)" where its pick-freeze interval resolves no
+    share (analysis.sobol.unresolved)."""
+    text = index_text(_at(getattr(out, kind), parameter, i))
+    ci = getattr(out, f"{kind}_ci").get(parameter)
+    if ci is not None and unresolved(getattr(out, kind)[parameter][i], ci[:, i]):
+        text += f" ({N_TOO_SMALL})"
+    return text
 
 
 def _at(indices: dict, parameter: str, i: int):

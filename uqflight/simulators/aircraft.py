@@ -329,6 +329,7 @@ def aero_functions(xml: bytes) -> list[AeroFunction]:
 DEFAULT_CONDITIONS = {
     "bacm": {"altitude_ft": 15000.0, "airspeed_ktas": 200.0},
     "c172p": {"altitude_ft": 4000.0, "airspeed_ktas": 100.0},
+    "c172x": {"altitude_ft": 4000.0, "airspeed_ktas": 100.0},  # trims level from 45 to 125 KTAS there
     "737": {"altitude_ft": 10000.0, "airspeed_ktas": 280.0},
     "f16": {"altitude_ft": 15000.0, "airspeed_ktas": 400.0},
 }

@@ -4,7 +4,12 @@
 to the campaign's folder, or the name of a script shipped with JSBSim (`c172_cruise_8K`). The aircraft
 and its initial conditions are the script's `<use aircraft= initialize=>`: the initialisation file
 beside the script when there is one, else the aircraft folder's (JSBSim's rule). `end_s` cuts the
-script's end time. A sample sets its `ic/...` properties before `run_ic`, the others after it.
+script's end time. A sample sets its `ic/...` properties before `run_ic`, the others after it, but for
+its `atmosphere/...` ones (turbulence, winds, gusts, the seed) in a script that trims itself (an `<event>`
+setting `simulation/do_simple_trim`): those are set at the first step after the script's first trim
+completed (JSBSim's `simulation/trim-completed`), so that the trim that sets the flight up is flown in the
+air the script itself gives, as a level flight trims in still air. A later trim of the script (a re-trim
+at 20 s) flies in the air then set; a failed trim says which air was active and where it came from.
 
 Every sample loads the script afresh (its events and local properties start over) with the script's
 `<output>` and state files sent to a scratch folder and disabled, so nothing is written beside the
@@ -30,7 +35,7 @@ import numpy as np
 
 from ..aircraft import AircraftFiles
 from ..base import FlightError, TrimError
-from ..jsbsim import DEFAULT_OUTPUTS, FlightResult, PropertyAccess, Watch, check_finite, ready_to_load
+from ..jsbsim import ATMOSPHERE, DEFAULT_OUTPUTS, FlightResult, PropertyAccess, Watch, check_finite, ready_to_load
 
 KEYS = ("output_rate_hz",)
 SCENARIO_KEYS = ("script", "end_s")
@@ -38,6 +43,19 @@ DEFAULT_OUTPUT_RATE_HZ = 20.0
 MAX_SCRIPT_BYTES = 1 << 20
 MAX_SUMMED = 10**8  # steps (800 MB of times): beyond, a script's step count is the closed form's
 TIME = "simulation/sim-time-sec"
+TRIM_PROPERTIES = ("simulation/do_simple_trim", "simulation/do_trim")  # an event setting one trims
+TRIM_COMPLETED = "simulation/trim-completed"  # JSBSim sets it to 1 after a successful trim
+# what a failed trim says was active: the turbulence model (JSBSim's FGWinds::tType) when it makes turbulence
+# (Milspec and Tustin: a severity or a wind at 20 ft; standard and Culp: a gain), its settings, the winds
+TURBULENCE_TYPES = {0: "none", 1: "standard", 2: "Culp", 3: "Milspec (Dryden)", 4: "Tustin (Milspec)"}
+TURBULENCE_SETTINGS = {1: ("atmosphere/turb-gain",), 2: ("atmosphere/turb-gain",),
+                       3: ("atmosphere/turbulence/milspec/severity",
+                           "atmosphere/turbulence/milspec/windspeed_at_20ft_AGL-fps"),
+                       4: ("atmosphere/turbulence/milspec/severity",
+                           "atmosphere/turbulence/milspec/windspeed_at_20ft_AGL-fps")}
+CALM_FPS = 1e-6  # a wind below this is the trim's rounding (JSBSim's trim leaves ~1e-13 ft/s), not a wind
+WINDS = ("atmosphere/wind-north-fps", "atmosphere/wind-east-fps", "atmosphere/wind-down-fps",
+         "atmosphere/gust-north-fps", "atmosphere/gust-east-fps", "atmosphere/gust-down-fps")
 
 
 class ScriptError(ValueError):
@@ -85,6 +103,7 @@ class ScriptFile:
     dt_s: float
     dt_text: str
     outputs_files: tuple[str, ...]  # `<output file=...>`, relative to the script's folder
+    trims: int | None = 0  # the script's trim events (each trims once); None: a persistent one trims again and again
 
     @classmethod
     def read(cls, path: Path) -> "ScriptFile":
@@ -113,7 +132,7 @@ class ScriptFile:
         for name in files:
             _inside(path.parent, name)
         return cls(path, use.get("aircraft").strip(), use.get("initialize").strip(), start, end, dt,
-                   run.get("dt").strip(), files)
+                   run.get("dt").strip(), files, _trim_events(root))
 
     @property
     def rate_hz(self) -> float:
@@ -175,6 +194,18 @@ class ScriptFile:
     def times(self, end_s: float | None = None) -> np.ndarray:
         """The simulator's time at the start and after every step until the end (see `steps`)."""
         return self._summed(self.steps(end_s))
+
+
+def _trim_events(root) -> int | None:
+    """The number of the script's `<event>`s that trim (set simulation/do_simple_trim); None when one of
+    them is persistent or continuous (it trims whenever its condition holds again)."""
+    count = 0
+    for event in root.iter("event"):
+        if any((item.get("name") or "").strip() in TRIM_PROPERTIES for item in event.iter("set")):
+            if (event.get("persistent") or "").strip() == "true" or (event.get("continuous") or "").strip() == "true":
+                return None
+            count += 1
+    return count
 
 
 def _script_file(config: dict, base: Path | None) -> ScriptFile:
@@ -339,18 +370,20 @@ class ScriptFlight(PropertyAccess):
         if getattr(self, "_flown", False):
             self._load()
         self._flown = True
+        held = {name: value for name, value in settings.items()
+                if name.startswith(ATMOSPHERE) and s.script.trims != 0}  # set after the script's trims
         try:
             for name, value in settings.items():
                 if name.startswith("ic/"):
                     self.node(name).set_double_value(float(value))
             self.fdm.run_ic()
             for name, value in settings.items():
-                if not name.startswith("ic/"):
+                if not name.startswith("ic/") and name not in held:
                     self.node(name).set_double_value(float(value))
-            data, times = self._run(observers)
+            data, times = self._run(observers, held)
         except jsbsim.TrimFailureError as exc:
             raise TrimError(f"a trim in the script failed at t = {self.fdm.get_sim_time():.4g} s: "
-                            f"{str(exc).strip() or 'no convergence'}") from exc
+                            f"{str(exc).strip() or 'no convergence'}; {self._active_air(held)}") from exc
         except jsbsim.BaseError as exc:
             raise FlightError(f"JSBSim stopped the script at t = {self.fdm.get_sim_time():.4g} s: {exc}") from exc
         finally:
@@ -368,9 +401,51 @@ class ScriptFlight(PropertyAccess):
         check_finite(data)
         return FlightResult(time=grid, outputs=dict(zip(s.outputs, data.T.copy())), trim=None)
 
-    def _run(self, observers) -> tuple[np.ndarray, np.ndarray]:
-        """Integrate the setup's steps, recording every steps_per_output steps: (outputs (T, n), times (T,))."""
+    def _active_air(self, held: dict) -> str:
+        """What air the failed trim flew in: the turbulence model with its settings and the winds that were
+        set (non-zero), each said to come from the script's own events or from the campaign (`held`: the
+        campaign's atmosphere settings, set after the script's first trim, or still held for then)."""
+        def value(name: str) -> float:
+            return self.node(name).get_double_value() if self.has_property(name) else 0.0
+
+        kind = int(value("atmosphere/turb-type"))
+        turbulence = ["atmosphere/turb-type", *TURBULENCE_SETTINGS.get(kind, ())] if any(
+            value(name) for name in TURBULENCE_SETTINGS.get(kind, ())) else []
+        active = [name for name in turbulence if name == "atmosphere/turb-type" or value(name)]
+        active += [name for name in WINDS if abs(value(name)) > CALM_FPS]
+        applied = held and self._air_applied
+
+        def shown(name: str) -> str:
+            text = f"{name} = {value(name):.4g}"
+            return text + f" ({TURBULENCE_TYPES.get(kind, '?')})" if name == "atmosphere/turb-type" else text
+
+        theirs = [shown(name) for name in active if not (applied and name in held)]
+        ours = [shown(name) for name in active if applied and name in held]
+        parts = []
+        if theirs:
+            parts.append("active at the trim from the script's own events: " + ", ".join(theirs)
+                         + " (set them in an event after its trim for a trim in still air)")
+        if ours:
+            parts.append("active at the trim from the campaign (simulator.properties or parameters, set after the "
+                         "script's first trim): " + ", ".join(ours))
+        if not parts:
+            parts.append("the trim flew in still air (no turbulence, gust or wind set)")
+        if held and not applied:
+            parts.append("held for after the script's first trim: "
+                         + ", ".join(f"{k} = {v:g}" for k, v in held.items()))
+        return "; ".join(parts)
+
+    def _run(self, observers, held: dict | None = None) -> tuple[np.ndarray, np.ndarray]:
+        """Integrate the setup's steps, recording every steps_per_output steps: (outputs (T, n), times (T,)).
+        `held`: settings applied at the first step after the script's first trim completed (see the module doc)."""
         s = self.setup
+        completed = self.node(TRIM_COMPLETED) if held and self.has_property(TRIM_COMPLETED) else None
+        self._air_applied = completed is None
+        if completed is not None:
+            completed.set_double_value(0.0)
+        else:  # nothing held, or a JSBSim that does not say when a trim completed: set now, as before the first step
+            for name, value in (held or {}).items():
+                self.node(name).set_double_value(float(value))
         k, steps = s.steps_per_output, s.steps
         clock = self.node(TIME)
         run = self.fdm.run
@@ -389,6 +464,14 @@ class ScriptFlight(PropertyAccess):
             if i % k == 0:
                 data[i // k] = [node.get_double_value() for node, _ in self._recorded]
                 times[i // k] = clock.get_double_value()
+            if completed is not None and completed.get_double_value() >= 1.0:  # for the steps after this one
+                for name, value in held.items():
+                    self.node(name).set_double_value(float(value))
+                completed, self._air_applied = None, True
+        if completed is not None:
+            raise FlightError(f"the script's first trim did not complete before its end {s.time[-1]:.6g} s, so "
+                              f"{', '.join(held)} (set after it) never took effect: end the flight later "
+                              "(simulator.scenario.end_s), or set them in the script's own events")
         data *= np.array([scale for _, scale in self._recorded])
         return data, times
 
