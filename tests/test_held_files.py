@@ -82,3 +82,17 @@ def test_reading_a_file_another_process_writes_names_that_process(decay_results,
                 done.stderr
         shown = cli("info", out)
         assert shown.returncode == 0 and "locked by another process" in shown.stdout, shown.stderr
+
+
+def test_calibrating_a_file_another_process_writes_names_that_process(decay_results, tmp_path):
+    """The same for `calibrate` (its --truth is read from the file first: a LockHeld traceback otherwise)."""
+    out, _ = _copy(decay_results, tmp_path)
+    data = tmp_path / "flight.csv"
+    data.write_text("time_s,x\n0,1\n1,0.5\n")
+    with held_open(out, "a") as pid:
+        for extra in ((), ("--truth", "a=1")):
+            done = cli("calibrate", out, "--data", data, "--out", tmp_path / "cal", *extra)
+            assert done.returncode == 2, done.stderr
+            errors = [line for line in done.stderr.splitlines() if "error" in line]
+            assert len(errors) == 1 and f"{out} is open in pid {pid}" in errors[0], done.stderr
+            assert "Traceback" not in done.stderr
