@@ -2,6 +2,7 @@
 create it otherwise, and compact a finished tSVD file."""
 from __future__ import annotations
 
+import os
 from pathlib import Path
 
 import h5py
@@ -43,6 +44,10 @@ def open_for_campaign(path, *, campaign_text: str, force: bool = False, restart:
         if not path.is_file():
             raise FileExistsError(f"{path} is not a regular file; uqflight does not replace it: choose "
                                   "another results file")
+        if not os.access(path, os.R_OK | os.W_OK):  # a file this user cannot read says nothing of its contents
+            raise FileExistsError(f"{path} cannot be {'read' if not os.access(path, os.R_OK) else 'written'} by "
+                                  "this user (its permissions); uqflight does not replace it: choose another results "
+                                  "file, or give this user access to it")
         if not h5py.is_hdf5(path):
             raise FileExistsError(f"{path} is not a uqflight results file (not HDF5); uqflight never "
                                   f"overwrites it, even with --force: remove it yourself (rm {path}) or "
