@@ -13,6 +13,7 @@ computed by one, at every integration step.
 from __future__ import annotations
 
 import math
+import os
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -275,6 +276,7 @@ class JSBSimFlight(PropertyAccess):
         self.setup = setup
         self._bind(jsbsim.FGFDMExec(str(setup.root)), setup.aircraft)
         self.fdm.set_debug_level(0)
+        self.fdm.set_output_path(os.devnull)  # no state file (directives.py)
         if not self.fdm.load_model(setup.aircraft):
             raise RuntimeError(f"JSBSim could not load aircraft {setup.aircraft!r} from {setup.root}")
         self.fdm.set_dt(1.0 / setup.rate_hz)
