@@ -17,6 +17,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .bounded import Refused, read_bounded
 from .campaign.schema import shown
 from .console import listed
 from .console import shown as shown_name
@@ -27,6 +28,7 @@ BASELINE_KIND = "uqflight-baseline"
 BASELINE_VERSION = 1
 STATISTICS = ("mean", "variance", "band99.lower", "band99.upper", "sobol_first", "sobol_total")
 TIME_ATOL = 1e-9  # seconds: time grids closer than this are the same grid
+MAX_BASELINE_BYTES = 128 << 20  # refused before it is read (parsing takes several times as much memory)
 
 
 @dataclass
@@ -97,7 +99,11 @@ def load_baseline(path: Path) -> dict:
         raise BadInput(f"{path}: {name} is not a value a baseline may hold (expected finite numbers, null or NaN)")
 
     try:
-        data = json.loads(path.read_text(encoding="utf-8"), parse_constant=refuse_constant)
+        data = json.loads(read_bounded(path, MAX_BASELINE_BYTES, "a baseline").decode("utf-8"),
+                          parse_constant=refuse_constant)
+    except Refused as exc:
+        raise BadInput(f"{path}: {exc}; a baseline holds a results file's statistics: write one with "
+                       "`uqflight report RESULTS.h5 --out DIR --write-baseline FILE`") from exc
     except OSError as exc:
         raise BadInput(f"{path}: cannot read the baseline ({exc.strerror or exc})") from exc
     except (UnicodeDecodeError, json.JSONDecodeError) as exc:

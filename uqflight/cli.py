@@ -365,7 +365,7 @@ def _exit_now(code: int):
 @app.command()
 def info(results: Path = typer.Argument(..., metavar="RESULTS", help="Results file (.h5).")):
     """Show a results file's campaign, design, done and failed runs, storage and versions."""
-    from .store import CorruptFile, ResultStore, Status, read_error
+    from .store import CorruptFile, LockHeld, ResultStore, Status, read_error
     from .store.lock import describe_holder, live_holder
 
     check_results_file(results)
@@ -375,7 +375,7 @@ def info(results: Path = typer.Argument(..., metavar="RESULTS", help="Results fi
     try:
         try:
             store = ResultStore.open(results, while_written=writer is not None)
-        except BlockingIOError:  # HDF5's lock held by a writer without a lock file of ours
+        except LockHeld:  # HDF5's lock held by a writer without a lock file of ours
             echo("locked by another process (a run writing it?): read as it is now")
             writer = {"locked": True}
             store = ResultStore.open(results, while_written=True)

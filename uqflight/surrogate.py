@@ -22,6 +22,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .bounded import read_bounded
 from .console import listed
 from .console import shown as shown_name
 
@@ -205,16 +206,9 @@ def load(path) -> Surrogate:
     file and the key, for anything else (a damaged or hand-edited file is never evaluated): a file
     above MAX_FILE_BYTES (refused before it is read), numbers that are strings, booleans or out of
     range, multi-indices that are not integers in [0, MAX_DEGREE] or repeat a row, laws whose germ is
-    not the one given, times that do not increase."""
+    not the one given, times that do not increase; no regular file (a FIFO, a device: refused unread)."""
     try:
-        size = Path(path).stat().st_size
-        if size > MAX_FILE_BYTES:
-            raise ValueError(f"{size / 2**20:.0f} MiB, more than the {MAX_FILE_BYTES >> 20} MiB a surrogate takes")
-        with open(path, "rb") as fh:
-            text = fh.read(MAX_FILE_BYTES + 1)
-        if len(text) > MAX_FILE_BYTES:
-            raise ValueError(f"more than the {MAX_FILE_BYTES >> 20} MiB a surrogate takes")
-        data = json.loads(text)
+        data = json.loads(read_bounded(path, MAX_FILE_BYTES, "a surrogate"))
     except (OSError, ValueError, RecursionError) as exc:
         raise SurrogateError(f"{path}: cannot read the surrogate ({exc})") from exc
     if not isinstance(data, dict) or data.get("format") != FORMAT:

@@ -158,8 +158,12 @@ def _truth(items: list[str], results: Path) -> dict[str, float] | None:
 
     if not items:
         return None
-    with ResultStore.open(results) as store:
-        names = list(store.parameter_names)
+    try:
+        with ResultStore.open(results) as store:
+            names = list(store.parameter_names)
+    except (OSError, ValueError) as exc:  # damaged, or held by another process (the message names it)
+        echo(f"error: {exc}" if str(exc).startswith(str(results)) else f"error: {results}: {exc}", err=True)
+        raise typer.Exit(EXIT_BAD_INPUT)
     try:
         return name_values(items, "--truth", "NAME=VALUE with a finite VALUE", names, f"the parameters of {results}")
     except DataError as exc:

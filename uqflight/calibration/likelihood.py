@@ -14,6 +14,7 @@ reaches this module as its coefficients and a basis function.
 from __future__ import annotations
 
 import csv
+import io
 import math
 from dataclasses import dataclass
 from pathlib import Path
@@ -21,12 +22,17 @@ from typing import Callable
 
 import numpy as np
 
+from ..bounded import Refused, read_bounded
 from ..console import listed, shown
 from ..parameters.germs import GERMS, germ_columns
 
 
 class DataError(ValueError):
     """Flight data or a noise setting that cannot be used; the message names the file or option."""
+
+
+MAX_DATA_BYTES = 64 << 20  # a flight data CSV (about 4 million cells): refused beyond, before it is read
+DATA_FORM = "the flight data is a CSV file as `uqflight simulate --out` writes it (time_s and output columns)"
 
 
 @dataclass
@@ -46,10 +52,12 @@ def read_flight_csv(path, outputs: list[str] | None, available: list[str]) -> Fl
     requested output missing from the file or from the campaign.
     """
     path = Path(path)
-    try:
-        with open(path, newline="", encoding="utf-8-sig") as fh:  # a byte-order mark is no part of the header
-            rows = list(csv.reader(fh))
-    except (OSError, UnicodeDecodeError) as exc:
+    try:  # a byte-order mark is no part of the header
+        text = read_bounded(path, MAX_DATA_BYTES, "flight data").decode("utf-8-sig")
+        rows = list(csv.reader(io.StringIO(text, newline="")))
+    except Refused as exc:
+        raise DataError(f"{path}: {exc}: {DATA_FORM}") from exc
+    except (OSError, UnicodeDecodeError, csv.Error) as exc:
         raise DataError(f"{path}: cannot read the file ({exc})") from exc
     rows = [row for row in rows if any(cell.strip() for cell in row)]
     if len(rows) < 2:

@@ -161,7 +161,8 @@ def draw_all(plots: list) -> None:
             plot()
         return
     pyplot()  # imported once here, not in each child
-    failed = [str(outcome) for outcome in wait_all([Child(plot) for plot in plots]) if isinstance(outcome, ChildFailed)]
+    failed = [str(outcome) if isinstance(outcome, ChildFailed) else f"raised {outcome}"
+              for outcome in wait_all([Child(plot) for plot in plots]) if isinstance(outcome, (ChildFailed, OSError))]
     if failed:
         raise RuntimeError(f"cannot write a calibration plot: its process {failed[0]} (the error is printed above)")
 

@@ -15,6 +15,8 @@ from pathlib import Path
 import numpy as np
 
 from ..campaign import Campaign, CampaignError, load_campaign
+from ..bounded import Refused, read_bounded
+from ..campaign.schema import MAX_FILE_BYTES
 from ..campaign.reading import campaign_folder, check_campaign_text, portable_mapping, results_campaign
 from ..console import listed
 from ..designs import is_sampled
@@ -107,8 +109,8 @@ def _campaign_of(store: ResultStore, results: Path, campaign_path: Path | None) 
     source = str(results)
     if campaign_path is not None:
         try:
-            text = campaign_path.read_bytes().decode("utf-8")
-        except (OSError, UnicodeDecodeError) as exc:
+            text = read_bounded(campaign_path, MAX_FILE_BYTES, "a campaign").decode("utf-8")
+        except (OSError, UnicodeDecodeError, Refused) as exc:
             raise SurrogateError(f"--campaign: cannot read {campaign_path} ({exc})") from exc
         if text != store.campaign_text:
             raise SurrogateError(f"{campaign_path} is not the campaign {results} was run from (the texts differ)")
@@ -141,8 +143,8 @@ def calibration_surrogate(results, method: str | None = None, order: int | None 
     results = Path(results)
     try:
         store = ResultStore.open(results)
-    except (OSError, ValueError) as exc:
-        raise SurrogateError(f"{results}: {exc}") from exc
+    except (OSError, ValueError) as exc:  # CorruptFile's message names the file already
+        raise SurrogateError(str(exc) if str(exc).startswith(f"{results}:") else f"{results}: {exc}") from exc
     with store:
         campaign = _campaign_of(store, results, Path(campaign_path) if campaign_path else None)
         try:

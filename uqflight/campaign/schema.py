@@ -621,4 +621,10 @@ def check_size(check: Checker, data: dict, simulator: dict, parameters: list, me
         check.fail("storage", f"the results file would take about {disk / 1e9:.3g} GB ({n:.4g} runs of "
                               f"{times:.4g} times x {n_outputs} outputs), more than limits.max_disk_gb = "
                               f"{limits['max_disk_gb']:g}")
+    from ..store.layout import MAX_OUTPUT_VALUES  # what every reader of the results file holds
+
+    if n * times > MAX_OUTPUT_VALUES:
+        check.fail("design", f"{n:.4g} runs x {times:.4g} times = {n * times:.4g} values per output, more than the "
+                             f"results file's readers hold ({MAX_OUTPUT_VALUES:.4g}): choose fewer runs, or record "
+                             "fewer times (a lower output rate or a shorter flight)")
     return figures
