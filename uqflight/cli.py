@@ -1,9 +1,28 @@
 """The `uqflight` command line: simulate, plan, run, report, check, info, demo."""
 from __future__ import annotations
 
-import csv
-import io
 import os
+import signal
+import threading
+
+
+def _interrupted_while_starting(signum, frame):
+    """Ctrl-C while the command line is still importing (NumPy, typer, ...): one line and exit 130, as an
+    interrupted command says, not a KeyboardInterrupt traceback from inside an import. Nothing has
+    been done yet, so nothing is left to clean up."""
+    os.write(2, b"\ninterrupted: uqflight was starting, nothing was done\n")
+    os._exit(130)
+
+
+# only where Python's own Ctrl-C handler is in place (an ignored SIGINT stays ignored, a program's own
+# handler stays its own), until the module is imported; the commands handle Ctrl-C from then on
+_STARTING = (threading.current_thread() is threading.main_thread()
+             and signal.getsignal(signal.SIGINT) is signal.default_int_handler)
+if _STARTING:
+    signal.signal(signal.SIGINT, _interrupted_while_starting)
+
+import csv  # noqa: E402 (the imports below are what Ctrl-C may interrupt)
+import io
 from collections import Counter
 from pathlib import Path
 from typing import List, Optional
@@ -13,13 +32,13 @@ import typer
 
 from .arguments import check_campaign_file, check_output, check_results_file
 from .calibration.command import register as register_calibrate
-from .console import echo, one_line, shown
+from .console import echo, listed, one_line, shown
 from . import stopping
 from .leaving import leave
 from .progress import Progress
 
 from .methods import METHOD_KINDS
-from .simulators.base import FlightError, NominalFailed
+from .simulators.base import FlightError
 from .simulators.aircraft import default_condition
 from .simulators.jsbsim import DEFAULT_OUTPUTS, Excitation, FlightSetup, JSBSimFlight
 
@@ -40,6 +59,8 @@ def main() -> None:
     try:
         app()
     except SystemExit as done:
+        if done.code == 130 and isinstance(getattr(done.__context__, "__cause__", None), KeyboardInterrupt):
+            echo("\ninterrupted", err=True)  # a Ctrl-C no command caught (typer exits 130 silently): say so
         leave(done.code)
     leave(0)
 
@@ -227,38 +248,38 @@ def _load(path: Path):
 def plan(campaign_file: Path = typer.Argument(..., metavar="CAMPAIGN", help="Campaign YAML file.")):
     """Validate a campaign and print its design, the number of runs and an estimated time."""
     from .designs import describe, is_adaptive, is_rare
+    from .execution import WorkerError, timed_nominal
+    from .methods import method_entry
 
     campaign = _load(campaign_file)
     design = campaign.design()
-    echo(f"campaign: {campaign.name} ({campaign_file})")
+    echo(f"campaign: {shown(str(campaign.name))} ({campaign_file})")
     echo("parameters:")
     for p in campaign.parameters:
-        echo(f"  {p.name:<10} {p.property:<18} {p.distribution:<16} nominal {p.nominal:<10.6g} "
+        echo(f"  {shown(p.name):<10} {shown(p.property):<18} {p.distribution:<16} nominal {p.nominal:<10.6g} "
              f"interval [{p.lower:.6g}, {p.upper:.6g}]")
     if campaign.dependence is not None:
-        echo(f"dependence: {campaign.dependence.kind} over {', '.join(campaign.dependence.names)} (standard-normal germs, "
+        echo(f"dependence: {campaign.dependence.kind} over {listed(campaign.dependence.names)} (standard-normal germs, "
              "Cholesky in this order)")
     echo(describe(design))
     kind = campaign.method["kind"]
     if is_rare(design.kind):  # its own estimator: the runs are not draws of the input law
         echo(f"method: none (the {design.kind} estimates the probability of its event only)")
     else:
-        echo(f"method: {kind}" + (f" (order {campaign.method['order']})" if _has_order(kind, design.kind) else ""))
+        order = campaign.method.get(method_entry(kind).order_key)  # sparse's is max_order
+        echo(f"method: {kind}" + (f" (order {order})" if _has_order(kind, design.kind) else ""))
     runs = campaign.runs or len(design.xi)  # an adaptive grid's budget: its rounds are made from the results
     echo(f"runs: {runs}" + (" at most (design.budget)" if is_adaptive(design.kind) else ""))
     echo(f"results: {Path(campaign.storage['path']).resolve()} (storage.path, from the working directory; "
          "--out to choose)")
     try:
-        seconds, simulator_of_plan = _seconds_per_run(campaign)
-    except NominalFailed as exc:  # its message says it all
+        timed = timed_nominal(campaign)
+    except WorkerError as exc:  # its message says it all (a hang, a crash, a build or nominal failure), as `run`'s
         echo(f"error: {campaign_file}: {exc}", err=True)
         raise typer.Exit(2)
-    except Exception as exc:  # the simulator's own code (a python model) failed to build or to fly: as `run` says
-        echo(f"error: {campaign_file}: {type(exc).__name__}: {exc}", err=True)
-        raise typer.Exit(2)
-    warning = getattr(getattr(simulator_of_plan, "flight", None), "surface_warning", None)
-    if warning:
-        echo(f"warning: the nominal flight: {warning}", err=True)
+    for warning in timed.warnings:  # e.g. the excitation left the elevator unmoved
+        echo(f"warning: the nominal flight: {one_line(warning)}", err=True)
+    seconds = timed.seconds
     workers = min(campaign.execution["workers"], CORES)
     echo(f"estimated time: {runs * seconds / workers:.0f} s with {workers} worker(s) "
          f"({seconds * 1e3:.0f} ms per run, one nominal run timed now on this machine)")
@@ -274,30 +295,6 @@ def _has_order(kind: str, design_kind: str) -> bool:
 
     entry = method_entry(kind)
     return entry.pce is not None and not (entry.runs_on_sampled and is_sampled(design_kind))
-
-
-def _seconds_per_run(campaign) -> tuple[float, object]:
-    """One nominal run of the campaign's simulator, timed here (after a first, warming run), and the simulator
-    that flew it (its flight's surface_warning: the excitation left the elevator unmoved)."""
-    import time
-
-    from .execution import nominal_kappa, worker_spec
-
-    from .quantities.recorder import QuantityRecorder
-
-    simulator = worker_spec(campaign).build()
-    nominal = nominal_kappa(campaign)  # the sample `run` flies first, the centre of every law (ξ = 0)
-    simulator.layout(nominal)  # as `run` learns the outputs first: NominalFailed says what to do when it fails
-    # the timed run computes the quantities too: a linearisation costs more than the flight
-    observers = (QuantityRecorder(campaign.quantities, simulator.source),) if campaign.quantities else ()
-    for timed in (False, True):  # the first run loads what every later one reuses (the Newton trim's nominal)
-        simulator.restart()
-        started = time.perf_counter()
-        try:
-            simulator.evaluate(nominal, observers if timed else ())
-        except FlightError:
-            pass
-    return time.perf_counter() - started, simulator
 
 
 @app.command()
@@ -371,7 +368,7 @@ def _exit_now(code: int):
 @app.command()
 def info(results: Path = typer.Argument(..., metavar="RESULTS", help="Results file (.h5).")):
     """Show a results file's campaign, design, done and failed runs, storage and versions."""
-    from .store import CorruptFile, ResultStore, Status, read_error
+    from .store import CorruptFile, LockHeld, ResultStore, Status, read_error
     from .store.lock import describe_holder, live_holder
 
     check_results_file(results)
@@ -381,7 +378,7 @@ def info(results: Path = typer.Argument(..., metavar="RESULTS", help="Results fi
     try:
         try:
             store = ResultStore.open(results, while_written=writer is not None)
-        except BlockingIOError:  # HDF5's lock held by a writer without a lock file of ours
+        except LockHeld:  # HDF5's lock held by a writer without a lock file of ours
             echo("locked by another process (a run writing it?): read as it is now")
             writer = {"locked": True}
             store = ResultStore.open(results, while_written=True)
@@ -407,14 +404,14 @@ def _describe_results(results, store, Status) -> None:
     status = store.status
     attrs = store.attrs
     echo(f"file: {results}")
-    echo(f"campaign: {shown(str(attrs.get('campaign_name', '?')))} (sha256 {store.campaign_hash[:12]})")
-    echo(f"design: {attrs.get('design_kind', '?')} {attrs.get('design_info', '')}")
+    echo(f"campaign: {shown(str(attrs.get('campaign_name', '?')))} (sha256 {one_line(str(store.campaign_hash[:12]))})")
+    echo(f"design: {shown(str(attrs.get('design_kind', '?')))} {one_line(str(attrs.get('design_info', '')))}")
     state = store.index_set()  # an adaptive grid's refinement (/design)
     if state is not None:
         echo(f"index set: {len(state.indices)} multi-indices, {state.rounds} rounds, "
              f"{'stopped by ' + state.stopped if state.stopped else 'refining (resume to go on)'}")
-    echo(f"parameters: {', '.join(map(shown, store.parameter_names))}")
-    echo(f"outputs: {', '.join(map(shown, store.output_names))} ({store.time.size} times, "
+    echo(f"parameters: {listed(store.parameter_names)}")
+    echo(f"outputs: {listed(store.output_names)} ({store.time.size} times, "
          f"{store.time[0]:g} to {store.time[-1]:g} s)")
     counts = {s.name.lower(): int(np.sum(status == s)) for s in Status}
     echo("runs: " + ", ".join(f"{v} {k}" for k, v in counts.items()) + f" (of {status.size})")
@@ -425,11 +422,11 @@ def _describe_results(results, store, Status) -> None:
         echo(f"  failed ({n}): {one_line(reason)}")
     problems = store.verify()  # reads every checksummed chunk: a flipped byte is reported
     for problem in problems:
-        echo(f"  problem: {problem}")
+        echo(f"  problem: {one_line(str(problem))}")
     echo(f"storage: {store.storage_description}")
-    echo(f"versions: {attrs.get('versions', '?')}")
+    echo(f"versions: {one_line(str(attrs.get('versions', '?')))}")  # text of the file's: one line whatever it holds
     if "aircraft_hash" in attrs:
-        echo(f"aircraft sha256: {attrs['aircraft_hash']}")
+        echo(f"aircraft sha256: {one_line(str(attrs['aircraft_hash']))}")
     if problems:
         raise typer.Exit(2)
 
@@ -604,7 +601,7 @@ def design(
             echo(f"error: cannot write {csv_path}: {exc.strerror}", err=True)
             raise typer.Exit(2)
     echo(f"wrote {'the design' if to_stdout else csv_path}: {len(points.xi)} points of a {points.kind} design in "
-         f"{len(names)} parameters ({', '.join(names)})", err=to_stdout)
+         f"{len(names)} parameters ({listed(names)})", err=to_stdout)
 
 
 @surrogate_app.command("export")
@@ -677,7 +674,7 @@ def check(
         echo(f"error: {exc}", err=True)
         raise typer.Exit(2)
     if expected.get("campaign_hash") and expected["campaign_hash"] != attrs.get("campaign_hash"):
-        echo(f"error: {results} comes from another campaign (sha256 {str(attrs.get('campaign_hash'))[:12]}) "
+        echo(f"error: {results} comes from another campaign (sha256 {one_line(str(attrs.get('campaign_hash'))[:12])}) "
              f"than the baseline {baseline} ({str(expected['campaign_hash'])[:12]}): compare a results file "
              "with the baseline of its own campaign", err=True)
         raise typer.Exit(2)
@@ -707,7 +704,7 @@ def aircraft_command(
 
     if list_ or aircraft is None:
         for origin, names in known_aircraft().items():
-            echo(f"{origin}: {' '.join(names)}")
+            echo(f"{origin}: {' '.join(map(shown, names))}")  # folder names: quoted when odd
         return
     try:
         located = _prepared(aircraft, [], [])
@@ -724,7 +721,8 @@ def aircraft_command(
     for f in functions:
         ref = refs[f.name]
         factor = f"ΔC x {ref.symbol}" if not ref.refusal else "offset_value only"
-        echo(f"  {f.axis or '-':<6} {f.name:<40} {ref.unit or 'own':<6} {factor:<17} {f.description[:60]}")
+        echo(f"  {shown(f.axis) if f.axis else '-':<6} {shown(f.name):<40} {ref.unit or 'own':<6} {factor:<17} "
+             f"{one_line(f.description[:60])}")
     condition = default_condition(located.name)
     condition.update({k: v for k, v in (("altitude_ft", altitude_ft), ("airspeed_ktas", airspeed_ktas)) if v is not None})
     setup = FlightSetup(aircraft=located.name, root=located.root, excitation=Excitation(kind="none"), **condition)
@@ -735,7 +733,7 @@ def aircraft_command(
         raise typer.Exit(2)
     echo("engines:")
     for i, (name, kind, thruster) in enumerate(engine_kinds(flight.fdm)):
-        echo(f"  {i}: {name:<24} {kind:<10} thruster: {thruster}")
+        echo(f"  {i}: {shown(name):<24} {shown(kind):<10} thruster: {shown(thruster)}")
     echo(f"elevator travel: {flight.elevator_travel_deg[0]:.1f} deg down, {flight.elevator_travel_deg[1]:.1f} deg up"
          + ("" if not flight.has_property("fcs/elevator-excitation-deg") else " (fcs/elevator-excitation-deg used)"))
     if trim:
@@ -754,3 +752,7 @@ def aircraft_command(
              f"{setup.airspeed_ktas:g} KTAS (--altitude-ft, --airspeed-ktas)")
     echo(f"reference factors {where} (an offset ΔC adds ΔC times its function's): " + ", ".join(
         f"{symbol} = {number:.6g} {unit}" for symbol, number, unit in factor_values(flight.property_value)))
+
+
+if _STARTING:  # imported: Ctrl-C is a KeyboardInterrupt again, which each command handles
+    signal.signal(signal.SIGINT, signal.default_int_handler)

@@ -47,6 +47,7 @@ from .analysis.resolution import RESOLUTION_RTOL, resolved_variance
 from .analysis.sobol import NEGLIGIBLE, UNRESOLVED_WIDTH, complete_rows, pick_freeze_indices, unresolved
 from .campaign.attributes import StoredFacts, stored_facts, stored_settings
 from .campaign.schema import CampaignError
+from .console import shown
 from .designs import REGISTRY as DESIGNS
 from .designs import is_rare, is_sampled
 from .designs.adaptive import index_set_summary
@@ -59,12 +60,13 @@ from .methods import validation
 from .methods.validity import method_problem
 from .parameters.distributions import SEED_REFUSAL
 from .parameters.germs import draw_germs
-from .store import CorruptFile, ResultStore, Status
+from .store import CorruptFile, LockHeld, ResultStore, Status
 from .store.results import one_line
 
 PDF_POINTS = 120
 TIME_BLOCK = 100  # recorded times whose runs or surrogate draws are rebuilt at once
 ANALYSIS_THREADS = min(2, os.cpu_count() or 1)  # time blocks analysed at once (each with one BLAS thread)
+MAX_MAGNITUDE = 1e75  # an output's or quantity's values beyond: their fourth powers (kurtosis) leave float64
 BAND_LEVEL = 0.99
 DEFAULT_QUANTILES = (0.005, 0.995)
 # The relative spread a JSBSim output can resolve: the same sample flown on a reused model and on a
@@ -239,6 +241,8 @@ def read_statistics(path, method: dict | None = None, partial: bool = False,
         raise
     except CorruptFile as exc:
         raise BadInput(str(exc) if str(exc).startswith(f"{path}:") else f"{path}: {exc}") from exc
+    except LockHeld as exc:  # names the file and the process holding it
+        raise BadInput(str(exc)) from exc
     except (OSError, ValueError, KeyError) as exc:
         raise BadInput(f"{path}: cannot analyse the results file ({one_line(exc)})") from exc
 
@@ -408,10 +412,21 @@ def _grid_failure_note(probability: dict) -> str:
             "(the nodes are not random draws); a sampled design gives one")
 
 
+def too_large(kind: str, name: str, peak: float) -> str | None:
+    """Why the values of output or quantity (`kind`) `name`, of magnitude up to `peak`, give no statistics
+    (their powers up to the fourth, the variance and the kurtosis, leave float64), or None."""
+    if peak <= MAX_MAGNITUDE:
+        return None
+    return (f"{kind} {name if name.isprintable() else repr(name)} holds values up to {peak:.3g}, beyond the "
+            f"{MAX_MAGNITUDE:.0e} its statistics take in float64 (their powers, up to the fourth in the kurtosis, "
+            "would overflow): record it in larger units")
+
+
 def output_basis(store: ResultStore, name: str, ok: np.ndarray,
                  unwrapped: list | None = None) -> tuple[np.ndarray, np.ndarray | None]:
     """The ok runs of `name` as basis @ scale: raw (Y, None), or tSVD (V rows, diag(s) Uᵀ). An angle (deg or
-    rad) whose runs wrap is unwrapped (analysis.angles), raw, and its name appended to `unwrapped`."""
+    rad) whose runs wrap is unwrapped (analysis.angles), raw, and its name appended to `unwrapped`. BadInput,
+    one line, for values whose statistics would overflow (`too_large`)."""
     period = angle_period(store.units.get(name) or name_unit(name))
     factors = store.output_factors(name)
     if factors is None:
@@ -419,15 +434,23 @@ def output_basis(store: ResultStore, name: str, ok: np.ndarray,
         histories = store.output_matrix(name, runs)
         bad = runs[~np.isfinite(histories).all(axis=1)]
         if bad.size:
-            raise CorruptFile(f"output {name}: {bad.size} runs with status ok hold values that are not finite "
+            raise CorruptFile(f"output {shown(name)}: {bad.size} runs with status ok hold values that are not finite "
                               f"(e.g. run {bad[0]}): the file is damaged (`uqflight info` lists its problems)")
+        problem = too_large("output", name, float(np.abs(histories).max(initial=0.0)))
+        if problem:
+            raise BadInput(f"{store.path}: {problem}")
         return _unwrapped(histories, period, name, unwrapped, histories), None
     U, s, V, columns = factors
     if not (np.isfinite(U).all() and np.isfinite(s).all() and np.isfinite(V).all()):
-        raise CorruptFile(f"output {name}: its tSVD factors hold values that are not finite: the file is damaged")
+        raise CorruptFile(f"output {shown(name)}: its tSVD factors hold values that are not finite: the file is damaged")
     row_of = np.full(ok.size, -1)
     row_of[columns] = np.arange(columns.size)
     basis, scale = V[row_of[np.flatnonzero(ok)]], s[:, None] * U.T
+    with np.errstate(over="ignore"):  # a bound of every value: sum over the rank of |V| |diag(s) Uᵀ|
+        peak = float((np.abs(basis).max(axis=0, initial=0.0) @ np.abs(scale)).max(initial=0.0))
+    problem = too_large("output", name, peak)
+    if problem:
+        raise BadInput(f"{store.path}: {problem}")
     if period is None:
         return basis, scale
     # no step of any run can jump by half a turn when Σ_k max_i |V_ik| |Δ(s Uᵀ)_kt| stays below it, and the
@@ -894,7 +917,10 @@ def quantity_statistics(store: ResultStore, stats: Statistics, name: str, germs:
     missing = int(ok.sum() - defined.sum())
     sampled = is_sampled(stats.design_kind)
     why = None
-    if not defined.any():
+    huge = too_large("quantity", name, float(np.abs(values[defined]).max(initial=0.0)))
+    if huge:
+        why = f"{huge}; its statistics are null"
+    elif not defined.any():
         why = f"quantity {name} is undefined in every successful run: its statistics are null"
     elif missing and not sampled:
         why = (f"quantity {name} is undefined in {missing} of {int(ok.sum())} successful runs: a projection on "

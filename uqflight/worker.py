@@ -22,6 +22,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .console import one_line
 from .forking import die_with_parent
 from .quantities import quantity_key
 from .quantities.recorder import QuantityRecorder
@@ -40,6 +41,7 @@ class WorkerSpec:
     base: str
     bundle: dict | None = None  # the aircraft's (or file.py's) files as bytes + hash (simulators/bundle.py)
     quantities: dict | None = None  # the campaign's quantities of interest, {name: spec} (uqflight.quantities)
+    time: tuple[float, ...] | None = None  # the nominal flight's times, which every run's values are stored against
 
     @property
     def key(self) -> str:
@@ -72,6 +74,9 @@ def run_chunk(spec: WorkerSpec, indices: np.ndarray, kappa: np.ndarray, n_times:
     (NaN where undefined or failed)."""
     simulator = worker_simulator(spec)
     simulator.restart()
+    expect_time = getattr(simulator, "expect_time", None)  # a model that gives its own times (python)
+    if expect_time is not None and spec.time is not None:
+        expect_time(np.asarray(spec.time, dtype=float))
     n = len(indices)
     status = np.zeros(n, dtype=np.int8)
     reasons = [""] * n
@@ -172,8 +177,8 @@ def main(argv=None) -> None:
             os._exit(0)
         except NominalFailed as exc:  # its message says it all
             conn.send(("error", str(exc)))
-        except Exception as exc:  # building the simulator failed: the runner reports it
-            conn.send(("error", f"{type(exc).__name__}: {exc}"))
+        except Exception as exc:  # building the simulator failed: the runner reports it, on one line
+            conn.send(("error", f"{type(exc).__name__}: {one_line(str(exc))}"))
 
 
 if __name__ == "__main__":  # `python -m uqflight.worker`: the imported module's main, so that the

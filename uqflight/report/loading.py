@@ -8,7 +8,9 @@ import re
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from ..campaign import CampaignError
 from ..campaign.attributes import stored_settings
+from ..campaign.reading import parameter_rows, results_campaign
 from ..designs import REGISTRY as DESIGNS
 from ..methods import method_entry
 from ..statistics import BadInput, Statistics, add_reference_errors, read_statistics
@@ -27,6 +29,7 @@ class Entry:
     path: str = ""  # the results file (several entries share one with several --method)
     output_files: dict = field(default_factory=dict)  # output name → its part of file names, unique in the entry
     file_stem: str = ""  # the results file's part of the names of its own figures (design, runs), unique in the report
+    parameters: list | None = None  # the stored campaign's parameters (STORED_KEYS); None: unreadable (a note)
 
     @property
     def outputs(self) -> dict:
@@ -160,7 +163,21 @@ def _entry(path: Path, stats: Statistics, attrs: dict, stems: set[str], file_ste
     output_files = {name: _unique(file_name(name), taken) for name in stats.outputs}
     return Entry(stats, stem, label, str(attrs.get("campaign_hash", "")),
                  input_distributions(str(attrs.get("campaign", ""))), dict(attrs), str(path), output_files,
-                 file_stems[Path(path).resolve()])
+                 file_stems[Path(path).resolve()], stored_parameters(path, attrs, stats))
+
+
+def stored_parameters(path, attrs: dict, stats: Statistics) -> list[dict] | None:
+    """The parameters of the campaign stored in the results file `path` (its root attributes `attrs`), read
+    as every reader reads it (`campaign.reading.results_campaign`); None when they cannot be, flagged in
+    the file's notes with the reason (the field and the fix): the report shows the stored text, and its
+    numbers do not depend on it."""
+    try:
+        return parameter_rows(results_campaign(attrs, str(path)).parameters)
+    except (CampaignError, OSError) as exc:
+        reason = " ".join(str(exc).removeprefix(f"{path}: ").split())
+        stats.notes.append(f"the parameters of the campaign stored in {path} cannot be read, and the parameters "
+                           f"table lacks them: {reason}")
+        return None
 
 
 def file_name(name: str) -> str:

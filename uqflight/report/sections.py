@@ -14,7 +14,6 @@ from .formats import shown_path
 from ..analysis.sobol import unresolved
 from ..forking import share_work
 from .sensitivity import N_TOO_SMALL, NEGLIGIBLE, index_text, plot_sensitivity
-from ..campaign.reading import stored_parameters
 from .loading import (Entry, _same_file, bounded, campaign_settings, campaign_simulator, estimator_label, flight_facts,
                       method_label)
 
@@ -139,15 +138,13 @@ def run_section(entries: list[Entry], out_dir: Path) -> Section:
                       ("method", methods), ("seed", settings.get("seed", 0)), ("runs", counts),
                       ("created", e.attrs.get("created", "?")), ("aircraft sha256", e.attrs.get("aircraft_hash", "-")),
                       ("campaign sha256", e.campaign_hash), ("versions", versions)])
-        parameters = stored_parameters(e.attrs)
-        if parameters is None:
-            parameter_rows.append([e.stem, "(the campaign text could not be read)", "", "", "", "", ""])
-        else:
-            for p in parameters:
-                spec = ((settings.get("parameters") or {}).get(p["name"]) or {})
-                interval = (f"±{spec['interval_pct']:g} % of nominal" if "interval_pct" in spec else "lower, upper")
-                parameter_rows.append([e.stem, p["name"], p["property"], p["distribution"], p["lower"], p["upper"],
-                                       p["nominal"], interval])
+        if e.parameters is None:  # the reason is in the notes (report.loading.stored_parameters)
+            parameter_rows.append([e.stem, "(the stored campaign cannot be read: see the notes)", "", "", "", "", ""])
+        for p in e.parameters or []:
+            spec = ((settings.get("parameters") or {}).get(p["name"]) or {})
+            interval = (f"±{spec['interval_pct']:g} % of nominal" if "interval_pct" in spec else "lower, upper")
+            parameter_rows.append([e.stem, p["name"], p["property"], p["distribution"], p["lower"], p["upper"],
+                                   p["nominal"], interval])
     header = ["fact"] + [row[0] for row in facts]
     rows = [[fact] + [row[k][1] for row in facts] for k, (fact, _) in enumerate(facts[0][1:], start=1)]
     blocks.append(Table("The campaign: flight condition, excitation, design, method, seed, provenance",

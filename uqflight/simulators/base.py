@@ -7,6 +7,8 @@ from __future__ import annotations
 
 import enum
 
+from ..console import one_line, shown
+
 
 class Status(enum.IntEnum):
     """Outcome of one run, as stored in /samples/status."""
@@ -45,10 +47,11 @@ class NominalFailed(RuntimeError):
 
 def nominal_failed(names, kappa, exc: Exception) -> NominalFailed:
     """The NominalFailed that says sample `kappa` of the parameters `names` failed with `exc`."""
-    values = ", ".join(f"{name} = {float(value):.10g}" for name, value in zip(names, kappa))
+    values = ", ".join(f"{shown(name)} = {float(value):.10g}" for name, value in zip(names, kappa))
     return NominalFailed(
         f"the nominal sample failed ({values}: the centre of every parameter's law, ξ = 0), which uqflight "
-        f"runs first to learn the outputs, the time grid and the cost of a run: {type(exc).__name__}: {exc}. "
+        f"runs first to learn the outputs, the time grid and the cost of a run: {type(exc).__name__}: "
+        f"{one_line(str(exc))}. "
         "Make the simulator succeed at these values (call simulator.function with them to see why), or move "
         "the parameters' intervals (lower and upper, or nominal with interval_pct) so that their centre is an "
         "input it accepts")

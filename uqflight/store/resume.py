@@ -2,12 +2,15 @@
 create it otherwise, and compact a finished tSVD file."""
 from __future__ import annotations
 
+import os
 from pathlib import Path
 
 import h5py
 import yaml
 
+from ..console import shown
 from .file_end import extend_file, past_recorded_end
+from .lock import LockHeld, held_message, is_lock_error, open_elsewhere
 from .results import READ_ERRORS, ResultStore, one_line, text_hash
 
 
@@ -29,6 +32,9 @@ def open_for_campaign(path, *, campaign_text: str, force: bool = False, restart:
     never deletes what is not a uqflight results file (a directory, a text file, another HDF5 file):
     those are refused, with how to remove them. (The caller holds the file's lock: `force` never
     touches a file another run writes.) `restart` starts a results file of this same campaign over.
+    A file another process holds open (HDF5's file lock: a reader, or a writer without our lock) is
+    refused with LockHeld naming that process, before anything is read: it is in use, not damaged,
+    and neither `force` nor `restart` replaces it.
     """
     path = Path(path)
     flown = {key: (create_args.get("attrs") or {}).get(key) for key in FLOWN}
@@ -39,6 +45,10 @@ def open_for_campaign(path, *, campaign_text: str, force: bool = False, restart:
         if not path.is_file():
             raise FileExistsError(f"{path} is not a regular file; uqflight does not replace it: choose "
                                   "another results file")
+        if not os.access(path, os.R_OK | os.W_OK):  # a file this user cannot read says nothing of its contents
+            raise FileExistsError(f"{path} cannot be {'read' if not os.access(path, os.R_OK) else 'written'} by "
+                                  "this user (its permissions); uqflight does not replace it: choose another results "
+                                  "file, or give this user access to it")
         if not h5py.is_hdf5(path):
             raise FileExistsError(f"{path} is not a uqflight results file (not HDF5); uqflight never "
                                   f"overwrites it, even with --force: remove it yourself (rm {path}) or "
@@ -46,6 +56,8 @@ def open_for_campaign(path, *, campaign_text: str, force: bool = False, restart:
         try:
             stored, stored_flown, ours = _stored_campaign(path)
         except READ_ERRORS as exc:  # e.g. killed while the file was being created: nothing to resume
+            if is_lock_error(exc):  # opened by another process since the check above
+                raise LockHeld(held_message(path)) from None
             if not force:
                 reason = one_line(exc)[:200]
                 if past_recorded_end(reason):  # and _stored_campaign could not move that end
@@ -69,18 +81,18 @@ def open_for_campaign(path, *, campaign_text: str, force: bool = False, restart:
                                           **{key: given[key] for key in READ_ONLY_KEYS if key in given}})
                 return store
         if stored == text_hash(campaign_text) and stored_flown == flown and not restart:
-            return ResultStore.open(path, "a")
+            return ResultStore.open(path, "a")  # LockHeld when another process opened it since the check
         if restart and stored == text_hash(campaign_text):
             force = True
         if not force:
             if stored == text_hash(campaign_text):
                 key = next(key for key in FLOWN if stored_flown.get(key) != flown[key])
                 what = {"aircraft_hash": "aircraft files (sha256", "scenario": "script files ("}[key]
-                raise FileExistsError(f"{path} was made with other {what} {str(stored_flown.get(key))[:80]}); "
+                raise FileExistsError(f"{path} was made with other {what} {shown(str(stored_flown.get(key))[:80])}); "
                                       "resuming would mix two models: choose another results file, or force "
                                       "to start over")
-            where = (f": its campaign differs first at {differs}" if differs else
-                     f" (campaign_hash {stored})")
+            where = (f": its campaign differs first at {shown(differs)}" if differs else
+                     f" (campaign_hash {shown(str(stored))})")
             if differs and differs.startswith("quantities"):
                 where += (" (a quantity is computed in the worker at every integration step, finer than the "
                           "stored histories: a changed one is flown again)")
@@ -88,6 +100,8 @@ def open_for_campaign(path, *, campaign_text: str, force: bool = False, restart:
                                   "file (--out), or --force (force=True in Python) to overwrite it and fly every "
                                   "run again (a change of analysis: alone resumes the file as it is; "
                                   "`uqflight report --exceedance` changes thresholds without a run)")
+        if open_elsewhere(path):  # opened meanwhile: it is in use, and stays
+            raise LockHeld(held_message(path))
         path.unlink()
     try:
         return ResultStore.create(path, campaign_text=campaign_text, **create_args)
