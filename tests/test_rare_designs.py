@@ -245,7 +245,23 @@ def test_no_surrogate_is_exported_from_a_rare_event_design(quick, tmp_path):
     assert done.returncode == 2 and "not draws of the input law" in done.stderr, done.stderr
     assert len(done.stderr.strip().splitlines()) == 1 and not (tmp_path / "s.json").exists()
     done = cli_in_process("info", out)
-    assert done.returncode == 0, done.stderr
+    assert done.returncode == 0 and "rare event: P(peak > 2.5) = " in done.stdout, done.stderr
+
+
+@pytest.mark.parametrize("damage", ["probability", "round_cov", "notes"])
+def test_a_damaged_rare_event_record_is_refused_naming_it(quick, tmp_path, damage):
+    _, out = copied(quick, tmp_path)
+    with h5py.File(out, "r+") as f:
+        group = f["rare_event"]
+        if damage == "round_cov":  # a length that differs from the other rounds'
+            del group[damage]
+            group.create_dataset(damage, data=np.zeros(1000))
+        else:
+            group.attrs[damage] = "many" if damage == "probability" else "[1, 2"
+    for command in (["report", out, "--out", tmp_path / "report"], ["info", out]):
+        done = cli_in_process(*command)
+        assert done.returncode == 2 and f"{out}: /rare_event" in done.stderr and "damaged" in done.stderr, done.stderr
+        assert len(done.stderr.strip().splitlines()) == 1
 
 
 FAILING_MODEL = '''

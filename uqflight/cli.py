@@ -410,6 +410,12 @@ def _describe_results(results, store, Status) -> None:
     if state is not None:
         echo(f"index set: {len(state.indices)} multi-indices, {state.rounds} rounds, "
              f"{'stopped by ' + state.stopped if state.stopped else 'refining (resume to go on)'}")
+    record = store.rare_event()  # a rare-event design's estimate (/rare_event), once its rounds finished
+    if record is not None:
+        echo(f"rare event: P({shown(record['of'])} {'>' if record['side'] == 'above' else '<'} {record['threshold']:g})"
+             f" = {record['probability']:.4g} (95 %: {record['lower']:.4g} to {record['upper']:.4g}), cov "
+             f"{record['cov']:.3g}".replace("cov nan", "cov undefined")
+             + f", {record['runs']} runs, stopped by {shown(record['stopped'])}")
     echo(f"parameters: {listed(store.parameter_names)}")
     echo(f"outputs: {listed(store.output_names)} ({store.time.size} times, "
          f"{store.time[0]:g} to {store.time[-1]:g} s)")
