@@ -1,26 +1,10 @@
-"""A rare-event design's estimate as recorded in its results file (/rare_event, `store.rare`) and read back:
+"""A rare-event design's estimate as its results file records it (/rare_event, written and read by `store.rare`):
 plain numbers and arrays, so that reading it imports no algorithm and runs no campaign code."""
 from __future__ import annotations
 
-import math
-
 import numpy as np
 
-FIELDS = ("probability", "lower", "upper", "cov", "beta")  # the estimate's numbers, NaN where undefined
-
-
-def reliability_index(probability: float) -> float:
-    """β = −Φ⁻¹(p): inf for p = 0, −inf for p = 1, NaN for no estimate."""
-    from scipy.special import ndtri
-
-    return float(-ndtri(probability)) if math.isfinite(probability) else math.nan
-
-
-def shares(u: np.ndarray) -> np.ndarray:
-    """α_k² = u_k²/|u|² of a design point in standard-normal space (summing to 1); NaN for u = 0."""
-    u = np.asarray(u, dtype=float)
-    total = float(u @ u)
-    return u**2 / total if total > 0 else np.full(u.shape, np.nan)
+from .estimate import importance_shares
 
 
 def estimate_record(estimate, settings, ends, campaign) -> dict:
@@ -31,19 +15,19 @@ def estimate_record(estimate, settings, ends, campaign) -> dict:
 
     d = len(campaign.germs)
     point = estimate.design_point
-    if point is None:
+    u = np.full(d, np.nan) if point is None else np.asarray(point, dtype=float).reshape(d)
+    if point is None or not np.any(u):  # no run in the event (the origin would have no direction to share)
         u = xi = kappa = importance = np.full(d, np.nan)
     else:
-        u = np.asarray(point, dtype=float).reshape(d)
         xi = germs_from_normal(u[None, :], campaign.germs)
         kappa = campaign.to_physical(xi)[0]
-        xi, importance = xi[0], shares(u)
+        xi, importance = xi[0], importance_shares(u)
     rounds = estimate.rounds
     return {"method": settings.kind, "of": settings.event.of, "side": settings.event.side,
             "threshold": settings.event.threshold, "budget": settings.budget,
             "probability": float(estimate.probability), "lower": float(estimate.lower),
             "upper": float(estimate.upper), "cov": float(estimate.cov),
-            "beta": reliability_index(float(estimate.probability)), "runs": int(estimate.runs),
+            "beta": float(estimate.beta), "runs": int(estimate.runs),
             "failed": int(estimate.failed), "stopped": str(estimate.stopped),
             "notes": [str(note) for note in estimate.notes],
             "round_runs": np.array([r.runs for r in rounds], dtype=np.int64),
