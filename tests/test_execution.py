@@ -214,13 +214,15 @@ T = np.linspace(0.0, 1.0, 11)
 def f(p):
     if p["a"] > 5.0:  # the process itself dies, as a crashing native simulator would
         os.kill(os.getpid(), signal.SIGKILL)
+    while p["a"] < 0.2:  # never returns
+        pass
     return {"time": T, "y": p["a"] * T, "z": p["b"] - T}
 '''
 
 
-def test_simulate_split_over_processes_equals_one_process_and_survives_a_dying_one(tmp_path):
-    # calibrate's predictive runs: the same numbers in 1 or 3 forked processes; a process killed by its
-    # simulator fails its own runs with the reason, the others' runs stand
+def test_simulate_split_over_processes_equals_one_process_and_survives_a_dying_or_hung_run(tmp_path):
+    # calibrate's predictive runs: the same numbers in 1 or 3 supervised worker processes; a run that kills
+    # its worker, or runs past execution.timeout_s, fails with its reason, the other runs stand
     from uqflight.execution import simulate
 
     (tmp_path / "model.py").write_text(CRASHING_MODEL)
@@ -240,10 +242,17 @@ design: {kind: monte_carlo, samples: 4}
     assert not split_failures and np.array_equal(split_time, time)
     for name in ("y", "z"):
         assert np.array_equal(split[name], one[name])
-    kappa[7, 0] = 8.0  # in the last of three chunks (rows 6-8)
+    kappa[7, 0] = 8.0
     _, crashed, failures = simulate(campaign, kappa, ["y", "z"], processes=3)
-    assert failures == ["the process flying this run died (signal 9)"] * 3
-    assert np.isnan(crashed["y"][6:]).all() and np.array_equal(crashed["y"][:6], one["y"][:6])
+    assert failures == ["worker process died: signal 9 (SIGKILL) (out of memory, or killed)"]
+    assert np.isnan(crashed["y"][7]).all()
+    others = np.arange(9) != 7
+    assert np.array_equal(crashed["y"][others], one["y"][others])
+    hung = parse_campaign(campaign.text.replace("design:", "execution: {timeout_s: 1}\ndesign:"), campaign.source)
+    kappa[7, 0], kappa[2, 0] = 4.0, 0.1  # row 2 never returns: it is stopped after 1 s, as `run` stops it
+    _, flown, failures = simulate(hung, kappa, ["y", "z"], processes=2)
+    assert failures == ["timed out: still running after 1 s (execution.timeout_s); its worker was replaced"]
+    assert np.isnan(flown["y"][2]).all() and np.isfinite(np.delete(flown["y"], 2, axis=0)).all()
 
 
 def test_restart_starts_a_same_campaign_file_over_and_force_keeps_its_meaning(tmp_path):

@@ -13,7 +13,7 @@ PACKAGE = Path(__file__).resolve().parents[1] / "uqflight"
 LAYERS = [
     ("uqflight.paper", "uqflight.labels", "uqflight.tsvd", "uqflight.simulators.base", "uqflight.parameters.germs",
      "uqflight.console", "uqflight.progress", "uqflight.forking", "uqflight.json_text", "uqflight.stopping",
-     "uqflight.leaving", "uqflight.arguments"),
+     "uqflight.leaving", "uqflight.arguments", "uqflight.bounded"),
     ("uqflight.parameters", "uqflight.analysis", "uqflight.simulators", "uqflight.quantities"),
     ("uqflight.designs",),
     ("uqflight.methods",),
@@ -73,6 +73,9 @@ def test_a_worker_imports_only_what_flying_needs():
             "if m.startswith(('uqflight', 'scipy', 'h5py', 'yaml', 'matplotlib', 'dask')))))")
     loaded = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout.split()
     # the quantities' recorder is part of flying: it sees every integration step; forking (the standard
-    # library only) makes it die with its runner
+    # library only) makes it die with its runner; labels (no imports) gives the unit a property's name ends
+    # in, which tells the recorder an angle to unwrap; console (typer only when it prints) quotes a refused
+    # file's names; bounded (the standard library only) reads a python model's file within its size
     assert all(m.startswith(("uqflight.simulators", "uqflight.worker", "uqflight.quantities"))
-               or m in ("uqflight", "uqflight.forking") for m in loaded), loaded
+               or m in ("uqflight", "uqflight.forking", "uqflight.labels", "uqflight.console", "uqflight.bounded")
+               for m in loaded), loaded

@@ -127,3 +127,13 @@ def test_refusals_through_the_cli_exit_2(tmp_path):
     for command in ("plan", "run"):
         done = cli_in_process(command, path)
         assert done.returncode == 2 and "limits.max_runs" in done.stderr, done.stderr
+
+
+def test_a_campaign_whose_results_no_reader_holds_is_refused_up_front():
+    """D08's other side: 10^6 runs of 5 s at 60 Hz (3.0e8 values per output) pass the memory and disk
+    limits raised for it, but give a file every reader refuses (store.layout.MAX_OUTPUT_VALUES): refused at
+    planning, not after the flights."""
+    text = limited(design="{kind: monte_carlo, samples: 1000000}") + \
+        "limits: {max_memory_gb: 1000, max_disk_gb: 10000}\n"
+    refused(text.replace("duration_s: 5}", "duration_s: 5, output_rate_hz: 60}"),
+            r"design: 1e\+06 runs x 301 times = 3.01e\+08 values per output, more than the results file's readers hold")

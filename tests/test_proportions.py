@@ -7,6 +7,7 @@ in a square of area 4; curved, so that no QMC net stratifies it exactly). Covera
 import numpy as np
 import pytest
 
+from uqflight.analysis.failures import wilson_interval
 from uqflight.analysis.proportions import sampled_proportion
 from uqflight.designs import REGISTRY, build_design
 
@@ -40,12 +41,31 @@ def test_independent_draws_get_the_wilson_interval_that_covers():
     assert 0.912 <= _coverage({"kind": "monte_carlo", "samples": 128}, 3) <= 0.988
 
 
-def test_randomised_qmc_replicates_give_a_student_t_interval_that_covers():
+def test_randomised_qmc_replicates_give_an_interval_that_covers():
+    # the hull of the pooled Wilson interval and the replicates' Student-t: at p = π/8 over 512 points the
+    # Wilson interval of independent draws is wider than the scrambled nets' own error, so it covers more
+    # than 0.95 (conservative); benchmarks/rqmc_interval_coverage.py measures it at a few exceedances
     spec = {"kind": "sobol", "samples": 64, "replicates": 8}
     found, hits = _found(spec, 3, 1)
     assert found["method"] == "replicates"
     assert found["estimate"] == pytest.approx(np.mean([hits[r * 64:(r + 1) * 64].mean() for r in range(8)]))
-    assert 0.912 <= _coverage(spec, 3) <= 0.988
+    wilson = wilson_interval(hits.mean(), hits.size)
+    assert found["lower"] <= wilson[0] and found["upper"] >= wilson[1]
+    assert _coverage(spec, 3) >= 0.912
+
+
+def test_randomised_qmc_covers_at_a_few_exceedances():
+    # the disk of probability 6/512 (six exceedances expected over 8 replicates of 64 points): the
+    # replicates' Student-t interval alone covers 0.93-0.96 there (benchmarks/rqmc_interval_coverage.py);
+    # the reported hull must cover >= 0.95 over these 300 seeds (it gave 0.97-0.99 in the benchmark)
+    radius = np.sqrt(4 * 6 / 512 / np.pi)
+    covered = []
+    for seed in SEEDS:
+        design = build_design({"kind": "sobol", "samples": 64, "replicates": 8}, ["uniform"] * 3, seed)
+        hits = design.xi[:, 0] ** 2 + design.xi[:, 1] ** 2 < radius**2
+        found = sampled_proportion(hits, np.ones(hits.size, bool), "net", design.info)
+        covered.append(found["lower"] <= 6 / 512 <= found["upper"])
+    assert np.mean(covered) >= 0.95
 
 
 def test_a_latin_hypercube_gets_the_conservative_wilson_interval_of_n_minus_one_draws():
@@ -63,10 +83,12 @@ def test_one_scrambled_net_is_flagged_and_fixed_points_get_no_interval():
     assert found["estimate"] == hits.mean()
 
 
-def test_replicates_that_all_agree_give_no_interval():
+def test_replicates_that_all_agree_get_the_pooled_wilson_interval():
+    # no exceedance in any of 4 replicates: their spread is 0, the pooled runs' Wilson interval remains
     hits, counted = np.zeros(32, bool), np.ones(32, bool)
     found = sampled_proportion(hits, counted, "net", {"replicates": 4, "scramble": True})
-    assert found["estimate"] == 0.0 and found["lower"] is None and "more samples" in found["sentence"]
+    assert found["estimate"] == 0.0 and (found["lower"], found["upper"]) == wilson_interval(0.0, 32)
+    assert "Wilson" in found["sentence"]
 
 
 def test_only_counted_runs_count():

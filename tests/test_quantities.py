@@ -27,6 +27,7 @@ CASES = {
     "final": ({"of": "y", "take": "final", "before_s": 3}, 3.5),
     "drop": ({"of": "w", "take": "drop", "after_s": 1, "before_s": 3}, 2.0),  # w(1) = -0.5, min w(3) = -2.5
     "drop_rising": ({"of": "y", "take": "drop"}, 0.0),
+    "change": ({"of": "w", "take": "change", "after_s": 1, "before_s": 3}, -2.0),  # w(3) - w(1) = -2.5 + 0.5
     "mean": ({"of": "z", "take": "mean"}, TRAPEZOID_Z),
     "mean_window": ({"of": "y", "take": "mean", "after_s": 1, "before_s": 3}, 2.5),
     "at": ({"of": "z", "take": "at", "at_s": 1.25}, 0.78125),

@@ -248,3 +248,29 @@ def test_the_cli_exits_2_when_the_disk_fills_past_the_check(tmp_path, small_disk
     assert_same_results(out, tmp_path / "whole.h5")
 
 
+
+
+def test_a_disk_that_fills_while_the_results_file_is_created_is_one_clean_line(tmp_path):
+    """D21: HDF5 met the full disk while releasing the new file's groups, and h5py printed each failure as an
+    "Exception ignored" traceback before the clean error. A real full disk: a 256 KiB tmpfs filled but for a
+    few KiB (sizes at which the creation itself fails: 8 to 12 KiB left)."""
+    from conftest import DECAY_TWO_INPUTS
+
+    yaml = tmp_path / "decay.yaml"
+    yaml.write_text(DECAY_TWO_INPUTS)
+    with mounted_tmpfs(tmp_path, "256k") as mount:
+        for free in (8, 10, 12):
+            for item in mount.iterdir():
+                item.unlink()
+            with open(mount / "filler", "wb") as fh:
+                try:
+                    fh.write(b"\0" * ((256 - free) * 1024))
+                except OSError:
+                    pass
+            out = mount / "r.h5"
+            done = subprocess.run([UQFLIGHT, "run", str(yaml), "--out", str(out), "--workers", "1"],
+                                  capture_output=True, text=True, timeout=120)
+            assert done.returncode == 2, (free, done.stderr)
+            assert "Traceback" not in done.stderr and "Exception ignored" not in done.stderr, (free, done.stderr)
+            assert done.stderr.strip().splitlines()[-1].startswith(f"error: no space left on {out}'s filesystem")
+            assert not out.exists()  # no half-made file that would later look damaged

@@ -141,3 +141,48 @@ def test_the_export_names_the_file_and_the_field_of_a_stored_campaign_it_cannot_
     assert done.returncode == 2 and not (tmp_path / "s.json").exists()
     assert done.stderr == (f"error: {path}: cannot read the parameters' distributions from the campaign stored in "
                            "the file: name: expected a non-empty string, got a list\n")
+
+
+SCRIPT_CAMPAIGN = """name: old-script
+seed: 3
+simulator:
+  kind: jsbsim
+  scenario: {kind: script, script: 737_cruise_steady_turn}
+  outputs: [h_ft]
+parameters:
+  a: {property: fcs/elevator-cmd-norm, distribution: normal, interval_pct: 10}
+  b: {property: fcs/aileron-cmd-norm, distribution: uniform, interval_pct: 10}
+design: {kind: sparse_grid, level: 3}
+method: {kind: pseudo_galerkin, order: 2}
+analysis: {band_samples: 500, bootstrap: 0}
+"""
+
+
+def test_a_stored_script_campaign_without_its_parameters_names_field_and_fix(decay_results, tmp_path):
+    """D11: a file without the parameters attribute (the older layout) whose stored campaign is a script's, which
+    names no simulator.aircraft: the report died in a plotting child on KeyError 'aircraft' (exit 1) and
+    surrogate export said "cannot export the surrogate ('aircraft')". The campaign reader refuses it naming the
+    field and `run --restart`: surrogate export, which needs the parameters, in one line (exit 2); the report,
+    whose numbers do not depend on them (it shows the stored text, test above), flags it in its notes."""
+    import hashlib
+
+    from conftest import read_summary
+
+    out = tmp_path / "old.h5"
+    shutil.copy(decay_results, out)
+    with h5py.File(out, "a") as f:
+        f.attrs["campaign"] = SCRIPT_CAMPAIGN
+        f.attrs["campaign_hash"] = hashlib.sha256(SCRIPT_CAMPAIGN.encode()).hexdigest()
+        del f.attrs["parameters"]
+    said = ("simulator.aircraft: the campaign stored in the file names no aircraft (its script does), and the file "
+            "records no parameters attribute to take the nominal values from: fly the campaign again (`uqflight run "
+            "CAMPAIGN --out FILE --restart` starts this file over)")
+    done = cli_in_process("surrogate", "export", out, "--out", tmp_path / "s.json")
+    assert done.returncode == 2 and not (tmp_path / "s.json").exists(), done.stderr
+    errors = [line for line in done.stderr.splitlines() if line.startswith("error:")]
+    assert len(errors) == 1 and "Traceback" not in done.stderr and errors[0].startswith(f"error: {out}: "), done.stderr
+    assert errors[0].endswith(said), errors[0]
+    done = cli_in_process("report", out, "--out", tmp_path / "rep")
+    assert done.returncode == 0, done.stderr
+    notes = read_summary(tmp_path / "rep" / "summary.json")["notes"]
+    assert any(note.endswith(said) and f"stored in {out} cannot be read" in note for note in notes), notes

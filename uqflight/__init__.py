@@ -74,14 +74,25 @@ def _methods(method) -> list[dict] | None:
     return [m if isinstance(m, dict) else parse_methods([m])[0] for m in items]
 
 
-def analyse(results, method=None, reference=None, partial: bool = False, allow_aliasing: bool = False):
+def _thresholds(exceedance) -> dict | None:
+    """`exceedance` as analyse takes it: "NAME>X" strings (one or a list) parsed, a mapping as it is."""
+    if exceedance is None or isinstance(exceedance, dict):
+        return exceedance
+    from .quantities.spec import parse_exceedance_option
+
+    return parse_exceedance_option([exceedance] if isinstance(exceedance, str) else list(exceedance))
+
+
+def analyse(results, method=None, reference=None, partial: bool = False, allow_aliasing: bool = False,
+            exceedance=None):
     """The statistics (`uqflight.statistics.Statistics`) of a results file, as `uqflight report` computes
     them: `.outputs[NAME]` (mean, variance, std, band99, quantiles, sobol_first, sobol_total, ... over
     time), `.quantities[NAME]`, `.notes`, `.failure_probability`. `method`: "KIND[:ORDER]" or
     {"kind", "order"} instead of the campaign's; `reference`: a results file for the errors ε_m, ε_v and
-    the KLD; `partial`, `allow_aliasing`: as `report --partial`, `--allow-aliasing`. Never runs campaign
-    code. Raises `uqflight.statistics.BadInput` (one line naming the file and what to do) when the file
-    cannot give right numbers."""
+    the KLD; `partial`, `allow_aliasing`: as `report --partial`, `--allow-aliasing`; `exceedance`: "NAME>X" /
+    "NAME<X" strings (or {NAME: [{above: X}]}) replacing the campaign's thresholds of NAME, as `report
+    --exceedance`. Never runs campaign code. Raises `uqflight.statistics.BadInput` (one line naming the file
+    and what to do) when the file cannot give right numbers."""
     from .statistics import BadInput
     from .statistics import analyse as statistics
 
@@ -90,7 +101,7 @@ def analyse(results, method=None, reference=None, partial: bool = False, allow_a
         raise ValueError("analyse takes one method; report compares several")
     try:
         return statistics(results, reference=reference, method=methods[0] if methods else None, partial=partial,
-                          allow_aliasing=allow_aliasing)
+                          allow_aliasing=allow_aliasing, exceedance=_thresholds(exceedance))
     except BadInput:
         raise
     except (OSError, KeyError) as exc:
@@ -98,19 +109,20 @@ def analyse(results, method=None, reference=None, partial: bool = False, allow_a
 
 
 def write_report(results, out=None, reference=None, method=None, times=(10.0, 25.0, float("inf")),
-           baseline=None, partial: bool = False, allow_aliasing: bool = False) -> list:
+           baseline=None, partial: bool = False, allow_aliasing: bool = False, exceedance=None) -> list:
     """Write the report of one results file or a list of them into `out` (default RESULTS-report/ beside
     the first), as `uqflight report` does; returns the paths written. `method`: "KIND[:ORDER]", a mapping
     or a list of them (compared on the same runs); `times`: the tables' times (inf: the final one);
-    `baseline`: also write the baseline of `uqflight check`. Raises BadInput as `analyse`. An example:
-    docs/python.md."""
+    `baseline`: also write the baseline of `uqflight check`; `exceedance`: "NAME>X" / "NAME<X" strings (or
+    {NAME: [{above: X}]}) replacing the campaign's thresholds of NAME, as `report --exceedance`. Raises
+    BadInput as `analyse` (ValueError for a malformed threshold). An example: docs/python.md."""
     from pathlib import Path
 
     from .report import write_report as write
 
     paths = [Path(p) for p in (results if isinstance(results, (list, tuple)) else [results])]
     return write(paths, out, reference=reference, times=times, baseline=baseline, method=_methods(method),
-                        partial=partial, allow_aliasing=allow_aliasing)
+                 partial=partial, allow_aliasing=allow_aliasing, exceedance=_thresholds(exceedance))
 
 
 def export_surrogate(results, out, method=None):
@@ -138,7 +150,7 @@ def simulate(settings: dict | None = None, *, aircraft: str = "bacm", altitude_f
     """Fly one flight as `uqflight simulate` does: trim in level flight (default: the aircraft's
     condition), excite the elevator and record the outputs (alpha_deg, theta_deg, h_ft, q_degps, vtas_kt
     and the JSBSim properties in `outputs`). `settings`: {property: value} set before the trim, e.g.
-    {"aero/uq/CL0": 0.22}. Returns a FlightResult (`.time`, `.outputs[NAME]`, `.trim`); raises FlightError
+    {"aero/uq/CL0": 0.22}. Returns a FlightResult (`.time`, `.outputs[NAME]`, `.trim`, `.warnings`); raises FlightError
     (`uqflight.simulators.base`) when the trim or the flight fails.
 
     >>> flight = simulate({"aero/uq/CL0": 0.22}, duration_s=2.0)

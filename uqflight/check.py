@@ -17,7 +17,10 @@ from pathlib import Path
 
 import numpy as np
 
+from .bounded import Refused, read_bounded
 from .campaign.schema import shown
+from .console import listed
+from .console import shown as shown_name
 from .json_text import json_text
 from .statistics import BadInput, Statistics, json_ready
 
@@ -25,6 +28,7 @@ BASELINE_KIND = "uqflight-baseline"
 BASELINE_VERSION = 1
 STATISTICS = ("mean", "variance", "band99.lower", "band99.upper", "sobol_first", "sobol_total")
 TIME_ATOL = 1e-9  # seconds: time grids closer than this are the same grid
+MAX_BASELINE_BYTES = 128 << 20  # refused before it is read (parsing takes several times as much memory)
 
 
 @dataclass
@@ -95,7 +99,11 @@ def load_baseline(path: Path) -> dict:
         raise BadInput(f"{path}: {name} is not a value a baseline may hold (expected finite numbers, null or NaN)")
 
     try:
-        data = json.loads(path.read_text(encoding="utf-8"), parse_constant=refuse_constant)
+        data = json.loads(read_bounded(path, MAX_BASELINE_BYTES, "a baseline").decode("utf-8"),
+                          parse_constant=refuse_constant)
+    except Refused as exc:
+        raise BadInput(f"{path}: {exc}; a baseline holds a results file's statistics: write one with "
+                       "`uqflight report RESULTS.h5 --out DIR --write-baseline FILE`") from exc
     except OSError as exc:
         raise BadInput(f"{path}: cannot read the baseline ({exc.strerror or exc})") from exc
     except (UnicodeDecodeError, json.JSONDecodeError) as exc:
@@ -117,13 +125,13 @@ def load_baseline(path: Path) -> dict:
     if not isinstance(outputs, dict) or not outputs:
         raise BadInput(f"{path}: outputs: expected a non-empty mapping of output names to statistics")
     for name, entry in outputs.items():
-        _check_entry(f"{path}: outputs.{name}", entry)
+        _check_entry(f"{path}: outputs.{shown_name(name)}", entry)
     quantities = data.get("quantities", {})
     if not isinstance(quantities, dict):
         raise BadInput(f"{path}: quantities: expected a mapping of quantity names to statistics")
     for name, entry in quantities.items():
         if entry is not None:  # undefined in every run
-            _check_entry(f"{path}: quantities.{name}", entry)
+            _check_entry(f"{path}: quantities.{shown_name(name)}", entry)
     return data
 
 
@@ -184,9 +192,9 @@ def _compare_section(what: str, fresh: dict, expected: dict, rtol: float, atol: 
     drifts in its mean."""
     if set(fresh) != set(expected):
         plural = {"output": "outputs", "quantity": "quantities"}[what]
-        raise BadInput(f"the baseline is for {plural} {', '.join(expected) or '-'}; the results have "
-                       f"{', '.join(fresh) or '-'}")
-    label = (lambda name: name) if what == "output" else (lambda name: f"quantity {name}")
+        raise BadInput(f"the baseline is for {plural} {listed(expected) or '-'}; the results have "
+                       f"{listed(fresh) or '-'}")
+    label = shown_name if what == "output" else (lambda name: f"quantity {shown_name(name)}")
     compared, drifts = 0, []
     for name, entry in expected.items():
         if entry is None or fresh[name] is None:
@@ -196,13 +204,13 @@ def _compare_section(what: str, fresh: dict, expected: dict, rtol: float, atol: 
             compared += 1
             continue
         time = np.asarray(fresh[name]["time"])
-        _check_time_grid(f"{what} {name}", time, np.asarray(entry["time"], dtype=float))
+        _check_time_grid(f"{what} {shown_name(name)}", time, np.asarray(entry["time"], dtype=float))
         values, reference = _series(fresh[name]), _series(entry)
         if set(values) != set(reference):
-            only_baseline = ", ".join(sorted(set(reference) - set(values))) or "-"
-            only_results = ", ".join(sorted(set(values) - set(reference))) or "-"
-            raise BadInput(f"{what} {name}: the baseline has statistics {only_baseline} that the results lack, the "
-                           f"results {only_results} that the baseline lacks (another method or parameters?)")
+            only_baseline = listed(sorted(set(reference) - set(values))) or "-"
+            only_results = listed(sorted(set(values) - set(reference))) or "-"
+            raise BadInput(f"{what} {shown_name(name)}: the baseline has statistics {only_baseline} that the results "
+                           f"lack, the results {only_results} that the baseline lacks (another method or parameters?)")
         for statistic, baseline_values in reference.items():
             value = np.asarray(values[statistic], dtype=float)
             base = np.asarray(baseline_values, dtype=float)

@@ -1,9 +1,28 @@
 """The `uqflight` command line: simulate, plan, run, report, check, info, demo."""
 from __future__ import annotations
 
-import csv
-import io
 import os
+import signal
+import threading
+
+
+def _interrupted_while_starting(signum, frame):
+    """Ctrl-C while the command line is still importing (NumPy, typer, ...): one line and exit 130, as an
+    interrupted command says, not a KeyboardInterrupt traceback from inside an import. Nothing has
+    been done yet, so nothing is left to clean up."""
+    os.write(2, b"\ninterrupted: uqflight was starting, nothing was done\n")
+    os._exit(130)
+
+
+# only where Python's own Ctrl-C handler is in place (an ignored SIGINT stays ignored, a program's own
+# handler stays its own), until the module is imported; the commands handle Ctrl-C from then on
+_STARTING = (threading.current_thread() is threading.main_thread()
+             and signal.getsignal(signal.SIGINT) is signal.default_int_handler)
+if _STARTING:
+    signal.signal(signal.SIGINT, _interrupted_while_starting)
+
+import csv  # noqa: E402 (the imports below are what Ctrl-C may interrupt)
+import io
 from collections import Counter
 from pathlib import Path
 from typing import List, Optional
@@ -13,13 +32,13 @@ import typer
 
 from .arguments import check_campaign_file, check_output, check_results_file
 from .calibration.command import register as register_calibrate
-from .console import echo, one_line, shown
+from .console import echo, listed, one_line, shown
 from . import stopping
 from .leaving import leave
 from .progress import Progress
 
 from .methods import METHOD_KINDS
-from .simulators.base import FlightError, NominalFailed
+from .simulators.base import FlightError
 from .simulators.aircraft import default_condition
 from .simulators.jsbsim import DEFAULT_OUTPUTS, Excitation, FlightSetup, JSBSimFlight
 
@@ -40,6 +59,8 @@ def main() -> None:
     try:
         app()
     except SystemExit as done:
+        if done.code == 130 and isinstance(getattr(done.__context__, "__cause__", None), KeyboardInterrupt):
+            echo("\ninterrupted", err=True)  # a Ctrl-C no command caught (typer exits 130 silently): say so
         leave(done.code)
     leave(0)
 
@@ -148,6 +169,8 @@ def simulate(
         echo(f"error: {exc.args[0]}", err=True)
         raise typer.Exit(2)
     echo(result.trim.describe())
+    if flight.surface_warning:
+        echo(f"warning: {flight.surface_warning}", err=True)
     for line in _offset_lines(located, flight):
         echo(line)
     if sigmas:
@@ -225,32 +248,35 @@ def _load(path: Path):
 def plan(campaign_file: Path = typer.Argument(..., metavar="CAMPAIGN", help="Campaign YAML file.")):
     """Validate a campaign and print its design, the number of runs and an estimated time."""
     from .designs import describe, is_adaptive
+    from .execution import WorkerError, timed_nominal
+    from .methods import method_entry
 
     campaign = _load(campaign_file)
     design = campaign.design()
-    echo(f"campaign: {campaign.name} ({campaign_file})")
+    echo(f"campaign: {shown(str(campaign.name))} ({campaign_file})")
     echo("parameters:")
     for p in campaign.parameters:
-        echo(f"  {p.name:<10} {p.property:<18} {p.distribution:<16} nominal {p.nominal:<10.6g} "
+        echo(f"  {shown(p.name):<10} {shown(p.property):<18} {p.distribution:<16} nominal {p.nominal:<10.6g} "
              f"interval [{p.lower:.6g}, {p.upper:.6g}]")
     if campaign.dependence is not None:
-        echo(f"dependence: {campaign.dependence.kind} over {', '.join(campaign.dependence.names)} (standard-normal germs, "
+        echo(f"dependence: {campaign.dependence.kind} over {listed(campaign.dependence.names)} (standard-normal germs, "
              "Cholesky in this order)")
     echo(describe(design))
     kind = campaign.method["kind"]
-    echo(f"method: {kind}" + (f" (order {campaign.method['order']})" if _has_order(kind, design.kind) else ""))
+    order = campaign.method.get(method_entry(kind).order_key)  # sparse's is max_order
+    echo(f"method: {kind}" + (f" (order {order})" if _has_order(kind, design.kind) else ""))
     runs = campaign.runs or len(design.xi)  # an adaptive grid's budget: its rounds are made from the results
     echo(f"runs: {runs}" + (" at most (design.budget)" if is_adaptive(design.kind) else ""))
     echo(f"results: {Path(campaign.storage['path']).resolve()} (storage.path, from the working directory; "
          "--out to choose)")
     try:
-        seconds = _seconds_per_run(campaign)
-    except NominalFailed as exc:  # its message says it all
+        timed = timed_nominal(campaign)
+    except WorkerError as exc:  # its message says it all (a hang, a crash, a build or nominal failure), as `run`'s
         echo(f"error: {campaign_file}: {exc}", err=True)
         raise typer.Exit(2)
-    except Exception as exc:  # the simulator's own code (a python model) failed to build or to fly: as `run` says
-        echo(f"error: {campaign_file}: {type(exc).__name__}: {exc}", err=True)
-        raise typer.Exit(2)
+    for warning in timed.warnings:  # e.g. the excitation left the elevator unmoved
+        echo(f"warning: the nominal flight: {one_line(warning)}", err=True)
+    seconds = timed.seconds
     workers = min(campaign.execution["workers"], CORES)
     echo(f"estimated time: {runs * seconds / workers:.0f} s with {workers} worker(s) "
          f"({seconds * 1e3:.0f} ms per run, one nominal run timed now on this machine)")
@@ -266,29 +292,6 @@ def _has_order(kind: str, design_kind: str) -> bool:
 
     entry = method_entry(kind)
     return entry.pce is not None and not (entry.runs_on_sampled and is_sampled(design_kind))
-
-
-def _seconds_per_run(campaign) -> float:
-    """One nominal run of the campaign's simulator, timed here (after a first, warming run)."""
-    import time
-
-    from .execution import nominal_kappa, worker_spec
-
-    from .quantities.recorder import QuantityRecorder
-
-    simulator = worker_spec(campaign).build()
-    nominal = nominal_kappa(campaign)  # the sample `run` flies first, the centre of every law (ξ = 0)
-    simulator.layout(nominal)  # as `run` learns the outputs first: NominalFailed says what to do when it fails
-    # the timed run computes the quantities too: a linearisation costs more than the flight
-    observers = (QuantityRecorder(campaign.quantities, simulator.source),) if campaign.quantities else ()
-    for timed in (False, True):  # the first run loads what every later one reuses (the Newton trim's nominal)
-        simulator.restart()
-        started = time.perf_counter()
-        try:
-            simulator.evaluate(nominal, observers if timed else ())
-        except FlightError:
-            pass
-    return time.perf_counter() - started
 
 
 @app.command()
@@ -362,7 +365,7 @@ def _exit_now(code: int):
 @app.command()
 def info(results: Path = typer.Argument(..., metavar="RESULTS", help="Results file (.h5).")):
     """Show a results file's campaign, design, done and failed runs, storage and versions."""
-    from .store import CorruptFile, ResultStore, Status, read_error
+    from .store import CorruptFile, LockHeld, ResultStore, Status, read_error
     from .store.lock import describe_holder, live_holder
 
     check_results_file(results)
@@ -372,7 +375,7 @@ def info(results: Path = typer.Argument(..., metavar="RESULTS", help="Results fi
     try:
         try:
             store = ResultStore.open(results, while_written=writer is not None)
-        except BlockingIOError:  # HDF5's lock held by a writer without a lock file of ours
+        except LockHeld:  # HDF5's lock held by a writer without a lock file of ours
             echo("locked by another process (a run writing it?): read as it is now")
             writer = {"locked": True}
             store = ResultStore.open(results, while_written=True)
@@ -398,14 +401,14 @@ def _describe_results(results, store, Status) -> None:
     status = store.status
     attrs = store.attrs
     echo(f"file: {results}")
-    echo(f"campaign: {shown(str(attrs.get('campaign_name', '?')))} (sha256 {store.campaign_hash[:12]})")
-    echo(f"design: {attrs.get('design_kind', '?')} {attrs.get('design_info', '')}")
+    echo(f"campaign: {shown(str(attrs.get('campaign_name', '?')))} (sha256 {one_line(str(store.campaign_hash[:12]))})")
+    echo(f"design: {shown(str(attrs.get('design_kind', '?')))} {one_line(str(attrs.get('design_info', '')))}")
     state = store.index_set()  # an adaptive grid's refinement (/design)
     if state is not None:
         echo(f"index set: {len(state.indices)} multi-indices, {state.rounds} rounds, "
              f"{'stopped by ' + state.stopped if state.stopped else 'refining (resume to go on)'}")
-    echo(f"parameters: {', '.join(map(shown, store.parameter_names))}")
-    echo(f"outputs: {', '.join(map(shown, store.output_names))} ({store.time.size} times, "
+    echo(f"parameters: {listed(store.parameter_names)}")
+    echo(f"outputs: {listed(store.output_names)} ({store.time.size} times, "
          f"{store.time[0]:g} to {store.time[-1]:g} s)")
     counts = {s.name.lower(): int(np.sum(status == s)) for s in Status}
     echo("runs: " + ", ".join(f"{v} {k}" for k, v in counts.items()) + f" (of {status.size})")
@@ -416,11 +419,11 @@ def _describe_results(results, store, Status) -> None:
         echo(f"  failed ({n}): {one_line(reason)}")
     problems = store.verify()  # reads every checksummed chunk: a flipped byte is reported
     for problem in problems:
-        echo(f"  problem: {problem}")
+        echo(f"  problem: {one_line(str(problem))}")
     echo(f"storage: {store.storage_description}")
-    echo(f"versions: {attrs.get('versions', '?')}")
+    echo(f"versions: {one_line(str(attrs.get('versions', '?')))}")  # text of the file's: one line whatever it holds
     if "aircraft_hash" in attrs:
-        echo(f"aircraft sha256: {attrs['aircraft_hash']}")
+        echo(f"aircraft sha256: {one_line(str(attrs['aircraft_hash']))}")
     if problems:
         raise typer.Exit(2)
 
@@ -454,6 +457,11 @@ def report(
     figure_format: str = typer.Option("png", "--format", metavar="png|svg|pdf",
                                       help="Format of plots/: png; svg (the page embeds the SVGs); pdf (beside "
                                            "PNGs of the same names, which the page embeds and links to the PDFs)."),
+    exceedance: List[str] = typer.Option([], "--exceedance", metavar="NAME>X|NAME<X",
+                                         help="P(NAME > X) or P(NAME < X) of a quantity of interest, repeatable: "
+                                              "replaces the campaign's analysis.exceedance thresholds of NAME, "
+                                              "computed from the stored runs (nothing is flown again); quote it "
+                                              "in the shell, e.g. --exceedance 'peak_nz>3.5'."),
 ):
     """Statistics, tables, plots and a report page of one or more results files.
 
@@ -482,8 +490,16 @@ def report(
         overrides = parse_methods(method, order)
     except ValueError as exc:
         raise typer.BadParameter(str(exc), param_hint="--method")
+    from .quantities.spec import parse_exceedance_option
+
+    try:
+        thresholds = parse_exceedance_option(exceedance)
+    except ValueError as exc:
+        raise typer.BadParameter(str(exc), param_hint="--exceedance")
     for path in [*results, *([reference] if reference else [])]:
         check_results_file(path)
+    if thresholds:
+        _check_quantities(thresholds, results)
     out = out if out is not None else default_out_dir(results[0])
     if not out.exists() and not out.is_symlink():  # an existing DIR is the report's to judge (check_replaceable)
         check_output(out, "--out", folder=True, create=True)
@@ -495,7 +511,7 @@ def report(
         with Progress(0, label="report") as progress:
             written = write_report(results, out, reference=reference, times=selected, baseline=write_baseline,
                                    method=overrides or None, progress=progress, partial=partial,
-                                   allow_aliasing=allow_aliasing, fmt=figure_format)
+                                   allow_aliasing=allow_aliasing, fmt=figure_format, exceedance=thresholds or None)
     except BadInput as exc:
         echo(f"error: {exc}", err=True)
         raise typer.Exit(2)
@@ -511,10 +527,29 @@ def report(
         echo(f"wrote baseline {write_baseline}")
 
 
+def _check_quantities(thresholds: dict, results: list[Path]) -> None:
+    """Exit 2 naming --exceedance when a threshold names a quantity some results file does not have (an
+    unreadable file is the report's to refuse)."""
+    from .store import ResultStore
+
+    for path in results:
+        try:
+            with ResultStore.open(path) as store:
+                names = list(store.quantity_names)
+        except (OSError, KeyError, ValueError):
+            continue
+        unknown = [name for name in thresholds if name not in names]
+        if unknown:
+            echo(f"error: --exceedance: {path} has no quantity {unknown[0]!r}; its quantities: "
+                 f"{', '.join(names) or 'none (the campaign has no quantities: mapping)'}", err=True)
+            raise typer.Exit(2)
+
+
 def _check_times(text: str, selected: list[float], results: list[Path]) -> None:
     """Exit 2 naming --times and the flight's time range when a time lies outside a file's recorded
     times (more than half a recording step); 'end' is always inside. An unreadable file is the
     report's to refuse."""
+    from .labels import shown_time
     from .store import ResultStore
 
     for path in results:
@@ -527,7 +562,8 @@ def _check_times(text: str, selected: list[float], results: list[Path]) -> None:
         outside = [t for t in selected if np.isfinite(t) and not time[0] - half <= t <= time[-1] + half]
         if outside:
             echo(f"error: --times {text}: {', '.join(f'{t:g}' for t in outside)} s outside the flight of {path}, "
-                 f"which records {time[0]:g} to {time[-1]:g} s; choose times in that range or 'end'", err=True)
+                 f"which records {shown_time(time, 0):g} to {shown_time(time, -1):g} s; choose times in that range "
+                 "or 'end'", err=True)
             raise typer.Exit(2)
 
 
@@ -562,7 +598,7 @@ def design(
             echo(f"error: cannot write {csv_path}: {exc.strerror}", err=True)
             raise typer.Exit(2)
     echo(f"wrote {'the design' if to_stdout else csv_path}: {len(points.xi)} points of a {points.kind} design in "
-         f"{len(names)} parameters ({', '.join(names)})", err=to_stdout)
+         f"{len(names)} parameters ({listed(names)})", err=to_stdout)
 
 
 @surrogate_app.command("export")
@@ -635,7 +671,7 @@ def check(
         echo(f"error: {exc}", err=True)
         raise typer.Exit(2)
     if expected.get("campaign_hash") and expected["campaign_hash"] != attrs.get("campaign_hash"):
-        echo(f"error: {results} comes from another campaign (sha256 {str(attrs.get('campaign_hash'))[:12]}) "
+        echo(f"error: {results} comes from another campaign (sha256 {one_line(str(attrs.get('campaign_hash'))[:12])}) "
              f"than the baseline {baseline} ({str(expected['campaign_hash'])[:12]}): compare a results file "
              "with the baseline of its own campaign", err=True)
         raise typer.Exit(2)
@@ -654,15 +690,18 @@ def aircraft_command(
     altitude_ft: Optional[float] = typer.Option(None, help="Trim altitude [ft] (default: the aircraft's)."),
     airspeed_ktas: Optional[float] = typer.Option(None, help="Trim true airspeed [kt] (default: the aircraft's)."),
     list_: bool = typer.Option(False, "--list", help="List the project's and JSBSim's aircraft."),
+    trim: bool = typer.Option(False, "--trim", help="Also trim the aircraft in level flight at the altitude and "
+                                                    "airspeed (exit 1 when it cannot, saying why and what to do)."),
 ):
-    """An aircraft's aerodynamic functions (axis, name, description), engines and nominal trim."""
+    """An aircraft's aerodynamic functions (axis, name, description), engines and elevator travel, without
+    flying it; with --trim its nominal trim too."""
     from .simulators.aircraft import AircraftFiles, aero_functions, known_aircraft
     from .simulators.engines import engine_kinds
     from .simulators.reference import factor_values, references
 
     if list_ or aircraft is None:
         for origin, names in known_aircraft().items():
-            echo(f"{origin}: {' '.join(names)}")
+            echo(f"{origin}: {' '.join(map(shown, names))}")  # folder names: quoted when odd
         return
     try:
         located = _prepared(aircraft, [], [])
@@ -679,7 +718,8 @@ def aircraft_command(
     for f in functions:
         ref = refs[f.name]
         factor = f"ΔC x {ref.symbol}" if not ref.refusal else "offset_value only"
-        echo(f"  {f.axis or '-':<6} {f.name:<40} {ref.unit or 'own':<6} {factor:<17} {f.description[:60]}")
+        echo(f"  {shown(f.axis) if f.axis else '-':<6} {shown(f.name):<40} {ref.unit or 'own':<6} {factor:<17} "
+             f"{one_line(f.description[:60])}")
     condition = default_condition(located.name)
     condition.update({k: v for k, v in (("altitude_ft", altitude_ft), ("airspeed_ktas", airspeed_ktas)) if v is not None})
     setup = FlightSetup(aircraft=located.name, root=located.root, excitation=Excitation(kind="none"), **condition)
@@ -690,14 +730,26 @@ def aircraft_command(
         raise typer.Exit(2)
     echo("engines:")
     for i, (name, kind, thruster) in enumerate(engine_kinds(flight.fdm)):
-        echo(f"  {i}: {name:<24} {kind:<10} thruster: {thruster}")
+        echo(f"  {i}: {shown(name):<24} {shown(kind):<10} thruster: {shown(thruster)}")
     echo(f"elevator travel: {flight.elevator_travel_deg[0]:.1f} deg down, {flight.elevator_travel_deg[1]:.1f} deg up"
          + ("" if not flight.has_property("fcs/elevator-excitation-deg") else " (fcs/elevator-excitation-deg used)"))
-    echo(f"nominal trim at {setup.altitude_ft:g} ft, {setup.airspeed_ktas:g} KTAS:")
-    try:
-        echo(flight.trim({}).describe())
-    except FlightError as exc:
-        echo(f"trim failed: {exc}")
-        raise typer.Exit(1)
-    echo("reference factors at the trim (an offset ΔC adds ΔC times its function's): " + ", ".join(
+    if trim:
+        echo(f"nominal trim at {setup.altitude_ft:g} ft, {setup.airspeed_ktas:g} KTAS:")
+        try:
+            echo(flight.trim({}).describe())
+        except FlightError as exc:
+            echo(f"trim failed: {exc}", err=True)
+            raise typer.Exit(1)
+        where = "at the trim"
+    else:  # qbar = ρ V² / 2 at the condition's altitude and airspeed: the trim's, without trimming
+        flight.prepare_validation_view()
+        flight.fdm.run_ic()
+        where = f"at {setup.altitude_ft:g} ft, {setup.airspeed_ktas:g} KTAS"
+        echo(f"not trimmed: `uqflight aircraft {aircraft} --trim` trims it at {setup.altitude_ft:g} ft, "
+             f"{setup.airspeed_ktas:g} KTAS (--altitude-ft, --airspeed-ktas)")
+    echo(f"reference factors {where} (an offset ΔC adds ΔC times its function's): " + ", ".join(
         f"{symbol} = {number:.6g} {unit}" for symbol, number, unit in factor_values(flight.property_value)))
+
+
+if _STARTING:  # imported: Ctrl-C is a KeyboardInterrupt again, which each command handles
+    signal.signal(signal.SIGINT, signal.default_int_handler)

@@ -8,8 +8,6 @@ import os
 import re
 import sys
 
-import typer
-
 CONTROL = re.compile("[\x00-\x08\x0b-\x1f\x7f-\x9f]")  # C0 but tab and newline, DEL, C1
 EXIT_CLOSED_PIPE = 141  # 128 + SIGPIPE
 
@@ -27,17 +25,25 @@ def shown(name: str) -> str:
     return name if plain and name else repr(name)
 
 
+def listed(names) -> str:
+    """Names from a file as one comma-separated listing, each as `shown` gives it."""
+    return ", ".join(shown(str(name)) for name in names)
+
+
 LINE_BREAK = re.compile("[\n\u2028\u2029]")  # what `clean` keeps that starts a new line
 
 
 def one_line(text: str) -> str:
     """Text from a file that is not a name (a failure reason) on one line: as it is when it holds no line
     break (echo strips its control characters), else quoted as repr shows it (a newline as \\n)."""
+    text = str(text)  # a NumPy string read from a file shows as np.str_('...') in its own repr
     return repr(text) if LINE_BREAK.search(text) else text
 
 
 def echo(message: object = "", err: bool = False, nl: bool = True) -> None:
     """typer.echo of `message` cleaned; a reader gone (closed pipe) exits quietly with 141."""
+    import typer  # here: the quoting helpers above serve modules that never print (uqflight.surrogate)
+
     try:
         typer.echo(clean(str(message)), err=err, nl=nl)
     except BrokenPipeError:

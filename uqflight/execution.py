@@ -34,7 +34,7 @@ import subprocess
 import sys
 import time
 from collections import Counter, deque
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from importlib import metadata
 from multiprocessing.connection import Connection
 from multiprocessing.connection import wait as wait_connections
@@ -48,7 +48,6 @@ from .campaign.reading import parameters_attribute
 from .campaign.schema import WORKER_BYTES
 from .console import one_line
 from .designs import Design, is_adaptive
-from .forking import FORKS, Child, ChildFailed, wait_all
 from .parameters import seed_names
 from .stopping import check as check_stop
 from .progress import Progress
@@ -92,6 +91,7 @@ class RunSummary:
     failures: Counter = field(default_factory=Counter)
     timeout_s: float = float("nan")
     nominal_failure: str | None = None  # why the nominal flight (ξ = 0) failed, when it did
+    nominal_warnings: list[str] = field(default_factory=list)  # what it warned of (an unmoved surface)
 
     def describe(self) -> str:
         rate = self.ran / self.seconds if self.seconds > 0 else float("nan")
@@ -99,8 +99,9 @@ class RunSummary:
                  f"{self.skipped} already done, {sum(self.failures.values())} failed"]
         if self.nominal_failure:
             lines.append(f"  warning: the nominal flight (every parameter at its law's centre) failed: "
-                         f"{self.nominal_failure}; runs near it fail the same way: check the campaign's flight with "
+                         f"{one_line(self.nominal_failure)}; runs near it fail the same way: check the campaign's flight with "
                          "`uqflight simulate` and its --set")
+        lines += [f"  warning: the nominal flight: {one_line(warning)}" for warning in self.nominal_warnings]
         lines += [f"  failed ({n}): {one_line(reason)}" for reason, n in self.failures.most_common(10)]
         return "\n".join(lines)
 
@@ -153,63 +154,40 @@ def prepare_store(campaign: Campaign, design: Design, out: Path, force: bool, no
 
 
 def simulate(campaign: Campaign, kappa: np.ndarray, outputs: list[str], processes: int = 1, meanwhile=None):
-    """Fly (or call) the campaign's simulator at every row of kappa (M, d), as a worker of `uqflight run`
-    does (e.g. the calibration's posterior-predictive runs): in this process, or split over `processes`
-    forked children (where the system forks). Each run starts from a fresh simulator state, so the
-    numbers do not depend on the split. `meanwhile` (no arguments) is called here while the children fly,
-    e.g. an import the caller needs next.
+    """Fly (or call) the campaign's simulator at every row of kappa (M, d) as `uqflight run` flies its
+    samples (e.g. the calibration's posterior-predictive runs): in `processes` supervised worker processes,
+    each run from a fresh simulator state (the numbers do not depend on the split) and under the campaign's
+    per-run limit (execution.timeout_s, else max(60 s, 50 flights at the nominal), the nominal flown first). A run
+    that fails, kills its worker or runs past the limit is a failed run with its reason; the others stand.
+    `meanwhile` (no arguments) is called here while the workers start, e.g. an import the caller needs next.
 
-    Returns (time (T,), {output: (M, T)} with NaN rows for failed runs, [failure reasons]).
-    """
+    Returns (time (T,), {output: (M, T)} with NaN rows for failed runs, [failure reasons in row order]).
+    Raises WorkerError when no simulator can be built (the message says why)."""
     kappa = np.asarray(kappa, dtype=float)
-    chunks = np.array_split(np.arange(len(kappa)), max(1, min(processes, len(kappa))))
-    if len(chunks) == 1 or not FORKS:
-        found = _simulate_rows(campaign, kappa, outputs)
-        if meanwhile is not None:
-            meanwhile()
-        return found
-    children = [Child(lambda rows=rows: _simulate_rows(campaign, kappa[rows], outputs)) for rows in chunks]
+    spec = replace(worker_spec(campaign), quantities=None)  # the outputs only
+    timeout = campaign.execution.get("timeout_s")
+    pool = WorkerPool(spec, max(1, min(processes, len(kappa))), timeout or NOMINAL_TIMEOUT_S)
     try:
+        pool.start_warmup(nominal_kappa(campaign), measure_resolution=False)  # the time grid, a run's cost
         if meanwhile is not None:
             meanwhile()
+        nominal = pool.warmup_result()
+        pool.timeout = timeout or default_timeout(nominal.seconds)
+        pool.spec = replace(spec, time=tuple(map(float, nominal.time)))  # every run on the nominal's times
+        time = np.asarray(nominal.time, dtype=float)
+        values = {name: np.full((len(kappa), time.size), np.nan) for name in outputs}
+        failures = {}
+        tasks = [Task(np.array([row]), kappa[row:row + 1]) for row in range(len(kappa))]  # a fresh state each
+        for indices, status, reasons, flown in pool.run(tasks, time.size, list(outputs)):
+            row = int(indices[0])
+            if status[0] != Status.OK:
+                failures[row] = str(reasons[0])
+                continue
+            for name in outputs:
+                values[name][row] = flown[name][0]
     finally:
-        found = wait_all(children)
-    time = next((f[0] for f in found if not isinstance(f, ChildFailed)), None)
-    if time is None:  # every child died: the time grid from the simulator here
-        time = _simulate_rows(campaign, kappa[:0], outputs)[0]
-    values = {name: np.full((len(kappa), len(time)), np.nan) for name in outputs}
-    failures = []
-    for rows, f in zip(chunks, found):
-        if isinstance(f, ChildFailed):  # a child that died: its runs failed, with how
-            failures += [f"the process flying this run {f}"] * len(rows)
-            continue
-        failures += f[2]
-        for name in outputs:
-            values[name][rows] = f[1][name]
-    return time, values, failures
-
-
-def _simulate_rows(campaign: Campaign, kappa: np.ndarray, outputs: list[str]):
-    """`simulate` of every row in this process."""
-    from .simulators import make_simulator
-    from .simulators.base import FlightError
-
-    names = [p.name for p in campaign.parameters]
-    properties = [p.property for p in campaign.parameters]
-    simulator = make_simulator(campaign.simulator, names, properties, Path(campaign.source).resolve().parent)
-    time, _ = simulator.layout(kappa[0] if len(kappa) else nominal_kappa(campaign))
-    values = {name: np.full((len(kappa), len(time)), np.nan) for name in outputs}
-    failures = []
-    for row, k in enumerate(kappa):
-        simulator.restart()  # each run as from a fresh worker: independent of the order of the draws
-        try:
-            result = simulator.evaluate(k)
-        except FlightError as exc:
-            failures.append(str(exc))
-            continue
-        for name in outputs:
-            values[name][row] = result[name]
-    return np.asarray(time, dtype=float), values, failures
+        pool.close()
+    return time, values, [failures[row] for row in sorted(failures)]
 
 
 def nominal_kappa(campaign: Campaign) -> np.ndarray:
@@ -226,6 +204,22 @@ def worker_spec(campaign: Campaign) -> WorkerSpec:
                       properties=properties, base=base,
                       bundle=make_bundle(campaign.simulator, properties, base),  # files travel with the task
                       quantities=campaign.quantities or None)
+
+
+def timed_nominal(campaign: Campaign) -> NominalFlight:
+    """One nominal flight of the campaign timed on this machine (`uqflight plan`'s estimate: its
+    `seconds`, and its `warnings`), flown as `run` flies it: in a supervised worker process, under the
+    campaign's time limit (execution.timeout_s, else NOMINAL_TIMEOUT_S, plus STARTUP_GRACE_S for the
+    worker's start), a first flight warming what every later one reuses (the Newton trim's nominal),
+    the second timed. Raises WorkerError when the worker dies, runs past the limit or cannot build the
+    simulator (the message says which), as `run` does."""
+    pool = WorkerPool(worker_spec(campaign), 1, campaign.execution.get("timeout_s") or NOMINAL_TIMEOUT_S)
+    kappa = nominal_kappa(campaign)
+    try:
+        pool.nominal_flight(kappa, measure_resolution=False)
+        return pool.nominal_flight(kappa, measure_resolution=False)
+    finally:
+        pool.close()
 
 
 def local_workers(campaign: Campaign, workers: int, chunk: int) -> int:
@@ -325,6 +319,8 @@ def run_campaign(campaign: Campaign, out: Path | None = None, workers: int | Non
         design = campaign.design()  # built while the workers start
         nominal = pool.warmup_result()
         seconds = nominal.seconds
+        # every run is stored against the nominal's times: a model giving other times fails the run
+        pool.spec = spec = replace(spec, time=tuple(map(float, nominal.time)))
         timeout = execution.get("timeout_s") or default_timeout(seconds)
         pool.timeout = timeout
         # One BLAS thread here, for the folds on opening too: the workers keep every core busy, a
@@ -363,6 +359,7 @@ def run_campaign(campaign: Campaign, out: Path | None = None, workers: int | Non
     summary.seconds = time.perf_counter() - started
     summary.timeout_s = timeout
     summary.nominal_failure = nominal.failure
+    summary.nominal_warnings = list(getattr(nominal, "warnings", []))
     return summary
 
 
@@ -522,23 +519,24 @@ class WorkerPool:
         self.spec, self.workers, self.timeout = spec, max(1, int(workers)), float(timeout)
         self.slots: list[WorkerProcess] = []
 
-    def nominal_flight(self, kappa: np.ndarray) -> NominalFlight:
+    def nominal_flight(self, kappa: np.ndarray, measure_resolution: bool = True) -> NominalFlight:
         """The NominalFlight at `kappa` (worker.nominal_flight), from a worker:
         `start_warmup`, then `warmup_result`."""
-        self.start_warmup(kappa)
+        self.start_warmup(kappa, measure_resolution)
         return self.warmup_result()
 
-    def start_warmup(self, kappa: np.ndarray) -> None:
+    def start_warmup(self, kappa: np.ndarray, measure_resolution: bool = True) -> None:
         """Start every worker of the pool and ask each to fly the nominal `kappa`, so that all are warm
         (imports, aircraft, the Newton trim's nominal) when the chunks start. Returns at once: the
-        caller may work meanwhile, then call `warmup_result`."""
+        caller may work meanwhile, then call `warmup_result`. `measure_resolution` false: the first
+        worker does not measure the simulator's resolution either (a second flight for JSBSim)."""
         slot = self._slot()
         while len(self.slots) < self.workers:
             self.slots.append(WorkerProcess())
         for other in self.slots[1:]:  # a warm-up only: the trims' drift is measured once, by the first
             if not other.send(("nominal", self.spec, kappa, False)):
                 self._drop(other)
-        if not slot.send(("nominal", self.spec, kappa)):
+        if not slot.send(("nominal", self.spec, kappa, measure_resolution)):
             raise WorkerError(death_reason(self._drop(slot)))
 
     def warmup_result(self) -> NominalFlight:
@@ -670,7 +668,7 @@ def supervised_chunk(spec: WorkerSpec, indices, kappa, n_times: int, outputs: li
     pool = _DASK_POOLS.get(spec.key)
     if pool is None:
         pool = _DASK_POOLS[spec.key] = WorkerPool(spec, 1, timeout)
-    pool.timeout = timeout
+    pool.spec, pool.timeout = spec, timeout  # this campaign's nominal times (WorkerSpec.time)
     return next(iter(pool.run([Task(np.asarray(indices), np.asarray(kappa))], n_times, outputs)))
 
 

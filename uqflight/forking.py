@@ -37,7 +37,12 @@ class Child:
             _fresh_standard_streams()
             code = 0
             try:
-                payload = pickle.dumps(work(), protocol=pickle.HIGHEST_PROTOCOL)
+                try:
+                    payload = pickle.dumps((True, work()), protocol=pickle.HIGHEST_PROTOCOL)
+                except OSError as exc:  # a file it could not write (a full disk): the parent's error, no traceback
+                    error = OSError(exc.errno, exc.strerror, exc.filename) if exc.errno is not None and exc.strerror \
+                        else OSError(" ".join(str(exc).split()))
+                    payload = pickle.dumps((False, error))
                 with os.fdopen(write, "wb") as pipe:
                     pipe.write(payload)
             except BaseException:
@@ -53,8 +58,8 @@ class Child:
         return self._read
 
     def wait(self):
-        """The child's result; ChildFailed when it raised or died. After a wait cut short (an interrupt while
-        reading), a second one reaps the child."""
+        """The child's result; ChildFailed when it raised or died, the OSError it raised (errno, message and
+        file) raised here. After a wait cut short (an interrupt while reading), a second one reaps the child."""
         read, self._read, payload = self._read, None, b""
         if read is not None:
             with os.fdopen(read, "rb") as pipe:  # read first: a large result would block the child
@@ -64,7 +69,10 @@ class Child:
             raise ChildFailed(f"died (signal {-status})")
         if status != 0 or not payload:
             raise ChildFailed(f"failed (exit {status})")
-        return pickle.loads(payload)
+        done, result = pickle.loads(payload)
+        if not done:
+            raise result
+        return result
 
 
 def die_with_parent(parent: int, watch: bool = False) -> None:
@@ -103,12 +111,13 @@ def _tell_error(text: str) -> None:
 
 
 def wait_all(children: list[Child]) -> list:
-    """Wait for every child in turn: its result, or the ChildFailed saying how it failed, in their order."""
+    """Wait for every child in turn: its result, or the ChildFailed saying how it failed (the OSError it
+    raised), in their order."""
     outcomes = []
     for child in children:
         try:
             outcomes.append(child.wait())
-        except ChildFailed as exc:
+        except (ChildFailed, OSError) as exc:
             outcomes.append(exc)
     return outcomes
 
@@ -156,7 +165,7 @@ def share_work(jobs: list[Callable[[], object]], order: list[int] | None = None,
         outcomes = wait_all(children)
         os.close(read)
     for outcome in outcomes:
-        if isinstance(outcome, ChildFailed):
+        if isinstance(outcome, (ChildFailed, OSError)):
             raise outcome
         results.update(outcome)
     return [results[index] for index in range(len(jobs))]

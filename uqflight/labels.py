@@ -16,7 +16,16 @@ PARAMETER_UNITS = {"aero/uq/CL0": "-", "aero/uq/CLalpha": "1/rad", "aero/uq/CD0"
 # JSBSim's property names end in their unit: velocities/vt-fps, inertia/weight-lbs, ...
 PROPERTY_SUFFIXES = {"ft": "ft", "deg": "deg", "rad": "rad", "lbs": "lbs", "kts": "kt", "fps": "ft/s",
                      "sqft": "ft²", "slug_ft2": "slug·ft²", "rad_sec": "rad/s", "deg_sec": "deg/s", "psf": "psf",
-                     "mps": "m/s", "m": "m", "kg": "kg", "sec": "s", "hz": "Hz"}
+                     "mps": "m/s", "m": "m", "kg": "kg", "sec": "s", "hz": "Hz", "mt": "m", "meters": "m",
+                     "norm": "-", "deg_sec2": "deg/s²", "rad_sec2": "rad/s²", "ft_sec": "ft/s", "ft_sec2": "ft/s²",
+                     "fps2": "ft/s²", "lbf": "lbf", "lbsft": "lbf·ft", "kt": "kt", "degps": "deg/s"}
+# JSBSim's load factors carry no suffix: they are in g
+UNITLESS_PROPERTIES = {"accelerations/Nx": "g", "accelerations/Ny": "g", "accelerations/Nz": "g"}
+# A quantity's unit: its `of`'s for a take that keeps it (max, min, final, drop, mean, at, at_first, change);
+# these takes have their own
+TAKE_UNITS = {"time_of_first": "s", "phugoid_period_s": "s", "phugoid_damping": "-",
+              "short_period_frequency_rad_s": "rad/s", "short_period_damping": "-"}
+ANGLE_PERIODS = {"deg": 360.0, "rad": 2 * 3.141592653589793}  # an angle's period in its unit
 
 
 def label(name: str, units: str = "") -> str:
@@ -38,14 +47,51 @@ def parameter_unit(prop: str) -> str:
         return PARAMETER_UNITS[prop]
     if prop.startswith("aero/uq/scale/"):
         return "-"
-    tail = prop.rsplit("/", 1)[-1].lower()
-    for k, char in enumerate(tail):  # the longest suffix after a - or _ that names a unit
+    return name_unit(prop)
+
+
+def name_unit(name: str) -> str:
+    """The unit a JSBSim property or output name ends in: the longest suffix after a - or _ of its last
+    part that names one (`attitude/psi-deg` deg, `velocities/vc-kts` kt, `h_ft` ft), else "" (unknown)."""
+    if name in UNITLESS_PROPERTIES:
+        return UNITLESS_PROPERTIES[name]
+    tail = name.rsplit("/", 1)[-1].lower()
+    for k, char in enumerate(tail):
         if char in "-_" and tail[k + 1:] in PROPERTY_SUFFIXES:
             return PROPERTY_SUFFIXES[tail[k + 1:]]
     return ""
+
+
+def quantity_unit(spec, output_units: dict[str, str]) -> str:
+    """The unit of a quantity whose campaign spec is `spec` ({take, of, ...}): its take's own (time_of_first
+    s, a damping -, a frequency rad/s), else its `of`'s (`output_units`, else from the name); "" unknown."""
+    if not isinstance(spec, dict) or not isinstance(spec.get("take"), str):
+        return ""
+    if spec["take"] in TAKE_UNITS:
+        return TAKE_UNITS[spec["take"]]
+    of = spec.get("of")
+    if not isinstance(of, str):
+        return ""
+    return output_units.get(of) or name_unit(of)
 
 
 def parameter_label(name: str, prop: str) -> str:
     """A parameter's axis label with its unit when known, e.g. "CLalpha [1/rad]"."""
     unit = parameter_unit(prop)
     return f"{name} [{unit}]" if unit else name
+
+
+def shown_time(time, i: int) -> float:
+    """The recorded time `time[i]` as a reader asked for it: snapped to the recording grid t0 + k / rate
+    (the rate read from the grid to 4 digits) when within 10 % of a step of it, so that 9.99996 s (JSBSim's
+    clock adding 1/120 s steps) reads 10 s and 24.9999 s reads 25 s; a time off that grid keeps its
+    digits. Full precision stays in the time arrays."""
+    t = float(time[i])
+    if len(time) < 2:
+        return t
+    t0, step = float(time[0]), (float(time[-1]) - float(time[0])) / (len(time) - 1)
+    if not step > 0:
+        return t
+    rate = float(f"{1.0 / step:.4g}")
+    snapped = round(round(t0, 6) + round((t - t0) * rate) / rate, 9)
+    return snapped + 0.0 if abs(snapped - t) <= 0.1 * step else t  # + 0.0: no "-0"

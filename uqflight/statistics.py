@@ -26,42 +26,47 @@ import math
 import os
 from collections import deque
 from concurrent.futures import Executor, ThreadPoolExecutor
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Callable
 
 import numpy as np
 from threadpoolctl import threadpool_limits
 
+from .analysis.angles import angle_period, branch_shifts, unwrapped_runs
 from .analysis.density import pdf_over_time
 from .analysis.divergence import kl_divergence
 from .analysis.errors import error_summary, relative_errors
-from .analysis.exceedance import exceedance_from_pce, exceedance_from_runs
+from .analysis.exceedance import exceedance_from_pce, exceedance_from_runs, unit_slip
 from .analysis.failures import grid_failure_probability
 from .analysis.proportions import sampled_proportion
-from .analysis.floors import central_moments, floors_from_moments, kld_floor
+from .analysis.floors import central_moments, floors_from_moments, kld_estimator_bias, kld_floor
 from .analysis.moments import (modified_cov, sorted_by_time, standardised_moments, weighted_moments,
                                weighted_quantiles)
 from .analysis.resolution import RESOLUTION_RTOL, resolved_variance
-from .analysis.sobol import pick_freeze_indices
-from .campaign.attributes import StoredFacts, stored_facts
+from .analysis.sobol import NEGLIGIBLE, UNRESOLVED_WIDTH, complete_rows, pick_freeze_indices, unresolved
+from .campaign.attributes import StoredFacts, stored_facts, stored_settings
 from .campaign.schema import CampaignError
+from .console import shown
 from .designs import REGISTRY as DESIGNS
 from .designs import is_sampled
 from .designs.adaptive import index_set_summary
-from .methods import PCE, METHODS, failed_runs_note, fit, method_entry, method_settings, normalised
+from .labels import name_unit, quantity_unit
+from .methods import (AUTO_CANDIDATES, PCE, METHODS, failed_runs_note, fit, method_entry, method_settings,
+                      normalised)
 from .methods.basis import orthonormal_basis
-from .methods.loo import relative_loo_error
 from .methods.pce_moments import pce_standardised_moments, triple_products
+from .methods import validation
 from .methods.validity import method_problem
 from .parameters.distributions import SEED_REFUSAL
 from .parameters.germs import draw_germs
-from .store import CorruptFile, ResultStore, Status
+from .store import CorruptFile, LockHeld, ResultStore, Status
 from .store.results import one_line
 
 PDF_POINTS = 120
 TIME_BLOCK = 100  # recorded times whose runs or surrogate draws are rebuilt at once
 ANALYSIS_THREADS = min(2, os.cpu_count() or 1)  # time blocks analysed at once (each with one BLAS thread)
+MAX_MAGNITUDE = 1e75  # an output's or quantity's values beyond: their fourth powers (kurtosis) leave float64
 BAND_LEVEL = 0.99
 DEFAULT_QUANTILES = (0.005, 0.995)
 # The relative spread a JSBSim output can resolve: the same sample flown on a reused model and on a
@@ -77,11 +82,13 @@ class BadInput(ValueError):
 
 @dataclass
 class Options:
-    """How the statistics are computed (from the campaign's `analysis:` mapping, or defaults)."""
+    """How the statistics are computed (from the campaign's `analysis:` mapping, or defaults). `seed` seeds
+    every draw of the analysis (band and PDF draws, bootstrap, exceedance draws, the KLD floor's splits);
+    None: the results file's campaign seed."""
 
     band_samples: int = 20000
     bootstrap: int = 200
-    seed: int = 0
+    seed: int | None = None
     quantiles: tuple[float, ...] = DEFAULT_QUANTILES
 
 
@@ -107,12 +114,16 @@ class OutputStatistics:
     loo_error: np.ndarray | None = None  # relative leave-one-out error of a fit, (T,)
     selection: dict | None = None  # what a selecting method (sparse) chose: terms, order, corrected LOO error
     convergence: dict | None = None  # difference to the next lower order of a projection
+    validation: dict | None = None  # the expansion checked on its own runs (methods.validation): error, band
+    method: dict | None = None  # what `method: {kind: auto}` took for this output (auto_method), None otherwise
     coefficient_decay: dict[int, np.ndarray] | None = None  # degree -> RSS of its PCE coefficients (T,)
     final_samples: np.ndarray | None = None  # runs or surrogate draws at the final time, for the KLD
     fourth_central: np.ndarray | None = None  # of the runs, for a sampled reference's noise floor
     replicate_moments: tuple[np.ndarray, np.ndarray] | None = None  # (R, T) means and variances of RQMC replicates
     errors: dict = field(default_factory=dict)
     pce: PCE | None = None  # the expansion behind the statistics (None: statistics of the runs themselves)
+    flags: list[str] = field(default_factory=list)
+    unwrapped: bool = False  # an angle whose runs wrap, made continuous before any statistic (analysis.angles)
 
     @property
     def std(self) -> np.ndarray:
@@ -143,6 +154,7 @@ class Statistics:
     quantities: dict[str, QuantityStatistics] = field(default_factory=dict)
     index_set: dict | None = None  # an adaptive grid's refinement (designs.adaptive.index_set_summary)
     design_info: dict = field(default_factory=dict)  # the design's recorded facts (replicates, n_base, ...)
+    seed: int = 0  # what seeded the analysis's draws (the campaign's seed unless Options said otherwise)
 
 
 @dataclass
@@ -154,6 +166,50 @@ class QuantityStatistics:
     missing: int  # successful runs where the quantity is undefined
     output: OutputStatistics | None
     exceedance: list[dict] = field(default_factory=list)
+    units: str = ""  # its take's own, or its `of`'s (labels.quantity_unit)
+    flags: list[str] = field(default_factory=list)  # its statistics' (output.flags) and its thresholds' (unit slips)
+
+    def _first(self, attribute: str):
+        """The output's `attribute` at its one time point (None when the statistics are undefined)."""
+        return None if self.output is None else _at_first_time(getattr(self.output, attribute))
+
+    @property
+    def mean(self) -> float | None:
+        """The mean (None where undefined), as summary.json's quantities.NAME.mean."""
+        return self._first("mean")
+
+    @property
+    def variance(self) -> float | None:
+        return self._first("variance")
+
+    @property
+    def std(self) -> float | None:
+        return self._first("std")
+
+    @property
+    def band99(self) -> tuple[float, float] | None:
+        """(lower, upper) of the 99 % band."""
+        return None if self.output is None else (float(self.output.band99[0][0]), float(self.output.band99[1][0]))
+
+    @property
+    def quantiles(self) -> dict[float, float]:
+        return {} if self.output is None else self._first("quantiles")
+
+    @property
+    def skewness(self) -> float | None:
+        return None if self.output is None or self.output.skewness is None else self._first("skewness")
+
+    @property
+    def kurtosis(self) -> float | None:
+        return None if self.output is None or self.output.kurtosis is None else self._first("kurtosis")
+
+    @property
+    def sobol_first(self) -> dict[str, float]:
+        return {} if self.output is None else self._first("sobol_first")
+
+    @property
+    def sobol_total(self) -> dict[str, float]:
+        return {} if self.output is None else self._first("sobol_total")
 
 
 def campaign_facts(store: ResultStore, path) -> StoredFacts:
@@ -166,32 +222,41 @@ def campaign_facts(store: ResultStore, path) -> StoredFacts:
 
 
 def read_statistics(path, method: dict | None = None, partial: bool = False,
-                    allow_aliasing: bool = False, progress=None) -> tuple[Statistics, dict]:
+                    allow_aliasing: bool = False, progress=None,
+                    exceedance: dict | None = None) -> tuple[Statistics, dict]:
     """The statistics of a results file (`method` overriding the campaign's) and its root attributes;
-    BadInput, one line naming the file, when it cannot give right numbers. `progress`: see analyse."""
+    BadInput, one line naming the file, when it cannot give right numbers. `progress`, `exceedance`: see
+    analyse."""
     path = Path(path)
     if not path.is_file():
         raise BadInput(f"{path}: no such results file")
     try:
         with ResultStore.open(path) as store:
             attrs = store.attrs
-        return analyse(path, method=method, partial=partial, allow_aliasing=allow_aliasing, progress=progress), attrs
+        return analyse(path, method=method, partial=partial, allow_aliasing=allow_aliasing, progress=progress,
+                       exceedance=exceedance), attrs
     except BadInput:
         raise
     except CorruptFile as exc:
         raise BadInput(str(exc) if str(exc).startswith(f"{path}:") else f"{path}: {exc}") from exc
+    except LockHeld as exc:  # names the file and the process holding it
+        raise BadInput(str(exc)) from exc
     except (OSError, ValueError, KeyError) as exc:
         raise BadInput(f"{path}: cannot analyse the results file ({one_line(exc)})") from exc
 
 
 def analyse(path, reference: str | None = None, options: Options | None = None, method: dict | None = None,
-            partial: bool = False, allow_aliasing: bool = False, progress=None) -> Statistics:
+            partial: bool = False, allow_aliasing: bool = False, progress=None,
+            exceedance: dict | None = None) -> Statistics:
     """All statistics of the results file `path` (and errors against `reference`).
 
     `method` ({"kind", "order", "split"}) overrides the campaign's: the runs of one grid serve every
     method, so methods and orders are compared on the same runs. `partial` analyses a file with pending
     runs where a subset of the runs is valid; `allow_aliasing` lets a projection exceed the grid's degree.
     `progress` (a uqflight.progress.Progress) gets a stage per file and counts its outputs and quantities.
+    `exceedance` ({quantity: [{above: X} | {below: X}]}) replaces the campaign's `analysis.exceedance` of the
+    quantities it names (`report --exceedance`: thresholds changed without flying again); BadInput when it
+    names a quantity the file does not have.
     """
     # one BLAS thread: the matrices are tall and thin (runs or draws × terms), where several threads are no
     # faster, and 10-20x slower on a loaded machine; the time blocks run in threads instead
@@ -202,6 +267,8 @@ def analyse(path, reference: str | None = None, options: Options | None = None, 
         allow_aliasing = allow_aliasing or bool(method.get("allow_aliasing"))
         options = options or Options(**{k: (tuple(v) if k == "quantiles" else v) for k, v in analysis.items()
                                         if k in ("band_samples", "bootstrap", "quantiles")})
+        if options.seed is None:
+            options = replace(options, seed=facts.seed)
         status, design_kind = store.status, facts.design_kind
         if method["kind"] not in METHODS:
             raise BadInput(f"{path}: unknown method {method['kind']!r}: expected one of {', '.join(METHODS)}")
@@ -210,7 +277,7 @@ def analyse(path, reference: str | None = None, options: Options | None = None, 
         pending = int(np.sum(status == Status.PENDING))
         stats = Statistics(str(path), store.attrs.get("campaign_name", ""), method, design_kind,
                            store.parameter_names, int(status.size), int(ok.sum()), int(np.sum(status > 0)),
-                           pending, {}, partial=pending > 0, design_info=facts.design_info)
+                           pending, {}, partial=pending > 0, design_info=facts.design_info, seed=options.seed)
         _check_runs(store, stats, sampled, partial)
         state = store.index_set()
         stats.index_set = None if state is None else index_set_summary(state, store.parameter_names)
@@ -227,6 +294,11 @@ def analyse(path, reference: str | None = None, options: Options | None = None, 
             raise BadInput(f"{path}: method {method['kind']} order {method['order']}: {problem}")
         _note_runs(store, stats, sampled, allow_aliasing)
         stats.from_runs = method_entry(method["kind"]).runs_on_sampled and sampled
+        if stats.from_runs and DESIGNS[design_kind].sobol_from_runs:
+            note = pick_freeze_note(ok, len(store.parameter_names), "pending runs" if not stats.failed else
+                                    "failed and pending runs" if stats.pending else "failed runs")
+            if note:
+                stats.notes.append(note)
         replicates = facts.design_info.get("replicates", 1)
         stats.replicates = replicates if stats.from_runs and ok.all() else 1
         if progress is not None:
@@ -242,26 +314,37 @@ def analyse(path, reference: str | None = None, options: Options | None = None, 
             def finish_oldest():
                 name, finish = in_flight.popleft()
                 out = stats.outputs[name] = finish()
+                if out.unwrapped:
+                    stats.notes.append(unwrapped_note(f"output {name}", out.units))
+                stats.notes.extend(f"output {name}: {flag}" for flag in out.flags)
                 if stats.replicates > 1:
                     out.replicate_moments = _replicate_moments(store, name, stats.replicates)
                 if progress is not None:
                     progress.advance()
 
             for name in store.output_names:
-                in_flight.append((name, _start_output(store, name, method, germs, design_kind, ok, options, pool,
-                                                      reused)))
+                chosen, runs_only, record = auto_method(store, name, method, germs, design_kind, ok, options.seed)
+                start = _start_output(store, name, chosen, germs, design_kind, ok, options, pool, reused, runs_only,
+                                      record is not None)
+                in_flight.append((name, _with_method(record, start)))
                 if len(in_flight) >= ANALYSIS_THREADS:
                     finish_oldest()
             while in_flight:
                 finish_oldest()
+        unknown = [name for name in exceedance or {} if name not in store.quantity_names]
+        if unknown:
+            raise BadInput(f"{path}: --exceedance {unknown[0]}: no such quantity in the file; its quantities: "
+                           + (", ".join(store.quantity_names) or "none"))
+        thresholds = {**analysis.get("exceedance", {}), **(exceedance or {})}
         for name in store.quantity_names:
             stats.quantities[name] = quantity_statistics(store, stats, name, germs, ok, options,
-                                                         analysis.get("exceedance", {}).get(name, []))
+                                                         thresholds.get(name, []))
             if progress is not None:
                 progress.advance()
+    _note_auto(stats)
     if reference:
         add_reference_errors(stats, analyse(reference, options=Options(
-            band_samples=options.band_samples, bootstrap=0, seed=options.seed, quantiles=options.quantiles)))
+            band_samples=options.band_samples, bootstrap=0, quantiles=options.quantiles)))
     return stats
 
 
@@ -315,30 +398,148 @@ def _grid_failure_note(probability: dict) -> str:
             "(the nodes are not random draws); a sampled design gives one")
 
 
-def output_basis(store: ResultStore, name: str, ok: np.ndarray) -> tuple[np.ndarray, np.ndarray | None]:
-    """The ok runs of `name` as basis @ scale: raw (Y, None), or tSVD (V rows, diag(s) Uᵀ)."""
+def too_large(kind: str, name: str, peak: float) -> str | None:
+    """Why the values of output or quantity (`kind`) `name`, of magnitude up to `peak`, give no statistics
+    (their powers up to the fourth, the variance and the kurtosis, leave float64), or None."""
+    if peak <= MAX_MAGNITUDE:
+        return None
+    return (f"{kind} {name if name.isprintable() else repr(name)} holds values up to {peak:.3g}, beyond the "
+            f"{MAX_MAGNITUDE:.0e} its statistics take in float64 (their powers, up to the fourth in the kurtosis, "
+            "would overflow): record it in larger units")
+
+
+def output_basis(store: ResultStore, name: str, ok: np.ndarray,
+                 unwrapped: list | None = None) -> tuple[np.ndarray, np.ndarray | None]:
+    """The ok runs of `name` as basis @ scale: raw (Y, None), or tSVD (V rows, diag(s) Uᵀ). An angle (deg or
+    rad) whose runs wrap is unwrapped (analysis.angles), raw, and its name appended to `unwrapped`. BadInput,
+    one line, for values whose statistics would overflow (`too_large`)."""
+    period = angle_period(store.units.get(name) or name_unit(name))
     factors = store.output_factors(name)
     if factors is None:
         runs = np.flatnonzero(ok)
         histories = store.output_matrix(name, runs)
         bad = runs[~np.isfinite(histories).all(axis=1)]
         if bad.size:
-            raise CorruptFile(f"output {name}: {bad.size} runs with status ok hold values that are not finite "
+            raise CorruptFile(f"output {shown(name)}: {bad.size} runs with status ok hold values that are not finite "
                               f"(e.g. run {bad[0]}): the file is damaged (`uqflight info` lists its problems)")
-        return histories, None
+        problem = too_large("output", name, float(np.abs(histories).max(initial=0.0)))
+        if problem:
+            raise BadInput(f"{store.path}: {problem}")
+        return _unwrapped(histories, period, name, unwrapped, histories), None
     U, s, V, columns = factors
     if not (np.isfinite(U).all() and np.isfinite(s).all() and np.isfinite(V).all()):
-        raise CorruptFile(f"output {name}: its tSVD factors hold values that are not finite: the file is damaged")
+        raise CorruptFile(f"output {shown(name)}: its tSVD factors hold values that are not finite: the file is damaged")
     row_of = np.full(ok.size, -1)
     row_of[columns] = np.arange(columns.size)
-    return V[row_of[np.flatnonzero(ok)]], s[:, None] * U.T
+    basis, scale = V[row_of[np.flatnonzero(ok)]], s[:, None] * U.T
+    with np.errstate(over="ignore"):  # a bound of every value: sum over the rank of |V| |diag(s) Uᵀ|
+        peak = float((np.abs(basis).max(axis=0, initial=0.0) @ np.abs(scale)).max(initial=0.0))
+    problem = too_large("output", name, peak)
+    if problem:
+        raise BadInput(f"{store.path}: {problem}")
+    if period is None:
+        return basis, scale
+    # no step of any run can jump by half a turn when Σ_k max_i |V_ik| |Δ(s Uᵀ)_kt| stays below it, and the
+    # runs' first values need no turn: then nothing is rebuilt
+    steps = np.abs(basis).max(axis=0, initial=0.0) @ np.abs(np.diff(scale, axis=1))
+    if not (steps > 0.5 * period).any() and not branch_shifts(basis @ scale[:, 0], period).any():
+        return basis, scale
+    found = _unwrapped(basis @ scale, period, name, unwrapped, None)
+    return (basis, scale) if found is None else (found, None)
+
+
+def unwrapped_note(what: str, units: str) -> str:
+    """The note of an angle made continuous before its statistics (analysis.angles)."""
+    turn = f"{angle_period(units):g} {units}" if units == "deg" else "2π rad"
+    return (f"{what} is an angle whose runs jump by about a turn ({turn}): unwrapped along each run and moved by "
+            "whole turns onto the first run's branch before any statistic")
+
+
+def _unwrapped(histories: np.ndarray, period: float | None, name: str, unwrapped: list | None, unchanged):
+    """`histories` unwrapped (analysis.angles) when `period` says it is an angle and its runs wrap, `name`
+    then appended to `unwrapped`; else `unchanged`."""
+    if period is None:
+        return unchanged
+    found, moved = unwrapped_runs(histories, period)
+    if not moved:
+        return unchanged
+    if unwrapped is not None:
+        unwrapped.append(name)
+    return found
 
 
 def _output_statistics(store: ResultStore, name: str, method: dict, germs: list[str], design_kind: str,
                        ok: np.ndarray, options: Options) -> OutputStatistics:
     """The statistics of output `name` over the `ok` runs, its time blocks in ANALYSIS_THREADS threads."""
+    chosen, runs_only, record = auto_method(store, name, method, germs, design_kind, ok, options.seed)
     with ThreadPoolExecutor(ANALYSIS_THREADS) as pool:
-        return _start_output(store, name, method, germs, design_kind, ok, options, pool, Reused())()
+        return _with_method(record, _start_output(store, name, chosen, germs, design_kind, ok, options, pool,
+                                                  Reused(), runs_only, record is not None))()
+
+
+def _with_method(record: dict | None, finish: Callable[[], OutputStatistics]) -> Callable[[], OutputStatistics]:
+    """`finish` whose statistics carry what auto took (`record`, None: the method was given)."""
+    def finished() -> OutputStatistics:
+        out = finish()
+        out.method = record
+        return out
+    return finished
+
+
+def auto_method(store: ResultStore, name: str, method: dict, germs: list[str], design_kind: str,
+                ok: np.ndarray, seed: int = 0) -> tuple[dict, bool, dict | None]:
+    """(the method for output `name`, whether its statistics are the runs' own, what auto took or None).
+
+    `method` other than auto is itself. For auto: among AUTO_CANDIDATES of its order that the design and its
+    runs allow (methods.validity), the one whose out-of-sample error (methods.validation, over the judged
+    times) is the lowest and below VALIDATION_THRESHOLD and whose band stays within the runs' allowed range (its
+    draws seeded by `seed`), ties (errors below 1e-12: exact fits) to the first;
+    when none validates, the runs' own statistics: monte_carlo on a sampled design, the weighted runs on a grid
+    of weights >= 0; a grid with signed weights has no statistics of its runs alone, so it keeps the expansion
+    of lowest error, flagged by its own check."""
+    if method["kind"] != "auto":
+        return method, False, None
+    xi, weights, order = store.xi[ok], store.weights[ok], method["order"]
+    sampled, missing = is_sampled(design_kind), int(ok.size - ok.sum())
+    basis, scale = output_basis(store, name, ok)
+    taken, errors, band_outside = validation.auto_choice(xi, weights, basis, scale, germs, order, sampled, missing,
+                                                         seed)
+    record = {"chosen_by": "auto", "order": order, "errors": errors, "threshold": validation.VALIDATION_THRESHOLD,
+              "band_beyond_runs": band_outside}
+    if taken is not None:
+        return ({**method, "kind": taken, "order": order}, False,
+                {**record, "kind": taken, "why": f"the lowest validated error, {errors[taken]:.3g}, its band "
+                                                 "within the runs' range"})
+    why = "no expansion validates on these runs"
+    if sampled:
+        return ({**method, "kind": "monte_carlo", "order": order}, False,
+                {**record, "kind": "monte_carlo", "why": f"{why}: the runs' own statistics"})
+    if (weights >= 0).all():
+        return ({**method, "kind": "integration", "order": order}, True,
+                {**record, "kind": "integration", "why": f"{why}: the runs' own statistics, weighted by the grid"})
+    if not [e for e in errors.values() if e is not None]:
+        raise ValueError(f"method auto: for {name}, no candidate ({', '.join(AUTO_CANDIDATES)}) of order "
+                         f"{order} can be applied to these runs, and a grid with negative weights gives no statistics "
+                         "of its runs alone: run a sampled design, or choose a method and order")
+    kind = min((e, i, k) for i, (k, e) in enumerate(errors.items()) if e is not None)[2]
+    return ({**method, "kind": kind, "order": order}, False,
+            {**record, "kind": kind, "why": f"{why}, and a grid with negative weights has no statistics of its runs "
+                                            "alone: the expansion of lowest error, flagged; run a sampled design"})
+
+
+def _note_auto(stats: Statistics) -> None:
+    """One note of what `method: {kind: auto}` took for each output and quantity."""
+    taken: dict[str, list[str]] = {}
+    entries = [(name, out) for name, out in stats.outputs.items()]
+    entries += [(name, q.output) for name, q in stats.quantities.items() if q.output is not None]
+    for name, out in entries:
+        if out.method is not None:
+            how = out.method["kind"] + (" (the runs' own statistics)" if out.method["kind"] in ("monte_carlo",
+                                                                                               "integration") else "")
+            taken.setdefault(how, []).append(name)
+    if taken:
+        stats.notes.append("auto took " + "; ".join(f"{how} for {', '.join(names)}" for how, names in taken.items())
+                           + " (each output's method in summary.json)")
 
 
 class Reused:
@@ -372,15 +573,19 @@ class Reused:
 
 
 def _start_output(store: ResultStore, name: str, method: dict, germs: list[str], design_kind: str,
-                  ok: np.ndarray, options: Options, pool: Executor, reused: Reused) -> Callable[[], OutputStatistics]:
+                  ok: np.ndarray, options: Options, pool: Executor, reused: Reused,
+                  runs_only: bool = False, auto: bool = False) -> Callable[[], OutputStatistics]:
     """Read and fit output `name` here and hand its time blocks to `pool`; returns what waits for them
-    and gives the output's statistics. `reused`: what the outputs of one analysis share (Reused)."""
+    and gives the output's statistics. `reused`: what the outputs of one analysis share (Reused).
+    `runs_only`: the statistics of the (weighted) runs themselves, as on a sampled design; `auto`: `method`
+    is what auto took (auto_method)."""
     xi, weights = store.xi[ok], store.weights[ok]
     kind, order = method["kind"], method["order"]
     entry = method_entry(kind)
-    basis, scale = output_basis(store, name, ok)
+    unwrapped: list[str] = []
+    basis, scale = output_basis(store, name, ok, unwrapped)
     truncation = _tsvd_resolution(store, scale, int(ok.sum()))
-    sampled = is_sampled(design_kind)
+    sampled = is_sampled(design_kind) or runs_only
     x0 = None
     # x = x0 + S with each run's initial value (needs the runs themselves); only the projections use
     # it: the other kinds fit the constant term themselves, where the split would change nothing
@@ -398,10 +603,12 @@ def _start_output(store: ResultStore, name: str, method: dict, germs: list[str],
         rows, row_scale, band_weights = basis, scale, (None if entry.moments == "sample" else weights / weights.sum())
     else:
         rows, row_scale, band_weights = reused.band_rows(germs, pce.indices, options), pce.coefficients, None
-    pick_freeze = from_runs and DESIGNS[design_kind].sobol_from_runs and ok.all()
-    joined_blocks = _over_time_blocks(rows, row_scale, store.time.size, band_weights,
-                                      len(store.parameter_names) if pick_freeze else 0, options, from_runs, pool, pce,
-                                      reused)
+    d = len(store.parameter_names)
+    pick_rows = _pick_freeze_rows(ok, d) if from_runs and DESIGNS[design_kind].sobol_from_runs else None
+    pick_freeze = pick_rows is not None
+    joined_blocks = _over_time_blocks(rows, row_scale, store.time.size, band_weights, d if pick_freeze else 0,
+                                      options, from_runs, pool, pce, reused,
+                                      pick_rows=None if pick_freeze and ok.all() else pick_rows)
 
     def finish() -> OutputStatistics:
         blocks = joined_blocks()
@@ -412,11 +619,12 @@ def _start_output(store: ResultStore, name: str, method: dict, germs: list[str],
         resolved = resolved_variance(variance, mean, scale=magnitude, rtol=rtol, n=int(ok.sum()),
                                      weights=None if from_runs else weights, atol=atol)
         cov = modified_cov(mean, np.sqrt(np.maximum(variance, 0)))
-        stats = OutputStatistics(name, store.units.get(name, ""), store.time, mean, variance, blocks["band"],
-                                 blocks["support"], blocks["density"], cov, resolved,
+        stats = OutputStatistics(name, store.units.get(name) or name_unit(name), store.time, mean, variance,
+                                 blocks["band"], blocks["support"], blocks["density"], cov, resolved,
                                  quantiles=dict(zip(options.quantiles, blocks["quantiles"])),
                                  skewness=blocks["skewness"], kurtosis=blocks["kurtosis"],
-                                 final_samples=blocks["final"], fourth_central=blocks.get("fourth"))
+                                 final_samples=blocks["final"], fourth_central=blocks.get("fourth"),
+                                 unwrapped=bool(unwrapped))
         names = store.parameter_names
 
         def masked(indices):
@@ -432,14 +640,65 @@ def _start_output(store: ResultStore, name: str, method: dict, germs: list[str],
                 stats.loo_error = _loo_error(entry, xi, weights, expand(basis), germs, pce.indices)
             elif entry.moments == "pce" and order >= 1:
                 stats.convergence = _lower_order_difference(kind, xi, weights, basis, scale, germs, order, x0, pce)
+            refit = (validation.refitting(kind, xi, weights, basis, scale, germs, order, sampled,
+                                          method_settings(method)) if entry.rule == "selection" else None)
+            _validate(stats, entry.rule, f"{kind} order {order}" + (" (taken by auto)" if auto else ""), xi, weights,
+                      expand(basis), germs, None if isinstance(store, _QuantityView) else store.time, options.seed,
+                      refit, auto)
         elif pick_freeze:
             stats.sobol_first = dict(zip(names, masked(blocks["first"])))
             stats.sobol_total = dict(zip(names, masked(blocks["total"])))
             stats.sobol_first_ci = dict(zip(names, np.moveaxis(blocks["first_ci"], 1, 0)))
             stats.sobol_total_ci = dict(zip(names, np.moveaxis(blocks["total_ci"], 1, 0)))
+            flag = unresolved_flag(stats)
+            if flag:
+                stats.flags.append(flag)
         return stats
 
     return finish
+
+
+def unresolved_flag(out: OutputStatistics) -> str | None:
+    """The flag of pick-freeze indices that resolve no share (analysis.sobol.unresolved), naming the
+    parameters and, over time, at how many times; None when every index is resolved. Times where the
+    variance is negligible (below analysis.sobol.NEGLIGIBLE of its largest) are not counted: an index
+    there is the share of almost nothing, which the plots grey."""
+    times: np.ndarray = np.zeros(out.time.size, dtype=bool)
+    variance = np.maximum(out.variance, 0.0)
+    counted = variance >= NEGLIGIBLE * (variance.max() if variance.size else 0.0)
+    named = []
+    for parameter in out.sobol_first:
+        where = counted & (unresolved(out.sobol_first[parameter], out.sobol_first_ci[parameter])
+                           | unresolved(out.sobol_total[parameter], out.sobol_total_ci[parameter]))
+        if where.any():
+            named.append(parameter)
+            times |= where
+    if not named:
+        return None
+    at = f" at {int(times.sum())} of {int(counted.sum())} times of non-negligible variance" if times.size > 1 else ""
+    return (f"Sobol' indices of {', '.join(named)} unresolved{at} (n too small): the 95 % interval is wider than "
+            f"{UNRESOLVED_WIDTH:g} or lies outside [0, 1]; run more base samples (design.samples)")
+
+
+def _pick_freeze_rows(ok: np.ndarray, d: int) -> np.ndarray | None:
+    """The ok runs' rows of a pick-freeze design's complete base rows (analysis.sobol.complete_rows), None when
+    fewer than 2 are complete (no index can be estimated)."""
+    rows = complete_rows(ok, d)
+    return rows if rows.size >= 2 * (d + 2) else None
+
+
+def pick_freeze_note(ok: np.ndarray, d: int, what: str) -> str | None:
+    """The note of a pick-freeze design whose runs `ok` miss some (failed, or `what` undefined in them):
+    the indices and the variance split come from the complete base rows, and how many were dropped."""
+    n = ok.size // (d + 2)
+    complete = complete_rows(ok, d).size // (d + 2)
+    if complete == n:
+        return None
+    if complete < 2:
+        return (f"{what}: no Sobol' indices: {complete} of the {n} base rows of the pick-freeze design are complete "
+                "(A, B and every AB_i ran), and the estimators need 2")
+    return (f"{what}: the pick-freeze Sobol' indices and the variance split are estimated on the {complete} complete "
+            f"base rows of {n} (A, B and every AB_i ran): {n - complete} rows dropped")
 
 
 def _replicate_moments(store: ResultStore, name: str, replicates: int) -> tuple[np.ndarray, np.ndarray]:
@@ -464,13 +723,24 @@ def _coefficient_decay(pce: PCE) -> dict[int, np.ndarray]:
     return {int(p): np.sqrt((pce.coefficients[degrees == p] ** 2).sum(axis=0)) for p in np.unique(degrees)}
 
 
+def _validate(out: OutputStatistics, rule: str, label: str, xi, weights, Y: np.ndarray, germs,
+              time: np.ndarray | None, seed: int, refit=None, auto: bool = False) -> None:
+    """Check `out`'s expansion on its own runs Y (methods.validation): its `validation` and its flags."""
+    edges = [*out.band99, *out.quantiles.values()]
+    found = validation.validate(rule, xi, weights, Y, germs, out.pce, out.loo_error, out.resolved, edges, seed,
+                                refit)
+    worst, excess = found.worst_error(), found.worst_excess()
+    out.validation = {"check": found.check, "threshold": validation.VALIDATION_THRESHOLD,
+                      "error": None if worst is None else worst[0],
+                      "time": None if worst is None or time is None else float(time[worst[1]]),
+                      "band_excess": None if excess is None else excess[0] + validation.BAND_MARGIN,
+                      "band_margin": validation.BAND_MARGIN, "validated": found.validates()}
+    out.flags.extend(validation.flags(found, rule, label, time, auto))
+
+
 def _loo_error(entry, xi, weights, Y, germs, indices) -> np.ndarray:
     """The relative leave-one-out error of the fit over time (methods.loo), weighted as the fit is."""
-    matrix = orthonormal_basis(germs, indices, xi)
-    try:
-        return relative_loo_error(matrix, Y, np.abs(weights) if entry.weighted else None)
-    except ValueError:  # a point the fit interpolates: leaving it out is undefined
-        return np.full(Y.shape[1], np.nan)
+    return validation.leave_one_out(entry.weighted, xi, weights, Y, germs, indices)
 
 
 def _lower_order_difference(kind, xi, weights, basis, scale, germs, order, x0, pce: PCE) -> dict:
@@ -482,14 +752,16 @@ def _lower_order_difference(kind, xi, weights, basis, scale, germs, order, x0, p
 
 
 def _over_time_blocks(rows, scale, n_times: int, weights, pick_freeze_dimensions: int, options: Options,
-                      from_runs: bool, pool: Executor, pce: PCE | None, reused: Reused) -> Callable[[], dict]:
+                      from_runs: bool, pool: Executor, pce: PCE | None, reused: Reused,
+                      pick_rows: np.ndarray | None = None) -> Callable[[], dict]:
     """Quantiles, 99 % band, skewness and kurtosis, PDFs, final-time samples (the runs' fourth central
     moments, pick-freeze indices) of Y = rows @ scale (scale None: Y = rows), rebuilding Y for
     TIME_BLOCK times at once: the memory stays that of one block per thread whatever the number of runs or
     draws. Every statistic here is per time, so blocks change nothing. A `pce`'s skewness and kurtosis are
     its exact ones (methods.pce_moments), not those of its draws; the KDE's std comes from the factors.
     The blocks are handed to `pool`; returns what waits for them and joins them. `reused`: the triple
-    products of outputs before (Reused)."""
+    products of outputs before (Reused). `pick_rows`: the rows of the pick-freeze estimators (the complete
+    base rows', analysis.sobol.complete_rows), None for every row."""
     probabilities = (0.5 * (1 - BAND_LEVEL), 0.5 * (1 + BAND_LEVEL), *options.quantiles)
     exact = None if pce is None else pce_standardised_moments(pce.germs, pce.indices, pce.coefficients,
                                                               reused.triple_products)
@@ -512,7 +784,8 @@ def _over_time_blocks(rows, scale, n_times: int, weights, pick_freeze_dimensions
         if from_runs and weights is None:
             found["fourth"] = central_moments(Y)[2]
         if pick_freeze_dimensions:
-            found.update(pick_freeze_indices(Y, pick_freeze_dimensions, n_boot=options.bootstrap, seed=options.seed))
+            found.update(pick_freeze_indices(Y if pick_rows is None else Y[pick_rows], pick_freeze_dimensions,
+                                             n_boot=options.bootstrap, seed=options.seed))
         return found
 
     # blocks in the pool's threads (numpy's sort, FFTs and BLAS release the GIL); each block's numbers are
@@ -550,6 +823,18 @@ def add_reference_errors(stats: Statistics, reference: Statistics) -> None:
                       "eps_v_summary": error_summary(eps_v), "kld_final": kld, **_reference_floor(reference, ref, out)}
 
 
+KLD_FLOOR_NOTE = ("; KLD floor = the KLD of two disjoint parts of the reference plus the estimator's bias for normal "
+                  "laws of the method's and the reference's means and spreads")
+
+
+def _kld_floor(reference: Statistics, ref: OutputStatistics, out: OutputStatistics) -> float:
+    """The KLD the reference's sampling noise (analysis.floors.kld_floor) and the estimator's bias
+    (kld_estimator_bias: a method's law wider than the reference's is overstated) give, seeded by the reference's
+    seed."""
+    split = kld_floor(ref.final_samples, n_method=len(out.final_samples), seed=reference.seed)
+    return float(split + kld_estimator_bias(out.final_samples, ref.final_samples, seed=reference.seed))
+
+
 def _reference_floor(reference: Statistics, ref: OutputStatistics, out: OutputStatistics) -> dict:
     """The errors a reference's own noise alone would show, and which floor that is."""
     if ref.replicate_moments is not None:
@@ -560,7 +845,7 @@ def _reference_floor(reference: Statistics, ref: OutputStatistics, out: OutputSt
         note = (f"reference: randomised QMC, {r} replicates of {reference.completed // r} scrambled Sobol' points; "
                 "floor = the standard errors of its mean and variance from the spread of the replicates")
         return {"eps_m_floor": se_mean / peak_mean, "eps_v_floor": se_variance / peak_variance,
-                "kld_floor": float(kld_floor(ref.final_samples, n_method=len(out.final_samples))), "floor_note": note}
+                "kld_floor": _kld_floor(reference, ref, out), "floor_note": note + KLD_FLOOR_NOTE}
     if reference.from_runs and ref.fourth_central is not None:
         floors = floors_from_moments(ref.mean, ref.variance, ref.fourth_central, reference.completed)
         qmc = reference.design_kind != "monte_carlo"
@@ -568,7 +853,7 @@ def _reference_floor(reference: Statistics, ref: OutputStatistics, out: OutputSt
                 "(σ/√N for the mean, the distribution-free s.e. of the variance)"
                 + ("; QMC converges faster than this Monte Carlo floor, so it is an upper bound" if qmc else ""))
         return {"eps_m_floor": floors["eps_m_floor"], "eps_v_floor": floors["eps_v_floor"],
-                "kld_floor": float(kld_floor(ref.final_samples, n_method=len(out.final_samples))), "floor_note": note}
+                "kld_floor": _kld_floor(reference, ref, out), "floor_note": note + KLD_FLOOR_NOTE}
     note = (f"reference: {reference.method['kind']} on a {reference.design_kind}, deterministic: it has no sampling "
             "floor; its own truncation error is not included (see its convergence estimate)")
     return {"eps_m_floor": None, "eps_v_floor": None, "kld_floor": None, "floor_note": note}
@@ -578,9 +863,9 @@ class _QuantityView:
     """A results file seen with one quantity as its only output, of one time point: what
     `_output_statistics` reads, so a quantity gets the outputs' methods, refusals and flags."""
 
-    def __init__(self, store: ResultStore, name: str, values: np.ndarray):
+    def __init__(self, store: ResultStore, name: str, values: np.ndarray, units: str):
         self._store, self._values = store, values
-        self.time, self.units = np.zeros(1), {name: ""}
+        self.time, self.units = np.zeros(1), {name: units}
 
     def __getattr__(self, attribute):  # the design, its weights, names and attributes: the file's
         return getattr(self._store, attribute)
@@ -601,11 +886,22 @@ def quantity_statistics(store: ResultStore, stats: Statistics, name: str, germs:
     a sampled design's statistics are conditional on the others (noted); a grid's are None (noted:
     a projection needs every run). Exceedance probabilities from the runs or from the PCE."""
     values = store.quantity(name)
+    text = store.attrs.get("campaign", "")  # the stored campaign text: its quantity's take and `of` give the unit
+    specs = stored_settings(text).get("quantities") if isinstance(text, str) else None
+    units = quantity_unit(specs.get(name) if isinstance(specs, dict) else None, store.units) or name_unit(name)
     defined = ok & np.isfinite(values)
+    period = angle_period(units)
+    shifts = None if period is None else branch_shifts(np.where(defined, values, np.nan), period)
+    if shifts is not None and shifts.any():
+        values = values + shifts
+        stats.notes.append(unwrapped_note(f"quantity {name}", units))
     missing = int(ok.sum() - defined.sum())
     sampled = is_sampled(stats.design_kind)
     why = None
-    if not defined.any():
+    huge = too_large("quantity", name, float(np.abs(values[defined]).max(initial=0.0)))
+    if huge:
+        why = f"{huge}; its statistics are null"
+    elif not defined.any():
         why = f"quantity {name} is undefined in every successful run: its statistics are null"
     elif missing and not sampled:
         why = (f"quantity {name} is undefined in {missing} of {int(ok.sum())} successful runs: a projection on "
@@ -621,22 +917,48 @@ def quantity_statistics(store: ResultStore, stats: Statistics, name: str, germs:
         stats.notes.append(why)
         nulls = [{**item, "probability": None, "lower": None, "upper": None, "method": None, "note": why}
                  for item in thresholds]
-        return QuantityStatistics(name, missing, None, nulls)
-    view = _QuantityView(store, name, values)
+        return QuantityStatistics(name, missing, None, nulls, units)
+    view = _QuantityView(store, name, values, units)
     out = _output_statistics(view, name, stats.method, germs, stats.design_kind, defined, options)
-    if out.pce is None:
+    out.unwrapped = shifts is not None and bool(shifts.any())
+    if missing and stats.from_runs and DESIGNS[stats.design_kind].sobol_from_runs:
+        note = pick_freeze_note(defined, len(store.parameter_names), f"quantity {name} (undefined in some runs)")
+        if note:
+            stats.notes.append(note)
+    if out.pce is None and not sampled:  # auto's runs' own statistics on a grid: the weighted runs
+        exceedance = _grid_exceedance(values, defined, store.weights, thresholds)
+    elif out.pce is None:
         exceedance = exceedance_from_runs(values, defined, thresholds, DESIGNS[stats.design_kind].draws,
-                                          stats.design_info)
+                                          stats.design_info, units)
     else:
         exceedance = exceedance_from_pce(out.pce.sample(options.band_samples, options.seed)[:, 0],
-                                         int(defined.sum()), thresholds)
-    return QuantityStatistics(name, missing, out, exceedance)
+                                         int(defined.sum()), thresholds, values[defined], units)
+    slips = [slip for item in thresholds if (slip := unit_slip(values[defined], next(iter(item.values())), units))]
+    flags = [*out.flags, *slips]
+    stats.notes.extend(f"quantity {name}: {flag}" for flag in flags)
+    return QuantityStatistics(name, missing, out, exceedance, units, flags)
+
+
+def _grid_exceedance(values: np.ndarray, defined: np.ndarray, weights: np.ndarray,
+                     thresholds: list[dict]) -> list[dict]:
+    """Exceedance probabilities of a grid's weighted runs (weights >= 0): the quadrature of the indicator,
+    without an interval (analysis.failures: the nodes are not random draws)."""
+    found = []
+    for item in thresholds:
+        (bound, threshold), = item.items()
+        beyond = values[defined] > threshold if bound == "above" else values[defined] < threshold
+        p = grid_failure_probability(beyond, weights[defined])
+        found.append({bound: threshold, "probability": p["estimate"], "lower": None, "upper": None, "method": "grid",
+                      "note": f"the grid's quadrature of the indicator {bound} {threshold:g}, without an interval "
+                              "(the nodes are not random draws); a sampled design gives one"})
+    return found
 
 
 def _quantity_json(quantity: QuantityStatistics, seeds: list[str]) -> dict:
     """summary.json's quantities.NAME: numbers, not lists (null where undefined)."""
     out = quantity.output
-    entry = {"missing": quantity.missing, "exceedance": quantity.exceedance}
+    entry = {"units": quantity.units, "missing": quantity.missing, "exceedance": quantity.exceedance,
+             "flags": quantity.flags}
     if out is None:
         return {"mean": None, "variance": None, "std": None, "band99": {"lower": None, "upper": None},
                 "quantiles": {}, "skewness": None, "kurtosis": None, "sobol_first": {}, "sobol_total": {}, **entry}
@@ -659,6 +981,10 @@ def _quantity_json(quantity: QuantityStatistics, seeds: list[str]) -> dict:
     if out.convergence is not None:
         entry["convergence"] = {**out.convergence, "eps_m": out.convergence["eps_m"][0],
                                 "eps_v": out.convergence["eps_v"][0]}
+    if out.validation is not None:
+        entry["validation"] = out.validation
+    if out.method is not None:
+        entry["method"] = out.method
     return entry
 
 
@@ -715,7 +1041,8 @@ def summary_json(stats: Statistics) -> dict:
     outputs = {}
     for name, out in stats.outputs.items():
         entry = {
-            "time": out.time, "units": out.units, "mean": out.mean, "variance": out.variance, "std": out.std,
+            "time": out.time, "units": out.units, "flags": out.flags, "mean": out.mean, "variance": out.variance,
+            "std": out.std,
             "band99": {"lower": out.band99[0], "upper": out.band99[1]},
             "quantiles": {f"{p:g}": values for p, values in out.quantiles.items()},
             "skewness": out.skewness, "kurtosis": out.kurtosis, "cov": out.cov, "resolved": out.resolved,
@@ -732,6 +1059,10 @@ def summary_json(stats: Statistics) -> dict:
             entry["selection"] = out.selection
         if out.convergence is not None:
             entry["convergence"] = out.convergence
+        if out.validation is not None:
+            entry["validation"] = out.validation
+        if out.method is not None:
+            entry["method"] = out.method
         if out.errors:
             errors = out.errors
             entry["errors"] = {"eps_m": errors["eps_m"], "eps_v": errors["eps_v"],

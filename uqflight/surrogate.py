@@ -22,6 +22,10 @@ from pathlib import Path
 
 import numpy as np
 
+from .bounded import read_bounded
+from .console import listed
+from .console import shown as shown_name
+
 FORMAT = "uqflight-pce"
 VERSION = 1
 MAX_FILE_BYTES = 64 << 20  # 64 MiB of JSON (about 3 million coefficients); parsing takes about 10 times that
@@ -58,7 +62,7 @@ class Surrogate:
         kappa = np.atleast_2d(np.asarray(kappa, dtype=float))
         if kappa.shape[1] != len(self.parameters):
             raise ValueError(f"expected {len(self.parameters)} values per point "
-                             f"({', '.join(p['name'] for p in self.parameters)}), got {kappa.shape[1]}")
+                             f"({listed(p['name'] for p in self.parameters)}), got {kappa.shape[1]}")
         laws = [Parameter(p["name"], p.get("property", p["name"]), p["distribution"], p["nominal"], p["lower"],
                           p["upper"]) for p in self.parameters]
         return to_standard(laws, kappa, _copula(self.dependence))
@@ -99,7 +103,7 @@ def fit_surrogate(path, method: dict | None = None, partial: bool = False, allow
     with ResultStore.open(path) as store:
         facts = campaign_facts(store, path)
         stored, design_kind = normalised(facts.method), facts.design_kind
-        parameters, units, time = _parameters(store, path), dict(store.units), np.asarray(store.time, dtype=float)
+        parameters, time = _parameters(store, path), np.asarray(store.time, dtype=float)
     override = dict(method or {})
     kind = override.get("kind", stored.get("kind"))
     if isinstance(kind, str) and kind in METHOD_KINDS:  # else analyse refuses
@@ -107,6 +111,7 @@ def fit_surrogate(path, method: dict | None = None, partial: bool = False, allow
     stats = analyse(path, method=override, partial=partial, allow_aliasing=allow_aliasing,
                     options=options or Options(band_samples=200, bootstrap=0), progress=progress)
     pces = {name: out.pce for name, out in stats.outputs.items()}
+    units = {name: out.units for name, out in stats.outputs.items()}  # the simulator's, else from the name
     dependence = {k: v for k, v in stats.dependence.items() if k != "sobol_of"} if stats.dependence else None
     return Surrogate(parameters, list(next(iter(pces.values())).germs),
                      {name: np.asarray(pce.indices, dtype=int) for name, pce in pces.items()}, time,
@@ -144,8 +149,8 @@ def _parameters(store, path) -> list[dict]:
         raise SurrogateError(f"{path}: cannot read the parameters' distributions from the campaign stored in the "
                              f"file: {reason}") from exc
     if [p["name"] for p in found] != store.parameter_names:
-        raise SurrogateError(f"{path}: the parameters of the stored campaign ({', '.join(p['name'] for p in found)}) "
-                             f"are not the file's ({', '.join(store.parameter_names)})")
+        raise SurrogateError(f"{path}: the parameters of the stored campaign ({listed(p['name'] for p in found)}) "
+                             f"are not the file's ({listed(store.parameter_names)})")
     return found
 
 
@@ -201,16 +206,9 @@ def load(path) -> Surrogate:
     file and the key, for anything else (a damaged or hand-edited file is never evaluated): a file
     above MAX_FILE_BYTES (refused before it is read), numbers that are strings, booleans or out of
     range, multi-indices that are not integers in [0, MAX_DEGREE] or repeat a row, laws whose germ is
-    not the one given, times that do not increase."""
+    not the one given, times that do not increase; no regular file (a FIFO, a device: refused unread)."""
     try:
-        size = Path(path).stat().st_size
-        if size > MAX_FILE_BYTES:
-            raise ValueError(f"{size / 2**20:.0f} MiB, more than the {MAX_FILE_BYTES >> 20} MiB a surrogate takes")
-        with open(path, "rb") as fh:
-            text = fh.read(MAX_FILE_BYTES + 1)
-        if len(text) > MAX_FILE_BYTES:
-            raise ValueError(f"more than the {MAX_FILE_BYTES >> 20} MiB a surrogate takes")
-        data = json.loads(text)
+        data = json.loads(read_bounded(path, MAX_FILE_BYTES, "a surrogate"))
     except (OSError, ValueError, RecursionError) as exc:
         raise SurrogateError(f"{path}: cannot read the surrogate ({exc})") from exc
     if not isinstance(data, dict) or data.get("format") != FORMAT:
@@ -251,7 +249,7 @@ def _checked(data: dict) -> Surrogate:
                         p["upper"])
         germ = "normal" if copula is not None and law.name in copula.names else law.germ
         if germ != germs[j]:
-            raise ValueError(f"parameters[{j}] ({p['name']}): a {p['distribution']} law is driven by a {germ} "
+            raise ValueError(f"parameters[{j}] ({shown_name(p['name'])}): a {p['distribution']} law is driven by a {germ} "
                              f"germ{' (dependence:)' if germ != law.germ else ''}, but germs[{j}] is {germs[j]}")
     unknown = set(copula.names) - {p["name"] for p in parameters} if copula is not None else set()
     if unknown:
@@ -269,13 +267,13 @@ def _checked(data: dict) -> Surrogate:
     coefficients, indices = {}, {}
     for name, output in outputs.items():
         if shared is None or "multi_indices" in output:
-            indices[name] = _multi_indices(output["multi_indices"], f"outputs.{name}.multi_indices", d, order)
+            indices[name] = _multi_indices(output["multi_indices"], f"outputs.{shown_name(name)}.multi_indices", d, order)
         else:
             indices[name] = shared
-        coefficients[name] = _array(output["coefficients"], f"outputs.{name}.coefficients",
+        coefficients[name] = _array(output["coefficients"], f"outputs.{shown_name(name)}.coefficients",
                                     (len(indices[name]), time.size))
         if not isinstance(output.get("units", ""), str):
-            raise ValueError(f"outputs.{name}.units: expected a string, got {_shown(output['units'])}")
+            raise ValueError(f"outputs.{shown_name(name)}.units: expected a string, got {_shown(output['units'])}")
     for key, kind in (("method", str), ("split", bool), ("campaign", str)):
         if key in data and not isinstance(data[key], kind):
             raise ValueError(f"{key}: expected a {kind.__name__}, got {_shown(data[key])}")

@@ -17,11 +17,12 @@ import os
 import signal
 import sys
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
+from .console import one_line
 from .forking import die_with_parent
 from .quantities import quantity_key
 from .quantities.recorder import QuantityRecorder
@@ -40,6 +41,7 @@ class WorkerSpec:
     base: str
     bundle: dict | None = None  # the aircraft's (or file.py's) files as bytes + hash (simulators/bundle.py)
     quantities: dict | None = None  # the campaign's quantities of interest, {name: spec} (uqflight.quantities)
+    time: tuple[float, ...] | None = None  # the nominal flight's times, which every run's values are stored against
 
     @property
     def key(self) -> str:
@@ -72,6 +74,9 @@ def run_chunk(spec: WorkerSpec, indices: np.ndarray, kappa: np.ndarray, n_times:
     (NaN where undefined or failed)."""
     simulator = worker_simulator(spec)
     simulator.restart()
+    expect_time = getattr(simulator, "expect_time", None)  # a model that gives its own times (python)
+    if expect_time is not None and spec.time is not None:
+        expect_time(np.asarray(spec.time, dtype=float))
     n = len(indices)
     status = np.zeros(n, dtype=np.int8)
     reasons = [""] * n
@@ -111,8 +116,8 @@ def run_chunk(spec: WorkerSpec, indices: np.ndarray, kappa: np.ndarray, n_times:
 class NominalFlight:
     """What the runner needs to create the results file and derive the default per-run time limit,
     measured in a worker: the recorded times, the output names and units, the seconds one flight at the
-    nominal took, the simulator's resolution there ({output: (T,)}, or None), and why that flight
-    failed (None when it flew)."""
+    nominal took, the simulator's resolution there ({output: (T,)}, or None), why that flight
+    failed (None when it flew), and what its flight warned of (an excitation that left its surface unmoved)."""
 
     time: np.ndarray
     outputs: list[str]
@@ -120,6 +125,7 @@ class NominalFlight:
     seconds: float
     resolution: dict[str, np.ndarray] | None
     failure: str | None = None
+    warnings: list[str] = field(default_factory=list)
 
 
 def nominal_flight(spec: WorkerSpec, kappa: np.ndarray, measure_resolution: bool = True) -> NominalFlight:
@@ -137,9 +143,10 @@ def nominal_flight(spec: WorkerSpec, kappa: np.ndarray, measure_resolution: bool
         failure = None
     seconds = time.perf_counter() - started
     resolution = getattr(simulator, "resolution", None)
+    warning = getattr(getattr(simulator, "flight", None), "surface_warning", None) if flown is not None else None
     return NominalFlight(np.asarray(time_grid, dtype=float), list(outputs), dict(getattr(simulator, "units", {}) or {}),
                          seconds, resolution(kappa, flown) if measure_resolution and resolution and flown is not None
-                         else None, failure)
+                         else None, failure, [warning] if warning else [])
 
 
 def main(argv=None) -> None:
@@ -170,8 +177,8 @@ def main(argv=None) -> None:
             os._exit(0)
         except NominalFailed as exc:  # its message says it all
             conn.send(("error", str(exc)))
-        except Exception as exc:  # building the simulator failed: the runner reports it
-            conn.send(("error", f"{type(exc).__name__}: {exc}"))
+        except Exception as exc:  # building the simulator failed: the runner reports it, on one line
+            conn.send(("error", f"{type(exc).__name__}: {one_line(str(exc))}"))
 
 
 if __name__ == "__main__":  # `python -m uqflight.worker`: the imported module's main, so that the

@@ -83,3 +83,25 @@ def kld_floor(samples_ref, n_method: int | None = None, repeats: int = 5, seed=0
         total += kl_divergence(Y[order[:n_p]], Y[order[n_p:]], grid_points, rule)
     floor = total / repeats
     return floor if samples.ndim > 1 else float(floor[0])
+
+
+def kld_estimator_bias(samples_method, samples_ref, seed=0, grid_points: int = 512, rule: str = "scott"):
+    """The bias of the KLD estimator (kl_divergence) for normal laws of the method's and the reference's means
+    and spreads, drawn in their sample sizes: |estimate − closed form| with D_KL(N(μp, σp²) || N(μq, σq²)) =
+    ln(σq/σp) + (σp² + (μp − μq)²)/(2σq²) − 1/2. A method's law wider than the reference's puts samples where
+    the reference's KDE has collapsed, which the estimator overstates (+20 to +30 % for σp = 1.2 σq); the split
+    floor (kld_floor), of two samples of one law, cannot see that. A float for (N,) samples, (T,) for (N, T);
+    NaN where a spread is zero. Draws: numpy default_rng(seed)."""
+    p_samples, q_samples = np.asarray(samples_method, dtype=float), np.asarray(samples_ref, dtype=float)
+    p, q = as_runs_by_time(p_samples), as_runs_by_time(q_samples)
+    mean_p, std_p, mean_q, std_q = p.mean(axis=0), p.std(axis=0), q.mean(axis=0), q.std(axis=0)
+    defined = (std_p > 0) & (std_q > 0)
+    rng = np.random.default_rng(seed)
+    normal_p = mean_p + std_p * rng.standard_normal(p.shape)
+    normal_q = mean_q + np.where(defined, std_q, 1.0) * rng.standard_normal(q.shape)
+    estimate = kl_divergence(normal_p, normal_q, grid_points, rule)
+    ratio = np.where(defined, std_p / np.where(defined, std_q, 1.0), 1.0)
+    closed = -np.log(np.where(defined, ratio, 1.0)) + 0.5 * ratio**2 + np.where(
+        defined, (mean_p - mean_q) ** 2 / (2 * np.where(defined, std_q, 1.0) ** 2), 0.0) - 0.5
+    bias = np.where(defined, np.abs(estimate - closed), np.nan)
+    return bias if p_samples.ndim > 1 else float(bias[0])

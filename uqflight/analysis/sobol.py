@@ -4,6 +4,11 @@ The design's runs are stacked [A (n); B (n); AB_1 (n); …; AB_d (n)], AB_i bein
 column i taken from B. Per time, with V the variance of [f(A); f(B)]:
 first order (Saltelli 2010)  S_i  = mean(f(B) (f(AB_i) − f(A))) / V,
 total (Jansen 1999)          ST_i = mean((f(A) − f(AB_i))²) / (2 V).
+
+With failed runs the estimators use the complete base rows only (`complete_rows`: the rows j whose
+A_j, B_j and every AB_i,j ran), which are a Saltelli design of their own of fewer rows. An index is
+unresolved (`unresolved`) where its interval is wider than half the unit interval, or where the whole
+interval lies outside [0, 1]: the estimate then says nothing about the share, and n is too small.
 """
 import numpy as np
 
@@ -23,6 +28,35 @@ def _split_design(Y, d: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     blocks = Y.reshape(d + 2, n, Y.shape[1])
     blocks = blocks - blocks[:2].mean(axis=(0, 1))
     return blocks[0], blocks[1], blocks[2:]
+
+
+UNRESOLVED_WIDTH = 0.5  # an interval wider than this (half of [0, 1]) does not resolve a share
+NEGLIGIBLE = 1e-4  # a variance below this share of its largest over time (std < 1 % of its largest) is negligible:
+#                    an index there is the share of almost nothing, and is not flagged
+
+
+def complete_rows(ok, d: int) -> np.ndarray:
+    """Where the complete base rows' runs sit among the `ok` runs (bool (N,), N = n (d + 2), design order):
+    indices into the ok runs, in the order [A; B; AB_1 … AB_d] of the base rows j whose d + 2 runs are all
+    ok. Their count divided by d + 2 is the number of complete rows."""
+    ok = np.asarray(ok, dtype=bool)
+    n, remainder = divmod(ok.size, d + 2)
+    if remainder:
+        raise ValueError(f"{ok.size} runs do not form a Saltelli design [A; B; AB_1..AB_{d}]")
+    complete = np.flatnonzero(ok.reshape(d + 2, n).all(axis=0))
+    runs = (np.arange(d + 2)[:, None] * n + complete[None, :]).ravel()
+    return (np.cumsum(ok) - 1)[runs]
+
+
+def unresolved(index, ci) -> np.ndarray:
+    """bool, shaped as `index`: the estimate is no share, its 95 % interval (`ci`: (lower, upper), each
+    shaped as `index`) being wider than UNRESOLVED_WIDTH or lying wholly outside [0, 1]. An interval of no
+    width is none (`bootstrap: 0` gives the estimate twice): it resolves nothing and flags nothing."""
+    index = np.asarray(index, dtype=float)
+    lower, upper = (np.asarray(bound, dtype=float) for bound in ci)
+    with np.errstate(invalid="ignore"):
+        width = upper - lower
+        return np.isfinite(index) & ((width > UNRESOLVED_WIDTH) | ((width > 0) & ((lower > 1.0) | (upper < 0.0))))
 
 
 def pick_freeze_indices(Y, d: int, n_boot: int = 200, seed=0, confidence: float = 0.95) -> dict[str, np.ndarray]:

@@ -10,7 +10,7 @@ from typing import List, Optional
 import typer
 
 from ..arguments import check_campaign_file, check_output, check_results_file
-from ..console import echo
+from ..console import echo, one_line, shown
 from ..progress import Progress
 
 EXIT_BAD_INPUT = 2
@@ -90,6 +90,7 @@ def calibrate_command(
         echo(f"error: {exc}", err=True)
         raise typer.Exit(EXIT_BAD_INPUT)
     known = _truth(truth, results)
+    from ..execution import WorkerError
     from .run import NotConverged, SurrogateError, calibrate
 
     streams, previous = (sys.stdout, sys.stderr), signal.signal(signal.SIGINT, _interrupted)
@@ -104,6 +105,9 @@ def calibrate_command(
         raise typer.Exit(EXIT_INTERRUPTED)
     except (DataError, SurrogateError, ValueError) as exc:
         echo(f"error: {exc}", err=True)
+        raise typer.Exit(EXIT_BAD_INPUT)
+    except WorkerError as exc:  # no simulator for the predictive runs (the model cannot be built or hangs)
+        echo(f"error: {results}: the posterior predictive runs cannot be flown: {exc}", err=True)
         raise typer.Exit(EXIT_BAD_INPUT)
     except NotConverged as exc:
         echo("not converged: no posterior is reported.", err=True)
@@ -127,20 +131,24 @@ def calibrate_command(
          f"{'narrowing':>9}  95 % interval")
     for name, p in summary["parameters"].items():
         narrowing = p["narrowing"]
-        echo(f"{name:<10} {p['prior']['mean']:12.6g} {p['prior']['std']:11.4g} {p['posterior']['mean']:12.6g} "
+        echo(f"{shown(name):<10} {p['prior']['mean']:12.6g} {p['prior']['std']:11.4g} {p['posterior']['mean']:12.6g} "
              f"{p['posterior']['std']:11.4g} {narrowing if narrowing is not None else float('nan'):9.2f}  "
              f"[{p['posterior']['ci95'][0]:.6g}, {p['posterior']['ci95'][1]:.6g}]")
     for name, n in summary["noise"].items():
         if n["inferred"]:
-            echo(f"noise {name}: sigma {n['inferred']['mean']:.4g} (inferred)")
+            echo(f"noise {shown(name)}: sigma {n['inferred']['mean']:.4g} (inferred)")
     pred = summary["predictive"]
-    cover = ", ".join(f"{k} {v:.0%}" if v is not None else f"{k} -" for k, v in pred["coverage95"].items())
+    cover = ", ".join(f"{shown(k)} {v:.0%}" if v is not None else f"{shown(k)} -" for k, v in pred["coverage95"].items())
     echo(f"posterior predictive ({pred['draws']} simulator runs, {pred['failed']} failed): data inside the "
          f"95 % band: {cover}")
     written = list(result.written)
     if _page[0] is not None:
         written.append(_page[0](out).name)
     echo(f"wrote {', '.join(written)} to {out} ({summary['seconds']['total']:.1f} s)")
+    refused = summary.get("calibrated_campaign", {}).get("refused")
+    if refused:
+        echo(f"warning: calibrated.yaml not written: {one_line(refused)}; the calibration is kept (posterior.h5, "
+             "summary.json, the plots): write the campaign from summary.json's posterior", err=True)
 
 
 def _truth(items: list[str], results: Path) -> dict[str, float] | None:
@@ -150,8 +158,12 @@ def _truth(items: list[str], results: Path) -> dict[str, float] | None:
 
     if not items:
         return None
-    with ResultStore.open(results) as store:
-        names = list(store.parameter_names)
+    try:
+        with ResultStore.open(results) as store:
+            names = list(store.parameter_names)
+    except (OSError, ValueError) as exc:  # damaged, or held by another process (the message names it)
+        echo(f"error: {exc}" if str(exc).startswith(str(results)) else f"error: {results}: {exc}", err=True)
+        raise typer.Exit(EXIT_BAD_INPUT)
     try:
         return name_values(items, "--truth", "NAME=VALUE with a finite VALUE", names, f"the parameters of {results}")
     except DataError as exc:

@@ -14,6 +14,7 @@ reaches this module as its coefficients and a basis function.
 from __future__ import annotations
 
 import csv
+import io
 import math
 from dataclasses import dataclass
 from pathlib import Path
@@ -21,11 +22,17 @@ from typing import Callable
 
 import numpy as np
 
+from ..bounded import Refused, read_bounded
+from ..console import listed, shown
 from ..parameters.germs import GERMS, germ_columns
 
 
 class DataError(ValueError):
     """Flight data or a noise setting that cannot be used; the message names the file or option."""
+
+
+MAX_DATA_BYTES = 64 << 20  # a flight data CSV (about 4 million cells): refused beyond, before it is read
+DATA_FORM = "the flight data is a CSV file as `uqflight simulate --out` writes it (time_s and output columns)"
 
 
 @dataclass
@@ -45,27 +52,29 @@ def read_flight_csv(path, outputs: list[str] | None, available: list[str]) -> Fl
     requested output missing from the file or from the campaign.
     """
     path = Path(path)
-    try:
-        with open(path, newline="", encoding="utf-8-sig") as fh:  # a byte-order mark is no part of the header
-            rows = list(csv.reader(fh))
-    except (OSError, UnicodeDecodeError) as exc:
+    try:  # a byte-order mark is no part of the header
+        text = read_bounded(path, MAX_DATA_BYTES, "flight data").decode("utf-8-sig")
+        rows = list(csv.reader(io.StringIO(text, newline="")))
+    except Refused as exc:
+        raise DataError(f"{path}: {exc}: {DATA_FORM}") from exc
+    except (OSError, UnicodeDecodeError, csv.Error) as exc:
         raise DataError(f"{path}: cannot read the file ({exc})") from exc
     rows = [row for row in rows if any(cell.strip() for cell in row)]
     if len(rows) < 2:
         raise DataError(f"{path}: expected a header (time_s, outputs...) and at least one row of data")
     header = [cell.strip() for cell in rows[0]]
     if "time_s" not in header:
-        raise DataError(f"{path}: no time_s column (header: {', '.join(header)})")
+        raise DataError(f"{path}: no time_s column (header: {listed(header)})")
     if outputs is None:
         outputs = [name for name in header if name in available]
         if not outputs:
-            raise DataError(f"{path}: none of the columns {', '.join(h for h in header if h != 'time_s')} is an "
-                            f"output of the campaign ({', '.join(available)})")
+            raise DataError(f"{path}: none of the columns {listed(h for h in header if h != 'time_s')} is an "
+                            f"output of the campaign ({listed(available)})")
     for name in outputs:
         if name not in available:
-            raise DataError(f"--output {name}: not an output of the campaign ({', '.join(available)})")
+            raise DataError(f"--output {shown(name)}: not an output of the campaign ({listed(available)})")
         if name not in header:
-            raise DataError(f"{path}: no column {name!r} (header: {', '.join(header)})")
+            raise DataError(f"{path}: no column {name!r} (header: {listed(header)})")
     table = np.full((len(rows) - 1, len(header)), np.nan)
     for i, row in enumerate(rows[1:], start=2):
         if len(row) != len(header):
@@ -76,7 +85,8 @@ def read_flight_csv(path, outputs: list[str] | None, available: list[str]) -> Fl
                 try:
                     table[i - 2, j] = float(cell)
                 except ValueError:
-                    raise DataError(f"{path}: line {i}, column {header[j]}: expected a number, got {cell!r}") from None
+                    raise DataError(f"{path}: line {i}, column {shown(header[j])}: expected a number, "
+                                    f"got {cell!r}") from None
     time = table[:, header.index("time_s")]
     if not np.all(np.isfinite(time)) or np.any(np.diff(time) <= 0):
         raise DataError(f"{path}: time_s must be finite and strictly increasing")
@@ -109,9 +119,9 @@ def name_values(pairs: list[str], option: str, form: str, names: list[str], amon
         if not sep or not name or not math.isfinite(value) or (positive and not value > 0):
             raise DataError(f"{option}: expected {form}, got {pair!r}")
         if name not in names:
-            raise DataError(f"{option} {name}: not one of {among} ({', '.join(names)})")
+            raise DataError(f"{option} {shown(name)}: not one of {among} ({listed(names)})")
         if name in values:
-            raise DataError(f"{option} {name}: given twice ({values[name]:g} and {value:g}); give it once")
+            raise DataError(f"{option} {shown(name)}: given twice ({values[name]:g} and {value:g}); give it once")
         values[name] = value
     return values
 

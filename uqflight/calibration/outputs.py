@@ -9,6 +9,7 @@ import h5py
 import numpy as np
 import yaml
 
+from ..campaign.schema import LAW_KEYS
 from ..forking import FORKS, Child, ChildFailed, wait_all
 from ..labels import label, parameter_label, short_label
 from ..statistics import json_ready as strict
@@ -96,7 +97,9 @@ def calibrated_campaign(mapping: dict, specs: dict, posterior: dict, prior: dict
     say nothing about them, and a normal approximation would only change their shape. `scores` (M, d)
     are the posterior draws as normal scores under those marginals (`run.normal_scores`): their
     correlation is the copula's; the parameters with a correlation of at least DEPENDENT with another
-    form the `dependence:` group (the others stay independent; an earlier `dependence:` is replaced)."""
+    form the `dependence:` group (the others stay independent; an earlier `dependence:` is replaced).
+    An informed parameter keeps every key but its law (LAW_KEYS): its `property`, or the `function` and
+    `perturbation` it perturbs, and any other."""
     mapping = dict(mapping)
     name = str(mapping.get("name", "campaign"))
     mapping["name"] = f"{name}-calibrated"
@@ -113,7 +116,7 @@ def calibrated_campaign(mapping: dict, specs: dict, posterior: dict, prior: dict
             kept.append(pname)
             continue
         mean, std = post["mean"], post["std"]
-        entry = {"property": original["property"]} if "property" in original else {}
+        entry = {key: value for key, value in original.items() if key not in LAW_KEYS}  # property, function, ...
         entry.update({"distribution": "normal", "nominal": float(mean),
                       "lower": float(mean - 3 * std), "upper": float(mean + 3 * std)})
         parameters[pname] = entry
@@ -158,7 +161,8 @@ def draw_all(plots: list) -> None:
             plot()
         return
     pyplot()  # imported once here, not in each child
-    failed = [str(outcome) for outcome in wait_all([Child(plot) for plot in plots]) if isinstance(outcome, ChildFailed)]
+    failed = [str(outcome) if isinstance(outcome, ChildFailed) else f"raised {outcome}"
+              for outcome in wait_all([Child(plot) for plot in plots]) if isinstance(outcome, (ChildFailed, OSError))]
     if failed:
         raise RuntimeError(f"cannot write a calibration plot: its process {failed[0]} (the error is printed above)")
 

@@ -20,7 +20,7 @@ from .outputs import (OUTPUT_FILES, calibrated_campaign, corner_plot, draw_all, 
                       predictive_plot, pyplot, write_json, write_posterior)
 from .sampler import sample
 from .size import MAX_STEPS, PREDICTIVE_NOISE_DRAWS, campaign_memory_limit, check_size
-from .surrogate import (SurrogateError, calibration_surrogate, check_campaign_text, portable_mapping,
+from .surrogate import (CampaignError, SurrogateError, calibration_surrogate, check_campaign_text, portable_mapping,
                         parameter_specs, prior_summaries, simulate, to_physical, to_standard)
 
 TIME_HANDLING = ("PCE coefficients (and the surrogate's error variance) interpolated linearly in time "
@@ -112,7 +112,8 @@ def _calibrate(results, data, out, outputs, noise, seed, walkers, steps, method,
                                      chain.log_prob[chain.burn:].T.reshape(-1), post, prior, specs, correlation)
     _write_outputs(out, results, data, seed, surrogate, flight, posterior, chain, posterior_draws, truth,
                    sampling, at_data, band, int((~ok).sum()), summary, started)
-    return Calibration(out, summary, list(OUTPUT_FILES))
+    return Calibration(out, summary, [name for name in OUTPUT_FILES if name != "calibrated.yaml"
+                                      or summary["calibrated_campaign"]["written"]])
 
 
 def _stage(progress, text: str, total: int = 0, unit: str = "steps") -> None:
@@ -307,8 +308,13 @@ def _write_outputs(out, results, data, seed, surrogate, flight, posterior, chain
         scores = normal_scores(surrogate.parameters, draws.kappa, draws.post, draws.prior)
         text = calibrated_campaign(portable_mapping(surrogate.campaign), specs, draws.post, draws.prior,
                                    scores, names, f"{results}, {data}")
-        check_campaign_text(text, str(out / "calibrated.yaml"))  # loadable by `uqflight plan`, or a bug here
-        (scratch / "calibrated.yaml").write_text(text, encoding="utf-8")
+        try:  # loadable by `uqflight plan`; a text it refuses is a bug here, which costs no finished calibration
+            check_campaign_text(text, str(out / "calibrated.yaml"))
+        except CampaignError as exc:
+            summary["calibrated_campaign"] = {"written": False, "refused": str(exc)}
+        else:
+            summary["calibrated_campaign"] = {"written": True, "refused": None}
+            (scratch / "calibrated.yaml").write_text(text, encoding="utf-8")
         truth_row = np.array([truth.get(n, np.nan) for n in names]) if truth else None
         properties = [specs[n]["property"] for n in names]
         prior_xi = sampling.prior_draw(posterior, np.random.default_rng(seed + 2), 20000)[:, :len(names)]
@@ -323,7 +329,10 @@ def _write_outputs(out, results, data, seed, surrogate, flight, posterior, chain
         write_json(scratch / "summary.json", summary)
         (out / "plots").mkdir(exist_ok=True)
         for name in OUTPUT_FILES:
-            (scratch / name).replace(out / name)
+            if (scratch / name).exists():
+                (scratch / name).replace(out / name)
+            elif (out / name).is_file():  # an earlier run's calibrated.yaml would look like this run's
+                (out / name).unlink()
     finally:
         shutil.rmtree(scratch, ignore_errors=True)
 

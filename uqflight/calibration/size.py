@@ -4,15 +4,18 @@ options, and refused beyond the campaign's memory limit (limits.max_memory_gb, a
 Per data row and calibrated output, the arrays that grow with the data: the posterior-predictive
 band (predictive draws x noise draws, and the copy its quantiles sort), the simulator runs and the
 surrogate at the draws, and the walkers' residuals in every log-posterior evaluation. The chain
-adds walkers x steps x parameters. The rows are counted without parsing, and only up to the most
-that fit: a file of 10^6 rows is refused after reading the first few hundred thousand lines.
+adds walkers x steps x parameters. The file is a regular file of at most MAX_DATA_BYTES (a device or
+a FIFO, which may never end, is refused before a byte is read); its rows are counted without parsing,
+and only up to the most that fit: a file of 10^6 rows is refused after reading the first few hundred
+thousand lines.
 """
 from __future__ import annotations
 
 from pathlib import Path
 
+from ..bounded import Refused, open_bounded
 from ..campaign.schema import DEFAULT_LIMITS
-from .likelihood import DataError
+from .likelihood import DATA_FORM, MAX_DATA_BYTES, DataError
 
 DEFAULT_WALKERS = 32  # the fewest `calibrate` uses when --walkers is not given
 MAX_STEPS = 6000  # the longest an adaptive chain (no --steps) runs (calibration.sampler)
@@ -51,7 +54,7 @@ def check_size(data, outputs: list[str] | None, walkers: int | None, steps: int 
         raise DataError(f"--walkers {walkers} x --steps {steps} keep a chain of about {chain / 1e9:.3g} GB, more than "
                         f"the {max_memory_gb:g} GB memory limit (limits.max_memory_gb): run fewer --steps")
     try:
-        with open(path, "rb") as fh:
+        with open_bounded(path, MAX_DATA_BYTES, "flight data") as fh:
             header = fh.readline(1 << 20).decode("utf-8-sig", "replace")
             columns = max(len(header.split(",")) - 1, 1)  # every column but time_s may be calibrated
             count = len(outputs) if outputs else columns
@@ -63,6 +66,8 @@ def check_size(data, outputs: list[str] | None, walkers: int | None, steps: int 
                 if not block:
                     return
                 rows += block.count(b"\n")
+    except Refused as exc:
+        raise DataError(f"{path}: {exc}: {DATA_FORM}") from exc
     except OSError as exc:
         raise DataError(f"{path}: cannot read the file ({exc.strerror or exc})") from exc
     raise DataError(f"{path}: more than {most} rows of data: calibrating {count} output(s) with {walkers} walkers "

@@ -15,7 +15,10 @@ from pathlib import Path
 import numpy as np
 
 from ..campaign import Campaign, CampaignError, load_campaign
+from ..bounded import Refused, read_bounded
+from ..campaign.schema import MAX_FILE_BYTES
 from ..campaign.reading import campaign_folder, check_campaign_text, portable_mapping, results_campaign
+from ..console import listed
 from ..designs import is_sampled
 from ..execution import simulate
 from ..methods import METHOD_KINDS, normalised
@@ -83,12 +86,6 @@ class CalibrationSurrogate:
             self._basis = Basis(self.germs, self.indices)
         return self._basis(xi)
 
-    def prior_mean_variance(self, output: str) -> tuple[np.ndarray, np.ndarray]:
-        """Mean and variance over time of the surrogate under the prior (orthonormal basis)."""
-        c = self.coefficients[output]
-        constant = ~self.indices.any(axis=1)
-        return c[constant].sum(axis=0), (c[~constant] ** 2).sum(axis=0)
-
 
 def to_physical(parameters, xi, dependence=None) -> np.ndarray:
     """κ (M, d) from ξ (M, d) (by the Nataf transform of the campaign's `dependence`, if any)."""
@@ -112,8 +109,8 @@ def _campaign_of(store: ResultStore, results: Path, campaign_path: Path | None) 
     source = str(results)
     if campaign_path is not None:
         try:
-            text = campaign_path.read_bytes().decode("utf-8")
-        except (OSError, UnicodeDecodeError) as exc:
+            text = read_bounded(campaign_path, MAX_FILE_BYTES, "a campaign").decode("utf-8")
+        except (OSError, UnicodeDecodeError, Refused) as exc:
             raise SurrogateError(f"--campaign: cannot read {campaign_path} ({exc})") from exc
         if text != store.campaign_text:
             raise SurrogateError(f"{campaign_path} is not the campaign {results} was run from (the texts differ)")
@@ -146,8 +143,8 @@ def calibration_surrogate(results, method: str | None = None, order: int | None 
     results = Path(results)
     try:
         store = ResultStore.open(results)
-    except (OSError, ValueError) as exc:
-        raise SurrogateError(f"{results}: {exc}") from exc
+    except (OSError, ValueError) as exc:  # CorruptFile's message names the file already
+        raise SurrogateError(str(exc) if str(exc).startswith(f"{results}:") else f"{results}: {exc}") from exc
     with store:
         campaign = _campaign_of(store, results, Path(campaign_path) if campaign_path else None)
         try:
@@ -165,7 +162,7 @@ def calibration_surrogate(results, method: str | None = None, order: int | None 
         missing = [name for name in names if name not in store.output_names]
         if missing:
             raise SurrogateError(f"{results} has no output {', '.join(map(repr, missing))} "
-                                 f"(it has {', '.join(store.output_names)})")
+                                 f"(it has {listed(store.output_names)})")
         try:  # the statistics' own PCE, after their checks (pending or failed runs, aliasing, rank)
             fitted = fit_surrogate(results, {"kind": kind, "order": order},
                                    options=Options(band_samples=200, bootstrap=0))

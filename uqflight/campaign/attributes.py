@@ -10,11 +10,10 @@ import functools
 import json
 from dataclasses import dataclass
 
-import yaml
-
 from ..designs import DESIGN_KINDS
 from ..designs.spec import is_integer
 from ..parameters.germs import GERMS
+from ..store.resume import campaign_mapping
 from . import schema
 from .schema import CampaignError, Checker, shown
 
@@ -26,7 +25,7 @@ TEXT = ("campaign_name", "campaign_hash", "campaign_path", "created", "aircraft_
 class StoredFacts:
     """What a results file was made with: its method, germs, analysis options, the parameters that are
     seeds, the copula of dependent inputs (GaussianCopula.summary; None: independent), and its design's kind
-    and recorded facts (designs.Design.info)."""
+    and recorded facts (designs.Design.info), and the campaign's `seed`, which seeds the analysis's draws."""
 
     method: dict
     germs: list[str]
@@ -35,6 +34,7 @@ class StoredFacts:
     dependence: dict | None
     design_kind: str
     design_info: dict
+    seed: int = 0
 
 
 class AttributeChecker(Checker):
@@ -77,30 +77,26 @@ def stored_facts(attrs: dict, source: str, parameters: list[str], quantities: li
     if isinstance(dependence, dict):  # what the indices are of is said again from the names
         dependence = {key: value for key, value in dependence.items() if key != "sobol_of"}
     copula = schema.dependence(check, dependence, parameters, seeds)
-    _check_seed(check, attrs.get("campaign", ""))
-    return StoredFacts(method, germs, analysis, seeds, None if copula is None else copula.summary(), kind, info)
-
-
-SAFE_LOADER = getattr(yaml, "CSafeLoader", yaml.SafeLoader)  # libyaml's, ten times faster, where PyYAML has it
+    seed = _checked_seed(check, attrs.get("campaign", ""))
+    return StoredFacts(method, germs, analysis, seeds, None if copula is None else copula.summary(), kind, info, seed)
 
 
 @functools.lru_cache(maxsize=8)
 def stored_settings(campaign_text: str) -> dict:
     """The stored campaign text's mapping as written (YAML), {} when unreadable or not a mapping: what the
     report shows and reads the seed and the excitation from (shared, not to be changed: the text read once)."""
-    try:
-        data = yaml.load(campaign_text, Loader=SAFE_LOADER)
-    except (yaml.YAMLError, ValueError, RecursionError):  # e.g. a date 2001-13-45, or nesting too deep
-        return {}
-    return data if isinstance(data, dict) else {}
+    return campaign_mapping(campaign_text)
 
 
-def _check_seed(check: Checker, text: str) -> None:
-    """The seed of the stored campaign text, read as the report reads it (it draws the report's runs): an
-    integer >= 0 when given (a text that is no mapping is the report's to show as unreadable)."""
+def _checked_seed(check: Checker, text: str) -> int:
+    """The seed of the stored campaign text, read as the report reads it (it draws the report's runs and
+    the analysis's band, bootstrap and exceedance draws): an integer >= 0 when given, 0 when not (a text
+    that is no mapping is the report's to show as unreadable)."""
     settings = stored_settings(text)
-    if "seed" in settings:
-        check.integer(settings["seed"], "campaign.seed", 0)
+    if "seed" not in settings:
+        return 0
+    check.integer(settings["seed"], "campaign.seed", 0)
+    return int(settings["seed"])
 
 
 def _design_info(check: Checker, info, kind: str, runs: int, d: int) -> dict:

@@ -17,7 +17,8 @@ KEYS = {
     "name": "Required. 1-100 characters among `A-Za-z0-9_.-`, not starting with `.` or `-`; the default "
             "results file is `results/NAME.h5`. `name: paper-pg2-l2`",
     "description": "Free text for people; not read. `description: the paper's level-2 grid`",
-    "seed": "Seeds every random choice (designs, bands, bootstrap, seed parameters). Default 0. `seed: 20261124`",
+    "seed": ("Seeds every random choice (designs, seed parameters, and the analysis's band, PDF, bootstrap, exceedance "
+             "and KLD-floor draws). Default 0. `seed: 20261124`"),
     "simulator": "Required. What flies each run: `{kind: jsbsim, ...}` or `{kind: python, function: ...}`.",
     "parameters": "Required. One entry per uncertain input: `parameters: {CL0: {property: aero/uq/CL0, "
                   "distribution: normal, interval_pct: 23.05}}`",
@@ -199,7 +200,10 @@ VALUES = {
         "interpolation": "Moments from the weights (Eq. 32–34), PCE by projection.",
         "regression": "Least-squares fit of the PCE, weights ignored (Eq. 35–37).",
         "least_squares": "Weighted least-squares fit of the PCE (Eq. 43–48).",
-        "monte_carlo": "Sample moments of the runs; sampled designs only."},
+        "monte_carlo": "Sample moments of the runs; sampled designs only.",
+        "auto": "Per output and quantity, among pseudo_galerkin (grids), least_squares and sparse of `order`, the "
+                "one with the lowest error validated on the runs; the runs' own statistics when none validates. "
+                "Each output's `method` in summary.json says which it took (see [methods](../methods.md))."},
     "design.rule": {
         "gauss_hermite": "Gauss–Hermite (normal inputs; nested: Genz–Keister).",
         "genz_keister": "Genz–Keister, nested (normal inputs).",
@@ -212,6 +216,9 @@ VALUES = {
         "final": "The last step's value.",
         "drop": "How far `of` falls below its value at the window's first step (first − min, 0 if it never "
                 "falls): `{of: h_ft, take: drop}` is an altitude loss.",
+        "change": "The last step's value minus the window's first (last − first): `{of: attitude/psi-deg, take: "
+                  "change}` is the heading change of a turn, continuous across 360° (an angle `of` is unwrapped "
+                  "along the run).",
         "mean": "Time average by the trapezoid rule over the window.",
         "at": "Linear interpolation at `at_s`.",
         "at_first": "The value of `of` at the first step meeting `when`, no interpolation: the touchdown sink "

@@ -22,6 +22,7 @@ from . import Campaign, build_campaign, read_settings, schema
 from .schema import CampaignError, Checker
 
 STORED_KEYS = ("name", "property", "distribution", "nominal", "lower", "upper")
+REFLY = "fly the campaign again (`uqflight run CAMPAIGN --out FILE --restart` starts this file over)"
 
 
 def parameter_rows(parameters: list[Parameter]) -> list[dict]:
@@ -93,6 +94,10 @@ def _from_aircraft(check: Checker, data: dict, simulator: dict, attrs: dict) -> 
     from ..simulators.validation_view import validation_view
 
     recorded = str(attrs.get("campaign_path", "")) or "<results file>"  # no path: the working directory
+    if not isinstance(simulator.get("aircraft"), str):  # e.g. a script's: only its run resolved it
+        check.fail("simulator.aircraft", "the campaign stored in the file names no aircraft (its script does), and "
+                                         f"the file records no parameters attribute to take the nominal values "
+                                         f"from: {REFLY}")
     simulator = dict(simulator)
     locate_aircraft(check, simulator, str(Path(recorded)))
     try:

@@ -26,6 +26,7 @@ EXECUTORS = ("local", "dask")
 TOP_KEYS = ("name", "description", "seed", "simulator", "parameters", "design", "method",
             "execution", "storage", "analysis", "limits", "quantities", "dependence")
 PARAMETER_KEYS = ("property", "function", "perturbation", "distribution", "nominal", "interval_pct", "lower", "upper")
+LAW_KEYS = ("distribution", "nominal", "interval_pct", "lower", "upper")  # a parameter's law; the rest say what it sets
 PERTURBATIONS = ("scale", "offset", "offset_value")
 METHOD_KEYS = ("kind", "order", "split", "allow_aliasing")
 EXECUTION_KEYS = ("workers", "executor", "scheduler", "chunk", "timeout_s")
@@ -620,4 +621,10 @@ def check_size(check: Checker, data: dict, simulator: dict, parameters: list, me
         check.fail("storage", f"the results file would take about {disk / 1e9:.3g} GB ({n:.4g} runs of "
                               f"{times:.4g} times x {n_outputs} outputs), more than limits.max_disk_gb = "
                               f"{limits['max_disk_gb']:g}")
+    from ..store.layout import MAX_OUTPUT_VALUES  # what every reader of the results file holds
+
+    if n * times > MAX_OUTPUT_VALUES:
+        check.fail("design", f"{n:.4g} runs x {times:.4g} times = {n * times:.4g} values per output, more than the "
+                             f"results file's readers hold ({MAX_OUTPUT_VALUES:.4g}): choose fewer runs, or record "
+                             "fewer times (a lower output rate or a shorter flight)")
     return figures

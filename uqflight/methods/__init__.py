@@ -11,7 +11,9 @@ is built, the rule its points must satisfy before it runs, and how its mean and 
 * ``regression``: V c = Y by least squares (Eq. 36), the weights ignored; moments from the PCE;
 * ``least_squares``: weighted least squares (Eq. 44) with |w|; moments from the PCE;
 * ``sparse``: LARS or OMP over q-hyperbolic candidates up to max_order, the basis and order chosen by the
-  corrected leave-one-out error (`sparse`); one basis per output for all times; moments from the PCE.
+  corrected leave-one-out error (`sparse`); one basis per output for all times; moments from the PCE;
+* ``auto``: per output, among the methods the design allows (AUTO_CANDIDATES), the one with the lowest
+  validated error (`validation`), or the runs' own statistics when none validates.
 
 Rules before anything runs (`validity.method_problem`): a projection of total order p needs a grid
 exact to degree 2p; a fit needs a design matrix of full rank Z on the actual points; a selection (sparse)
@@ -80,6 +82,9 @@ FAILED_RUNS = {
     "extrapolated": ("statistics of a fit extrapolated over the failed region",
                      "{kind} fits its PCE on the {ok} successful runs and its statistics are the PCE's over the "
                      "whole input law, including the region where the model has no value"),
+    "chosen": ("statistics of the method chosen per output",
+               "auto chose among the methods the {ok} successful runs allow: a fit extrapolates over the failed "
+               "region, the runs' own statistics are conditional on success (each output says which it took)"),
     "projected": ("statistics of a projection of the successful runs, of neither law",
                   "{kind} projects the {ok} successful runs alone: its mean is the mean conditional on success, "
                   "but its PCE (the bands, PDFs and Sobol' indices, and pseudo_galerkin's variance) is that of "
@@ -115,7 +120,13 @@ METHODS: dict[str, Method] = {
     "sparse": Method("sparse", sparse_pce, "pce", "selection", "extrapolated", partial=True, weighted=False,
                      linear=False, settings=(("selection", "lars"), ("q", 1.0)), order_key="max_order",
                      settings_problem=settings_problem),
+    # per output, the method of AUTO_CANDIDATES with the lowest validated error (statistics.auto_method)
+    "auto": Method("auto", None, "pce", None, "chosen", partial=True, weighted=False,
+                   exported_as=("least_squares", "pseudo_galerkin")),
 }
+# what `auto` chooses among, in this order of preference at equal error; the runs' own statistics
+# (monte_carlo on a sampled design, integration's weighted runs on a grid of weights >= 0) when none validates
+AUTO_CANDIDATES = ("pseudo_galerkin", "least_squares", "sparse")
 METHOD_KINDS = tuple(METHODS)
 
 
@@ -147,6 +158,14 @@ def fit(kind: str, xi, weights, Y, germs, order: int = 2, x0=None, *, scale=None
     from ..analysis.moments import as_runs_by_time, weighted_moments
 
     method = method_entry(kind)
+    if kind == "auto":  # the candidate that validates on these runs, or the runs' own moments (validation)
+        from .validation import auto_choice
+
+        Y = as_runs_by_time(Y)
+        taken = auto_choice(xi, weights, Y, scale, germs, order, sampled)[0]
+        fallback = "monte_carlo" if sampled else "integration"
+        return fit(taken or fallback, xi, weights, Y, germs, order, scale=scale, sampled=sampled or taken is None,
+                   settings=method_settings({"kind": taken}) if taken else None)
     if x0 is not None and not method.split:
         split = " and ".join(k for k, m in METHODS.items() if m.split)
         raise ValueError(f"x0 (the split form x = x0 + S) applies to {split}; {kind!r} either builds no "
@@ -200,5 +219,5 @@ def method_entry(kind: str) -> Method:
     return METHODS[kind]
 
 
-__all__ = ["FAILED_RUNS", "METHODS", "METHOD_KINDS", "PCE", "Method", "Result", "exported_kind", "failed_runs_note",
-           "fit", "method_entry"]
+__all__ = ["AUTO_CANDIDATES", "FAILED_RUNS", "METHODS", "METHOD_KINDS", "PCE", "Method", "Result", "exported_kind",
+           "failed_runs_note", "fit", "method_entry"]

@@ -3,7 +3,7 @@ the linearised model), from a campaign's top-level `quantities:` mapping, comput
 every integration step and stored in /quantities/<NAME> (NaN where undefined in a run).
 
 Kinds of `take` (keys in braces; every one but the modes takes `after_s`/`before_s` too):
-- max, min, final, mean, drop {of}; at {of, at_s}: see takes.py for exactly what each computes;
+- max, min, final, mean, drop, change {of}; at {of, at_s}: see takes.py for exactly what each computes;
 - at_first {of, when: {of, above | below}}; time_of_first {when};
 - phugoid_period_s, phugoid_damping, short_period_frequency_rad_s, short_period_damping {}: the modes
   of JSBSim's linearised model at the level-flight trim point (modes.py).
@@ -35,6 +35,7 @@ REGISTRY: dict[str, TakeKind] = {
     "min": TakeKind(takes.Min, ("of",), {"of": "h_ft", "take": "min"}),
     "final": TakeKind(takes.Final, ("of",), {"of": "h_ft", "take": "final"}),
     "drop": TakeKind(takes.Drop, ("of",), {"of": "h_ft", "take": "drop"}),
+    "change": TakeKind(takes.Change, ("of",), {"of": "h_ft", "take": "change"}),
     "mean": TakeKind(takes.Mean, ("of",), {"of": "h_ft", "take": "mean", "after_s": 10.0}),
     "at": TakeKind(takes.At, ("of", "at_s"), {"of": "h_ft", "take": "at", "at_s": 20.0}),
     "at_first": TakeKind(takes.AtFirst, ("of", "when"),

@@ -110,3 +110,23 @@ def check_exceedance(check, value, quantities: dict) -> dict[str, list[dict]]:
             (bound, threshold), = item.items()
             found[name].append({bound: check.number(threshold, f"{path}[{i}].{bound}")})
     return found
+
+
+def parse_exceedance_option(texts: list[str]) -> dict[str, list[dict]]:
+    """`report --exceedance` values, "NAME>X" (P(NAME > X)) or "NAME<X", into {NAME: [{above: X} | {below: X}]}
+    in the order given; ValueError naming the text and what is expected (X a finite number)."""
+    import math
+    import re
+
+    found: dict[str, list[dict]] = {}
+    for text in texts:
+        match = re.fullmatch(r"\s*([^<>\s]+)\s*([<>])\s*(\S+)\s*", text)
+        try:
+            threshold = float(match.group(3)) if match else math.nan
+        except ValueError:
+            threshold = math.nan
+        if match is None or not math.isfinite(threshold):
+            raise ValueError(f"expected NAME>X or NAME<X with X a finite number, e.g. peak_nz>3.5, got {text!r}")
+        bound = "above" if match.group(2) == ">" else "below"
+        found.setdefault(match.group(1), []).append({bound: threshold})
+    return found

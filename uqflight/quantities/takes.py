@@ -5,6 +5,7 @@ Every reduction sees the steps inside its window [after_s, before_s] (ends inclu
 WINDOW_SLACK_S); one that sees no step, or whose condition never holds, is undefined (NaN):
 * max, min: over the steps; final: the value at the last step; drop: how far the value falls below
   its value at the window's first step, first − min (0 when it never falls; an altitude loss);
+  change: the value at the last step minus that at the first, last − first (a heading change);
 * mean: the time average by the trapezoid rule over the steps, ∫y dt / (t_last − t_first); a window
   holding one step gives that step's value;
 * at: linear interpolation between the two steps around at_s (exact at a step's time);
@@ -60,6 +61,16 @@ class Drop(Reduction):
             self.first, self.value = x, 0.0
         elif self.first - x > self.value:
             self.value = self.first - x
+
+
+class Change(Reduction):
+    def reset(self):
+        self.value = self.first = NAN
+
+    def update(self, t, x, y):
+        if self.first != self.first:
+            self.first = x
+        self.value = x - self.first
 
 
 class Final(Reduction):

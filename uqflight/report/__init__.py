@@ -44,13 +44,15 @@ def default_out_dir(results: Path) -> Path:
 
 def write_report(paths: list[Path], out_dir: Path | None = None, reference: Path | None = None,
                  times=DEFAULT_TIMES, baseline: Path | None = None, method: dict | list[dict] | None = None,
-                 progress=None, partial: bool = False, allow_aliasing: bool = False, fmt: str = "png") -> list[Path]:
+                 progress=None, partial: bool = False, allow_aliasing: bool = False, fmt: str = "png",
+                 exceedance: dict | None = None) -> list[Path]:
     """Write the whole report of `paths` into `out_dir` (default: next to the first file,
     RESULTS-report/); returns the files written (the baseline last, when asked for).
 
     `method`: one override {"kind", "order"}, a list of them (each file analysed with each, overlaid
     in the plots), or None (each campaign's own). `progress` (a Progress) is told each stage. `partial`,
-    `allow_aliasing`: see statistics.analyse. `fmt`: the figures' format (formats.FORMATS; see
+    `allow_aliasing`, `exceedance` ({quantity: [{above: X} | {below: X}]}, replacing the campaign's
+    thresholds of the quantities it names): see statistics.analyse. `fmt`: the figures' format (formats.FORMATS; see
     formats.exporting). Everything is written into a temporary folder first and
     moved into place at the end; nothing is written when a file is refused (statistics.BadInput)."""
     out_dir = Path(os.path.abspath(out_dir if out_dir is not None else default_out_dir(paths[0])))
@@ -61,7 +63,7 @@ def write_report(paths: list[Path], out_dir: Path | None = None, reference: Path
     drawer = Standby(_ready_to_draw, _draw) if FORKS else None  # gets ready while the files are analysed
     try:
         entries, ref = load_entries(paths, reference, method, progress=progress, partial=partial,
-                                    allow_aliasing=allow_aliasing)
+                                    allow_aliasing=allow_aliasing, exceedance=exceedance)
         out_dir.parent.mkdir(parents=True, exist_ok=True)
         staging = make_staging(out_dir)
         try:

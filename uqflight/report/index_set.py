@@ -50,8 +50,9 @@ def index_set_section(entries: list[Entry], out_dir: Path) -> Section:
         levels = np.array(index_set["indices"], dtype=int).reshape(-1, len(parameters))
         eta = index_set["eta"]
         facts.append(f"{entry.label}: {index_set['rounds']} rounds, {len(levels)} multi-indices, stopped by "
-                     f"{index_set['stopped'] or 'nothing yet (interrupted)'}, error estimate η = "
-                     f"{'n/a' if eta is None else f'{eta:.3g}'}")
+                     f"{index_set['stopped'] or 'nothing yet (interrupted)'}, stopping indicator η = "
+                     f"{'n/a' if eta is None else f'{eta:.3g}'} (what the refinement stopped on, not an error "
+                     "estimate: it can lie far below the error; each output's validation is the check)")
         old = np.array(index_set["old"], dtype=bool)
         refined = np.count_nonzero(levels[old] > 0, axis=0)
         for k in sorted(range(len(parameters)), key=lambda k: (-refined[k], -int(levels[:, k].max()))):

@@ -8,7 +8,9 @@ import re
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from ..campaign import CampaignError
 from ..campaign.attributes import stored_settings
+from ..campaign.reading import parameter_rows, results_campaign
 from ..designs import REGISTRY as DESIGNS
 from ..methods import method_entry
 from ..statistics import Statistics, add_reference_errors, read_statistics
@@ -27,6 +29,7 @@ class Entry:
     path: str = ""  # the results file (several entries share one with several --method)
     output_files: dict = field(default_factory=dict)  # output name → its part of file names, unique in the entry
     file_stem: str = ""  # the results file's part of the names of its own figures (design, runs), unique in the report
+    parameters: list | None = None  # the stored campaign's parameters (STORED_KEYS); None: unreadable (a note)
 
     @property
     def outputs(self) -> dict:
@@ -97,10 +100,12 @@ def flight_facts(simulator: dict) -> dict[str, str]:
 
 
 def load_entries(paths: list[Path], reference: Path | None, method: dict | list[dict] | None = None,
-                 progress=None, partial: bool = False, allow_aliasing: bool = False) -> tuple[list[Entry], Entry | None]:
+                 progress=None, partial: bool = False, allow_aliasing: bool = False,
+                 exceedance: dict | None = None) -> tuple[list[Entry], Entry | None]:
     """Every file analysed once per method (`method`: one override, several, or None for the
     campaigns' own; the reference keeps its own), with errors against the reference unless it is
-    the reference itself, and the reference. `progress` (a Progress) counts each file's outputs."""
+    the reference itself, and the reference. `progress` (a Progress) counts each file's outputs.
+    `exceedance`: thresholds replacing the campaigns' (statistics.analyse)."""
     methods = method if isinstance(method, list) else [method]
     methods = methods or [None]
     stems: set[str] = set()
@@ -112,7 +117,7 @@ def load_entries(paths: list[Path], reference: Path | None, method: dict | list[
     for path in paths:
         for override in methods:
             stats, attrs = read_statistics(path, override, partial=partial, allow_aliasing=allow_aliasing,
-                                           progress=progress)
+                                           progress=progress, exceedance=exceedance)
             if ref is not None and not _same_file(path, reference):
                 add_reference_errors(stats, ref.stats)
             entries.append(_entry(path, stats, attrs, stems, file_stems, with_method=len(methods) > 1))
@@ -141,7 +146,21 @@ def _entry(path: Path, stats: Statistics, attrs: dict, stems: set[str], file_ste
     output_files = {name: _unique(file_name(name), taken) for name in stats.outputs}
     return Entry(stats, stem, label, str(attrs.get("campaign_hash", "")),
                  input_distributions(str(attrs.get("campaign", ""))), dict(attrs), str(path), output_files,
-                 file_stems[Path(path).resolve()])
+                 file_stems[Path(path).resolve()], stored_parameters(path, attrs, stats))
+
+
+def stored_parameters(path, attrs: dict, stats: Statistics) -> list[dict] | None:
+    """The parameters of the campaign stored in the results file `path` (its root attributes `attrs`), read
+    as every reader reads it (`campaign.reading.results_campaign`); None when they cannot be, flagged in
+    the file's notes with the reason (the field and the fix): the report shows the stored text, and its
+    numbers do not depend on it."""
+    try:
+        return parameter_rows(results_campaign(attrs, str(path)).parameters)
+    except (CampaignError, OSError) as exc:
+        reason = " ".join(str(exc).removeprefix(f"{path}: ").split())
+        stats.notes.append(f"the parameters of the campaign stored in {path} cannot be read, and the parameters "
+                           f"table lacks them: {reason}")
+        return None
 
 
 def file_name(name: str) -> str:

@@ -24,7 +24,8 @@ from matplotlib.figure import Figure  # noqa: E402
 from matplotlib.lines import Line2D  # noqa: E402
 from matplotlib.ticker import FixedLocator, FuncFormatter, LogLocator, MaxNLocator, NullFormatter  # noqa: E402
 
-from ..labels import label, short_label  # noqa: E402,F401 (plots.label: the report's captions)
+from ..analysis.sobol import unresolved  # noqa: E402
+from ..labels import label, short_label, shown_time  # noqa: E402,F401 (plots.label: the report's captions)
 from .formats import export_format, shown_path  # noqa: E402
 from .png import write_png  # noqa: E402
 
@@ -322,7 +323,7 @@ def plot_pdfs_over_time(figures: list, slice_times: list[float]) -> list[Path]:
             fig.colorbar(mesh, ax=top, label="density / peak density at that time")
         for color, index in zip(COLORS, time_indices(out.time, slice_times)):
             bottom.plot(out.pdf_support[index], out.pdf_density[index], color=color,
-                        label=f"t = {out.time[index]:g} s")
+                        label=f"t = {shown_time(out.time, index):g} s")
         bottom.set_xlabel(label(out.name, out.units), fontsize=9)
         bottom.set_ylabel(f"probability density [1/{out.units}]" if out.units else "probability density",
                           fontsize=9)
@@ -531,17 +532,59 @@ def plot_sobol(outputs: dict, path: Path, title: str) -> Path:
 
 
 def _sobol_bars(ax, out) -> None:
-    """The first-order indices of a scalar output as bars, with their bootstrap intervals if any."""
+    """The first-order indices of a scalar output as bars, with their bootstrap intervals if any (unclipped,
+    an unresolved index hatched: index_bars)."""
     parameters = list(out.sobol_first)
-    values = np.array([out.sobol_first[p][0] for p in parameters])
-    errors = None
-    if out.sobol_first_ci:
-        lower, upper = (np.array([out.sobol_first_ci[p][k][0] for p in parameters]) for k in (0, 1))
-        errors = np.clip([values - lower, upper - values], 0.0, None)
-    ax.bar(parameters, values, color=COLORS[:len(parameters)], yerr=errors, capsize=6)
+    x = np.arange(len(parameters))
+    ci = ([out.sobol_first_ci[p] for p in parameters] if out.sobol_first_ci else None)
+    found = index_bars(ax, x, [out.sobol_first[p] for p in parameters], ci, COLORS[:len(parameters)], 0.8)
+    index_axis(ax, found)
+    ax.set_xticks(x, parameters, fontsize=8)
     ax.set_title(short_label(out.name), fontsize=10)
     ax.set_ylabel("first-order Sobol' index S_i [-]", fontsize=8)
     ax.grid(alpha=0.3, axis="y")
+
+
+UNRESOLVED_HATCH = "//"
+
+
+def index_bars(ax, x, values, ci, color, width: float) -> list[float]:
+    """Bars of Sobol' indices (a scalar output's or quantity's: each value's first entry) at `x`, with their
+    95 % intervals (`ci`: per bar a (2, 1) array, or None) drawn as they are, never clipped to [0, 1]; a bar
+    whose interval resolves no share (analysis.sobol.unresolved) hatched and marked "n too small" (NaN: no
+    bar). Returns the values and bounds drawn, for `index_axis`."""
+    values = np.array([float(np.asarray(v).ravel()[0]) for v in values])
+    drawn = list(values[np.isfinite(values)])
+    bars = ax.bar(x, np.nan_to_num(values), width=width, color=color)
+    if ci is None:
+        return drawn
+    lower, upper = (np.array([float(np.asarray(c)[k].ravel()[0]) for c in ci]) for k in (0, 1))
+    shown = np.isfinite(values) & np.isfinite(lower) & np.isfinite(upper)
+    ax.vlines(np.asarray(x)[shown], lower[shown], upper[shown], color="k", lw=1.0)
+    for bound in (lower, upper):
+        ax.plot(np.asarray(x)[shown], bound[shown], ls="none", marker="_", color="k", ms=8)
+    drawn += [*lower[shown], *upper[shown]]
+    for bar, loose, top in zip(bars, unresolved(values, (lower, upper)), np.fmax(values, upper)):
+        if loose:
+            bar.set_hatch(UNRESOLVED_HATCH)
+            bar.set_alpha(0.5)
+            ax.annotate("n too small", (bar.get_x() + 0.5 * bar.get_width(), top), textcoords="offset points",
+                        xytext=(0, 3), ha="center", fontsize=6)
+    return drawn
+
+
+def index_axis(ax, drawn: list[float]) -> None:
+    """The y limits of Sobol' indices: [−0.05, 1.05] widened to every value drawn, the parts beyond [0, 1]
+    (where only sampling noise lies) greyed."""
+    finite = np.asarray(drawn, dtype=float)
+    finite = finite[np.isfinite(finite)]
+    low, high = -0.05, 1.05
+    if finite.size:
+        low, high = min(low, finite.min() - 0.05), max(high, finite.max() + 0.15)
+    ax.set_ylim(low, high)
+    if high > 1.05 or low < -0.05:
+        ax.axhspan(1.0, high, color="0.9", zorder=0)
+        ax.axhspan(low, min(0.0, high), color="0.9", zorder=0)
 
 
 def plot_band_comparison(entries: list[tuple[str, dict]], path: Path, title: str) -> Path:

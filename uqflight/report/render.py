@@ -141,7 +141,9 @@ def md(text: str) -> str:
 
 def _cell(value) -> str:
     """A table cell for reading: 4 significant digits, one decimal from 1000 on (an altitude of
-    14966.1 ft, not 1.497e+04); the CSVs keep full precision."""
+    14966.1 ft, not 1.497e+04); the CSVs keep full precision. No value (None) is "—"."""
+    if value is None:
+        return "—"
     if isinstance(value, (float, np.floating)):
         return f"{value:.1f}" if 1e3 <= abs(value) < 1e7 else f"{value:.4g}"
     return str(value)

@@ -9,10 +9,11 @@ import numpy as np
 
 from . import plots
 from .blocks import Figure, Section, Table, _rel
+from ..labels import shown_time
 from .formats import shown_path
+from ..analysis.sobol import unresolved
 from ..forking import share_work
-from .sensitivity import NEGLIGIBLE, index_text, plot_sensitivity
-from ..campaign.reading import stored_parameters
+from .sensitivity import N_TOO_SMALL, NEGLIGIBLE, index_text, plot_sensitivity
 from .loading import Entry, _same_file, bounded, campaign_settings, campaign_simulator, flight_facts, method_label
 
 BELOW_FLOOR = "below reference resolution"
@@ -131,15 +132,13 @@ def run_section(entries: list[Entry], out_dir: Path) -> Section:
                       ("method", methods), ("seed", settings.get("seed", 0)), ("runs", counts),
                       ("created", e.attrs.get("created", "?")), ("aircraft sha256", e.attrs.get("aircraft_hash", "-")),
                       ("campaign sha256", e.campaign_hash), ("versions", versions)])
-        parameters = stored_parameters(e.attrs)
-        if parameters is None:
-            parameter_rows.append([e.stem, "(the campaign text could not be read)", "", "", "", "", ""])
-        else:
-            for p in parameters:
-                spec = ((settings.get("parameters") or {}).get(p["name"]) or {})
-                interval = (f"±{spec['interval_pct']:g} % of nominal" if "interval_pct" in spec else "lower, upper")
-                parameter_rows.append([e.stem, p["name"], p["property"], p["distribution"], p["lower"], p["upper"],
-                                       p["nominal"], interval])
+        if e.parameters is None:  # the reason is in the notes (report.loading.stored_parameters)
+            parameter_rows.append([e.stem, "(the stored campaign cannot be read: see the notes)", "", "", "", "", ""])
+        for p in e.parameters or []:
+            spec = ((settings.get("parameters") or {}).get(p["name"]) or {})
+            interval = (f"±{spec['interval_pct']:g} % of nominal" if "interval_pct" in spec else "lower, upper")
+            parameter_rows.append([e.stem, p["name"], p["property"], p["distribution"], p["lower"], p["upper"],
+                                   p["nominal"], interval])
     header = ["fact"] + [row[0] for row in facts]
     rows = [[fact] + [row[k][1] for row in facts] for k, (fact, _) in enumerate(facts[0][1:], start=1)]
     blocks.append(Table("The campaign: flight condition, excitation, design, method, seed, provenance",
@@ -395,7 +394,8 @@ def sensitivity_section(entries: list[Entry], times: list[float], out_dir: Path)
         rows = [[e.label, name, out.time[i], *(_at(getattr(out, kind), p, i) for p in parameters)]
                 for e in with_sobol for name, out in e.outputs.items() for i in plots.time_indices(out.time, times)]
         caption = f"{what} Sobol' indices at the selected times" + (" (paper Table 3)" if kind == "sobol_first" else "")
-        page = [[label, name, f"{time:g}", *map(index_text, values)] for label, name, time, *values in rows]
+        page = [[e.label, name, f"{shown_time(out.time, i):g}", *(_shown(out, kind, p, i) for p in parameters)]
+                for e in with_sobol for name, out in e.outputs.items() for i in plots.time_indices(out.time, times)]
         blocks.append(Table(caption, ["file", "output", "time [s]", *parameters], rows, f"tables/{kind}.csv",
                             page=(["file", "output", "time [s]", *parameters], page), grouped=True))
     if any(e.pick_freeze for e in with_sobol) and any(not e.pick_freeze for e in with_sobol):
@@ -424,6 +424,16 @@ def pce_vs_mc_table(entries: list[Entry], parameters: list[str]) -> Table:
     page = [[name, f"{time:g}", parameter, *map(index_text, values)] for name, time, parameter, *values in rows]
     return Table("First-order Sobol' indices at the final time: PCE against Monte Carlo pick-freeze (paper Table 4)",
                  header, rows, "tables/sobol_pce_vs_mc.csv", page=(header, page))
+
+
+def _shown(out, kind: str, parameter: str, i: int) -> str:
+    """An index as the page shows it (index_text), "… (n too small)" where its pick-freeze interval resolves no
+    share (analysis.sobol.unresolved)."""
+    text = index_text(_at(getattr(out, kind), parameter, i))
+    ci = getattr(out, f"{kind}_ci").get(parameter)
+    if ci is not None and unresolved(getattr(out, kind)[parameter][i], ci[:, i]):
+        text += f" ({N_TOO_SMALL})"
+    return text
 
 
 def _at(indices: dict, parameter: str, i: int):

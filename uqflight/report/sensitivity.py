@@ -8,14 +8,15 @@ from pathlib import Path
 import numpy as np
 from matplotlib.patches import Patch
 
+from ..analysis.sobol import NEGLIGIBLE, unresolved  # noqa: F401 (NEGLIGIBLE: the report's too)
 from . import plots
 
-NEGLIGIBLE = 1e-4  # a variance below this share of its largest over time (std < 1 % of its largest) is negligible
 TINY_INDEX = 1e-3  # indices below this print as "<0.001"
 TOP = 3  # contributors the headline names
 SHOWN_SHARE = 0.01  # ... each with at least 1 % of the variance
 INTERACTIONS_SHOWN = 0.05  # the interactions' share is named from 5 % on
 UNRESOLVED = "unresolved"
+N_TOO_SMALL = "n too small"  # a pick-freeze index whose interval resolves no share
 GREY = "0.9"  # the times of negligible variance, on the indices
 INTERACTIONS = "0.6"  # the interactions' part of the stack
 
@@ -31,17 +32,32 @@ def index_text(value) -> str:
     return f"<{TINY_INDEX:g}" if abs(value) < TINY_INDEX else f"{value:#.3g}".rstrip(".")
 
 
-def top_contributors(first: dict[str, np.ndarray], i: int) -> str:
+def _percent(share: float) -> str:
+    """A share as a percentage within [0, 100] (an estimate or bound beyond it is sampling noise)."""
+    return f"{100 * min(max(share, 0.0), 1.0):.0f}"
+
+
+def top_contributors(first: dict[str, np.ndarray], i: int, first_ci: dict[str, np.ndarray] | None = None) -> str:
     """The largest first-order shares of the variance at time index i, e.g. "CL0 62 %, k2 21 %", the
-    interactions' share (1 − Σ S_i) appended when it is 5 % or more; "unresolved" where the variance is."""
+    interactions' share (1 − Σ S_i) appended when it is 5 % or more; "unresolved" where the variance is.
+    With pick-freeze intervals (`first_ci`: (2, T) per parameter) each share carries its 95 % interval,
+    "CL0 62 % (55–70 %)", and an index its interval does not resolve (analysis.sobol.unresolved) reads
+    "CL0 unresolved (−0.4 to 9.3, n too small)": no share is shown beyond [0, 100] %."""
     values = {p: float(v[i]) for p, v in first.items()}
     if not values or not all(np.isfinite(list(values.values()))):
         return UNRESOLVED
-    ranked = sorted(values.items(), key=lambda item: -item[1])
-    named = [f"{p} {100 * s:.0f} %" for p, s in ranked[:TOP] if s >= SHOWN_SHARE]
+    intervals = {p: (float(first_ci[p][0][i]), float(first_ci[p][1][i])) for p in values} if first_ci else {}
+    loose = [p for p in values if p in intervals and unresolved(values[p], intervals[p])]
+    ranked = sorted(((p, s) for p, s in values.items() if p not in loose), key=lambda item: -item[1])
+    named = []
+    for p, s in ranked[:TOP]:
+        if s >= SHOWN_SHARE:
+            interval = f" ({_percent(intervals[p][0])}–{_percent(intervals[p][1])} %)" if p in intervals else ""
+            named.append(f"{p} {_percent(s)} %{interval}")
     rest = 1.0 - sum(values.values())
-    if rest >= INTERACTIONS_SHOWN:
-        named.append(f"interactions {100 * rest:.0f} %")
+    if not loose and rest >= INTERACTIONS_SHOWN:
+        named.append(f"interactions {_percent(rest)} %")
+    named += [f"{p} {UNRESOLVED} ({intervals[p][0]:.2g} to {intervals[p][1]:.2g}, {N_TOO_SMALL})" for p in loose]
     return ", ".join(named) or "none above 1 %"
 
 

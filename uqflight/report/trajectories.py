@@ -11,6 +11,7 @@ from matplotlib.collections import LineCollection
 from matplotlib.lines import Line2D
 from matplotlib.ticker import MaxNLocator
 
+from ..analysis.angles import angle_period, on_branch
 from ..simulators.base import Status
 from ..store import ResultStore
 from . import plots
@@ -30,6 +31,15 @@ def run_subset(status: np.ndarray, count: int, seed: int) -> np.ndarray:
     return np.sort(np.random.default_rng(seed).choice(ok, size=count, replace=False))
 
 
+def drawn_runs(runs: np.ndarray, out) -> np.ndarray:
+    """The runs (N, T) as the statistics `out` see them: an angle's unwrapped onto the statistics' branch
+    (analysis.angles), the others as stored."""
+    period = angle_period(out.units)
+    if not out.unwrapped or period is None or not np.isfinite(out.mean[0]):
+        return runs
+    return on_branch(runs, float(out.mean[0]), period)
+
+
 def plot_spaghetti(results: Path, outputs: dict, path: Path, title: str, seed: int,
                    count: int = SPAGHETTI_RUNS) -> tuple[Path, int]:
     """One panel per output over time: the subset's runs thin, the mean and the 99 % band of `outputs`
@@ -37,7 +47,7 @@ def plot_spaghetti(results: Path, outputs: dict, path: Path, title: str, seed: i
     names = [name for name, out in outputs.items() if out.time.size > 1]
     with ResultStore.open(results) as store:
         rows = run_subset(store.status, count, seed)
-        histories = {name: store.output_matrix(name, rows) for name in names}
+        histories = {name: drawn_runs(store.output_matrix(name, rows), outputs[name]) for name in names}
     fig, axes = plots._panels(len(names), title, row_height=2.6)
     for ax, name in zip(axes, names):
         out = outputs[name]
@@ -70,17 +80,18 @@ def scatter_rows(results: Path, outputs: dict, quantities: dict, time: float, se
     """What `plot_scatter` draws, for a seeded subset of at most SCATTER_RUNS successful runs: their
     inputs in physical values ("kappa", "names"), and per row ("outputs": each output over time at the
     recorded time nearest `time`, labelled "NAME at T s [unit]", or its one value; "quantities": each
-    defined quantity)
+    defined quantity, labelled "NAME [unit]")
     (the runs' values, the total Sobol' indices {parameter: (T,)}, the time index)."""
     with ResultStore.open(results) as store:
         drawn = run_subset(store.status, SCATTER_RUNS, seed)
         at_time = {}
         for name, out in outputs.items():
             i = plots.time_indices(out.time, [time])[0]
-            at = f" at {out.time[i]:g} s" if out.time.size > 1 else ""
+            at = f" at {plots.shown_time(out.time, i):g} s" if out.time.size > 1 else ""
             at_time[f"{plots.short_label(name)}{at}" + (f" [{out.units}]" if out.units else "")] = (
-                store.output_matrix(name, drawn)[:, i], out.sobol_total, i)
-        of_quantities = {name: (store.quantity(name)[drawn], q.output.sobol_total, 0)
+                drawn_runs(store.output_matrix(name, drawn), out)[:, i], out.sobol_total, i)
+        of_quantities = {plots.label(name, q.units): (
+            drawn_runs(store.quantity(name)[drawn][:, None], q.output)[:, 0], q.output.sobol_total, 0)
                          for name, q in quantities.items() if q.output is not None}
         return {"kappa": store.kappa[drawn], "names": store.parameter_names, "outputs": at_time,
                 "quantities": of_quantities}

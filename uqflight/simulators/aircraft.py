@@ -13,13 +13,14 @@ the engines, thrusters and systems it names that live in the root's shared folde
 `AircraftFiles` holds them as bytes (keyed by path), hashes them, and writes them out as a root
 of their own (the patched copies and the copies on remote workers are such roots). Every name in
 those files (`file=` attributes, output files, symbolic links) must stay in the folders JSBSim
-looks in: `AircraftUnsafe` otherwise, before anything is read or written.
+looks in, every file must be one Python's parser reads (JSBSim's may read more), and the main file
+names no `<child>` aircraft: `AircraftUnsafe` otherwise, before anything is read or written
+(directives.py says what JSBSim does with each name).
 """
 from __future__ import annotations
 
 import hashlib
 import os
-import re
 import shutil
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass, field
@@ -27,6 +28,8 @@ from pathlib import Path
 
 import jsbsim
 
+from ..console import one_line
+from .directives import checked, local_name, parsed, without_io
 from .safe_paths import is_inside, outside_links, relative_name, single_name
 
 PACKAGE_ROOT = Path(__file__).resolve().parents[1]  # uqflight/: holds aircraft/bacm as package data
@@ -131,7 +134,6 @@ def locate(aircraft: str | os.PathLike, base: Path | None = None) -> AircraftLoc
 MAX_FILES = 4096          # an aircraft's files, and a bundle's (the largest stock aircraft: 13 files)
 MAX_BYTES = 64 * 2**20    # their total size (the largest stock aircraft: 0.3 MB)
 ENGINE_TAGS, SYSTEM_TAGS = ("engine", "thruster"), ("system", "flight_control", "autopilot")
-NETWORK_OUTPUTS = ("SOCKET", "FLIGHTGEAR")  # `<output type=...>` whose name is a host, not a file
 
 
 class AircraftUnsafe(AircraftUnreadable):
@@ -173,24 +175,19 @@ def _folder_files(folder: Path) -> dict[str, Path]:
 
 
 def _file_names(xml: bytes, file: Path) -> list[tuple[str, str]]:
-    """(tag, file= value) of every element naming a file, each checked to stay in its folder (and
-    the file an `<output>` directive has JSBSim write: its name, unless it is a network output)."""
-    names = []
-    for element in ET.fromstring(xml).iter():
-        attributes = ["file"]
-        if element.tag == "output" and (element.get("type") or "").upper() not in NETWORK_OUTPUTS:
-            attributes.append("name")
-        for attribute in attributes:
-            value = element.get(attribute)
-            if value is not None and relative_name(value) is None:
-                raise AircraftUnsafe(
-                    f'{file}: <{element.tag} {attribute}="{value}">: expected a path relative to the aircraft\'s '
-                    "folder (or to JSBSim's engine/ and systems/ folders), without / at the start, .. leading out "
-                    "of it, a drive or a backslash; uqflight neither reads nor copies a file outside them, nor "
-                    "lets JSBSim write one")
-        if element.get("file") is not None:
-            names.append((element.tag, element.get("file")))
-    return names
+    """(element name, file= value) of every element naming a file, each checked to stay in its folder
+    as JSBSim reads it (directives.checked); AircraftUnsafe naming the file when Python cannot parse it."""
+    return checked(parsed(xml, file, AircraftUnsafe), file, AircraftUnsafe,
+                   "the aircraft's folder (or to JSBSim's engine/ and systems/ folders)")
+
+
+def _no_child(xml: bytes, file: Path) -> None:
+    """Refuse a `<child>` aircraft in the main file: JSBSim would load it from the root, unchecked."""
+    for element in ET.fromstring(xml):
+        if local_name(element.tag) == "child":
+            raise AircraftUnsafe(f'{file}: <child name="{one_line(element.get("name", ""))}">: JSBSim would load that aircraft '
+                                 "from the root's aircraft folder, files uqflight neither checks nor copies; "
+                                 "uqflight flies one aircraft: remove the <child> element")
 
 
 @dataclass
@@ -217,17 +214,13 @@ class AircraftFiles:
                 raise AircraftUnsafe(f"{folder}: its .xml files exceed {MAX_BYTES / 2**20:.0f} MiB: expected an "
                                      "aircraft folder")
         main = f"{location.name}.xml"
-        names = []
-        for key, data in files.items():
-            try:
-                names += _file_names(data, paths[key])
-            except ET.ParseError as exc:
-                if key == main:
-                    raise AircraftUnreadable(f"{folder / main} is not well-formed XML ({exc}); JSBSim cannot "
-                                             "load it either") from None
         if main not in files:
             raise AircraftUnreadable(f"{folder / main} is not well-formed XML (no element found); JSBSim "
                                      "cannot load it either")
+        names = []
+        for key, data in files.items():  # every file JSBSim may read (its main file, or one named) is checked
+            names += _file_names(data, paths[key])
+        _no_child(files[main], folder / main)
         for tag, name in names:
             if tag not in ENGINE_TAGS + SYSTEM_TAGS:
                 continue
@@ -241,6 +234,7 @@ class AircraftFiles:
                     raise AircraftUnsafe(f"{shared} leads outside {location.root / kind} (a symbolic link): "
                                          "uqflight neither follows nor copies it")
                 files[f"{SHARED}{kind}/{file}"] = shared.read_bytes()
+                _file_names(files[f"{SHARED}{kind}/{file}"], shared)
         return cls(location.name, files)
 
     @property
@@ -255,6 +249,12 @@ class AircraftFiles:
 
     def with_main(self, xml: bytes) -> "AircraftFiles":
         return AircraftFiles(self.name, {**self.files, f"{self.name}.xml": xml})
+
+    def without_io(self) -> "AircraftFiles":
+        """The files with the main file's `<input>` and `<output>` directives removed (directives.py:
+        JSBSim then writes, connects to and listens on nothing); the files themselves when it has none."""
+        main = without_io(self.main)
+        return self if main is None else self.with_main(main)
 
     def write_root(self, root: Path) -> Path:
         """Write the files as a JSBSim root (`aircraft/NAME/...`, `engine/`, `systems/`); returns root.
@@ -325,25 +325,12 @@ def aero_functions(xml: bytes) -> list[AeroFunction]:
     return found
 
 
-def engines(xml: bytes) -> list[tuple[str, str]]:
-    """(engine file, thruster file) per engine of the aircraft, in order."""
-    tree = ET.fromstring(xml)
-    result = []
-    for engine in tree.iter("engine"):
-        thruster = engine.find("thruster")
-        result.append((engine.get("file", ""), thruster.get("file", "") if thruster is not None else ""))
-    return result
-
-
-def safe_name(text: str) -> str:
-    return re.sub(r"[^A-Za-z0-9_.-]+", "_", text)
-
-
 # Flight condition used when a campaign or the command line states none: inside each tested
 # aircraft's envelope (measured: trims and holds level flight, see docs/own-aircraft.md).
 DEFAULT_CONDITIONS = {
     "bacm": {"altitude_ft": 15000.0, "airspeed_ktas": 200.0},
     "c172p": {"altitude_ft": 4000.0, "airspeed_ktas": 100.0},
+    "c172x": {"altitude_ft": 4000.0, "airspeed_ktas": 100.0},  # trims level from 45 to 125 KTAS there
     "737": {"altitude_ft": 10000.0, "airspeed_ktas": 280.0},
     "f16": {"altitude_ft": 15000.0, "airspeed_ktas": 400.0},
 }

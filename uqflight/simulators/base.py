@@ -1,4 +1,4 @@
-"""What every simulator shares: the run status codes, the errors of a failed sample, the protocol.
+"""What every simulator shares: the run status codes, the errors of a failed sample.
 
 The status codes are stored per run in `/samples/status` of a results file; they are defined here
 once, and each error class carries its own code.
@@ -6,9 +6,8 @@ once, and each error class carries its own code.
 from __future__ import annotations
 
 import enum
-from typing import Protocol
 
-import numpy as np
+from ..console import one_line, shown
 
 
 class Status(enum.IntEnum):
@@ -48,29 +47,11 @@ class NominalFailed(RuntimeError):
 
 def nominal_failed(names, kappa, exc: Exception) -> NominalFailed:
     """The NominalFailed that says sample `kappa` of the parameters `names` failed with `exc`."""
-    values = ", ".join(f"{name} = {float(value):.10g}" for name, value in zip(names, kappa))
+    values = ", ".join(f"{shown(name)} = {float(value):.10g}" for name, value in zip(names, kappa))
     return NominalFailed(
         f"the nominal sample failed ({values}: the centre of every parameter's law, ξ = 0), which uqflight "
-        f"runs first to learn the outputs, the time grid and the cost of a run: {type(exc).__name__}: {exc}. "
+        f"runs first to learn the outputs, the time grid and the cost of a run: {type(exc).__name__}: "
+        f"{one_line(str(exc))}. "
         "Make the simulator succeed at these values (call simulator.function with them to see why), or move "
         "the parameters' intervals (lower and upper, or nominal with interval_pct) so that their centre is an "
         "input it accepts")
-
-
-class Simulator(Protocol):
-    """One object per worker that turns a row of physical values κ into outputs."""
-
-    units: dict[str, str]
-
-    def layout(self, kappa: np.ndarray) -> tuple[np.ndarray, list[str]]:
-        """The recorded times and the output names (one call at the nominal point, if needed)."""
-
-    def evaluate(self, kappa: np.ndarray, observers=()) -> dict[str, np.ndarray]:
-        """{output name: (T,)} for one sample; raises a FlightError subclass for a failed one. Each
-        observer's `step(t, values)` sees every step (uqflight.quantities.recorder)."""
-
-    def source(self, name: str) -> tuple[str, float]:
-        """The property (or output) a quantity's `of:` reads, and the scale to its unit."""
-
-    def restart(self) -> None:
-        """Forget what earlier samples left behind (called at the start of every chunk)."""

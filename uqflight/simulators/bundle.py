@@ -26,6 +26,7 @@ import zlib
 from dataclasses import replace
 from pathlib import Path
 
+from ..bounded import Refused, read_bounded
 from .aircraft import MAX_BYTES, MAX_FILES, AircraftFiles, AircraftUnsafe, cache_dir, unsafe_key
 from .safe_paths import relative_name, single_name
 from .scenarios import scenario_entry
@@ -135,7 +136,10 @@ def python_bundle(simulator: dict, base: str | Path) -> dict | None:
     if not module.endswith(".py"):
         return None
     file = Path(module) if Path(module).is_absolute() else Path(base) / module
-    data = file.read_bytes()
+    try:  # a regular file, bounded as an aircraft's files
+        data = read_bounded(file, MAX_BYTES, "a python model")
+    except Refused as exc:
+        raise Refused(f"simulator.function: {file}: {exc}") from None
     return {"kind": "python", "name": file.name, "attribute": attribute,
             "hash": hashlib.sha256(data).hexdigest(), "zip": _zip({file.name: data})}
 

@@ -13,6 +13,7 @@ computed by one, at every integration step.
 from __future__ import annotations
 
 import math
+import os
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -170,6 +171,7 @@ class FlightResult:
     time: np.ndarray
     outputs: dict[str, np.ndarray]
     trim: TrimResult | None  # None: the scenario has no trim of its own (a script trims itself, if at all)
+    warnings: list[str] = field(default_factory=list)  # what the reader must know, e.g. an unmoved surface
 
 
 class Observer(Protocol):
@@ -257,8 +259,15 @@ class PropertyAccess:
         return self.node(prop), scale
 
 
+SURFACE = "fcs/elevator-pos-deg"  # the surface the excitation must move
+UNMOVED_FRACTION = 0.1  # a surface that moves less than this share of the commanded amplitude is unmoved
+
+
 class JSBSimFlight(PropertyAccess):
     """A loaded aircraft that flies any number of samples: reset, set, trim, excite, record."""
+
+    diagnose_trim_failures = True  # a failed trim says why (stall, speed range); false: the state only
+    surface_warning: str | None = None  # after a flight: the excitation left the elevator unmoved (why), or None
 
     def __init__(self, setup: FlightSetup = FlightSetup(), preflight: bool = True):
         """`preflight` false: the caller reloads an aircraft this process has already loaded (and so
@@ -267,6 +276,7 @@ class JSBSimFlight(PropertyAccess):
         self.setup = setup
         self._bind(jsbsim.FGFDMExec(str(setup.root)), setup.aircraft)
         self.fdm.set_debug_level(0)
+        self.fdm.set_output_path(os.devnull)  # no state file (directives.py)
         if not self.fdm.load_model(setup.aircraft):
             raise RuntimeError(f"JSBSim could not load aircraft {setup.aircraft!r} from {setup.root}")
         self.fdm.set_dt(1.0 / setup.rate_hz)
@@ -377,9 +387,11 @@ class JSBSimFlight(PropertyAccess):
                 f"pitch trim = {fdm['fcs/pitch-trim-cmd-norm']:.3f}, elevator = {fdm['fcs/elevator-pos-deg']:.2f} deg")
         where = (f"JSBSim trim failed ({str(exc).strip() or 'no convergence'}) at {self.setup.altitude_ft:g} ft, "
                  f"{self.setup.airspeed_ktas:g} KTAS")
-        from .trim import lift_shortfall  # trim imports this module
+        if not self.diagnose_trim_failures:
+            return f"{where} ({left})"
+        from .trim import lift_shortfall, speed_range_shortfall  # trim imports this module
 
-        stall = lift_shortfall(self)
+        stall = lift_shortfall(self) or speed_range_shortfall(self)
         if stall:
             return f"{where}: {stall} (JSBSim's trim left {left})"
         return f"{where}: {worst.split('/')[-1].split('-')[0]} not trimmable ({left})"
@@ -430,18 +442,32 @@ class JSBSimFlight(PropertyAccess):
         watch = Watch(self, observers) if observers else None
         if watch:
             watch(0.0)
+        surface = self.node(SURFACE) if changes.size and self.has_property(SURFACE) else None
+        excited = np.flatnonzero(excitation) if surface is not None else ()
+        first, last = (int(excited[0]), int(excited[-1])) if len(excited) else (n_steps, -1)
+        trimmed_surface, moved = (surface.get_double_value() if surface is not None else 0.0), 0.0
         for i in range(n_steps):
             if i in change_at:
                 exc_node.set_double_value(exc_base + exc_per_deg * change_at[i])
             run()
+            if first <= i <= last:  # the excitation is on: how far has the surface gone from its trim
+                moved = max(moved, abs(surface.get_double_value() - trimmed_surface))
             if watch:
                 watch((i + 1) / s.rate_hz)
             if (i + 1) % k == 0:
                 data[(i + 1) // k] = [node.get_double_value() for node, _ in self._recorded]
         exc_node.set_double_value(exc_base)
+        commanded = float(np.max(np.abs(excitation))) if len(excited) else 0.0
+        self.surface_warning = None if not commanded or moved >= UNMOVED_FRACTION * commanded else (
+            f"the {s.excitation.kind} of {s.excitation.amplitude_deg:g} deg never moved the elevator: {SURFACE} "
+            f"went {moved:.3g} deg from its trimmed {trimmed_surface:.3g} deg while it was commanded (below "
+            f"{UNMOVED_FRACTION:.0%} of the amplitude: a dead band or hysteresis in the aircraft's actuator, e.g. "
+            "c172x's 2.9 deg), so the flight is not excited: give a larger amplitude (excitation.amplitude_deg in "
+            "a campaign, --amplitude-deg on the command line)")
         data *= np.array([scale for _, scale in self._recorded])
         self._check_envelope(data)
-        return FlightResult(time=time, outputs=dict(zip(s.outputs, data.T.copy())), trim=trim)
+        return FlightResult(time=time, outputs=dict(zip(s.outputs, data.T.copy())), trim=trim,
+                            warnings=[self.surface_warning] if self.surface_warning else [])
 
     def _excitation_input(self):
         """(node, trimmed value, command per degree) of the elevator excitation: the aircraft's

@@ -171,7 +171,9 @@ def declared_properties(xml: bytes) -> set[str]:
 
 class PreparedAircraft:
     """The aircraft a simulator flies: its name, the root JSBSim loads it from, its files (patched
-    when parameters scale or offset its functions) and their hash."""
+    when parameters scale or offset its functions, without the main file's `<input>` and `<output>`
+    directives: see directives.py) and their hash. Files changed either way are flown from a copy in
+    the cache."""
 
     def __init__(self, aircraft: str, base=None, properties=(), patches=()):
         from .aircraft import locate
@@ -182,10 +184,9 @@ class PreparedAircraft:
         own = declared_properties(original.main)
         self.patches = sorted(set(patches) | set(patches_from_properties(
             properties, self.functions, existing=lambda p: p in own)))
-        self.original_hash = original.hash()
-        self.files = patched_files(original, self.patches)
+        self.files = patched_files(original, self.patches).without_io()  # JSBSim's input and output directives go
         self.name = self.location.name
-        if self.patches or not self.location.loadable_from_root:
+        if self.files is not original or not self.location.loadable_from_root:
             self.root = self.files.cached_root()
         else:
             self.root = self.location.root

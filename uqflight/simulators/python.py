@@ -69,6 +69,7 @@ class PythonSimulator:
         self.seeds = set(config.get("seed_parameters", ()))  # given to the function as Python ints
         self.outputs = config.get("outputs")
         self.units: dict[str, str] = {}
+        self.time: np.ndarray | None = None  # the nominal run's times (`layout`), which every run must return
 
     def layout(self, kappa: np.ndarray) -> tuple[np.ndarray, list[str]]:
         """Time and output names, from one call at `kappa` (the nominal point); NominalFailed when the
@@ -86,13 +87,23 @@ class PythonSimulator:
         if len(set(lengths.values())) != 1:
             raise ValueError(f"simulator.outputs: outputs of different lengths {lengths}; run one campaign per time grid")
         length = next(iter(lengths.values()))
-        time = np.asarray(raw["time"], dtype=float) if "time" in raw else np.arange(length, dtype=float)
+        time = self._time(raw, length)
         if time.shape != (length,):
             raise ValueError(f"simulator.function: 'time' has {time.size} entries, the outputs {length}")
         if not np.isfinite(time).all() or np.any(np.diff(time) <= 0):
             raise ValueError("simulator.function: 'time' must be finite and strictly increasing")
         self.outputs = list(names)
+        self.time = time
         return time, self.outputs
+
+    def expect_time(self, time: np.ndarray) -> None:
+        """Check every run's times against `time`, the nominal run's (`layout`'s in another process)."""
+        self.time = np.asarray(time, dtype=float)
+
+    @staticmethod
+    def _time(raw: dict, length: int) -> np.ndarray:
+        """The times the function gave (its "time" entry), else its steps numbered 0, 1, 2, ..."""
+        return np.asarray(raw["time"], dtype=float) if "time" in raw else np.arange(length, dtype=float)
 
     def evaluate(self, kappa: np.ndarray, observers=()) -> dict[str, np.ndarray]:
         """The outputs at `kappa`; each observer gets `step(t, values)` at every time point of the
@@ -105,9 +116,29 @@ class PythonSimulator:
             result[name] = np.atleast_1d(np.asarray(raw[name], dtype=float))
             if not np.all(np.isfinite(result[name])):
                 raise DivergenceError(f"NaN or infinite value in output {name!r}")
+        self._check_time(raw, result)
         for observer in observers:
             self._feed(observer, raw, result)
         return result
+
+    def _check_time(self, raw: dict, result: dict) -> None:
+        """FlightError when the run's times are not the nominal run's (`layout`'s), which every run's values
+        are stored against: a run on another grid of the same length would be stored against the wrong
+        times."""
+        grid = self.time
+        if grid is None or not result:
+            return
+        time = self._time(raw, len(next(iter(result.values()))))
+        if time.shape != grid.shape and "time" not in raw:
+            return  # outputs of another length: the worker's check of the outputs' lengths says so
+        if time.shape != grid.shape or not np.array_equal(time, grid):
+            if time.shape != grid.shape:
+                found = f"{time.size} times"
+            else:
+                first = int(np.flatnonzero(time != grid)[0])
+                found = f"time {time[first]:g} where the nominal run has {grid[first]:g}"
+            raise FlightError(f"the function's 'time' differs from the nominal run's ({found}; {grid.size} times "
+                              f"from {grid[0]:g} to {grid[-1]:g}): every run must return the nominal's times")
 
     @staticmethod
     def _feed(observer, raw: dict, result: dict) -> None:

@@ -86,7 +86,6 @@ class LevelTrim:
         self.nominal_alpha = 0.0                    # alpha [rad] of the thrust table
         self.dthrust_dalpha = 0.0                   # its steady thrust's slope in alpha [lbf/rad]
         self.fallbacks = 0
-        self.last_steady_states = 0
 
     # -- evaluations at dt = 0 ---------------------------------------------------------------
     def _set(self, alpha: float, pitch: float, throttle: float | None = None) -> None:
@@ -107,7 +106,6 @@ class LevelTrim:
         self._set(alpha, pitch, throttle)
         self.fdm.run_ic()                   # the throttle and the air data reach the engines
         self._prop.get_steady_state()
-        self.last_steady_states += 1
         return self._evaluate()
 
     def _model(self, alpha: float, pitch: float, thrust: float) -> np.ndarray:
@@ -172,7 +170,6 @@ class LevelTrim:
         aircraft is left in the trimmed state, evaluated at dt = 0, and the engines run once
         more to their steady state, as after JSBSim's trim: three steady states in all.
         """
-        self.last_steady_states = 0
         alpha, throttle, pitch = (float(v) for v in start)
         wanted = float(np.interp(throttle, THROTTLE_GRID, self.thrust_grid))
         tol = JSBSIM_TOLERANCE * FRACTION
@@ -193,7 +190,6 @@ class LevelTrim:
                 return None
             if np.all(np.abs(r) <= tol):
                 self._prop.get_steady_state()   # leave the turboprops in their run phase
-                self.last_steady_states += 1
                 return np.array([alpha, throttle, pitch])
             offset = thrust - float(np.interp(throttle, THROTTLE_GRID, self.thrust_grid))
         return None
@@ -288,9 +284,62 @@ def lift_shortfall(flight) -> str | None:
             break
         best, best_alpha = lift, float(alpha)
     needed = weight / (qbar * area)
-    if not needed > best:
-        return None
+    if not (np.isfinite(best) and best > 0) or not needed > best:  # no α trimmed with lift: no stall to say
+        return None  # (speed_range_shortfall says what the speed is)
     slowest = flight.setup.airspeed_ktas * math.sqrt(needed / best)
     return (f"the stall: level flight needs a lift coefficient W/(qbar S) = {needed:.3f}, above the {best:.3f} "
             f"the aircraft reaches trimmed before it stalls (at alpha {best_alpha:.1f} deg); fly faster than "
             f"{math.ceil(slowest)} KTAS at this altitude, or lower, or lighter")
+
+
+# -- why a level trim cannot exist: the speed ---------------------------------------------------
+SPEED_SCAN_KTAS = np.arange(20.0, 601.0, 20.0)  # JSBSim's trim at each: ~60 ms a point, ~2 s in all
+_SPEED_RANGES: dict[tuple, tuple[float, float] | None] = {}
+
+
+def level_speed_range(setup) -> tuple[float, float] | None:
+    """(slowest, fastest) true airspeed [KTAS] of SPEED_SCAN_KTAS (every 20 kt) at which the aircraft, as
+    loaded, trims in level flight at `setup.altitude_ft` with JSBSim's trim; None when none does. Computed
+    once per process and flight condition, on fresh copies of the aircraft, so the flight that failed is
+    left as it was. (A trim near the range's edges can take a second each: no finer search.)"""
+    from .base import FlightError
+
+    key = (aircraft_hash(setup), str(setup.aircraft_file), setup.altitude_ft, setup.rate_hz)
+    if key in _SPEED_RANGES:
+        return _SPEED_RANGES[key]
+    from .jsbsim import JSBSimFlight
+
+    def trims(speed: float) -> bool:
+        flight = JSBSimFlight(replace(setup, airspeed_ktas=float(speed), trim="jsbsim"), preflight=False)
+        flight.diagnose_trim_failures = False  # a failure is an answer here, not a question
+        try:
+            flight.trim({})
+        except FlightError:
+            return False
+        return True
+
+    found = [float(v) for v in SPEED_SCAN_KTAS if trims(v)]
+    _SPEED_RANGES[key] = speeds = (min(found), max(found)) if found else None
+    return speeds
+
+
+def speed_range_shortfall(flight) -> str | None:
+    """When the flight condition's airspeed lies outside the speeds the aircraft trims level at at its
+    altitude (`level_speed_range`), or none trims there: the reason and what to do, else None."""
+    setup = flight.setup
+    speeds = level_speed_range(setup)
+    scanned = (f"{SPEED_SCAN_KTAS[0]:g} to {SPEED_SCAN_KTAS[-1]:g} KTAS scanned every "
+               f"{SPEED_SCAN_KTAS[1] - SPEED_SCAN_KTAS[0]:g} kt with JSBSim's trim, the aircraft as loaded")
+    if speeds is None:
+        return (f"no level trim at {setup.altitude_ft:g} ft at any airspeed ({scanned}): the altitude is above "
+                "what the aircraft holds level; fly lower (simulator.altitude_ft in a campaign, "
+                "--altitude-ft on the command line)")
+    slowest, fastest = speeds
+    where = (f"the aircraft trims level at {setup.altitude_ft:g} ft from {slowest:g} to {fastest:g} KTAS ({scanned})")
+    if setup.airspeed_ktas > fastest:
+        return (f"{setup.airspeed_ktas:g} KTAS is faster than {where}; fly within that range (simulator.airspeed_ktas "
+                "in a campaign, --airspeed-ktas on the command line)")
+    if setup.airspeed_ktas < slowest:
+        return (f"{setup.airspeed_ktas:g} KTAS is slower than {where}; fly within that range (simulator.airspeed_ktas "
+                "in a campaign, --airspeed-ktas on the command line)")
+    return None

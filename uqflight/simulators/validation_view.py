@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import jsbsim
 
+from .directives import LINEARIZATION
 from .jsbsim import flight_setup_from
 
 
@@ -31,7 +32,9 @@ class AircraftProperties:
         return self._flight.property_value(name)
 
     def writable(self, name: str) -> bool:
-        return self._flight.node(name).get_attribute(jsbsim.Attribute.WRITE)
+        """False for a read-only property, and for simulation/do_linearization: setting it makes JSBSim
+        write a file in the working directory (directives.py)."""
+        return LINEARIZATION not in name and self._flight.node(name).get_attribute(jsbsim.Attribute.WRITE)
 
     def hint(self, name: str) -> str:
         """'; did you mean ...?' with the aircraft's properties closest to `name`, or ''."""

@@ -16,6 +16,13 @@ KINDS = {"float": "f", "integer": "iu"}
 # Beyond any campaign (limits.max_runs defaults to 10^6), and beyond what a reader can hold in memory:
 # a damaged or hostile file declaring such sizes is refused before anything is read.
 MAX_RUNS, MAX_PARAMETERS, MAX_TIMES, MAX_DESIGN_VALUES = 10**8, 10**4, 10**7, 2 * 10**8
+# A reader holds one output's (N, T) histories at a time (raw, or rebuilt from its tSVD factors): 2 GB of
+# doubles; every other product a reader allocates from declared sizes is bounded by it too (a tSVD
+# factor or buffer, an adaptive grid's index set, the failure reasons' bytes / 8). Declared sizes are no
+# proof of data: a 0.3 MiB file may declare 60 runs x 10^7 times in chunks never written.
+MAX_OUTPUT_VALUES = 250_000_000
+MAX_STORED_VALUES = 10 * MAX_OUTPUT_VALUES  # every output's and quantity's values together: what info reads
+MAX_REASON_BYTES = 256  # a fixed-length failure reason (results.REASON_BYTES)
 
 
 def _dataset(f: h5py.File, path: str, kind: str, shape: tuple, problems: list[str]) -> h5py.Dataset | None:
@@ -82,10 +89,20 @@ def layout_problems(f: h5py.File) -> list[str]:
     weight = _dataset(f, "samples/weight", "float", (n,), problems)
     if weight is not None:
         _finite(weight, problems)
-    _dataset(f, "samples/reason", "string", (n,), problems)
+    reason = _dataset(f, "samples/reason", "string", (n,), problems)
+    length = None if reason is None else h5py.check_string_dtype(reason.dtype).length
+    if length is not None and length > MAX_REASON_BYTES:
+        return problems + [f"/samples/reason holds strings of {length} bytes, more than a reason takes "
+                           f"({MAX_REASON_BYTES})"]
+    if reason is not None and n * (length or MAX_REASON_BYTES) > 8 * MAX_OUTPUT_VALUES:
+        return problems + [f"/samples/reason declares {n} reasons of {length or MAX_REASON_BYTES} bytes, more than "
+                           f"a reader holds ({8 * MAX_OUTPUT_VALUES:.4g} bytes)"]
     time = _dataset(f, "time", "float", (None,), problems)
     if time is not None and time.shape[0] > MAX_TIMES:
         return problems + [f"/time declares {time.shape[0]} times, more than a reader holds ({MAX_TIMES})"]
+    too_large = _declared_values(f, n, None if time is None else time.shape[0])
+    if too_large:  # refused before any of it is read
+        return problems + [too_large]
     if time is not None:
         if not is_time_grid(time[()]):
             problems.append(f"/time must hold at least one finite time, strictly increasing ({time.size} values)")
@@ -124,6 +141,24 @@ def layout_problems(f: h5py.File) -> list[str]:
     return problems
 
 
+def _declared_values(f: h5py.File, n: int, n_times: int | None) -> str | None:
+    """What the sizes the file declares would make a reader allocate beyond its bounds, or None: one
+    output's N x T histories, every output's and quantity's values together."""
+    outputs = set()
+    for group in ("outputs", "tsvd"):
+        if isinstance(f.get(group), h5py.Group):
+            outputs |= set(f[group])
+    quantities = f["quantities"] if isinstance(f.get("quantities"), h5py.Group) else ()
+    if n_times is not None and n * n_times > MAX_OUTPUT_VALUES:
+        return (f"/samples/status and /time declare {n} runs x {n_times} times = {n * n_times:.4g} values per "
+                f"output, more than a reader holds ({MAX_OUTPUT_VALUES:.4g})")
+    total = len(outputs) * n * (n_times or 1) + len(quantities) * n
+    if total > MAX_STORED_VALUES:
+        return (f"the file declares {len(outputs)} outputs and {len(quantities)} quantities of {n} runs x "
+                f"{n_times} times = {total:.4g} values, more than a reader reads ({MAX_STORED_VALUES:.4g})")
+    return None
+
+
 def _tsvd_problems(f: h5py.File, group: h5py.Group, n: int, n_times, problems: list[str]) -> None:
     tol, batch = group.attrs.get("tol"), group.attrs.get("batch")
     if not (np.ndim(tol) == 0 and np.isreal(tol) and np.isfinite(tol) and tol >= 0):
@@ -145,8 +180,9 @@ def _tsvd_problems(f: h5py.File, group: h5py.Group, n: int, n_times, problems: l
         columns = _dataset(f, f"{path}/columns", "integer", (None if V is None else V.shape[0],), problems)
         buffer = _dataset(f, f"{path}/buffer", "float", (None, n_times), problems)
         index = _dataset(f, f"{path}/buffer_index", "integer", (None,), problems)
+        buffered = 2 * n + 1000 if n_times is None else min(2 * n + 1000, MAX_OUTPUT_VALUES // max(n_times, 1))
         sizes = {"rank": (rank, min(n, n_times or n)), "runs": (None if V is None else V.shape[0], n),
-                 "buffered runs": (None if buffer is None else buffer.shape[0], 2 * n + 1000),
+                 "buffered runs": (None if buffer is None else buffer.shape[0], buffered),
                  "buffer_index entries": (None if index is None else index.shape[0], 2 * n + 1000)}
         too_large = [f"{what} {size} (at most {most})" for what, (size, most) in sizes.items()
                      if size is not None and size > most]
@@ -164,6 +200,10 @@ def _tsvd_problems(f: h5py.File, group: h5py.Group, n: int, n_times, problems: l
 def _index_set_problems(f: h5py.File, d, problems: list[str]) -> None:
     """An adaptive grid's /design (store.rounds): its datasets of one length K, its attributes."""
     index_set = _dataset(f, "design/index_set", "integer", (None, d), problems)
+    if index_set is not None and index_set.size > MAX_DESIGN_VALUES:
+        problems.append(f"/design/index_set declares {index_set.shape[0]} multi-indices of {index_set.shape[1]} "
+                        f"levels, more than a reader holds ({MAX_DESIGN_VALUES} values)")
+        return
     k = None if index_set is None else index_set.shape[0]
     for key, kind in (("old", "integer"), ("round", "integer"), ("indicator", "float")):
         _dataset(f, f"design/{key}", kind, (k,), problems)

@@ -13,6 +13,7 @@ and what to do.
 from __future__ import annotations
 
 import errno
+import fcntl
 import json
 import os
 import socket
@@ -116,6 +117,83 @@ def describe_holder(holder: dict | None) -> str:
         return "a run whose lock file is unreadable"
     return (f"pid {holder.get('pid')} on {holder.get('host')}, since {holder.get('since')}"
             + (f" ({holder['command']})" if holder.get("command") else ""))
+
+
+HOLDERS_SHOWN = 3  # processes named in a message about a file held open
+PROCESSES_SCANNED = 100_000  # /proc entries looked at for them (bounded: a message, not a census)
+
+
+def is_lock_error(exc: BaseException) -> bool:
+    """HDF5 refused to open a file because another process holds it open (its file lock: EAGAIN)."""
+    return isinstance(exc, BlockingIOError) or getattr(exc, "errno", None) in (errno.EAGAIN, errno.EWOULDBLOCK) \
+        or "unable to lock file" in str(exc)
+
+
+def open_elsewhere(path) -> bool:
+    """True when another process holds `path` open under HDF5's file lock (flock, shared for a reader,
+    exclusive for a writer), so that a writer cannot open it now. Nothing is read or changed."""
+    try:
+        fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK)
+    except OSError:
+        return False
+    try:
+        fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+    except OSError as exc:
+        return exc.errno in (errno.EAGAIN, errno.EWOULDBLOCK)
+    else:
+        fcntl.flock(fd, fcntl.LOCK_UN)
+        return False
+    finally:
+        os.close(fd)
+
+
+def holders(path) -> list[str]:
+    """"pid N (command)" of up to HOLDERS_SHOWN other processes of this host with `path` open, as far as
+    /proc lets this user see them (empty when none is visible)."""
+    try:
+        target = os.stat(path)
+        entries = os.scandir("/proc")
+    except OSError:
+        return []
+    found = []
+    with entries:
+        for count, entry in enumerate(entries):
+            if count >= PROCESSES_SCANNED or len(found) >= HOLDERS_SHOWN:
+                break
+            if not entry.name.isdigit() or int(entry.name) == os.getpid():
+                continue
+            try:
+                fds = os.scandir(f"/proc/{entry.name}/fd")
+            except OSError:
+                continue
+            with fds:
+                held = False
+                for fd in fds:
+                    try:
+                        info = os.stat(fd.path)
+                    except OSError:
+                        continue
+                    if (info.st_dev, info.st_ino) == (target.st_dev, target.st_ino):
+                        held = True
+                        break
+            if held:
+                try:
+                    with open(f"/proc/{entry.name}/cmdline", "rb") as fh:
+                        command = fh.read(200).replace(b"\0", b" ")
+                except OSError:
+                    command = b""
+                text = " ".join(command.decode("utf-8", "replace").split())
+                found.append(f"pid {entry.name}" + (f" ({text})" if text else ""))
+    return found
+
+
+def held_message(path, to: str = "written") -> str:
+    """Why `path` cannot be opened (`to` be "written", or "read" while another process writes it): another
+    process holds it open (which says nothing of its contents: never a reason to replace it)."""
+    who = holders(path)
+    named = ", ".join(repr(w) if not w.isprintable() else w for w in who) or "another process"
+    return (f"{path} is open in {named} (HDF5's file lock), so it cannot be {to} now: wait until that "
+            "process closes it, or stop it, then run again")
 
 
 class ResultsLock:

@@ -41,9 +41,13 @@ reached the disk (HDF5 then fails, or crashes, on the next write).
 """
 from __future__ import annotations
 
+import contextlib
+import gc
 import hashlib
 import json
 import os
+import sys
+import traceback
 from collections.abc import Iterator
 from datetime import datetime, timezone
 
@@ -57,6 +61,7 @@ from .compressed import TsvdStorage
 from .file_end import HINT as END_HINT
 from .file_end import extend_to_file_end, past_recorded_end
 from .layout import is_time_grid, layout_problems
+from .lock import LockHeld, held_message, is_lock_error
 from .raw import RawStorage
 from .rounds import read_index_set, write_index_set
 from .storage import OutputStorage, key_of, name_of
@@ -115,6 +120,46 @@ def fit_reason(reason: str, size: int) -> bytes:
     return data[:size - 3].decode("utf-8", "ignore").encode("utf-8") + "…".encode("utf-8")
 
 
+@contextlib.contextmanager
+def _release_failures() -> Iterator[list]:
+    """h5py reports a write that fails while it releases an object (HDF5 writing the object's metadata
+    back, e.g. into a full disk) as an "Exception ignored" traceback on stderr, and goes on. Within the
+    block such failures are collected in the list yielded instead (h5py prints the traceback through
+    sys.excepthook, then the line through sys.unraisablehook); other reports pass through."""
+    caught: list[BaseException] = []
+    previous_unraisable, previous_except = sys.unraisablehook, sys.excepthook
+
+    def unraisable(report) -> None:
+        if isinstance(report.exc_value, READ_ERRORS):
+            caught.append(report.exc_value)
+        else:
+            previous_unraisable(report)
+
+    def excepthook(kind, value, tb) -> None:
+        if isinstance(value, READ_ERRORS):
+            caught.append(value)
+        else:
+            previous_except(kind, value, tb)
+
+    sys.unraisablehook, sys.excepthook = unraisable, excepthook
+    try:
+        yield caught
+    finally:
+        sys.unraisablehook, sys.excepthook = previous_unraisable, previous_except
+
+
+def _abandon(f: h5py.File, exc: BaseException) -> None:
+    """Close a file whose writing failed (a full disk) while `exc` is raised, quietly: its objects are
+    released here (the frames of the traceback hold some), each failing again to write its metadata."""
+    traceback.clear_frames(exc.__traceback__)
+    with _release_failures():
+        try:
+            f.close()
+        except READ_ERRORS:
+            pass
+        gc.collect()
+
+
 def _no_reasons(data: h5py.Dataset, n: int):
     """n empty reasons, in the form the reason dataset takes (fixed-length, or variable in older files)."""
     return [""] * n if h5py.check_string_dtype(data.dtype).length is None else np.zeros(n, dtype=data.dtype)
@@ -159,9 +204,26 @@ class ResultStore:
             raise ValueError("nothing would be stored: turn on raw storage or tsvd compression")
         settings = None if tsvd is None else TsvdStorage.settings(tsvd)  # a bad tolerance: refused before the file
 
+        f = h5py.File(path, "w-")
+        try:
+            with _release_failures() as failed:
+                cls._lay_out(f, campaign_text, xi, kappa, weights, parameter_names, outputs, time, raw, settings,
+                             attrs, units, batch_rows, resolution, quantities, capacity)
+                f.flush()
+            if failed:  # a write failed where h5py could not raise it
+                raise failed[0]
+        except BaseException as exc:  # e.g. a full disk: closed here, without h5py's "Exception ignored"
+            _abandon(f, exc)
+            raise
+        return cls(f)
+
+    @staticmethod
+    def _lay_out(f: h5py.File, campaign_text, xi, kappa, weights, parameter_names, outputs, time, raw, settings,
+                 attrs, units, batch_rows, resolution, quantities, capacity) -> None:
+        """Write `create`'s layout into the new file `f`."""
+        n, d = xi.shape
         grow = {} if capacity is None else {"maxshape": (None,)}  # resizable along the runs
         rows_hint = n if capacity is None else max(n, capacity)
-        f = h5py.File(path, "w-")
         f.attrs.update({"campaign": campaign_text, "campaign_hash": text_hash(campaign_text),
                         "created": datetime.now(timezone.utc).isoformat(timespec="seconds")})
         f.attrs.update({k: json.dumps(v) if isinstance(v, dict) else v for k, v in (attrs or {}).items()})
@@ -192,20 +254,24 @@ class ResultStore:
             for name in quantities:
                 group.create_dataset(key_of(name), shape=(n,), dtype="f8", fillvalue=np.nan,
                                      chunks=(min(rows_hint, QUANTITY_ROWS),), fletcher32=True, **grow)
-        if tsvd is not None:
+        if settings is not None:
             TsvdStorage.create(f, outputs, units, time.size, *settings)
-        f.flush()
-        return cls(f)
 
     @classmethod
     def open(cls, path, mode: str = "r", while_written: bool = False) -> ResultStore:
         """An existing file, read-only ("r") or to resume ("a": half-done steps of a killed writer are mended).
         `while_written`: read a file that a live run is writing (HDF5's file lock off; the writer flushes
-        whole batches, so what is read is a consistent earlier state, or an OSError to retry)."""
+        whole batches, so what is read is a consistent earlier state, or an OSError to retry). LockHeld
+        (an OSError) naming the process when another one holds the file under HDF5's lock."""
         if mode not in ("r", "a"):
             raise ValueError(f"mode must be 'r' or 'a', got {mode!r}")
-        f = h5py.File(path, "r", locking=False) if while_written and mode == "r" else \
-            h5py.File(path, "r" if mode == "r" else "r+")
+        try:
+            f = h5py.File(path, "r", locking=False) if while_written and mode == "r" else \
+                h5py.File(path, "r" if mode == "r" else "r+")
+        except OSError as exc:  # held by another process: in use, not damaged
+            if is_lock_error(exc):
+                raise LockHeld(held_message(path, "read" if mode == "r" else "written")) from None
+            raise
         # before anything is written: space past the recorded end is not free (file_end)
         extended = mode == "a" and extend_to_file_end(f)
         try:
@@ -246,6 +312,11 @@ class ResultStore:
             for storage in store._storages:
                 storage.settle(status)
         return store
+
+    @property
+    def path(self) -> str:
+        """The file's path, as it was opened."""
+        return self._file.filename
 
     def close(self) -> None:
         self._file.close()

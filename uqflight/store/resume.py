@@ -2,14 +2,21 @@
 create it otherwise, and compact a finished tSVD file."""
 from __future__ import annotations
 
+import os
 from pathlib import Path
 
 import h5py
+import yaml
 
+from ..console import shown
 from .file_end import extend_file, past_recorded_end
+from .lock import LockHeld, held_message, is_lock_error, open_elsewhere
 from .results import READ_ERRORS, ResultStore, one_line, text_hash
 
 
+# top-level campaign keys that change how the stored runs are read, never what they flew: a file whose campaign
+# differs in these alone is resumed with the new text (the report reads its analysis from there)
+READ_ONLY_KEYS = ("analysis", "description")
 FLOWN = ("aircraft_hash", "scenario")  # what a results file's runs flew beside the campaign text (the
 # aircraft's files; a script scenario's script and initialisation files, simulators.simulator_provenance)
 
@@ -19,10 +26,15 @@ def open_for_campaign(path, *, campaign_text: str, force: bool = False, restart:
     """Resume `path` when it holds this campaign, else create it (see ResultStore.create).
 
     A file holding another campaign (a different campaign_hash), or made with other aircraft or script
-    files (attrs["aircraft_hash"], attrs["scenario"]), is refused unless `force`, which deletes and recreates it. `force`
+    files (attrs["aircraft_hash"], attrs["scenario"]), is refused unless `force`, which deletes and recreates it;
+    the refusal names the first key where the campaigns differ. A campaign that differs in READ_ONLY_KEYS
+    alone (analysis:, description:) resumes the file, which then stores the new text. `force`
     never deletes what is not a uqflight results file (a directory, a text file, another HDF5 file):
     those are refused, with how to remove them. (The caller holds the file's lock: `force` never
     touches a file another run writes.) `restart` starts a results file of this same campaign over.
+    A file another process holds open (HDF5's file lock: a reader, or a writer without our lock) is
+    refused with LockHeld naming that process, before anything is read: it is in use, not damaged,
+    and neither `force` nor `restart` replaces it.
     """
     path = Path(path)
     flown = {key: (create_args.get("attrs") or {}).get(key) for key in FLOWN}
@@ -33,6 +45,10 @@ def open_for_campaign(path, *, campaign_text: str, force: bool = False, restart:
         if not path.is_file():
             raise FileExistsError(f"{path} is not a regular file; uqflight does not replace it: choose "
                                   "another results file")
+        if not os.access(path, os.R_OK | os.W_OK):  # a file this user cannot read says nothing of its contents
+            raise FileExistsError(f"{path} cannot be {'read' if not os.access(path, os.R_OK) else 'written'} by "
+                                  "this user (its permissions); uqflight does not replace it: choose another results "
+                                  "file, or give this user access to it")
         if not h5py.is_hdf5(path):
             raise FileExistsError(f"{path} is not a uqflight results file (not HDF5); uqflight never "
                                   f"overwrites it, even with --force: remove it yourself (rm {path}) or "
@@ -40,6 +56,8 @@ def open_for_campaign(path, *, campaign_text: str, force: bool = False, restart:
         try:
             stored, stored_flown, ours = _stored_campaign(path)
         except READ_ERRORS as exc:  # e.g. killed while the file was being created: nothing to resume
+            if is_lock_error(exc):  # opened by another process since the check above
+                raise LockHeld(held_message(path)) from None
             if not force:
                 reason = one_line(exc)[:200]
                 if past_recorded_end(reason):  # and _stored_campaign could not move that end
@@ -52,19 +70,38 @@ def open_for_campaign(path, *, campaign_text: str, force: bool = False, restart:
             raise FileExistsError(f"{path} is an HDF5 file but not a uqflight results file (no campaign_hash "
                                   "or /samples/status); uqflight never overwrites it, even with --force: "
                                   f"remove it yourself (rm {path}) or choose another results file")
+        differs = None
+        if stored != text_hash(campaign_text) and stored_flown == flown and not restart:
+            stored_text = _stored_text(path)
+            differs = first_difference(stored_text, campaign_text)
+            if differs is not None and _only_read_keys_differ(stored_text, campaign_text):
+                store = ResultStore.open(path, "a")  # the runs stand: the new reading of them is stored
+                given = create_args.get("attrs") or {}
+                store._file.attrs.update({"campaign": campaign_text, "campaign_hash": text_hash(campaign_text),
+                                          **{key: given[key] for key in READ_ONLY_KEYS if key in given}})
+                return store
         if stored == text_hash(campaign_text) and stored_flown == flown and not restart:
-            return ResultStore.open(path, "a")
+            return ResultStore.open(path, "a")  # LockHeld when another process opened it since the check
         if restart and stored == text_hash(campaign_text):
             force = True
         if not force:
             if stored == text_hash(campaign_text):
                 key = next(key for key in FLOWN if stored_flown.get(key) != flown[key])
                 what = {"aircraft_hash": "aircraft files (sha256", "scenario": "script files ("}[key]
-                raise FileExistsError(f"{path} was made with other {what} {str(stored_flown.get(key))[:80]}); "
+                raise FileExistsError(f"{path} was made with other {what} {shown(str(stored_flown.get(key))[:80])}); "
                                       "resuming would mix two models: choose another results file, or force "
                                       "to start over")
-            raise FileExistsError(f"{path} holds the results of another campaign (campaign_hash {stored}); "
-                                  "choose another results file, or force to overwrite it")
+            where = (f": its campaign differs first at {shown(differs)}" if differs else
+                     f" (campaign_hash {shown(str(stored))})")
+            if differs and differs.startswith("quantities"):
+                where += (" (a quantity is computed in the worker at every integration step, finer than the "
+                          "stored histories: a changed one is flown again)")
+            raise FileExistsError(f"{path} holds the results of another campaign{where}; choose another results "
+                                  "file (--out), or --force (force=True in Python) to overwrite it and fly every "
+                                  "run again (a change of analysis: alone resumes the file as it is; "
+                                  "`uqflight report --exceedance` changes thresholds without a run)")
+        if open_elsewhere(path):  # opened meanwhile: it is in use, and stays
+            raise LockHeld(held_message(path))
         path.unlink()
     try:
         return ResultStore.create(path, campaign_text=campaign_text, **create_args)
@@ -72,6 +109,61 @@ def open_for_campaign(path, *, campaign_text: str, force: bool = False, restart:
         if path.exists():
             path.unlink()
         raise
+
+
+def _stored_text(path: Path) -> str:
+    """The campaign text a results file stores ("" when it has none)."""
+    with h5py.File(path, "r") as f:
+        text = f.attrs.get("campaign", "")
+    return text.decode("utf-8", "replace") if isinstance(text, bytes) else str(text)
+
+
+SAFE_LOADER = getattr(yaml, "CSafeLoader", yaml.SafeLoader)  # libyaml's, ten times faster, where PyYAML has it
+
+
+def campaign_mapping(campaign_text: str) -> dict:
+    """A campaign text's mapping as written (YAML), {} when unreadable or not a mapping."""
+    try:
+        data = yaml.load(campaign_text, Loader=SAFE_LOADER)
+    except (yaml.YAMLError, ValueError, RecursionError):  # e.g. a date 2001-13-45, or nesting too deep
+        return {}
+    return data if isinstance(data, dict) else {}
+
+
+def first_difference(stored_text: str, campaign_text: str) -> str | None:
+    """The first key (a dotted path such as analysis.exceedance.peak_nz[0].above, in the new campaign's
+    order) where two campaign texts' mappings differ; None when they hold the same mapping (a comment or
+    the layout differs) or when the stored text cannot be read."""
+    stored, ours = campaign_mapping(stored_text), campaign_mapping(campaign_text)
+    if not stored:
+        return None
+    return _difference(stored, ours, "")
+
+
+def _difference(old, new, path: str) -> str | None:
+    if isinstance(old, dict) and isinstance(new, dict):
+        for key in [*new, *(k for k in old if k not in new)]:
+            where = f"{path}.{key}" if path else str(key)
+            if key not in old or key not in new:
+                return where
+            found = _difference(old[key], new[key], where)
+            if found:
+                return found
+        return None
+    if isinstance(old, list) and isinstance(new, list):
+        for i, (a, b) in enumerate(zip(old, new)):
+            found = _difference(a, b, f"{path}[{i}]")
+            if found:
+                return found
+        return None if len(old) == len(new) else f"{path}[{min(len(old), len(new))}]"
+    return None if old == new and type(old) is type(new) else path or "(the whole text)"
+
+
+def _only_read_keys_differ(stored_text: str, campaign_text: str) -> bool:
+    """Whether the two campaigns' mappings differ in READ_ONLY_KEYS alone."""
+    stored, ours = campaign_mapping(stored_text), campaign_mapping(campaign_text)
+    keys = set(stored) | set(ours)
+    return bool(stored) and all(stored.get(k) == ours.get(k) for k in keys if k not in READ_ONLY_KEYS)
 
 
 def _stored_campaign(path: Path) -> tuple:

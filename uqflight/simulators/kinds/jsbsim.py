@@ -6,6 +6,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ...labels import name_unit
 from ..jsbsim import DEFAULT_OUTPUTS, NAMED_OUTPUTS, UNITS, aircraft_hash
 from ..scenarios import DEFAULT as DEFAULT_SCENARIO
 from ..scenarios import REGISTRY as SCENARIOS
@@ -83,7 +84,7 @@ class JSBSimSimulator:
         self.fixed = {str(k): float(v) for k, v in config.get("properties", {}).items()}  # every run's settings
         self.flight = self.scenario.flight(self.setup)
         self._flown = False
-        self.units = {name: UNITS.get(name, "") for name in self.setup.outputs}
+        self.units = {name: UNITS.get(name) or name_unit(name) for name in self.setup.outputs}
 
     def layout(self, kappa: np.ndarray) -> tuple[np.ndarray, list[str]]:
         return self.setup.time, list(self.setup.outputs)

@@ -4,22 +4,27 @@
 to the campaign's folder, or the name of a script shipped with JSBSim (`c172_cruise_8K`). The aircraft
 and its initial conditions are the script's `<use aircraft= initialize=>`: the initialisation file
 beside the script when there is one, else the aircraft folder's (JSBSim's rule). `end_s` cuts the
-script's end time. A sample sets its `ic/...` properties before `run_ic`, the others after it.
+script's end time. A sample sets its `ic/...` properties before `run_ic`, the others after it, but for
+its `atmosphere/...` ones (turbulence, winds, gusts, the seed) in a script that trims itself (an `<event>`
+setting `simulation/do_simple_trim`): those are set at the first step after the script's first trim
+completed (JSBSim's `simulation/trim-completed`), so that the trim that sets the flight up is flown in the
+air the script itself gives, as a level flight trims in still air. A later trim of the script (a re-trim
+at 20 s) flies in the air then set; a failed trim says which air was active and where it came from.
 
-Every sample loads the script afresh (its events and local properties start over) with the script's
-`<output>` and state files sent to a scratch folder and disabled, so nothing is written beside the
-script, the aircraft or the working directory. The recorded times are the simulator's own
-(`simulation/sim-time-sec`): the script's dt summed as JSBSim sums it, the same for every sample.
+Every sample loads the script afresh (its events and local properties start over). JSBSim reads a
+copy of the script without its `<input>` and `<output>` directives (in uqflight's cache; see
+directives.py), with its output path at os.devnull: nothing is written beside the script, the
+aircraft or the working directory, and no socket is opened. The recorded times are the simulator's
+own (`simulation/sim-time-sec`): the script's dt summed as JSBSim sums it, the same for every
+sample; at most MAX_STEPS steps, counted from `<run>` before any is held.
 """
 from __future__ import annotations
 
 import difflib
+import hashlib
 import json
 import math
-import shutil
-import tempfile
-import weakref
-import xml.etree.ElementTree as ET
+import os
 from dataclasses import dataclass
 from functools import cached_property
 from decimal import Decimal, InvalidOperation
@@ -28,16 +33,30 @@ from pathlib import Path
 import jsbsim
 import numpy as np
 
-from ..aircraft import AircraftFiles
+from ..aircraft import AircraftFiles, cache_dir
+from ..directives import checked, parsed, without_io
 from ..base import FlightError, TrimError
-from ..jsbsim import DEFAULT_OUTPUTS, FlightResult, PropertyAccess, Watch, check_finite, ready_to_load
+from ..jsbsim import ATMOSPHERE, DEFAULT_OUTPUTS, FlightResult, PropertyAccess, Watch, check_finite, ready_to_load
 
 KEYS = ("output_rate_hz",)
 SCENARIO_KEYS = ("script", "end_s")
 DEFAULT_OUTPUT_RATE_HZ = 20.0
 MAX_SCRIPT_BYTES = 1 << 20
-MAX_SUMMED = 10**8  # steps (800 MB of times): beyond, a script's step count is the closed form's
+MAX_STEPS = 10**7  # integration steps (80 MB of step times; 23 h at 120 Hz), as many as a results file holds times
 TIME = "simulation/sim-time-sec"
+TRIM_PROPERTIES = ("simulation/do_simple_trim", "simulation/do_trim")  # an event setting one trims
+TRIM_COMPLETED = "simulation/trim-completed"  # JSBSim sets it to 1 after a successful trim
+# what a failed trim says was active: the turbulence model (JSBSim's FGWinds::tType) when it makes turbulence
+# (Milspec and Tustin: a severity or a wind at 20 ft; standard and Culp: a gain), its settings, the winds
+TURBULENCE_TYPES = {0: "none", 1: "standard", 2: "Culp", 3: "Milspec (Dryden)", 4: "Tustin (Milspec)"}
+TURBULENCE_SETTINGS = {1: ("atmosphere/turb-gain",), 2: ("atmosphere/turb-gain",),
+                       3: ("atmosphere/turbulence/milspec/severity",
+                           "atmosphere/turbulence/milspec/windspeed_at_20ft_AGL-fps"),
+                       4: ("atmosphere/turbulence/milspec/severity",
+                           "atmosphere/turbulence/milspec/windspeed_at_20ft_AGL-fps")}
+CALM_FPS = 1e-6  # a wind below this is the trim's rounding (JSBSim's trim leaves ~1e-13 ft/s), not a wind
+WINDS = ("atmosphere/wind-north-fps", "atmosphere/wind-east-fps", "atmosphere/wind-down-fps",
+         "atmosphere/gust-north-fps", "atmosphere/gust-east-fps", "atmosphere/gust-down-fps")
 
 
 class ScriptError(ValueError):
@@ -84,7 +103,8 @@ class ScriptFile:
     end_s: float
     dt_s: float
     dt_text: str
-    outputs_files: tuple[str, ...]  # `<output file=...>`, relative to the script's folder
+    outputs_files: tuple[str, ...]  # `<output file=...>`, relative to the script's folder (hashed; JSBSim never reads them)
+    trims: int | None = 0  # the script's trim events (each trims once); None: a persistent one trims again and again
 
     @classmethod
     def read(cls, path: Path) -> "ScriptFile":
@@ -92,10 +112,7 @@ class ScriptFile:
         data = path.read_bytes()
         if len(data) > MAX_SCRIPT_BYTES:
             raise ScriptError(f"{path} is larger than {MAX_SCRIPT_BYTES >> 10} KiB; a run script is a few pages of XML")
-        try:
-            root = ET.fromstring(data)
-        except ET.ParseError as exc:
-            raise ScriptError(f"{path} is not well-formed XML ({exc})") from None
+        root = parsed(data, path, ScriptError)
         if root.tag != "runscript":
             raise ScriptError(f"{path} is not a JSBSim run script (its root element is <{root.tag}>, not <runscript>)")
         use, run = root.find("use"), root.find("run")
@@ -107,13 +124,15 @@ class ScriptFile:
             start, end, dt = (float(run.get(key, "0").strip()) for key in ("start", "end", "dt"))
         except ValueError:
             raise ScriptError(f"{path}: <run> start, end and dt must be numbers") from None
-        if not dt > 0 or not end > start:
-            raise ScriptError(f"{path}: <run> needs dt > 0 and end > start, got start={start:g}, end={end:g}, dt={dt:g}")
-        files = tuple(e.get("file").strip() for e in root.iter("output") if e.get("file"))
+        if not all(map(math.isfinite, (start, end, dt))) or not dt > 0 or not end > start:
+            raise ScriptError(f"{path}: <run> needs finite numbers with dt > 0 and end > start, got start={start:g}, "
+                              f"end={end:g}, dt={dt:g}")
+        named = checked(root, path, ScriptError, "the script's folder")
+        files = tuple(name.strip() for tag, name in named if tag == "output")
         for name in files:
             _inside(path.parent, name)
         return cls(path, use.get("aircraft").strip(), use.get("initialize").strip(), start, end, dt,
-                   run.get("dt").strip(), files)
+                   run.get("dt").strip(), files, _trim_events(root))
 
     @property
     def rate_hz(self) -> float:
@@ -138,13 +157,18 @@ class ScriptFile:
         return k if abs(k * self.dt_s - 1.0 / output_rate_hz) <= tolerance else None
 
     def initfile(self, aircraft_folder: Path) -> Path | None:
-        """The initialisation file beside the script (passed to JSBSim), else None: then JSBSim reads
-        the aircraft folder's; ScriptError when neither exists."""
+        """The initialisation file beside the script (passed to JSBSim, checked as directives.py checks
+        what JSBSim reads), else None: then JSBSim reads the aircraft folder's (checked with the
+        aircraft's files); ScriptError when neither exists."""
         for folder in (self.path.parent, Path(aircraft_folder)):
             for name in (self.initialize, f"{self.initialize}.xml"):
                 candidate = _inside(folder, name)
                 if candidate.is_file():
-                    return candidate if folder == self.path.parent else None
+                    if folder != self.path.parent:
+                        return None
+                    checked(parsed(candidate.read_bytes(), candidate, ScriptError), candidate, ScriptError,
+                            "the script's folder")
+                    return candidate
         raise ScriptError(f"{self.path}: initialize={self.initialize!r} names no file beside the script nor in the "
                           f"aircraft folder {aircraft_folder}")
 
@@ -153,16 +177,27 @@ class ScriptFile:
         JSBSim's own margin (FGScript)."""
         return (self.end_s if end_s is None else min(self.end_s, end_s)) + 0.99 * self.dt_s
 
+    def bounded_steps(self, end_s: float | None = None) -> int:
+        """The steps before the end by the closed form, without holding any: ScriptError naming the
+        file and what to change when they are more than MAX_STEPS."""
+        n = max(0, math.floor((self._end(end_s) - self.start_s) / self.dt_s))
+        if n > MAX_STEPS:
+            cut = "" if end_s is None else f" cut at {end_s:g} s"
+            raise ScriptError(f"{self.path}: <run start={self.start_s:g} end={self.end_s:g} dt={self.dt_text}>{cut} is "
+                              f"{n:.3g} integration steps, more than {MAX_STEPS}: cut the flight with "
+                              f"simulator.scenario.end_s (at most {self.start_s + MAX_STEPS * self.dt_s:.6g} s) "
+                              "or give the script a larger dt")
+        return n
+
     def steps(self, end_s: float | None = None) -> int:
         """The steps JSBSim runs before the end: the largest n whose summed time start + dt + ... + dt
         is at most the end. The closed form decides unless the sum's rounding (n additions) could
-        cross the end, then the sum itself does (beyond MAX_SUMMED steps the closed form stands: a
-        size estimate off by one step of a flight that long)."""
+        cross the end, then the sum itself does. ScriptError beyond MAX_STEPS (`bounded_steps`)."""
         end, dt = self._end(end_s), self.dt_s
-        n = max(0, math.floor((end - self.start_s) / dt))
+        n = self.bounded_steps(end_s)
         slack = (n + 2) * max(abs(end), abs(self.start_s)) * 2.3e-16
         near = min(abs(self.start_s + k * dt - end) for k in (n, n + 1)) <= slack
-        if near and n <= MAX_SUMMED:
+        if near:
             summed = self._summed(n + 1)
             n = int(np.searchsorted(summed, end, side="right")) - 1
         return n
@@ -175,6 +210,32 @@ class ScriptFile:
     def times(self, end_s: float | None = None) -> np.ndarray:
         """The simulator's time at the start and after every step until the end (see `steps`)."""
         return self._summed(self.steps(end_s))
+
+    def flown(self) -> Path:
+        """The file JSBSim loads: the script itself, or, when it has `<input>` or `<output>` directives,
+        a copy without them in uqflight's cache (keyed by its sha256, written once, all or nothing)."""
+        text = without_io(self.path.read_bytes())
+        if text is None:
+            return self.path
+        path = cache_dir("scripts", hashlib.sha256(text).hexdigest()[:24], self.path.name)
+        if not path.is_file() or path.read_bytes() != text:
+            path.parent.mkdir(parents=True, exist_ok=True)
+            tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
+            tmp.write_bytes(text)
+            tmp.replace(path)
+        return path
+
+
+def _trim_events(root) -> int | None:
+    """The number of the script's `<event>`s that trim (set simulation/do_simple_trim); None when one of
+    them is persistent or continuous (it trims whenever its condition holds again)."""
+    count = 0
+    for event in root.iter("event"):
+        if any((item.get("name") or "").strip() in TRIM_PROPERTIES for item in event.iter("set")):
+            if (event.get("persistent") or "").strip() == "true" or (event.get("continuous") or "").strip() == "true":
+                return None
+            count += 1
+    return count
 
 
 def _script_file(config: dict, base: Path | None) -> ScriptFile:
@@ -197,11 +258,16 @@ def check(check, sim: dict, folder: Path) -> dict:
     except (ScriptError, OSError) as exc:
         check.fail("simulator.scenario.script", str(exc))
     sim["script_path"] = str(script.path)
+    end = None
     if "end_s" in scenario:
         end = check.number(scenario["end_s"], "simulator.scenario.end_s")
         if not script.start_s < end <= script.end_s:
             check.fail("simulator.scenario.end_s", f"expected a time after the script's start {script.start_s:g} s and "
                                                    f"at most its end {script.end_s:g} s, got {end:g}")
+    try:
+        script.bounded_steps(end)
+    except ScriptError as exc:
+        check.fail("simulator.scenario.end_s" if end is not None else "simulator.scenario.script", str(exc))
     rate = DEFAULT_OUTPUT_RATE_HZ
     if "output_rate_hz" in sim:
         rate = check.number(sim["output_rate_hz"], "simulator.output_rate_hz", 0.0, strict=True)
@@ -306,16 +372,15 @@ class ScriptFlight(PropertyAccess):
     def __init__(self, setup: ScriptSetup, preflight: bool = True):
         ready_to_load(setup, preflight)
         self.setup = setup
-        self._scratch = Path(tempfile.mkdtemp(prefix="uqflight-script-"))  # JSBSim's output and state files
-        weakref.finalize(self, shutil.rmtree, self._scratch, True)
+        self._flown_script = str(setup.script.flown())
         self._load()
 
     def _load(self) -> None:
         s = self.setup
         fdm = jsbsim.FGFDMExec(str(s.root))
         fdm.set_debug_level(0)
-        fdm.set_output_path(str(self._scratch))
-        if not fdm.load_script(str(s.script.path), 0.0, str(s.initfile) if s.initfile else ""):
+        fdm.set_output_path(os.devnull)  # no state file (directives.py)
+        if not fdm.load_script(self._flown_script, 0.0, str(s.initfile) if s.initfile else ""):
             raise FlightError(f"JSBSim could not load the script {s.script.path} with aircraft {s.aircraft!r} "
                               f"from {s.root}")
         fdm.disable_output()
@@ -339,26 +404,22 @@ class ScriptFlight(PropertyAccess):
         if getattr(self, "_flown", False):
             self._load()
         self._flown = True
+        held = {name: value for name, value in settings.items()
+                if name.startswith(ATMOSPHERE) and s.script.trims != 0}  # set after the script's trims
         try:
             for name, value in settings.items():
                 if name.startswith("ic/"):
                     self.node(name).set_double_value(float(value))
             self.fdm.run_ic()
             for name, value in settings.items():
-                if not name.startswith("ic/"):
+                if not name.startswith("ic/") and name not in held:
                     self.node(name).set_double_value(float(value))
-            data, times = self._run(observers)
+            data, times = self._run(observers, held)
         except jsbsim.TrimFailureError as exc:
             raise TrimError(f"a trim in the script failed at t = {self.fdm.get_sim_time():.4g} s: "
-                            f"{str(exc).strip() or 'no convergence'}") from exc
+                            f"{str(exc).strip() or 'no convergence'}; {self._active_air(held)}") from exc
         except jsbsim.BaseError as exc:
             raise FlightError(f"JSBSim stopped the script at t = {self.fdm.get_sim_time():.4g} s: {exc}") from exc
-        finally:
-            for child in self._scratch.iterdir():  # the header of a disabled output, a state file
-                if child.is_dir():
-                    shutil.rmtree(child)
-                else:
-                    child.unlink()
         grid = s.time
         if not np.array_equal(times, grid):
             at = int(np.argmax(times != grid))
@@ -368,9 +429,51 @@ class ScriptFlight(PropertyAccess):
         check_finite(data)
         return FlightResult(time=grid, outputs=dict(zip(s.outputs, data.T.copy())), trim=None)
 
-    def _run(self, observers) -> tuple[np.ndarray, np.ndarray]:
-        """Integrate the setup's steps, recording every steps_per_output steps: (outputs (T, n), times (T,))."""
+    def _active_air(self, held: dict) -> str:
+        """What air the failed trim flew in: the turbulence model with its settings and the winds that were
+        set (non-zero), each said to come from the script's own events or from the campaign (`held`: the
+        campaign's atmosphere settings, set after the script's first trim, or still held for then)."""
+        def value(name: str) -> float:
+            return self.node(name).get_double_value() if self.has_property(name) else 0.0
+
+        kind = int(value("atmosphere/turb-type"))
+        turbulence = ["atmosphere/turb-type", *TURBULENCE_SETTINGS.get(kind, ())] if any(
+            value(name) for name in TURBULENCE_SETTINGS.get(kind, ())) else []
+        active = [name for name in turbulence if name == "atmosphere/turb-type" or value(name)]
+        active += [name for name in WINDS if abs(value(name)) > CALM_FPS]
+        applied = held and self._air_applied
+
+        def shown(name: str) -> str:
+            text = f"{name} = {value(name):.4g}"
+            return text + f" ({TURBULENCE_TYPES.get(kind, '?')})" if name == "atmosphere/turb-type" else text
+
+        theirs = [shown(name) for name in active if not (applied and name in held)]
+        ours = [shown(name) for name in active if applied and name in held]
+        parts = []
+        if theirs:
+            parts.append("active at the trim from the script's own events: " + ", ".join(theirs)
+                         + " (set them in an event after its trim for a trim in still air)")
+        if ours:
+            parts.append("active at the trim from the campaign (simulator.properties or parameters, set after the "
+                         "script's first trim): " + ", ".join(ours))
+        if not parts:
+            parts.append("the trim flew in still air (no turbulence, gust or wind set)")
+        if held and not applied:
+            parts.append("held for after the script's first trim: "
+                         + ", ".join(f"{k} = {v:g}" for k, v in held.items()))
+        return "; ".join(parts)
+
+    def _run(self, observers, held: dict | None = None) -> tuple[np.ndarray, np.ndarray]:
+        """Integrate the setup's steps, recording every steps_per_output steps: (outputs (T, n), times (T,)).
+        `held`: settings applied at the first step after the script's first trim completed (see the module doc)."""
         s = self.setup
+        completed = self.node(TRIM_COMPLETED) if held and self.has_property(TRIM_COMPLETED) else None
+        self._air_applied = completed is None
+        if completed is not None:
+            completed.set_double_value(0.0)
+        else:  # nothing held, or a JSBSim that does not say when a trim completed: set now, as before the first step
+            for name, value in (held or {}).items():
+                self.node(name).set_double_value(float(value))
         k, steps = s.steps_per_output, s.steps
         clock = self.node(TIME)
         run = self.fdm.run
@@ -389,6 +492,14 @@ class ScriptFlight(PropertyAccess):
             if i % k == 0:
                 data[i // k] = [node.get_double_value() for node, _ in self._recorded]
                 times[i // k] = clock.get_double_value()
+            if completed is not None and completed.get_double_value() >= 1.0:  # for the steps after this one
+                for name, value in held.items():
+                    self.node(name).set_double_value(float(value))
+                completed, self._air_applied = None, True
+        if completed is not None:
+            raise FlightError(f"the script's first trim did not complete before its end {s.time[-1]:.6g} s, so "
+                              f"{', '.join(held)} (set after it) never took effect: end the flight later "
+                              "(simulator.scenario.end_s), or set them in the script's own events")
         data *= np.array([scale for _, scale in self._recorded])
         return data, times
 

@@ -1,0 +1,106 @@
+"""Script and aircraft set-ups (issue 45): `uqflight aircraft` lists without flying and trims only with
+--trim; a trim that cannot exist says why in true numbers (never -inf or 0 KTAS) and what speeds to fly;
+an excitation that leaves the elevator unmoved is warned about. JSBSim's own c172x, as it ships."""
+import re
+
+import pytest
+from conftest import cli_in_process
+
+from uqflight.simulators.jsbsim import Excitation, FlightSetup, JSBSimFlight
+from uqflight.simulators.trim import level_speed_range
+
+
+def _setup(**condition):
+    from uqflight.cli import _prepared
+
+    located = _prepared("c172x", [], [])
+    return FlightSetup(aircraft=located.name, root=located.root, duration_s=4.0, **condition)
+
+
+def test_aircraft_lists_the_functions_without_trimming():
+    shown = cli_in_process("aircraft", "c172x", "--altitude-ft", "15000", "--airspeed-ktas", "200")
+    assert shown.returncode == 0, shown.stderr
+    assert re.search(r"PITCH +aero/coefficient/Cmde ", shown.stdout)
+    assert "trim:" not in shown.stdout and "trim failed" not in shown.stdout + shown.stderr
+    assert "`uqflight aircraft c172x --trim` trims it at 15000 ft, 200 KTAS" in shown.stdout
+    assert re.search(r"reference factors at 15000 ft, 200 KTAS .*qbar·S = [0-9.]+ lbf", shown.stdout)
+
+
+def test_a_trim_too_fast_for_the_aircraft_says_its_speed_range():
+    failed = cli_in_process("aircraft", "c172x", "--trim", "--altitude-ft", "15000", "--airspeed-ktas", "200")
+    assert failed.returncode == 1
+    assert "-inf" not in failed.stderr and " 0 KTAS" not in failed.stderr
+    found = re.search(r"200 KTAS is faster than the aircraft trims level at 15000 ft from ([0-9.]+) to ([0-9.]+) KTAS",
+                      failed.stderr)
+    assert found, failed.stderr
+    slowest, fastest = map(float, found.groups())
+    assert "--airspeed-ktas" in failed.stderr
+    # the range it gives is true: JSBSim's trim succeeds inside it, at both ends, and fails past them
+    for speed, ok in ((slowest, True), (fastest, True), (0.5 * (slowest + fastest), True), (fastest + 10, False)):
+        flight = JSBSimFlight(_setup(altitude_ft=15000.0, airspeed_ktas=speed, trim="jsbsim"))
+        flight.diagnose_trim_failures = False
+        try:
+            flight.trim({})
+            trimmed = True
+        except Exception:
+            trimmed = False
+        assert trimmed == ok, speed
+
+
+def test_a_trim_above_the_ceiling_says_to_fly_lower():
+    failed = cli_in_process("aircraft", "c172x", "--trim", "--altitude-ft", "30000", "--airspeed-ktas", "100")
+    assert failed.returncode == 1
+    assert "no level trim at 30000 ft at any airspeed" in failed.stderr and "fly lower" in failed.stderr
+
+
+def test_the_speed_range_is_scanned_once_per_condition():
+    setup = _setup(altitude_ft=4000.0, airspeed_ktas=100.0)
+    first = level_speed_range(setup)
+    assert first[0] < 100.0 < first[1] and level_speed_range(setup) is first
+
+
+def test_a_pulse_that_never_moves_the_elevator_is_warned_about():
+    # c172x's elevator actuator has a 2.9-deg hysteresis: a 1-deg pulse leaves it where the trim put it
+    flight = JSBSimFlight(_setup(altitude_ft=4000.0, airspeed_ktas=100.0))
+    result = flight.fly({})
+    assert len(result.warnings) == 1 and "never moved the elevator" in result.warnings[0]
+    bigger = JSBSimFlight(_setup(altitude_ft=4000.0, airspeed_ktas=100.0,
+                                 excitation=Excitation(kind="pulse", amplitude_deg=5.0)))
+    assert bigger.fly({}).warnings == []
+    still = JSBSimFlight(_setup(altitude_ft=4000.0, airspeed_ktas=100.0, excitation=Excitation(kind="none")))
+    assert still.fly({}).warnings == []  # nothing commanded, nothing to warn about
+
+
+def test_simulate_warns_on_the_command_line():
+    shown = cli_in_process("simulate", "--aircraft", "c172x", "--duration-s", "3", "--no-files")
+    assert shown.returncode == 0, shown.stderr
+    assert "warning: the pulse of 1 deg never moved the elevator" in shown.stderr
+    assert "--amplitude-deg" in shown.stderr
+    quiet = cli_in_process("simulate", "--duration-s", "3", "--no-files")  # bacm: the pulse moves it
+    assert quiet.returncode == 0 and "warning" not in quiet.stderr
+
+
+def test_plan_warns_when_the_nominal_flights_pulse_leaves_the_elevator_unmoved(tmp_path):
+    text = """
+name: c172x-pulse
+simulator:
+  kind: jsbsim
+  aircraft: c172x
+  flight: {altitude_ft: 4000, airspeed_ktas: 100}
+  excitation: {kind: pulse, amplitude_deg: AMPLITUDE, start_s: 0.5, duration_s: 1.0}
+  duration_s: 3
+parameters:
+  CL: {function: aero/coefficient/CLwbh, perturbation: scale, distribution: normal, interval_pct: 10}
+design: {kind: sparse_grid, rule: gauss_hermite, level: 1}
+method: {kind: pseudo_galerkin, order: 1}
+storage: {path: c.h5}
+"""
+    for amplitude, warned in (("1.0", True), ("5.0", False)):
+        (tmp_path / "c.yaml").write_text(text.replace("AMPLITUDE", amplitude))
+        shown = cli_in_process("plan", tmp_path / "c.yaml", cwd=tmp_path)
+        assert shown.returncode == 0, shown.stderr
+        assert ("warning: the nominal flight: the pulse of 1 deg never moved the elevator" in shown.stderr) == warned
+    (tmp_path / "c.yaml").write_text(text.replace("AMPLITUDE", "1.0"))
+    ran = cli_in_process("run", tmp_path / "c.yaml", cwd=tmp_path)  # run says it too, in its summary
+    assert ran.returncode == 0, ran.stderr
+    assert "warning: the nominal flight: the pulse of 1 deg never moved the elevator" in ran.stdout
