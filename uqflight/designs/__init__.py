@@ -6,6 +6,7 @@ Kinds (keys in braces):
 - sparse_grid {level, rule, nested, growth}: Smolyak combination technique on 1-D rules.
 - tensor_grid {rule, points}: full tensor product.
 - pick_freeze {samples}: Saltelli's [A; B; AB_1; …; AB_d] for Sobol' index estimators.
+- morris {trajectories, levels}: Morris's trajectories for elementary-effects screening.
 - adaptive_sparse_grid {rule, budget, tolerance}: Gerstner–Griebel's dimension-adaptive grid, built
   round by round from the results (`adaptive`; the runner refines it).
 """
@@ -20,6 +21,7 @@ from ..parameters.germs import check_germs
 from .adaptive import adaptive_design, adaptive_size
 from .montecarlo import (halton_design, latin_hypercube_design, monte_carlo_design, samples_size, sobol_design,
                          sobol_size)
+from .morris import NOT_DRAWS, morris_design, morris_screening, morris_size
 from .pickfreeze import pick_freeze_design, pick_freeze_size
 from .smolyak import sparse_grid_design, sparse_grid_size
 from .spec import is_integer
@@ -35,7 +37,10 @@ class DesignKind:
     (analysis.proportions), or None for a quadrature grid (its weights are valid only all together);
     `sobol_from_runs`: its runs give Sobol' indices themselves (pick-freeze estimators), without a PCE;
     `adaptive`: the builder gives the first round only; the runner adds the others from the results
-    (designs.adaptive), up to `size` runs."""
+    (designs.adaptive), up to `size` runs; `screening`: (xi, Y, ok, info, bootstrap, seed) -> (its
+    measures per parameter, a note or None), the screening its runs give per output and quantity
+    (designs.morris), stored under the kind's name; `not_draws`: the note of a design whose points are
+    not draws of the law, so that the runs' own statistics are not the law's."""
 
     build: Callable
     size: Callable
@@ -43,6 +48,8 @@ class DesignKind:
     example: dict  # a small `design:` mapping of this kind (help text and tests)
     sobol_from_runs: bool = False
     adaptive: bool = False
+    screening: Callable | None = None
+    not_draws: str | None = None
 
     @property
     def sampled(self) -> bool:
@@ -61,6 +68,8 @@ REGISTRY: dict[str, DesignKind] = {
     "tensor_grid": DesignKind(tensor_grid_design, tensor_grid_size, None, {"kind": "tensor_grid", "points": 4}),
     "pick_freeze": DesignKind(pick_freeze_design, pick_freeze_size, "pick_freeze",
                               {"kind": "pick_freeze", "samples": 16}, sobol_from_runs=True),
+    "morris": DesignKind(morris_design, morris_size, "points", {"kind": "morris", "trajectories": 4},
+                         screening=morris_screening, not_draws=NOT_DRAWS),
     "adaptive_sparse_grid": DesignKind(adaptive_design, adaptive_size, None,
                                        {"kind": "adaptive_sparse_grid", "budget": 50, "tolerance": 1e-4},
                                        adaptive=True),
