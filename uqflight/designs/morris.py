@@ -19,12 +19,13 @@ import numpy as np
 
 from ..parameters.germs import GERMS
 from .montecarlo import equal_weights
-from .spec import check_keys, given_count, integer
+from .spec import check_keys, given_count, integer, is_integer
 
 DEFAULT_LEVELS = 4
 NOT_DRAWS = ("morris design: its runs are points of trajectories on a grid, not draws of the inputs' law: the "
-             "mean, variance, band, quantiles, densities and failure share are the runs' own, not the law's; it "
-             "gives no Sobol' indices; its elementary effects screen the inputs (outputs.NAME.morris)")
+             "mean, variance, band, quantiles, densities and failure share are the runs' own, not the law's; its "
+             "runs give no Sobol' indices themselves; their elementary effects screen the inputs "
+             "(outputs.NAME.morris)")
 
 
 def morris_jump(levels: int) -> float:
@@ -199,7 +200,7 @@ def morris_measures(effects: np.ndarray, n_boot: int, seed: int, confidence: flo
 def morris_screening(xi: np.ndarray, Y: np.ndarray, ok: np.ndarray, info: dict, n_boot: int,
                      seed: int) -> tuple[dict, str | None]:
     """The Morris measures of values `Y` of the `ok` runs of a Morris design, and the note of the
-    trajectories dropped (None when none is).
+    trajectories dropped (None when none is); ValueError naming the fact of `info` that does not fit the runs.
 
     Parameters
     ----------
@@ -221,7 +222,13 @@ def morris_screening(xi: np.ndarray, Y: np.ndarray, ok: np.ndarray, info: dict, 
     tuple
         (`morris_measures`' dict, the note or None).
     """
-    effects, dropped = elementary_effects(xi, Y, ok, int(info.get("levels", DEFAULT_LEVELS)))
+    levels, trajectories = info.get("levels"), info.get("trajectories")
+    if not (is_integer(levels) and levels >= 2 and levels % 2 == 0):
+        raise ValueError(f"design_info.levels: expected an even integer >= 2, got {levels!r}")
+    if not (is_integer(trajectories) and trajectories * (xi.shape[1] + 1) == len(xi)):
+        raise ValueError(f"design_info.trajectories: expected the {len(xi)} runs' trajectories of "
+                         f"{xi.shape[1]} + 1 points, got {trajectories!r}")
+    effects, dropped = elementary_effects(xi, Y, ok, levels)
     note = None
     if dropped:
         kept = len(effects)
