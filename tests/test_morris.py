@@ -157,3 +157,28 @@ def test_a_design_info_that_does_not_fit_the_runs_is_refused_in_one_line(tmp_pat
     assert done.returncode == 2 and "Traceback" not in done.stdout + done.stderr
     line, = done.stderr.strip().splitlines()
     assert line.startswith(f"error: {path}: ") and field in line, line
+
+
+def test_measures_without_trajectories_are_null_and_sigma_needs_two():
+    from uqflight.designs.morris import morris_measures
+    from uqflight.statistics import json_ready
+
+    none = json_ready(morris_measures(np.empty((0, 2, 3)), n_boot=10, seed=0))
+    assert none["mu_star"] == [[None] * 3] * 2 and none["sigma"] == [[None] * 3] * 2
+    one = morris_measures(np.ones((1, 2, 3)), n_boot=10, seed=0)
+    assert (one["mu_star"] == 1.0).all() and np.isnan(one["sigma"]).all()
+
+
+def test_the_report_plots_mu_star_against_sigma_and_ranks_the_inputs_in_the_headline(tmp_path):
+    # y(t) = (1 + t)(2 x1 − 3 x2 + 0.5 x3) on ranges 1, 2, 4: μ* at t = 1 is 4, 12 and 4, x2 first
+    from conftest import cli_in_process
+
+    path = run_python_campaign(tmp_path, campaign("linear", UNIFORM))
+    done = cli_in_process("report", path, "--out", tmp_path / "report")
+    assert done.returncode == 0, done.stderr
+    page = (tmp_path / "report" / "report.md").read_text()
+    assert "## Morris screening" in page and "plots/morris_c.png" in page
+    assert "| inputs ranked by μ\\* (Morris) |" in page and "x2 12, " in page
+    assert (tmp_path / "report" / "plots" / "morris_c.png").stat().st_size > 10_000
+    table = (tmp_path / "report" / "tables" / "morris.csv").read_text().splitlines()
+    assert table[0].startswith("file,output or quantity,parameter,mu_star")

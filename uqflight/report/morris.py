@@ -75,8 +75,9 @@ def plot_morris(panels: list[tuple[str, dict, int]], path: Path, title: str) -> 
         ax.set_title(caption, fontsize=9)
         ax.tick_params(labelsize=7)
         ax.grid(alpha=0.3)
-    handles, labels = axes[0].get_legend_handles_labels()
-    return plots._save(fig, path, (handles, labels), legend_columns=6)
+    handles = [plots.Line2D([], [], marker="o", ls="", color=plots.COLORS[k % len(plots.COLORS)])
+               for k in range(len(names))]
+    return plots._save(fig, path, (handles, names), legend_columns=6)
 
 
 def morris_section(entries: list[Entry], times: list[float], out_dir: Path) -> Section:
