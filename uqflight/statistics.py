@@ -124,6 +124,7 @@ class OutputStatistics:
     pce: PCE | None = None  # the expansion behind the statistics (None: statistics of the runs themselves)
     flags: list[str] = field(default_factory=list)
     unwrapped: bool = False  # an angle whose runs wrap, made continuous before any statistic (analysis.angles)
+    morris: dict | None = None  # a Morris design's measures per parameter: mu_star, mu, sigma, mu_star_ci (screen)
 
     @property
     def std(self) -> np.ndarray:
@@ -304,6 +305,8 @@ def analyse(path, reference: str | None = None, options: Options | None = None, 
             raise BadInput(f"{path}: method {method['kind']} order {method['order']}: {problem}")
         _note_runs(store, stats, sampled, allow_aliasing)
         stats.from_runs = method_entry(method["kind"]).runs_on_sampled and sampled
+        if DESIGNS[design_kind].not_draws:
+            stats.notes.append(DESIGNS[design_kind].not_draws)
         if stats.from_runs and DESIGNS[design_kind].sobol_from_runs:
             note = pick_freeze_note(ok, len(store.parameter_names), "pending runs" if not stats.failed else
                                     "failed and pending runs" if stats.pending else "failed runs")
@@ -329,6 +332,9 @@ def analyse(path, reference: str | None = None, options: Options | None = None, 
                 stats.notes.extend(f"output {name}: {flag}" for flag in out.flags)
                 if stats.replicates > 1:
                     out.replicate_moments = _replicate_moments(store, name, stats.replicates)
+                if DESIGNS[design_kind].screening is not None:
+                    basis, scale = output_basis(store, name, ok)
+                    screen(stats, out, store.xi, basis if scale is None else basis @ scale, ok, options, "")
                 if progress is not None:
                     progress.advance()
 
@@ -694,6 +700,39 @@ def unresolved_flag(out: OutputStatistics) -> str | None:
             f"{UNRESOLVED_WIDTH:g} or lies outside [0, 1]; run more base samples (design.samples)")
 
 
+def screen(stats: Statistics, out: OutputStatistics, xi: np.ndarray, Y: np.ndarray, ok: np.ndarray, options: Options,
+           what: str) -> None:
+    """Set `out.morris` to the screening measures of the design (DesignKind.screening), if it has one, of the
+    values `Y` (n_ok, T) of the `ok` runs, `xi` every run's germs; its note, after `what`, in stats.notes once.
+
+    Parameters
+    ----------
+    stats : Statistics
+        The file's statistics: its design kind and facts, parameters and notes.
+    out : OutputStatistics
+        The output's or quantity's statistics, given its `morris` measures.
+    xi : numpy.ndarray
+        Every run's germs (N, d), in design order.
+    Y : numpy.ndarray
+        The ok runs' values.
+    ok : numpy.ndarray
+        bool (N,): the runs that give a value.
+    options : Options
+        Its bootstrap resamples and seed.
+    what : str
+        What the note is of ("" for every output).
+    """
+    screening = DESIGNS[stats.design_kind].screening
+    if screening is None:
+        return
+    found, note = screening(xi, Y, ok, stats.design_info, options.bootstrap, options.seed)
+    out.morris = {name: {"mu_star": found["mu_star"][i], "mu": found["mu"][i], "sigma": found["sigma"][i],
+                         "mu_star_ci": {"lower": found["mu_star_ci"][0][i], "upper": found["mu_star_ci"][1][i]}}
+                  for i, name in enumerate(stats.parameter_names)}
+    if note and what + note not in stats.notes:
+        stats.notes.append(what + note)
+
+
 def _pick_freeze_rows(ok: np.ndarray, d: int) -> np.ndarray | None:
     """The ok runs' rows of a pick-freeze design's complete base rows (analysis.sobol.complete_rows), None when
     fewer than 2 are complete (no index can be estimated)."""
@@ -940,6 +979,8 @@ def quantity_statistics(store: ResultStore, stats: Statistics, name: str, germs:
     view = _QuantityView(store, name, values, units)
     out = _output_statistics(view, name, stats.method, germs, stats.design_kind, defined, options)
     out.unwrapped = shifts is not None and bool(shifts.any())
+    screen(stats, out, store.xi, values[defined][:, None], defined, options,
+           f"quantity {name} (undefined in some runs): " if missing else "")
     if missing and stats.from_runs and DESIGNS[stats.design_kind].sobol_from_runs:
         note = pick_freeze_note(defined, len(store.parameter_names), f"quantity {name} (undefined in some runs)")
         if note:
@@ -1004,6 +1045,8 @@ def _quantity_json(quantity: QuantityStatistics, seeds: list[str]) -> dict:
         entry["validation"] = out.validation
     if out.method is not None:
         entry["method"] = out.method
+    if out.morris is not None:
+        entry["morris"] = _at_first_time(out.morris)
     return entry
 
 
@@ -1082,6 +1125,8 @@ def summary_json(stats: Statistics) -> dict:
             entry["validation"] = out.validation
         if out.method is not None:
             entry["method"] = out.method
+        if out.morris is not None:
+            entry["morris"] = out.morris
         if out.errors:
             errors = out.errors
             entry["errors"] = {"eps_m": errors["eps_m"], "eps_v": errors["eps_v"],

@@ -119,6 +119,10 @@ KEYS = {
     "design.growth": "Sparse grids: `linear` (default; level i exact to degree 2i−1) or `exponential` (the "
                      "rules' own nested sequences).",
     "design.points": "Tensor grids: points per dimension, >= 1. `points: 5`",
+    "design.trajectories": "`morris` only, required: the trajectories R >= 2, of d + 1 runs each "
+                           "(N = R(d + 1) runs). `trajectories: 20`",
+    "design.levels": "`morris`: the levels p of the grid in the unit cube, even, >= 2; the jump is "
+                     "Δ = p/(2(p − 1)). Default 4. `levels: 6`",
     # method
     "method.kind": "The method (below).",
     "method.order": "Total degree of the PCE, >= 0. Default 2, or the largest a grid's projection allows. "

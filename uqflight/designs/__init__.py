@@ -6,6 +6,7 @@ Kinds (keys in braces):
 - sparse_grid {level, rule, nested, growth}: Smolyak combination technique on 1-D rules.
 - tensor_grid {rule, points}: full tensor product.
 - pick_freeze {samples}: Saltelli's [A; B; AB_1; …; AB_d] for Sobol' index estimators.
+- morris {trajectories, levels}: Morris's trajectories for elementary-effects screening.
 - adaptive_sparse_grid {rule, budget, tolerance}: Gerstner–Griebel's dimension-adaptive grid, built
   round by round from the results (`adaptive`; the runner refines it).
 - subset_simulation {event, budget, samples_per_level, p0}, importance_sampling {event, budget, samples},
@@ -23,6 +24,7 @@ from ..parameters.germs import check_germs
 from .adaptive import adaptive_design, adaptive_size
 from .montecarlo import (halton_design, latin_hypercube_design, monte_carlo_design, samples_size, sobol_design,
                          sobol_size)
+from .morris import NOT_DRAWS, morris_design, morris_screening, morris_size
 from .pickfreeze import pick_freeze_design, pick_freeze_size
 from .rare import active_learning_design, importance_sampling_design, rare_size, subset_simulation_design
 from .smolyak import sparse_grid_design, sparse_grid_size
@@ -41,7 +43,11 @@ class DesignKind:
     `adaptive`: the builder gives the first round only; the runner adds the others from the results
     (designs.adaptive), up to `size` runs; `rare`: an adaptive design that estimates the probability of its
     `event` (designs.rare): its builder takes the `redrawn` columns (seed parameters), its runs are not draws
-    of the input law (the analysis gives the event's probability only) and `uqflight.rare_rounds` runs it."""
+    of the input law (the analysis gives the event's probability only) and `uqflight.rare_rounds` runs it;
+    `screening`: (xi, Y, ok, info, bootstrap, seed) -> (its measures per parameter, a note or None), the
+    screening its runs give per output and quantity (designs.morris), stored under the kind's name;
+    `not_draws`: the note of a design whose points are not draws of the law, so that the runs' own
+    statistics are not the law's."""
 
     build: Callable
     size: Callable
@@ -50,6 +56,8 @@ class DesignKind:
     sobol_from_runs: bool = False
     adaptive: bool = False
     rare: bool = False
+    screening: Callable | None = None
+    not_draws: str | None = None
 
     @property
     def sampled(self) -> bool:
@@ -68,6 +76,8 @@ REGISTRY: dict[str, DesignKind] = {
     "tensor_grid": DesignKind(tensor_grid_design, tensor_grid_size, None, {"kind": "tensor_grid", "points": 4}),
     "pick_freeze": DesignKind(pick_freeze_design, pick_freeze_size, "pick_freeze",
                               {"kind": "pick_freeze", "samples": 16}, sobol_from_runs=True),
+    "morris": DesignKind(morris_design, morris_size, "points", {"kind": "morris", "trajectories": 4},
+                         screening=morris_screening, not_draws=NOT_DRAWS),
     "adaptive_sparse_grid": DesignKind(adaptive_design, adaptive_size, None,
                                        {"kind": "adaptive_sparse_grid", "budget": 50, "tolerance": 1e-4},
                                        adaptive=True),

@@ -80,6 +80,10 @@ def section_jobs(entries: list[Entry], ref: Entry | None, times: list[float],
         from .variance_split import variance_split_section
 
         jobs.append((0, "writing the variance split", lambda: variance_split_section(entries, times)))
+    if any(out.morris for e in entries for out in e.outputs.values()):
+        from .morris import morris_section
+
+        jobs.append((outputs * k, "drawing the Morris screening", lambda: morris_section(entries, times, out_dir)))
     if any(e.has_sobol for e in entries):
         jobs.append((3 * outputs * k, "drawing the Sobol' indices",
                      lambda: sensitivity_section(entries, times, out_dir)))
