@@ -65,7 +65,7 @@ def _method_design_cases():
 @pytest.mark.parametrize("method, design", _method_design_cases())
 def test_plan_plans_every_method_and_design_kind(tmp_path, method, design):
     entry, spec = METHODS[method], dict(DESIGNS[design].example)
-    settings = f", {entry.order_key}: 1" if entry.pce is not None else ""
+    settings = f", {entry.order_key}: 1" if entry.expands else ""
     body = ", ".join(f"{k}: {v}" for k, v in spec.items())
     (tmp_path / "c.yaml").write_text(
         f"name: every\nseed: 5\nsimulator: {{kind: python, function: \"{DATA / 'trust_models.py'}:sum_of_squares\"}}\n"

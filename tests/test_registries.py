@@ -10,7 +10,7 @@ import yaml
 from uqflight.designs import REGISTRY as DESIGNS
 from uqflight.designs import build_design, design_size
 from uqflight.designs.rules import RULE_TABLE, nodes_weights
-from uqflight.methods import METHODS, exported_kind, fit, method_entry
+from uqflight.methods import METHODS, fit
 from uqflight.methods.basis import orthonormal_basis, orthonormal_polynomials, total_degree_indices
 from uqflight.parameters import DISTRIBUTIONS, GERMS, make_parameter
 from uqflight.simulators.kinds import REGISTRY as SIMULATORS
@@ -208,7 +208,7 @@ def test_every_method_gives_the_same_pce_from_tsvd_factors_as_from_the_runs(kind
     np.testing.assert_allclose(factored.coefficients, direct.coefficients, atol=1e-10 * np.abs(direct.coefficients).max())
 
 
-@pytest.mark.parametrize("kind", [k for k, m in METHODS.items() if m.pce is not None and m.rule != "projection"])
+@pytest.mark.parametrize("kind", [k for k, m in METHODS.items() if m.expands and not m.projects])
 def test_every_fit_weighs_the_runs_as_its_entry_says(kind):
     # the same points and runs with other (positive) weights: a weighted fit changes, an unweighted one does not
     germs = ["normal", "uniform"]
@@ -219,18 +219,18 @@ def test_every_fit_weighs_the_runs_as_its_entry_says(kind):
     other = fit(kind, design.xi, weights, Y, germs, order=2).pce
     same = equal.indices.shape == other.indices.shape and np.allclose(equal.coefficients, other.coefficients,
                                                                        rtol=1e-12, atol=1e-12)
-    assert same != method_entry(kind).weighted
+    assert same != METHODS[kind].weighted
 
 
 @pytest.mark.parametrize("kind", list(METHODS))
 def test_every_method_is_exported_as_a_kind_that_builds_its_own_pce(kind):
     """...on every design it runs on; one that needs a sampled design stays itself on a grid (refused there)."""
     for sampled in (True, False):
-        if method_entry(kind).sampled_only and not sampled:
-            assert exported_kind(kind, sampled) == kind
+        if METHODS[kind].sampled_only and not sampled:
+            assert METHODS[kind].exported_kind(sampled) == kind
             continue
-        target = method_entry(exported_kind(kind, sampled))
-        assert target.pce is not None and target.exported_as is None
+        target = METHODS[METHODS[kind].exported_kind(sampled)]
+        assert target.expands and target.exported_as is None
         assert not (sampled and target.runs_on_sampled)
 
 

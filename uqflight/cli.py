@@ -247,9 +247,9 @@ def _load(path: Path):
 @app.command()
 def plan(campaign_file: Path = typer.Argument(..., metavar="CAMPAIGN", help="Campaign YAML file.")):
     """Validate a campaign and print its design, the number of runs and an estimated time."""
-    from .designs import describe, is_adaptive, is_rare
+    from .designs import describe, is_adaptive, is_rare, is_sampled
     from .execution import WorkerError, timed_nominal
-    from .methods import method_entry
+    from .methods import METHODS
 
     campaign = _load(campaign_file)
     design = campaign.design()
@@ -266,8 +266,10 @@ def plan(campaign_file: Path = typer.Argument(..., metavar="CAMPAIGN", help="Cam
     if is_rare(design.kind):  # its own estimator: the runs are not draws of the input law
         echo(f"method: none (the {design.kind} estimates the probability of its event only)")
     else:
-        order = campaign.method.get(method_entry(kind).order_key)  # sparse's is max_order
-        echo(f"method: {kind}" + (f" (order {order})" if _has_order(kind, design.kind) else ""))
+        entry = METHODS[kind]
+        order = campaign.method.get(entry.order_key)
+        echo(f"method: {kind}" + (f" ({entry.order_key.replace('_', ' ')} {order})"
+                                  if entry.builds_pce(is_sampled(design.kind)) else ""))
     runs = campaign.runs or len(design.xi)  # an adaptive grid's budget: its rounds are made from the results
     echo(f"runs: {runs}" + (" at most (design.budget)" if is_adaptive(design.kind) else ""))
     echo(f"results: {Path(campaign.storage['path']).resolve()} (storage.path, from the working directory; "
@@ -286,15 +288,6 @@ def plan(campaign_file: Path = typer.Argument(..., metavar="CAMPAIGN", help="Cam
 
 
 CORES = os.cpu_count() or 1
-
-
-def _has_order(kind: str, design_kind: str) -> bool:
-    """Whether method `kind` builds a PCE on this design, so that its order means something."""
-    from .designs import is_sampled
-    from .methods import method_entry
-
-    entry = method_entry(kind)
-    return entry.pce is not None and not (entry.runs_on_sampled and is_sampled(design_kind))
 
 
 @app.command()
@@ -489,8 +482,6 @@ def report(
                     [float("inf") if t.strip() == "end" else float(t) for t in times.split(",")])
     except ValueError:
         raise typer.BadParameter(f"expected comma-separated seconds or 'end', got {times!r}", param_hint="--times")
-    if order is not None and order < 0:
-        raise typer.BadParameter(f"expected an integer >= 0, got {order}", param_hint="--order")
     if figure_format not in ("png", "svg", "pdf"):
         raise typer.BadParameter(f"expected png, svg or pdf, got {figure_format!r}", param_hint="--format")
     if order is not None and not method:

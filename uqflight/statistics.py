@@ -52,8 +52,7 @@ from .designs import REGISTRY as DESIGNS
 from .designs import is_rare, is_sampled
 from .designs.adaptive import index_set_summary
 from .labels import name_unit, quantity_unit
-from .methods import (AUTO_CANDIDATES, PCE, METHODS, failed_runs_note, fit, method_entry, method_settings,
-                      normalised)
+from .methods import AUTO_CANDIDATES, DEFAULT_ORDER, PCE, METHODS, Auto, Method, normalised
 from .methods.basis import orthonormal_basis
 from .methods.pce_moments import pce_standardised_moments, triple_products
 from .methods import validation
@@ -266,7 +265,7 @@ def analyse(path, reference: str | None = None, options: Options | None = None, 
     with ResultStore.open(path) as store, threadpool_limits(limits=1):
         facts = campaign_facts(store, path)
         germs, analysis = facts.germs, facts.analysis
-        method = {"order": 2, **normalised(facts.method), **normalised(method or {})}
+        method = {"order": DEFAULT_ORDER, **normalised(facts.method), **normalised(method or {})}
         allow_aliasing = allow_aliasing or bool(method.get("allow_aliasing"))
         options = options or Options(**{k: (tuple(v) if k == "quantiles" else v) for k, v in analysis.items()
                                         if k in ("band_samples", "bootstrap", "quantiles")})
@@ -294,7 +293,7 @@ def analyse(path, reference: str | None = None, options: Options | None = None, 
         stats.index_set = None if state is None else index_set_summary(state, store.parameter_names)
         problem = method_problem(method["kind"], method["order"], store.xi[ok], store.weights[ok], germs, sampled,
                                  missing=int(status.size - ok.sum()), allow_aliasing=allow_aliasing)
-        if facts.seeds and not (sampled and method_entry(method["kind"]).runs_on_sampled):
+        if facts.seeds and not (sampled and METHODS[method["kind"]].runs_on_sampled):
             problem = f"parameter {facts.seeds[0]} is a seed: {SEED_REFUSAL}"
         stats.seeds, stats.dependence = facts.seeds, facts.dependence
         if stats.dependence:
@@ -304,7 +303,7 @@ def analyse(path, reference: str | None = None, options: Options | None = None, 
         if problem:
             raise BadInput(f"{path}: method {method['kind']} order {method['order']}: {problem}")
         _note_runs(store, stats, sampled, allow_aliasing)
-        stats.from_runs = method_entry(method["kind"]).runs_on_sampled and sampled
+        stats.from_runs = METHODS[method["kind"]].runs_on_sampled and sampled
         if DESIGNS[design_kind].not_draws:
             stats.notes.append(DESIGNS[design_kind].not_draws)
         if stats.from_runs and DESIGNS[design_kind].sobol_from_runs:
@@ -372,7 +371,7 @@ def _check_runs(store: ResultStore, stats: Statistics, sampled: bool, partial: b
         raise BadInput(f"{path}: {stats.pending} of {n} runs are pending (interrupted, or still running): resume "
                        f"them with `uqflight run {campaign} --out {path}`, or add --partial to analyse the "
                        f"{stats.completed} completed runs (Monte Carlo, QMC, least squares and regression only)")
-    if stats.pending and not sampled and not method_entry(stats.method["kind"]).partial:
+    if stats.pending and not sampled and not METHODS[stats.method["kind"]].partial:
         raise BadInput(f"{path}: --partial: {stats.method['kind']} on a {stats.design_kind} needs every run of "
                        f"the grid ({stats.pending} of {n} pending); use --method least_squares or regression, "
                        f"or resume the campaign")
@@ -394,12 +393,12 @@ def _note_runs(store: ResultStore, stats: Statistics, sampled: bool, allow_alias
         stats.failure_probability = grid_failure_probability(failed, store.weights[done])
     if stats.failed:
         stats.failures = failed_runs(store)
-        stats.notes.append(failed_runs_note(stats.method["kind"], stats.failed, int(done.sum())))
+        stats.notes.append(METHODS[stats.method["kind"]].failed_runs_note(stats.failed, int(done.sum())))
         if not sampled:
             stats.notes.append("failure probability: " + _grid_failure_note(stats.failure_probability))
     if stats.pending:
         stats.notes.append(f"partial: {stats.completed} of {stats.runs} runs")
-    if allow_aliasing and not sampled and method_entry(stats.method["kind"]).rule == "projection":
+    if allow_aliasing and not sampled and METHODS[stats.method["kind"]].projects:
         stats.notes.append("aliasing allowed: the projection's order may exceed what the grid integrates exactly")
 
 
@@ -517,7 +516,7 @@ def auto_method(store: ResultStore, name: str, method: dict, germs: list[str], d
     when none validates, the runs' own statistics: monte_carlo on a sampled design, the weighted runs on a grid
     of weights >= 0; a grid with signed weights has no statistics of its runs alone, so it keeps the expansion
     of lowest error, flagged by its own check."""
-    if method["kind"] != "auto":
+    if not isinstance(METHODS[method["kind"]], Auto):
         return method, False, None
     xi, weights, order = store.xi[ok], store.weights[ok], method["order"]
     sampled, missing = is_sampled(design_kind), int(ok.size - ok.sum())
@@ -530,13 +529,11 @@ def auto_method(store: ResultStore, name: str, method: dict, germs: list[str], d
         return ({**method, "kind": taken, "order": order}, False,
                 {**record, "kind": taken, "why": f"the lowest validated error, {errors[taken]:.3g}, its band "
                                                  "within the runs' range"})
-    why = "no expansion validates on these runs"
-    if sampled:
-        return ({**method, "kind": "monte_carlo", "order": order}, False,
-                {**record, "kind": "monte_carlo", "why": f"{why}: the runs' own statistics"})
-    if (weights >= 0).all():
-        return ({**method, "kind": "integration", "order": order}, True,
-                {**record, "kind": "integration", "why": f"{why}: the runs' own statistics, weighted by the grid"})
+    why, own = "no expansion validates on these runs", Method.of_runs(sampled).kind
+    if sampled or (weights >= 0).all():
+        return ({**method, "kind": own, "order": order}, not sampled,
+                {**record, "kind": own, "why": f"{why}: the runs' own statistics"
+                                              + ("" if sampled else ", weighted by the grid")})
     if not [e for e in errors.values() if e is not None]:
         raise ValueError(f"method auto: for {name}, no candidate ({', '.join(AUTO_CANDIDATES)}) of order "
                          f"{order} can be applied to these runs, and a grid with negative weights gives no statistics "
@@ -554,8 +551,8 @@ def _note_auto(stats: Statistics) -> None:
     entries += [(name, q.output) for name, q in stats.quantities.items() if q.output is not None]
     for name, out in entries:
         if out.method is not None:
-            how = out.method["kind"] + (" (the runs' own statistics)" if out.method["kind"] in ("monte_carlo",
-                                                                                               "integration") else "")
+            own = out.method["kind"] in (Method.of_runs(True).kind, Method.of_runs(False).kind)
+            how = out.method["kind"] + (" (the runs' own statistics)" if own else "")
             taken.setdefault(how, []).append(name)
     if taken:
         stats.notes.append("auto took " + "; ".join(f"{how} for {', '.join(names)}" for how, names in taken.items())
@@ -601,7 +598,7 @@ def _start_output(store: ResultStore, name: str, method: dict, germs: list[str],
     is what auto took (auto_method)."""
     xi, weights = store.xi[ok], store.weights[ok]
     kind, order = method["kind"], method["order"]
-    entry = method_entry(kind)
+    entry = METHODS[kind]
     unwrapped: list[str] = []
     basis, scale = output_basis(store, name, ok, unwrapped)
     truncation = _tsvd_resolution(store, scale, int(ok.sum()))
@@ -616,11 +613,10 @@ def _start_output(store: ResultStore, name: str, method: dict, germs: list[str],
     def expand(a):
         return a if scale is None else a @ scale
 
-    result = fit(kind, xi, weights, basis, germs, order, x0, scale=scale, sampled=sampled,
-                 settings=method_settings(method))
+    result = entry.fit(xi, weights, basis, germs, order, x0, scale=scale, sampled=sampled, settings=method)
     mean, variance, pce, from_runs = result.mean, result.variance, result.pce, result.from_runs
     if from_runs:  # bands, PDFs and pick-freeze indices from the runs themselves
-        rows, row_scale, band_weights = basis, scale, (None if entry.moments == "sample" else weights / weights.sum())
+        rows, row_scale, band_weights = basis, scale, (None if entry.run_weights(weights) is None else weights / weights.sum())
     else:
         rows, row_scale, band_weights = reused.band_rows(germs, pce.indices, options), pce.coefficients, None
     d = len(store.parameter_names)
@@ -656,12 +652,12 @@ def _start_output(store: ResultStore, name: str, method: dict, germs: list[str],
             stats.sobol_total = dict(zip(names, masked(pce.sobol_total())))
             stats.coefficient_decay = _coefficient_decay(pce)
             stats.selection = pce.selection
-            if entry.rule in ("fit", "selection"):
+            if entry.fits:
                 stats.loo_error = _loo_error(entry, xi, weights, expand(basis), germs, pce.indices)
-            elif entry.moments == "pce" and order >= 1:
+            elif entry.projects and not entry.quadrature and order >= 1:
                 stats.convergence = _lower_order_difference(kind, xi, weights, basis, scale, germs, order, x0, pce)
-            refit = (validation.refitting(kind, xi, weights, basis, scale, germs, order, sampled,
-                                          method_settings(method)) if entry.rule == "selection" else None)
+            refit = (validation.refitting(kind, xi, weights, basis, scale, germs, order, sampled, method)
+                     if entry.selects else None)
             _validate(stats, entry.rule, f"{kind} order {order}" + (" (taken by auto)" if auto else ""), xi, weights,
                       expand(basis), germs, None if isinstance(store, _QuantityView) else store.time, options.seed,
                       refit, auto)
@@ -799,7 +795,7 @@ def _loo_error(entry, xi, weights, Y, germs, indices) -> np.ndarray:
 def _lower_order_difference(kind, xi, weights, basis, scale, germs, order, x0, pce: PCE) -> dict:
     """ε_m, ε_v (Eq. 49's normalisation) between this projection and the one of order − 1 on the same
     runs: a cheap estimate of the truncation error, with no reference needed."""
-    lower = fit(kind, xi, weights, basis, germs, order - 1, x0, scale=scale).pce
+    lower = METHODS[kind].fit(xi, weights, basis, germs, order - 1, x0, scale=scale).pce
     eps_m, eps_v = relative_errors(lower.mean(), lower.variance(), pce.mean(), pce.variance())
     return {"against": f"order {order - 1}", "eps_m": eps_m, "eps_v": eps_v}
 

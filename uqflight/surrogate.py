@@ -96,7 +96,7 @@ def fit_surrogate(path, method: dict | None = None, partial: bool = False, allow
     and the calibration both fit here. `options`: statistics.Options (default 200 band draws: the PCE
     does not depend on them, and its bands and PDFs are not exported); `progress`: see analyse."""
     from .designs import REGISTRY as DESIGNS
-    from .methods import METHOD_KINDS, exported_kind, normalised
+    from .methods import METHODS, normalised
     from .statistics import BadInput, Options, analyse, campaign_facts
     from .store import ResultStore
 
@@ -110,8 +110,8 @@ def fit_surrogate(path, method: dict | None = None, partial: bool = False, allow
         parameters, time = _parameters(store, path), np.asarray(store.time, dtype=float)
     override = dict(method or {})
     kind = override.get("kind", stored.get("kind"))
-    if isinstance(kind, str) and kind in METHOD_KINDS:  # else analyse refuses
-        override["kind"] = exported_kind(kind, DESIGNS[design_kind].sampled)
+    if isinstance(kind, str) and kind in METHODS:  # else analyse refuses
+        override["kind"] = METHODS[kind].exported_kind(DESIGNS[design_kind].sampled)
     stats = analyse(path, method=override, partial=partial, allow_aliasing=allow_aliasing,
                     options=options or Options(band_samples=200, bootstrap=0), progress=progress)
     pces = {name: out.pce for name, out in stats.outputs.items()}

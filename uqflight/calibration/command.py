@@ -176,7 +176,7 @@ def _method(text: str, order: int | None) -> tuple[str, int | None]:
     from ..methods.parsing import parse_methods
 
     try:
-        parsed = parse_methods([text])[0]
+        parsed = parse_methods([text], order)[0]
     except ValueError as exc:
         echo(f"error: --method: {exc}", err=True)
         raise typer.Exit(EXIT_BAD_INPUT)

@@ -21,7 +21,7 @@ from ..campaign.reading import campaign_folder, check_campaign_text, portable_ma
 from ..console import listed
 from ..designs import is_sampled
 from ..execution import simulate
-from ..methods import METHOD_KINDS, normalised
+from ..methods import DEFAULT_ORDER, METHOD_KINDS, normalised
 from ..methods.basis import Basis, orthonormal_basis
 from ..methods.loo import loo_residuals, relative_loo_error
 from ..parameters import Parameter
@@ -154,7 +154,7 @@ def calibration_surrogate(results, method: str | None = None, order: int | None 
         stored, germs = normalised(facts.method), facts.germs
         sampled = is_sampled(facts.design_kind)
         kind = method or stored["kind"]
-        order = stored.get("order", 2) if order is None else order
+        order = stored.get("order", DEFAULT_ORDER) if order is None else order
         if kind not in METHOD_KINDS:
             raise SurrogateError(f"--method: expected one of {', '.join(METHOD_KINDS)}, got {kind!r}")
         ok = store.status == Status.OK

@@ -14,7 +14,7 @@ import numpy as np
 import yaml
 
 from ..designs import DESIGN_KINDS, SAMPLED_DESIGNS, Design, build_design, design_size, is_adaptive, is_rare
-from ..methods import method_entry
+from ..methods import METHODS, Method
 from ..parameters import Parameter, germs_of, seed_names, to_physical
 from ..parameters.dependence import GaussianCopula
 from ..quantities.spec import check_quantities
@@ -125,8 +125,9 @@ def parse_campaign(text: str, source: str = "<campaign>", view: ValidationView |
         campaign.runs = int(design_size(campaign.design_spec, campaign.germs))
         return campaign
     if is_adaptive(design.kind):  # its grid is made from the results: its points are checked on analysis
-        campaign.method.setdefault("order", schema.DEFAULT_ORDER)
-        if method_entry(campaign.method["kind"]).sampled_only:
+        entry = METHODS[campaign.method["kind"]]
+        campaign.method.setdefault(entry.order_key, entry.keys[entry.order_key].default)
+        if entry.sampled_only:
             check.fail("method.kind", f"{campaign.method['kind']} needs a sampled design; an adaptive grid needs "
                                       "its weights: use integration, pseudo_galerkin or interpolation")
         campaign.runs = int(design_size(campaign.design_spec, campaign.germs))
@@ -160,7 +161,7 @@ def build_campaign(check: Checker, data: dict, simulator: dict, parameters: list
     name = data["name"]
     design_kind = data["design"].get("kind") if isinstance(data["design"], dict) else None
     rare = isinstance(design_kind, str) and design_kind in DESIGN_KINDS and is_rare(design_kind)
-    default_method = "monte_carlo" if design_kind in SAMPLED_DESIGNS or rare else "integration"
+    default_method = Method.of_runs(design_kind in SAMPLED_DESIGNS or rare).kind
     method = schema.method(check, data.get("method", {"kind": default_method}))
     schema.check_seeds(check, parameters, design_kind, method)
     seeds = seed_names(parameters)

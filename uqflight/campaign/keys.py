@@ -12,6 +12,8 @@ import inspect
 import re
 from dataclasses import dataclass
 
+from ..methods import METHODS, Method
+
 # The meaning of each key, its default and an example, by its path (NAME: a name the user chooses).
 KEYS = {
     "name": "Required. 1-100 characters among `A-Za-z0-9_.-`, not starting with `.` or `-`; the default "
@@ -125,17 +127,6 @@ KEYS = {
                      "Δ = p/(2(p − 1)). Default 4. `levels: 6`",
     # method
     "method.kind": "The method (below).",
-    "method.order": "Total degree of the PCE, >= 0. Default 2, or the largest a grid's projection allows. "
-                    "`order: 3`",
-    "method.max_order": "sparse only: the largest total degree of the candidate terms, >= 1. Default 2. "
-                        "`max_order: 5`",
-    "method.selection": "sparse only: `lars` (least-angle regression, the default) or `omp` (orthogonal "
-                        "matching pursuit) orders the candidate terms.",
-    "method.q": "sparse only: the hyperbolic truncation ‖α‖_q ≤ max_order, 0 < q ≤ 1; 1 (the default) is "
-                "total degree, smaller keeps fewer interactions. `q: 0.75`",
-    "method.split": "Use the paper's split form x = x0 + S (Eq. 22–24) for projections. Default false.",
-    "method.allow_aliasing": "Let a projection's order exceed what the grid integrates exactly (refused "
-                             "otherwise; the report says so). Default false.",
     # execution
     "execution.workers": "Worker processes, >= 1. Default 1; `run --workers` overrides.",
     "execution.executor": "`local` (a pool of worker processes, the default) or `dask`.",
@@ -193,6 +184,9 @@ KEYS = {
     "quantities.NAME.when.above": "The event: the first step where `of` > above.",
     "quantities.NAME.when.below": "The event: the first step where `of` < below.",
 }
+# a method's keys are described where they are declared, on its class (methods.Key)
+KEYS.update({f"method.{key}": spec.description for entry in (Method, *METHODS.values())
+             for key, spec in entry.keys.items()})
 
 # The meaning of a kind, where its registry entry's docstring does not say it.
 VALUES = {
@@ -206,20 +200,6 @@ VALUES = {
                         "`excitation`, `duration_s`, `output_rate_hz`, `trim`).",
         "script": "Fly a JSBSim run script as JSBSim does, its events included (keys `scenario.script`, "
                   "`scenario.end_s`, `output_rate_hz`)."},
-    "method.kind": {
-        "sparse": "Sparse PCE: candidate terms up to `max_order` (q-hyperbolic), ordered by LARS or OMP, the "
-                  "basis and order chosen by the corrected leave-one-out error; on any design (see "
-                  "[methods](../methods.md)).",
-        "integration": "Weighted sums of the runs (Eq. 17); on a grid the PCE for bands, PDFs and Sobol' "
-                       "indices is the projection.",
-        "pseudo_galerkin": "Projection of the runs on the PCE (Eq. 19–21); moments from the PCE.",
-        "interpolation": "Moments from the weights (Eq. 32–34), PCE by projection.",
-        "regression": "Least-squares fit of the PCE, weights ignored (Eq. 35–37).",
-        "least_squares": "Weighted least-squares fit of the PCE (Eq. 43–48).",
-        "monte_carlo": "Sample moments of the runs; sampled designs only.",
-        "auto": "Per output and quantity, among pseudo_galerkin (grids), least_squares and sparse of `order`, the "
-                "one with the lowest error validated on the runs; the runs' own statistics when none validates. "
-                "Each output's `method` in summary.json says which it took (see [methods](../methods.md))."},
     "design.rule": {
         "gauss_hermite": "Gauss–Hermite (normal inputs; nested: Genz–Keister).",
         "genz_keister": "Genz–Keister, nested (normal inputs).",
@@ -281,7 +261,6 @@ def accepted_keys() -> list[Key]:
     """Every key the campaign schema accepts, in the order of the reference."""
     from ..designs import REGISTRY as DESIGNS
     from ..designs.rules import RULE_TABLE
-    from ..methods import METHODS
     from ..parameters import DISTRIBUTIONS
     from ..quantities import REGISTRY as TAKES
     from ..quantities.spec import KEYS as QUANTITY_KEYS
@@ -312,10 +291,10 @@ def accepted_keys() -> list[Key]:
     from ..designs.rare import EVENT_KEYS
 
     found += [Key(p, "design") for p in _paths("design.event", EVENT_KEYS)]
-    own = dict.fromkeys(k for entry in METHODS.values() if entry.settings
-                        for k in (entry.order_key, *(key for key, _ in entry.settings)))
-    found += [Key(p, "method", dict(METHODS) if p == "method.kind" else None)
-              for p in _paths("method", tuple(dict.fromkeys((*schema.METHOD_KEYS, *own))))]
+    kinds = {kind: type(entry) for kind, entry in METHODS.items()}  # described by their classes' docstrings
+    found += [Key(p, "method", kinds if p == "method.kind" else None)
+              for p in _paths("method", ("kind", *dict.fromkeys(k for entry in (Method, *METHODS.values())
+                                                                   for k in entry.keys)))]
     found += [Key(p, "execution") for p in _paths("execution", schema.EXECUTION_KEYS)]
     found += [Key(p, "storage") for p in _paths("storage", schema.STORAGE_KEYS) + _paths("storage.tsvd",
                                                                                            schema.TSVD_KEYS)]

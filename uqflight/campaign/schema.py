@@ -11,7 +11,7 @@ import numpy as np
 import yaml
 
 from ..designs import DESIGN_KINDS, SAMPLED_DESIGNS, Design, design_size, is_rare, is_sampled
-from ..methods import METHOD_KINDS, METHODS, method_entry
+from ..methods import DEFAULT_ORDER, METHOD_KINDS, METHODS, Method
 from ..methods.exactness import exact_total_degree, max_projection_order
 from ..methods.validity import MAX_TERMS, method_problem
 from ..parameters import DISTRIBUTIONS, Parameter, make_parameter, seed_names
@@ -28,11 +28,9 @@ TOP_KEYS = ("name", "description", "seed", "simulator", "parameters", "design", 
 PARAMETER_KEYS = ("property", "function", "perturbation", "distribution", "nominal", "interval_pct", "lower", "upper")
 LAW_KEYS = ("distribution", "nominal", "interval_pct", "lower", "upper")  # a parameter's law; the rest say what it sets
 PERTURBATIONS = ("scale", "offset", "offset_value")
-METHOD_KEYS = ("kind", "order", "split", "allow_aliasing")
 EXECUTION_KEYS = ("workers", "executor", "scheduler", "chunk", "timeout_s")
 STORAGE_KEYS = ("path", "raw", "tsvd")
 TSVD_KEYS = ("tol", "batch")
-DEFAULT_ORDER = 2
 DEPENDENCE_KEYS = ("kind", "parameters", "correlation")
 ANALYSIS_KEYS = ("band_samples", "bootstrap", "quantiles", "exceedance")
 # A million draws of one output are sorted 100 times at once (statistics.TIME_BLOCK): about 1.6 GB in two threads.
@@ -223,17 +221,17 @@ def check_method_fits_design(check: Checker, method: dict, design: Design, germs
     """Refuse, before anything runs, a method the design's points cannot carry (methods.validity).
     Without `order`, the order is 2, or the largest a grid's projection allows when that is lower."""
     sampled = is_sampled(design.kind)
-    entry = method_entry(method["kind"])
+    entry = METHODS[method["kind"]]
     key = entry.order_key
     if key not in method:
         method[key] = DEFAULT_ORDER
-        if entry.rule == "projection" and not sampled:
+        if entry.projects and not sampled:
             degree = exact_total_degree(design.xi, design.weights, germs, max_degree=2 * DEFAULT_ORDER)
             method[key] = max(0, min(DEFAULT_ORDER, max_projection_order(degree)))
     problem = method_problem(method["kind"], method[key], design.xi, design.weights, germs, sampled,
                              allow_aliasing=method.get("allow_aliasing", False))
     if problem:
-        check.fail(f"method.{key}" if entry.pce is not None else "method.kind", problem)
+        check.fail(f"method.{key}" if entry.expands else "method.kind", problem)
 
 
 def simulator(check: Checker, value) -> dict:
@@ -366,7 +364,7 @@ def check_seeds(check: Checker, parameters: list[Parameter], design_kind, method
             and not is_rare(design_kind):  # a rare-event design redraws a seed (designs.rare)
         check.fail(where, f"a seed needs a sampled design ({', '.join(SAMPLED_DESIGNS)}), not {design_kind}: "
                           "a random stream has no polynomial expansion for a grid to integrate")
-    if not method_entry(method["kind"]).runs_on_sampled:  # it would fit a PCE in the seed's ξ
+    if not METHODS[method["kind"]].runs_on_sampled:  # it would fit a PCE in the seed's ξ
         check.fail(where, f"{SEED_REFUSAL} ({method['kind']})")
 
 
@@ -475,24 +473,22 @@ def function_property(check: Checker, spec: dict, path: str, kind: str, aircraft
 
 
 def method(check: Checker, value) -> dict:
+    """The `method:` mapping checked against its kind's keys (`Method.keys`: an unknown kind, the shared ones)."""
     kind = value.get("kind") if isinstance(value, dict) else None
     entry = METHODS.get(kind) if isinstance(kind, str) else None
-    if entry is not None and entry.settings:  # a kind with keys of its own (sparse): exactly those
-        keys = ("kind", entry.order_key, *(key for key, _ in entry.settings))
-        method = dict(check.mapping(value, "method", keys, required=("kind",)))
-        if entry.order_key in method:
-            check.integer(method[entry.order_key], f"method.{entry.order_key}", 1)
-        problem = entry.settings_problem(method)
-        if problem:
-            check.fail(f"method.{problem[0]}", problem[1])
-        return method
-    method = dict(check.mapping(value, "method", METHOD_KEYS, required=("kind",)))
+    keys = (entry or Method).keys
+    method = dict(check.mapping(value, "method", ("kind", *keys), required=("kind",)))
     check.string(method["kind"], "method.kind", METHOD_KINDS)
-    if "order" in method:
-        check.integer(method["order"], "method.order", 0)
-    method["split"] = check.boolean(method.get("split", False), "method.split")
-    if "allow_aliasing" in method:  # kept only when given, so that files of older campaigns stay identical
-        check.boolean(method["allow_aliasing"], "method.allow_aliasing")
+    for key, spec in keys.items():
+        if key not in method and spec.filled:
+            method[key] = spec.default
+        if key in method and isinstance(spec.default, bool):
+            check.boolean(method[key], f"method.{key}")
+        elif key in method and spec.minimum is not None:
+            check.integer(method[key], f"method.{key}", spec.minimum)
+    problem = entry.problem(method) if entry else None
+    if problem:
+        check.fail(f"method.{problem[0]}", problem[1])
     return method
 
 
@@ -590,8 +586,7 @@ def check_size(check: Checker, data: dict, simulator: dict, parameters: list, me
     if points is not None and points > limits["max_runs"]:
         check.fail("design", f"{points:.4g} runs (points built), more than limits.max_runs = {limits['max_runs']}; "
                              "choose a smaller design or raise limits.max_runs")
-    entry = METHODS.get(method.get("kind"))
-    order = method.get(entry.order_key if entry else "order", DEFAULT_ORDER)  # without it, DEFAULT_ORDER at most
+    order = method.get(METHODS.get(method.get("kind"), Method).order_key, DEFAULT_ORDER)  # DEFAULT_ORDER at most
     terms = math.comb(d + order, order) if order <= 10**6 else math.inf
     figures["pce_terms"] = terms
     if terms > limits["max_pce_terms"]:

@@ -1,7 +1,8 @@
-"""Non-intrusive UQ methods (paper section 4): the registry every other part reads.
+"""Non-intrusive UQ methods (paper section 4): one class per kind, registered by subclassing `Method`.
 
-A method is one module plus one entry in METHODS, which says which designs it accepts, how its PCE
-is built, the rule its points must satisfy before it runs, and how its mean and variance follow:
+A kind's class says which designs it accepts, its keys of `method:` (`Method.keys`), how its PCE is built
+(`Method.expansion`), the rule its points must satisfy before it runs, and how its mean and variance follow
+(`Method.fit`):
 
 * ``monte_carlo``: sample mean and unbiased variance of the runs, no PCE; sampled designs only;
 * ``integration``: weighted sums (Eq. 17); on a grid the PCE for bands, PDFs and Sobol' indices is the
@@ -28,106 +29,40 @@ runs, which is of neither law. A grid with failed runs accepts only the fits (`v
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Callable
+from typing import Callable, ClassVar
 
 import numpy as np
 
-from .collocation import least_squares, regression
-from .galerkin import pseudo_galerkin
 from .pce import PCE
-from .sparse import settings_problem, sparse_pce
+
+DEFAULT_ORDER = 2  # a method's order (sparse: max_order) when the campaign gives none
 
 
 @dataclass(frozen=True)
-class Method:
-    """One registered method.
+class Key:
+    """One key of a `method:` mapping besides `kind`: its default, its meaning in the key reference, and
+    what it accepts (an integer >= `minimum`, one of `choices`, true or false, or what `check(value)` says:
+    why it is refused, or None). `filled`: validation writes the default into the mapping when absent."""
 
-    label: its name in the paper's legends. pce: how its PCE is built from (xi, weights, Y, germs,
-    order, x0) -> PCE, or None (no PCE). moments: "sample" (sample moments of the runs, unbiased),
-    "weights" (weighted sums of the runs) or "pce" (the expansion's). sampled_only: refuses grids.
-    runs_on_sampled: on a sampled design its statistics are those of the runs themselves (no PCE).
-    rule: "projection" (needs exactness 2p), "fit" (needs rank Z) or None. split: accepts x0.
-    failed_runs: what its statistics are when runs failed, on the designs that accept it (a key of
-    FAILED_RUNS). partial: valid on a subset of a design's runs (failed or pending runs left out).
-    weighted: its fit (and the rank check and leave-one-out error of a fit) weighs the runs by |w|;
-    False: the points alone. linear: linear in the runs, so applied to tSVD factors V and multiplied
-    by diag(s) Uᵀ after; False: it is given the factors. exported_as: the kinds whose PCE a surrogate
-    (export, calibration) carries on a sampled design and on a grid; None: its own PCE. settings: its
-    own keys of `method:` beyond kind and order, with their defaults, passed to its `pce` by name.
-    order_key: the `method:` key of its order (sparse: max_order, the largest candidate order).
-    settings_problem: (method mapping) -> (key, why) of a bad setting, or None.
-    """
+    default: object
+    description: str
+    minimum: int | None = None
+    choices: tuple[str, ...] = ()
+    check: Callable[[object], str | None] | None = None
+    filled: bool = False
 
-    label: str
-    pce: Callable | None
-    moments: str
-    rule: str | None
-    failed_runs: str
-    sampled_only: bool = False
-    runs_on_sampled: bool = False
-    split: bool = False
-    partial: bool = False
-    weighted: bool = True
-    linear: bool = True
-    exported_as: tuple[str, str] | None = None
-    settings: tuple[tuple[str, object], ...] = ()
-    order_key: str = "order"
-    settings_problem: Callable | None = None
+    def problem(self, value) -> str | None:
+        """Why `value` is refused by the key's choices or check, or None (its type: the campaign schema)."""
+        if self.choices and value not in self.choices:
+            return f"expected one of {', '.join(self.choices)}, got {value!r}"
+        return self.check(value) if self.check else None
 
 
-# (what the statistics are, why) when runs failed; `failed_runs_note` fills in the counts.
-FAILED_RUNS = {
-    "conditional": ("statistics conditional on success",
-                    "they are those of the {ok} successful runs alone, not of the whole input law"),
-    "extrapolated": ("statistics of a fit extrapolated over the failed region",
-                     "{kind} fits its PCE on the {ok} successful runs and its statistics are the PCE's over the "
-                     "whole input law, including the region where the model has no value"),
-    "chosen": ("statistics of the method chosen per output",
-               "auto chose among the methods the {ok} successful runs allow: a fit extrapolates over the failed "
-               "region, the runs' own statistics are conditional on success (each output says which it took)"),
-    "projected": ("statistics of a projection of the successful runs, of neither law",
-                  "{kind} projects the {ok} successful runs alone: its mean is the mean conditional on success, "
-                  "but its PCE (the bands, PDFs and Sobol' indices, and pseudo_galerkin's variance) is that of "
-                  "the output divided by the success rate where runs succeeded and 0 where they failed; use "
-                  "monte_carlo for statistics conditional on success or least_squares for a fit"),
-}
-
-
-def failed_runs_note(kind: str, failed: int, done: int) -> str:
-    """The note that says what `kind`'s statistics are when `failed` of the `done` runs failed."""
-    headline, why = FAILED_RUNS[method_entry(kind).failed_runs]
-    return f"{headline}: {failed} of {done} runs failed; {why.format(ok=done - failed, kind=kind)}"
-
-
-def _regression(xi, weights, Y, germs, order, x0=None) -> PCE:
-    return regression(xi, Y, germs, order)
-
-
-def _least_squares(xi, weights, Y, germs, order, x0=None) -> PCE:
-    return least_squares(xi, weights, Y, germs, order)
-
-
-METHODS: dict[str, Method] = {
-    "integration": Method("Int", pseudo_galerkin, "weights", "projection", "conditional", runs_on_sampled=True,
-                          split=True, exported_as=("least_squares", "pseudo_galerkin")),
-    "pseudo_galerkin": Method("PG", pseudo_galerkin, "pce", "projection", "projected", split=True),
-    "interpolation": Method("interpolation", pseudo_galerkin, "weights", "projection", "projected", split=True,
-                            exported_as=("pseudo_galerkin", "pseudo_galerkin")),
-    "regression": Method("regression", _regression, "pce", "fit", "extrapolated", partial=True, weighted=False),
-    "least_squares": Method("least squares", _least_squares, "pce", "fit", "extrapolated", partial=True),
-    "monte_carlo": Method("MC", None, "sample", None, "conditional", sampled_only=True, runs_on_sampled=True,
-                          partial=True, weighted=False, exported_as=("least_squares", "pseudo_galerkin")),
-    "sparse": Method("sparse", sparse_pce, "pce", "selection", "extrapolated", partial=True, weighted=False,
-                     linear=False, settings=(("selection", "lars"), ("q", 1.0)), order_key="max_order",
-                     settings_problem=settings_problem),
-    # per output, the method of AUTO_CANDIDATES with the lowest validated error (statistics.auto_method)
-    "auto": Method("auto", None, "pce", None, "chosen", partial=True, weighted=False,
-                   exported_as=("least_squares", "pseudo_galerkin")),
-}
-# what `auto` chooses among, in this order of preference at equal error; the runs' own statistics
-# (monte_carlo on a sampled design, integration's weighted runs on a grid of weights >= 0) when none validates
-AUTO_CANDIDATES = ("pseudo_galerkin", "least_squares", "sparse")
-METHOD_KINDS = tuple(METHODS)
+ORDER = Key(DEFAULT_ORDER, "Total degree of the PCE, >= 0. Default 2, or the largest a grid's projection allows. "
+                           "`order: 3`", minimum=0)
+SPLIT = Key(False, "Use the paper's split form x = x0 + S (Eq. 22–24) for projections. Default false.", filled=True)
+ALLOW_ALIASING = Key(False, "Let a projection's order exceed what the grid integrates exactly (refused otherwise; "
+                            "the report says so). Default false.")
 
 
 @dataclass
@@ -144,80 +79,238 @@ class Result:
         return self.pce is None
 
 
-def fit(kind: str, xi, weights, Y, germs, order: int = 2, x0=None, *, scale=None, sampled: bool = False,
-        settings: dict | None = None) -> Result:
-    """Apply method ``kind`` to the runs Y = rows @ scale at points xi (N, d) with weights (N,): the one
-    dispatch the statistics, the surrogate export and the calibration use.
+def scaled(pce: PCE, scale) -> PCE:
+    """The PCE of Y = rows @ scale from the PCE of the rows (a method linear in the runs); scale None: itself."""
+    return pce if scale is None else PCE(pce.germs, pce.indices, pce.coefficients @ np.asarray(scale, dtype=float))
 
-    Y: the runs (N, T), or with ``scale`` (r, T) the rows (N, r) of tSVD factors (a linear method is
-    applied to them and its coefficients multiplied by scale). ``order`` is the PCE's total degree;
-    x0 ((T,) or (N, 1)) selects the split form of the projections (see galerkin). ``sampled``: the
-    points are random draws, where a method that `runs_on_sampled` gives the runs' own moments.
-    ``settings``: the method's other keys (its entry's). Moments follow the method's entry in METHODS.
+
+class Method:
+    """A method kind: subclass it with a ``kind`` name and it is registered in METHODS.
+
+    Class attributes say the facts the rest of uqflight asks of a method; hooks say what it does.
+
+    Attributes
+    ----------
+    kind : str
+        Its name in `method: {kind: ...}` and `--method KIND[:ORDER]`.
+    label : str
+        Its name in the paper's legends.
+    rule : str or None
+        What its points must satisfy (`validity`): "projection" (a grid exact to degree 2p), "fit"
+        (a design matrix of rank Z), "selection" (a candidate set, refused at the fit) or None (no PCE).
+    failed_runs : str
+        What its statistics are when runs failed, a key of FAILED_RUNS.
+    keys : dict of str to Key
+        Its keys of `method:` besides ``kind``; ``order_key`` is the one that sets its order.
+    sampled_only : bool
+        It refuses grids.
+    runs_on_sampled : bool
+        On a sampled design its statistics are those of the runs themselves (no PCE).
+    split : bool
+        It accepts the split form x0 (a projection).
+    partial : bool
+        It is valid on a subset of a design's runs (failed or pending runs left out).
+    weighted : bool
+        Its fit (and the rank check and leave-one-out error of a fit) weighs the runs by |w|.
+    quadrature : bool
+        Its mean and variance are the weighted sums of the runs, its PCE serves bands, PDFs and Sobol'.
+    exported_as : tuple of str or None
+        The kinds whose PCE a surrogate (export, calibration) carries on a sampled design and on a grid;
+        None: its own PCE.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from uqflight.methods import METHODS, Method
+    >>> pg = Method.of("pseudo_galerkin")
+    >>> pg is METHODS["pseudo_galerkin"], pg.order_key, Method.of("sparse").order_key
+    (True, 'order', 'max_order')
+    >>> xi, w = np.array([[-1.0], [0.0], [1.0]]), np.array([1, 4, 1]) / 6  # Simpson = 3-point Gauss-Lobatto
+    >>> result = pg.fit(xi, w, 2 * xi + 1, ["uniform"], order=1)
+    >>> float(result.mean[0]), round(float(result.variance[0]), 12)
+    (1.0, 1.333333333333)
     """
-    from ..analysis.moments import as_runs_by_time, weighted_moments
 
-    method = method_entry(kind)
-    if kind == "auto":  # the candidate that validates on these runs, or the runs' own moments (validation)
-        from .validation import auto_choice
+    kind: ClassVar[str]
+    label: ClassVar[str]
+    rule: ClassVar[str | None] = None
+    failed_runs: ClassVar[str] = "conditional"
+    keys: ClassVar[dict[str, Key]] = {"order": ORDER, "split": SPLIT, "allow_aliasing": ALLOW_ALIASING}
+    order_key: ClassVar[str] = "order"
+    sampled_only: ClassVar[bool] = False
+    runs_on_sampled: ClassVar[bool] = False
+    split: ClassVar[bool] = False
+    partial: ClassVar[bool] = False
+    weighted: ClassVar[bool] = True
+    quadrature: ClassVar[bool] = False
+    exported_as: ClassVar[tuple[str, str] | None] = None
 
+    def __init_subclass__(cls, **kwargs):
+        super().__init_subclass__(**kwargs)
+        if "kind" in cls.__dict__:
+            METHODS[cls.kind] = cls()
+
+    @staticmethod
+    def of(kind: str) -> Method:
+        """The method of `kind`; an unknown kind is a ValueError listing the kinds."""
+        if kind not in METHODS:
+            raise ValueError(f"unknown method kind {kind!r}: expected one of {', '.join(METHODS)}")
+        return METHODS[kind]
+
+    @staticmethod
+    def of_runs(sampled: bool) -> Method:
+        """The method whose statistics are the runs' own: monte_carlo on a sampled design, else integration."""
+        return METHODS["monte_carlo" if sampled else "integration"]
+
+    @property
+    def settings(self) -> tuple[str, ...]:
+        """Its keys its `expansion` takes by name (beyond the order and the split form)."""
+        return tuple(k for k in self.keys if k not in (self.order_key, "split", "allow_aliasing"))
+
+    @property
+    def projects(self) -> bool:
+        """Its PCE is a projection (needs a grid exact to degree 2p)."""
+        return self.rule == "projection"
+
+    @property
+    def fits(self) -> bool:
+        """Its PCE is a least-squares fit (with or without a selection of its basis): a leave-one-out error."""
+        return self.rule in ("fit", "selection")
+
+    @property
+    def selects(self) -> bool:
+        """It chooses its basis from the runs: its out-of-sample error redoes the choice per fold."""
+        return self.rule == "selection"
+
+    @property
+    def expands(self) -> bool:
+        """It builds a PCE, on a grid at least (False: the runs' own statistics, or another kind's PCE)."""
+        return self.rule is not None
+
+    def builds_pce(self, sampled: bool) -> bool:
+        """Whether it builds a PCE on a design (sampled or a grid), so that its order means something."""
+        return self.expands and not (sampled and self.runs_on_sampled)
+
+    def settings_of(self, method: dict | None) -> dict:
+        """The settings of a `method:` mapping its expansion takes, defaults filled in."""
+        return {key: (method or {}).get(key, self.keys[key].default) for key in self.settings}
+
+    def problem(self, method: dict) -> tuple[str, str] | None:
+        """(key, why) of the first key of a `method:` mapping its Key refuses, or None."""
+        for key, spec in self.keys.items():
+            why = spec.problem(method[key]) if key in method else None
+            if why:
+                return key, why
+        return None
+
+    def expansion(self, xi, weights, Y, germs, order: int, x0=None, scale=None, **settings) -> PCE:
+        """Its PCE of Y = rows @ scale (scale None: Y (N, T)) at the points xi (N, d) with weights (N,)."""
+        raise NotImplementedError(f"{self.kind} builds no PCE")
+
+    def fit(self, xi, weights, Y, germs, order: int = DEFAULT_ORDER, x0=None, *, scale=None, sampled: bool = False,
+            settings: dict | None = None) -> Result:
+        """Apply the method to the runs Y = rows @ scale at points xi (N, d) with weights (N,).
+
+        Y: the runs (N, T), or with ``scale`` (r, T) the rows (N, r) of tSVD factors. ``order`` is the PCE's
+        total degree; x0 ((T,) or (N, 1)) selects the split form of the projections (see galerkin).
+        ``sampled``: the points are random draws, where a method that `runs_on_sampled` gives the runs' own
+        moments. ``settings``: its other keys (`settings`).
+        """
+        from ..analysis.moments import as_runs_by_time, weighted_moments
+
+        if x0 is not None and not self.split:
+            split = " and ".join(k for k, m in METHODS.items() if m.split)
+            raise ValueError(f"x0 (the split form x = x0 + S) applies to {split}; {self.kind!r} either builds no "
+                             "PCE or fits the constant term itself, so the split would change nothing")
         Y = as_runs_by_time(Y)
-        taken = auto_choice(xi, weights, Y, scale, germs, order, sampled)[0]
-        fallback = "monte_carlo" if sampled else "integration"
-        return fit(taken or fallback, xi, weights, Y, germs, order, scale=scale, sampled=sampled or taken is None,
-                   settings=method_settings({"kind": taken}) if taken else None)
-    if x0 is not None and not method.split:
-        split = " and ".join(k for k, m in METHODS.items() if m.split)
-        raise ValueError(f"x0 (the split form x = x0 + S) applies to {split}; {kind!r} either builds no "
-                         "PCE or fits the constant term itself, so the split would change nothing")
-    Y = as_runs_by_time(Y)
-    if method.pce is None or (sampled and method.runs_on_sampled):
-        sample = method.moments == "sample"
-        mean, variance = weighted_moments(Y, None if sample else weights, scale, unbiased=sample)
-        return Result(mean, variance, None)
-    if method.linear:
-        fitted = method.pce(xi, weights, Y, germs, order, x0)
-        pce = fitted if scale is None else PCE(fitted.germs, fitted.indices, fitted.coefficients @ scale)
-    else:
-        pce = method.pce(xi, weights, Y, germs, order, x0, scale=scale, **(settings or {}))
-    if method.moments == "weights":  # quadrature moments; the PCE serves bands, PDFs, Sobol'
-        mean, variance = weighted_moments(Y, weights, scale)
-    else:
-        mean, variance = pce.mean(), pce.variance()
-    return Result(mean, variance, pce)
+        if not self.builds_pce(sampled):
+            own = self.run_weights(weights)
+            mean, variance = weighted_moments(Y, own, scale, unbiased=own is None)
+            return Result(mean, variance, None)
+        pce = self.expansion(xi, weights, Y, germs, order, x0, scale, **self.settings_of(settings))
+        if self.quadrature:  # quadrature moments; the PCE serves bands, PDFs, Sobol'
+            mean, variance = weighted_moments(Y, weights, scale)
+        else:
+            mean, variance = pce.mean(), pce.variance()
+        return Result(mean, variance, pce)
+
+    def run_weights(self, weights):
+        """The weights of the runs in its statistics of the runs themselves (None: equal, Monte Carlo's)."""
+        return weights
+
+    def exported_kind(self, sampled: bool) -> str:
+        """The kind whose PCE a surrogate of this method carries (`exported_as`); a kind that needs a sampled
+        design stays itself on a grid, for the analysis to refuse (never another method in its place)."""
+        if self.exported_as is None or (self.sampled_only and not sampled):
+            return self.kind
+        return self.exported_as[0 if sampled else 1]
+
+    def failed_runs_note(self, failed: int, done: int) -> str:
+        """The note that says what its statistics are when `failed` of the `done` runs failed."""
+        headline, why = FAILED_RUNS[self.failed_runs]
+        return f"{headline}: {failed} of {done} runs failed; {why.format(ok=done - failed, kind=self.kind)}"
 
 
-def exported_kind(kind: str, sampled: bool) -> str:
-    """The kind whose PCE a surrogate of method `kind` carries (its entry's `exported_as`); a kind that
-    needs a sampled design stays itself on a grid, for the analysis to refuse (never another method
-    in its place)."""
-    entry = method_entry(kind)
-    if entry.exported_as is None or (entry.sampled_only and not sampled):
-        return kind
-    return entry.exported_as[0 if sampled else 1]
+METHODS: dict[str, Method] = {}  # filled, in this order, by the subclasses below and in their modules
 
 
-def method_settings(method: dict) -> dict:
-    """The settings of a `method:` mapping its kind takes (its entry's `settings`), defaults filled in."""
-    return {key: method.get(key, default) for key, default in method_entry(method["kind"]).settings}
+# (what the statistics are, why) when runs failed; `Method.failed_runs_note` fills in the counts.
+FAILED_RUNS = {
+    "conditional": ("statistics conditional on success",
+                    "they are those of the {ok} successful runs alone, not of the whole input law"),
+    "extrapolated": ("statistics of a fit extrapolated over the failed region",
+                     "{kind} fits its PCE on the {ok} successful runs and its statistics are the PCE's over the "
+                     "whole input law, including the region where the model has no value"),
+    "chosen": ("statistics of the method chosen per output",
+               "auto chose among the methods the {ok} successful runs allow: a fit extrapolates over the failed "
+               "region, the runs' own statistics are conditional on success (each output says which it took)"),
+    "projected": ("statistics of a projection of the successful runs, of neither law",
+                  "{kind} projects the {ok} successful runs alone: its mean is the mean conditional on success, "
+                  "but its PCE (the bands, PDFs and Sobol' indices, and pseudo_galerkin's variance) is that of "
+                  "the output divided by the success rate where runs succeeded and 0 where they failed; use "
+                  "monte_carlo for statistics conditional on success or least_squares for a fit"),
+}
+
+from .galerkin import Integration, Interpolation, PseudoGalerkin  # noqa: E402  (registers, in this order)
+from .collocation import LeastSquares, Regression  # noqa: E402
 
 
-def normalised(method: dict) -> dict:
-    """A `method:` mapping with its kind's order key (its entry's `order_key`) as "order"."""
-    key = method_entry(method["kind"]).order_key if method.get("kind") in METHODS else "order"
-    if key == "order" or key not in method:
-        return dict(method)
-    method = dict(method)
-    method["order"] = method.pop(key)
-    return method
+class MonteCarlo(Method):
+    """Sample moments of the runs; sampled designs only."""
+
+    kind, label, sampled_only, runs_on_sampled, partial, weighted = "monte_carlo", "MC", True, True, True, False
+    exported_as = ("least_squares", "pseudo_galerkin")
+
+    def run_weights(self, weights):
+        return None
+
+
+from .sparse import Sparse  # noqa: E402
+from .validation import AUTO_CANDIDATES, Auto  # noqa: E402
+
+METHOD_KINDS = tuple(METHODS)
 
 
 def method_entry(kind: str) -> Method:
-    """The registry entry of `kind`; an unknown kind is a ValueError listing the kinds."""
-    if kind not in METHODS:
-        raise ValueError(f"unknown method kind {kind!r}: expected one of {', '.join(METHOD_KINDS)}")
-    return METHODS[kind]
+    """The method of `kind` (Method.of)."""
+    return Method.of(kind)
 
 
-__all__ = ["AUTO_CANDIDATES", "FAILED_RUNS", "METHODS", "METHOD_KINDS", "PCE", "Method", "Result", "exported_kind",
-           "failed_runs_note", "fit", "method_entry"]
+def normalised(method: dict) -> dict:
+    """A `method:` mapping with its kind's order key (`Method.order_key`) as "order"."""
+    method = dict(method)
+    key = METHODS[method["kind"]].order_key if method.get("kind") in METHODS else "order"
+    if key != "order" and key in method:
+        method["order"] = method.pop(key)
+    return method
+
+
+def fit(kind: str, *args, **kwargs) -> Result:
+    """Method `kind`'s fit (Method.fit): the one dispatch the statistics, the surrogate export and the
+    calibration use."""
+    return Method.of(kind).fit(*args, **kwargs)
+
+
+__all__ = ["AUTO_CANDIDATES", "DEFAULT_ORDER", "FAILED_RUNS", "METHODS", "METHOD_KINDS", "PCE", "Auto", "Integration",
+           "Interpolation", "Key", "LeastSquares", "Method", "MonteCarlo", "PseudoGalerkin", "Regression", "Result",
+           "Sparse", "fit", "method_entry", "normalised", "scaled"]

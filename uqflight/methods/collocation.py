@@ -7,6 +7,7 @@ import numpy as np
 
 from ..analysis.moments import as_runs_by_time, probability_weights
 from ..parameters.germs import check_germs
+from . import Method, scaled
 from .basis import orthonormal_basis, total_degree_indices
 from .pce import PCE
 
@@ -56,3 +57,21 @@ def least_squares(xi, weights, Y, germs, order: int = 2) -> PCE:
     root_weights = np.sqrt(np.abs(probability_weights(weights, len(Y))))[:, None]
     indices, matrix = _basis_matrix(xi, germs, order)
     return PCE(germs, indices, _solve(root_weights * matrix, root_weights * Y, order))
+
+
+class Regression(Method):
+    """Least-squares fit of the PCE, weights ignored (Eq. 35–37)."""
+
+    kind, label, rule, failed_runs, partial, weighted = "regression", "regression", "fit", "extrapolated", True, False
+
+    def expansion(self, xi, weights, Y, germs, order: int, x0=None, scale=None, **settings) -> PCE:
+        return scaled(regression(xi, Y, germs, order), scale)
+
+
+class LeastSquares(Method):
+    """Weighted least-squares fit of the PCE (Eq. 43–48)."""
+
+    kind, label, rule, failed_runs, partial = "least_squares", "least squares", "fit", "extrapolated", True
+
+    def expansion(self, xi, weights, Y, germs, order: int, x0=None, scale=None, **settings) -> PCE:
+        return scaled(least_squares(xi, weights, Y, germs, order), scale)

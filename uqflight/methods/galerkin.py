@@ -16,6 +16,7 @@ import numpy as np
 
 from ..analysis.moments import as_runs_by_time, probability_weights
 from ..parameters.germs import check_germs
+from . import Method, scaled
 from .basis import orthonormal_basis, total_degree_indices
 from .pce import PCE
 
@@ -52,3 +53,33 @@ def pseudo_galerkin(xi, weights, Y, germs, order: int = 2, x0=None) -> PCE:
     else:
         coefficients += project(xi, weights, x0, germs, indices)
     return PCE(germs, indices, coefficients)
+
+
+
+class Projection(Method):
+    """A PCE by projection (Eq. 21), split form with x0 (Eq. 24): the kinds below (no kind of its own)."""
+
+    rule, failed_runs, split = "projection", "projected", True
+
+    def expansion(self, xi, weights, Y, germs, order: int, x0=None, scale=None, **settings) -> PCE:
+        return scaled(pseudo_galerkin(xi, weights, Y, germs, order, x0), scale)
+
+
+class Integration(Projection):
+    """Weighted sums of the runs (Eq. 17); on a grid the PCE for bands, PDFs and Sobol' indices is the
+    projection."""
+
+    kind, label, failed_runs, runs_on_sampled, quadrature = "integration", "Int", "conditional", True, True
+    exported_as = ("least_squares", "pseudo_galerkin")
+
+
+class PseudoGalerkin(Projection):
+    """Projection of the runs on the PCE (Eq. 19–21); moments from the PCE."""
+
+    kind, label = "pseudo_galerkin", "PG"
+
+
+class Interpolation(Projection):
+    """Moments from the weights (Eq. 32–34), PCE by projection."""
+
+    kind, label, quadrature, exported_as = "interpolation", "interpolation", True, ("pseudo_galerkin", "pseudo_galerkin")

@@ -1,14 +1,14 @@
 """`KIND[:ORDER[:KEY=VALUE,...]]`, the one way a method is written on the command line (report, surrogate
-export, calibrate)."""
+export, calibrate), with `--order N` as the ORDER of a bare KIND."""
 from __future__ import annotations
 
-from . import METHOD_KINDS, method_entry
+from . import METHOD_KINDS, Method
 
 
 def parse_methods(methods: list[str], order: int | None = None) -> list[dict]:
     """`KIND[:ORDER[:KEY=VALUE,...]]` strings into method overrides (KEY one of the kind's settings,
     e.g. `sparse:4:selection=omp,q=0.75`); a bare KIND takes `order` (when given). ValueError naming
-    the bad item."""
+    the bad item: an ORDER, written or given, is refused in one sentence."""
     parsed = []
     for text in methods:
         kind, sep, rest = text.partition(":")
@@ -17,36 +17,33 @@ def parse_methods(methods: list[str], order: int | None = None) -> list[dict]:
         if kind not in METHOD_KINDS:
             raise ValueError(f"expected KIND[:ORDER] with KIND one of {', '.join(METHOD_KINDS)}, got {text!r}")
         method = {"kind": kind}
-        if sep:
+        if sep or order is not None:
+            given = repr(text) if sep else f"--order {order}"
             try:
-                method["order"] = int(number)
+                method["order"] = int(number if sep else order)
             except ValueError:
-                raise ValueError(f"expected an integer ORDER >= 0 after {kind}:, got {text!r}") from None
+                method["order"] = -1
             if method["order"] < 0:
-                raise ValueError(f"expected an integer ORDER >= 0 after {kind}:, got {text!r}")
-        elif order is not None:
-            method["order"] = order
+                raise ValueError(f"expected an integer ORDER >= 0 after {kind}:, got {given}")
         if more:
-            method.update(_settings(kind, pairs, text))
+            method.update(_settings(Method.of(kind), pairs, text))
         parsed.append(method)
     return parsed
 
 
-def _settings(kind: str, pairs: str, text: str) -> dict:
-    """The KEY=VALUE,... after KIND:ORDER: as settings of `kind` (numbers where they parse)."""
-    entry = method_entry(kind)
-    known = [key for key, _ in entry.settings]
+def _settings(entry: Method, pairs: str, text: str) -> dict:
+    """The KEY=VALUE,... after KIND:ORDER: as settings of the method (numbers where they parse)."""
     settings = {}
     for pair in pairs.split(","):
         key, equals, value = (part.strip() for part in pair.partition("="))
-        if not equals or key not in known:
-            raise ValueError(f"expected KIND:ORDER:KEY=VALUE,... with KEY one of {', '.join(known) or '(none)'} "
-                             f"for {kind}, got {text!r}")
+        if not equals or key not in entry.settings:
+            raise ValueError(f"expected KIND:ORDER:KEY=VALUE,... with KEY one of {', '.join(entry.settings) or '(none)'} "
+                             f"for {entry.kind}, got {text!r}")
         try:
             settings[key] = float(value)
         except ValueError:
             settings[key] = value
-    problem = entry.settings_problem(settings) if entry.settings_problem else None
+    problem = entry.problem(settings)
     if problem:
         raise ValueError(f"{text!r}: {problem[0]}: {problem[1]}")
     return settings

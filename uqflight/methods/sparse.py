@@ -25,6 +25,7 @@ import warnings
 import numpy as np
 
 from ..parameters.germs import check_germs
+from . import METHODS, Key, Method
 from .basis import orthonormal_basis, total_degree_indices
 from .pce import PCE
 
@@ -129,13 +130,9 @@ def _order_basis(candidates: np.ndarray, points: np.ndarray, germs, Y: np.ndarra
     return terms, float(error)
 
 
-def settings_problem(method: dict) -> tuple[str, str] | None:
-    """(key, why) of a bad `selection` or `q` of a sparse `method:` mapping, or None."""
-    selection, q = method.get("selection", "lars"), method.get("q", 1.0)
-    if selection not in SELECTIONS:
-        return "selection", f"expected one of {', '.join(SELECTIONS)}, got {selection!r}"
+def _q_problem(q) -> str | None:
     if isinstance(q, bool) or not isinstance(q, (int, float)) or not 0 < q <= 1:
-        return "q", f"expected a number in (0, 1] (1: total degree; below 1: hyperbolic truncation), got {q!r}"
+        return f"expected a number in (0, 1] (1: total degree; below 1: hyperbolic truncation), got {q!r}"
     return None
 
 
@@ -144,7 +141,7 @@ def sparse_pce(xi, weights, Y, germs, order: int = 3, x0=None, *, scale=None, se
     """The sparse PCE of Y = rows @ scale (scale None: Y (N, T)) at the points xi (N, d): orders 1..order,
     q-hyperbolic candidates, `selection` lars or omp; its `selection` record says what was chosen.
     ValueError when no candidate order gives a defined leave-one-out error (too few points)."""
-    problem = settings_problem({"selection": selection, "q": q})
+    problem = METHODS["sparse"].problem({"selection": selection, "q": q})
     if problem:
         raise ValueError(f"{problem[0]}: {problem[1]}")
     germs = check_germs(germs)
@@ -172,4 +169,21 @@ def sparse_pce(xi, weights, Y, germs, order: int = 3, x0=None, *, scale=None, se
     return PCE(germs, indices, coefficients, selection=record)
 
 
-__all__ = ["SELECTIONS", "hyperbolic_indices", "settings_problem", "sparse_pce"]
+class Sparse(Method):
+    """Sparse PCE: candidate terms up to `max_order` (q-hyperbolic), ordered by LARS or OMP, the basis and
+    order chosen by the corrected leave-one-out error; on any design (see [methods](../methods.md))."""
+
+    kind, label, rule, failed_runs, partial, weighted = "sparse", "sparse", "selection", "extrapolated", True, False
+    order_key = "max_order"
+    keys = {"max_order": Key(2, "sparse only: the largest total degree of the candidate terms, >= 1. Default 2. "
+                                "`max_order: 5`", minimum=1),
+            "selection": Key("lars", "sparse only: `lars` (least-angle regression, the default) or `omp` (orthogonal "
+                                     "matching pursuit) orders the candidate terms.", choices=SELECTIONS),
+            "q": Key(1.0, "sparse only: the hyperbolic truncation ‖α‖_q ≤ max_order, 0 < q ≤ 1; 1 (the default) is "
+                          "total degree, smaller keeps fewer interactions. `q: 0.75`", check=_q_problem)}
+
+    def expansion(self, xi, weights, Y, germs, order: int, x0=None, scale=None, **settings) -> PCE:
+        return sparse_pce(xi, weights, Y, germs, order, x0, scale=scale, **settings)
+
+
+__all__ = ["SELECTIONS", "Sparse", "hyperbolic_indices", "sparse_pce"]

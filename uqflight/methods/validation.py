@@ -29,11 +29,13 @@ from typing import Callable
 
 import numpy as np
 
+from ..analysis.moments import as_runs_by_time
+from ..parameters.germs import draw_germs
+from . import DEFAULT_ORDER, METHODS, Method, Result
 from .basis import orthonormal_basis
 from .loo import relative_loo_error
 from .pce import PCE
 from .validity import method_problem
-from ..parameters.germs import draw_germs
 
 # An expansion that leaves more than 5 % of the runs' variance unexplained out of sample (an RMS error
 # above 22 % of their std) is flagged: the smooth flights and closed forms of the tests stay below 1e-2,
@@ -49,6 +51,9 @@ JUDGED_SPREAD = 1e-2
 CV_FOLDS = 5
 ALLOWANCE_DRAWS = 4000  # draws of the runs' additive quadratic fit whose 99 % band widens their range
 AUTO_BAND_DRAWS = 2000  # draws of a candidate's PCE whose 99 % band auto checks against the runs
+# what `auto` chooses among, in this order of preference at equal error; the runs' own statistics
+# (monte_carlo on a sampled design, integration's weighted runs on a grid of weights >= 0) when none validates
+AUTO_CANDIDATES = ("pseudo_galerkin", "least_squares", "sparse")
 
 
 @dataclass
@@ -269,23 +274,19 @@ def auto_choice(xi, weights, basis, scale, germs, order: int, sampled: bool, mis
     whose 99 % band (of AUTO_BAND_DRAWS draws seeded by `seed`) stays within the runs' allowed range, ties
     (below 1e-12: exact) to the first; None when none validates, {kind: its error, None: undefined}).
     Candidates the design and its runs refuse (methods.validity) are left out."""
-    from . import AUTO_CANDIDATES, fit, method_entry, method_settings
-
     Y = basis if scale is None else basis @ scale
     judged = judged_times(Y, np.ones(Y.shape[1], dtype=bool))
     errors: dict[str, float | None] = {}
     band_outside: set[str] = set()
     for kind in AUTO_CANDIDATES:
-        entry = method_entry(kind)
-        if (entry.rule == "projection" and sampled) or method_problem(kind, order, xi, weights, germs, sampled,
-                                                                       missing=missing):
+        entry = METHODS[kind]
+        if (entry.projects and sampled) or method_problem(kind, order, xi, weights, germs, sampled, missing=missing):
             continue
         try:
-            pce = fit(kind, xi, weights, basis, germs, order, scale=scale, sampled=sampled,
-                      settings=method_settings({"kind": kind})).pce
+            pce = entry.fit(xi, weights, basis, germs, order, scale=scale, sampled=sampled).pce
         except ValueError:  # e.g. sparse with no basis of a defined leave-one-out error
             continue
-        loo = None if entry.rule == "projection" else leave_one_out(entry.weighted, xi, weights, Y, germs,
+        loo = None if entry.projects else leave_one_out(entry.weighted, xi, weights, Y, germs,
                                                                     pce.indices)
         refit = refitting(kind, xi, weights, basis, scale, germs, order, sampled)
         found = out_of_sample_error(entry.rule, xi, weights, Y, germs, pce, loo, refit)[0]
@@ -306,9 +307,23 @@ def auto_choice(xi, weights, basis, scale, germs, order: int, sampled: bool, mis
 def refitting(kind: str, xi, weights, basis, scale, germs, order: int, sampled: bool,
            settings: dict | None = None) -> Callable[[np.ndarray], PCE]:
     """train (bool (N,)) -> the PCE of method `kind` fitted on those runs alone (cross_validated_error)."""
-    from . import fit, method_settings
+    method = Method.of(kind)
+    return lambda train: method.fit(xi[train], weights[train], basis[train], germs, order, scale=scale,
+                                    sampled=sampled, settings=settings).pce
 
-    settings = method_settings({"kind": kind, **(settings or {})})
-    return lambda train: fit(kind, xi[train], weights[train], basis[train], germs, order, scale=scale,
-                             sampled=sampled, settings=settings).pce
 
+class Auto(Method):
+    """Per output and quantity, among pseudo_galerkin (grids), least_squares and sparse of `order`, the one
+    with the lowest error validated on the runs; the runs' own statistics when none validates. Each output's
+    `method` in summary.json says which it took (see [methods](../methods.md))."""
+
+    kind, label, failed_runs, partial, weighted = "auto", "auto", "chosen", True, False
+    exported_as = ("least_squares", "pseudo_galerkin")
+
+    def fit(self, xi, weights, Y, germs, order: int = DEFAULT_ORDER, x0=None, *, scale=None, sampled: bool = False,
+            settings: dict | None = None) -> Result:
+        """The fit of the candidate that validates on these runs (`auto_choice`), or the runs' own moments."""
+        Y = as_runs_by_time(Y)
+        taken = auto_choice(xi, weights, Y, scale, germs, order, sampled)[0]
+        method = METHODS[taken] if taken else Method.of_runs(sampled)
+        return method.fit(xi, weights, Y, germs, order, scale=scale, sampled=sampled or taken is None)

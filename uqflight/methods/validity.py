@@ -18,7 +18,7 @@ from __future__ import annotations
 
 import math
 
-from . import method_entry
+from . import Method
 from .exactness import design_matrix_rank, exact_total_degree, max_projection_order
 
 MAX_TERMS = 100_000  # PCE terms beyond which a fit is refused before any basis is built (campaign: limits.max_pce_terms)
@@ -29,12 +29,12 @@ def method_problem(kind: str, order: int, xi, weights, germs: list[str], sampled
     """Why method `kind` of total `order` cannot be applied to the points xi (N, d) with weights (the
     runs that exist), or None. `sampled`: the design draws random points. `missing`: the design's runs
     that are absent (failed or pending). `allow_aliasing` waives the projection's exactness rule."""
-    method = method_entry(kind)
+    method = Method.of(kind)
     d, n = len(germs), len(xi)
     if method.sampled_only and not sampled:
         return (f"{kind} needs a sampled design (Monte Carlo, QMC, pick-freeze); a grid needs its weights: "
                 "use integration, pseudo_galerkin, interpolation, regression or least_squares")
-    if method.pce is None or (sampled and method.runs_on_sampled):
+    if not method.builds_pce(sampled):
         return None
     terms = math.comb(d + order, order)
     if terms > MAX_TERMS:
@@ -64,7 +64,7 @@ def method_problem(kind: str, order: int, xi, weights, germs: list[str], sampled
 
 def largest_fitting_order(kind: str, xi, weights, germs: list[str], below: int) -> int:
     """The largest order < `below` whose design matrix has full rank on the points (−1 if none)."""
-    weighted = method_entry(kind).weighted
+    weighted = Method.of(kind).weighted
     for order in range(below - 1, -1, -1):
         rank, terms = design_matrix_rank(xi, germs, order, weights if weighted else None)
         if rank == terms:

@@ -12,7 +12,7 @@ from ..campaign import CampaignError
 from ..campaign.attributes import stored_settings
 from ..campaign.reading import parameter_rows, results_campaign
 from ..designs import REGISTRY as DESIGNS
-from ..methods import method_entry
+from ..methods import METHODS
 from ..statistics import BadInput, Statistics, add_reference_errors, read_statistics
 
 
@@ -37,7 +37,7 @@ class Entry:
 
     @property
     def monte_carlo(self) -> bool:
-        return method_entry(self.stats.method["kind"]).pce is None
+        return not METHODS[self.stats.method["kind"]].expands
 
     @property
     def pick_freeze(self) -> bool:
@@ -55,9 +55,9 @@ class Entry:
 
 def method_label(method: dict) -> str:
     """A method as in the paper's legends, e.g. "PG order 2", "MC"."""
-    entry = method_entry(method["kind"])
+    entry = METHODS[method["kind"]]
     name = entry.label
-    if entry.pce is None:
+    if not entry.expands:
         return name
     return f"{name} order {method['order']}" + (" split" if method.get("split") else "")
 
