@@ -41,3 +41,12 @@ def test_the_check_finds_the_comparisons_it_is_for():
     source = ('if method["kind"] == "auto": pass\nif kind in ("monte_carlo", "integration"): pass\n'
               'if "sparse" != kind: pass\nif design_kind != "monte_carlo": pass\nx = {"kind": "sparse"}\n')
     assert [line for line, _ in comparisons_with_method_kinds(source)] == [1, 2, 3]
+
+
+def test_the_method_class_example_runs():
+    import doctest
+
+    import uqflight.methods
+
+    result = doctest.testmod(uqflight.methods)
+    assert result.attempted >= 4 and result.failed == 0

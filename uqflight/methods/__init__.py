@@ -33,6 +33,7 @@ from typing import Callable, ClassVar
 
 import numpy as np
 
+from ..analysis.moments import as_runs_by_time, weighted_moments
 from .pce import PCE
 
 DEFAULT_ORDER = 2  # a method's order (sparse: max_order) when the campaign gives none
@@ -216,8 +217,6 @@ class Method:
         ``sampled``: the points are random draws, where a method that `runs_on_sampled` gives the runs' own
         moments. ``settings``: its other keys (`settings`).
         """
-        from ..analysis.moments import as_runs_by_time, weighted_moments
-
         if x0 is not None and not self.split:
             split = " and ".join(k for k, m in METHODS.items() if m.split)
             raise ValueError(f"x0 (the split form x = x0 + S) applies to {split}; {self.kind!r} either builds no "
@@ -291,11 +290,6 @@ from .validation import AUTO_CANDIDATES, Auto  # noqa: E402
 METHOD_KINDS = tuple(METHODS)
 
 
-def method_entry(kind: str) -> Method:
-    """The method of `kind` (Method.of)."""
-    return Method.of(kind)
-
-
 def normalised(method: dict) -> dict:
     """A `method:` mapping with its kind's order key (`Method.order_key`) as "order"."""
     method = dict(method)
@@ -313,4 +307,4 @@ def fit(kind: str, *args, **kwargs) -> Result:
 
 __all__ = ["AUTO_CANDIDATES", "DEFAULT_ORDER", "FAILED_RUNS", "METHODS", "METHOD_KINDS", "PCE", "Auto", "Integration",
            "Interpolation", "Key", "LeastSquares", "Method", "MonteCarlo", "PseudoGalerkin", "Regression", "Result",
-           "Sparse", "fit", "method_entry", "normalised", "scaled"]
+           "Sparse", "fit", "normalised", "scaled"]
