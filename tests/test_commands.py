@@ -66,6 +66,8 @@ def test_calibrate_takes_kind_colon_order_as_report_does():
     (("--method", "least_squares:2", "--order", "3"), "error: --method least_squares:2 and --order 3 give two orders"),
     (("--method", "lsq:2"), "error: --method: expected KIND[:ORDER] with KIND one of"),
     (("--method", "least_squares:x"), "error: --method: expected an integer ORDER >= 0 after least_squares:"),
+    (("--method", "least_squares", "--order", "-1"),
+     "error: --method: expected an integer ORDER >= 0 after least_squares:, got --order -1"),
 ])
 def test_calibrate_refuses_a_bad_method_before_any_work(results, tmp_path, args, message):
     data = tmp_path / "flight.csv"
@@ -119,3 +121,19 @@ def test_design_csv(tmp_path):
     np.testing.assert_allclose(kappa[:, 1], 1.5 + 0.5 * xi[:, 1], rtol=1e-14)  # uniform on [1, 2]
     missing = cli_in_process("design", tmp_path / "missing.yaml", "--csv", out)
     assert missing.returncode == 2 and "Traceback" not in missing.stderr
+
+
+@pytest.mark.parametrize("args", [("--method", "least_squares:-1"), ("--method", "least_squares", "--order", "-1")])
+def test_report_refuses_a_bad_order_one_way_whichever_way_it_is_given(results, tmp_path, args):
+    refused = cli_in_process("report", results, *args, "--out", tmp_path / "r")
+    assert refused.returncode == 2 and "expected an integer ORDER >= 0 after least_squares:" in refused.stderr
+    assert "Traceback" not in refused.stderr and not (tmp_path / "r").exists()
+
+
+def test_a_sparse_order_is_refused_below_its_max_order_bound():
+    from uqflight.methods.parsing import parse_methods
+
+    with pytest.raises(ValueError, match="expected an integer ORDER >= 1 after sparse:, got 'sparse:0'"):
+        parse_methods(["sparse:0"])
+    assert parse_methods(["sparse", "least_squares:1"], 3) == [{"kind": "sparse", "order": 3},
+                                                               {"kind": "least_squares", "order": 1}]

@@ -52,7 +52,7 @@ from .designs import REGISTRY as DESIGNS
 from .designs import is_rare, is_sampled
 from .designs.adaptive import index_set_summary
 from .labels import name_unit, quantity_unit
-from .methods import AUTO_CANDIDATES, DEFAULT_ORDER, PCE, METHODS, Auto, Method, normalised
+from .methods import DEFAULT_ORDER, PCE, METHODS, Auto, Method, normalised
 from .methods.basis import orthonormal_basis
 from .methods.pce_moments import pce_standardised_moments, triple_products
 from .methods import validation
@@ -507,41 +507,15 @@ def _with_method(record: dict | None, finish: Callable[[], OutputStatistics]) ->
 
 def auto_method(store: ResultStore, name: str, method: dict, germs: list[str], design_kind: str,
                 ok: np.ndarray, seed: int = 0) -> tuple[dict, bool, dict | None]:
-    """(the method for output `name`, whether its statistics are the runs' own, what auto took or None).
-
-    `method` other than auto is itself. For auto: among AUTO_CANDIDATES of its order that the design and its
-    runs allow (methods.validity), the one whose out-of-sample error (methods.validation, over the judged
-    times) is the lowest and below VALIDATION_THRESHOLD and whose band stays within the runs' allowed range (its
-    draws seeded by `seed`), ties (errors below 1e-12: exact fits) to the first;
-    when none validates, the runs' own statistics: monte_carlo on a sampled design, the weighted runs on a grid
-    of weights >= 0; a grid with signed weights has no statistics of its runs alone, so it keeps the expansion
-    of lowest error, flagged by its own check."""
+    """(the method for output `name`, whether its statistics are the runs' own, what auto took or None):
+    `method` itself, or for auto what it takes on these runs (validation.Auto.choose, its draws seeded by `seed`)."""
     if not isinstance(METHODS[method["kind"]], Auto):
         return method, False, None
-    xi, weights, order = store.xi[ok], store.weights[ok], method["order"]
-    sampled, missing = is_sampled(design_kind), int(ok.size - ok.sum())
     basis, scale = output_basis(store, name, ok)
-    taken, errors, band_outside = validation.auto_choice(xi, weights, basis, scale, germs, order, sampled, missing,
-                                                         seed)
-    record = {"chosen_by": "auto", "order": order, "errors": errors, "threshold": validation.VALIDATION_THRESHOLD,
-              "band_beyond_runs": band_outside}
-    if taken is not None:
-        return ({**method, "kind": taken, "order": order}, False,
-                {**record, "kind": taken, "why": f"the lowest validated error, {errors[taken]:.3g}, its band "
-                                                 "within the runs' range"})
-    why, own = "no expansion validates on these runs", Method.of_runs(sampled).kind
-    if sampled or (weights >= 0).all():
-        return ({**method, "kind": own, "order": order}, not sampled,
-                {**record, "kind": own, "why": f"{why}: the runs' own statistics"
-                                              + ("" if sampled else ", weighted by the grid")})
-    if not [e for e in errors.values() if e is not None]:
-        raise ValueError(f"method auto: for {name}, no candidate ({', '.join(AUTO_CANDIDATES)}) of order "
-                         f"{order} can be applied to these runs, and a grid with negative weights gives no statistics "
-                         "of its runs alone: run a sampled design, or choose a method and order")
-    kind = min((e, i, k) for i, (k, e) in enumerate(errors.items()) if e is not None)[2]
-    return ({**method, "kind": kind, "order": order}, False,
-            {**record, "kind": kind, "why": f"{why}, and a grid with negative weights has no statistics of its runs "
-                                            "alone: the expansion of lowest error, flagged; run a sampled design"})
+    kind, runs_only, record = METHODS[method["kind"]].choose(
+        store.xi[ok], store.weights[ok], basis, scale, germs, method["order"], is_sampled(design_kind),
+        int(ok.size - ok.sum()), seed, name)
+    return {**method, "kind": kind}, runs_only, record
 
 
 def _note_auto(stats: Statistics) -> None:

@@ -76,11 +76,7 @@ def calibrate_command(
              "an earlier calibration did not write (no posterior.h5 of one there); choose another --out, or move "
              "them away", err=True)
         raise typer.Exit(EXIT_BAD_INPUT)
-    if order is not None and order < 0:
-        echo(f"error: --order: expected an integer >= 0, got {order}", err=True)
-        raise typer.Exit(EXIT_BAD_INPUT)
-    if method is not None:
-        method, order = _method(method, order)
+    method, order = _method(method, order)
     if predictive_draws < 1:
         echo(f"error: --predictive-draws: expected an integer >= 1, got {predictive_draws}", err=True)
         raise typer.Exit(EXIT_BAD_INPUT)
@@ -171,14 +167,16 @@ def _truth(items: list[str], results: Path) -> dict[str, float] | None:
         raise typer.Exit(EXIT_BAD_INPUT)
 
 
-def _method(text: str, order: int | None) -> tuple[str, int | None]:
+def _method(text: str | None, order: int | None) -> tuple[str | None, int | None]:
     """--method KIND[:ORDER] (the report's parser) and --order into (kind, order); exit 2 naming the option."""
-    from ..methods.parsing import parse_methods
+    from ..methods.parsing import checked_order, parse_methods
 
     try:
+        if text is None:
+            return None, None if order is None else checked_order(order)
         parsed = parse_methods([text], order)[0]
     except ValueError as exc:
-        echo(f"error: --method: {exc}", err=True)
+        echo(f"error: {'--method' if text else '--order'}: {exc}", err=True)
         raise typer.Exit(EXIT_BAD_INPUT)
     if order is not None and parsed.get("order", order) != order:
         echo(f"error: --method {text} and --order {order} give two orders: give one", err=True)

@@ -2,19 +2,8 @@
 
 A kind's class says which designs it accepts, its keys of `method:` (`Method.keys`), how its PCE is built
 (`Method.expansion`), the rule its points must satisfy before it runs, and how its mean and variance follow
-(`Method.fit`):
-
-* ``monte_carlo``: sample mean and unbiased variance of the runs, no PCE; sampled designs only;
-* ``integration``: weighted sums (Eq. 17); on a grid the PCE for bands, PDFs and Sobol' indices is the
-  projection (Eq. 21);
-* ``pseudo_galerkin``: projection (Eq. 21), split form (Eq. 24) with x0; moments from the PCE;
-* ``interpolation``: moments from the weights (Eq. 32–34), PCE by projection (Eq. 41–42);
-* ``regression``: V c = Y by least squares (Eq. 36), the weights ignored; moments from the PCE;
-* ``least_squares``: weighted least squares (Eq. 44) with |w|; moments from the PCE;
-* ``sparse``: LARS or OMP over q-hyperbolic candidates up to max_order, the basis and order chosen by the
-  corrected leave-one-out error (`sparse`); one basis per output for all times; moments from the PCE;
-* ``auto``: per output, among the methods the design allows (AUTO_CANDIDATES), the one with the lowest
-  validated error (`validation`), or the runs' own statistics when none validates.
+(`Method.fit`): monte_carlo (below), integration, pseudo_galerkin and interpolation (`galerkin`),
+regression and least_squares (`collocation`), sparse (`sparse`) and auto (`validation`).
 
 Rules before anything runs (`validity.method_problem`): a projection of total order p needs a grid
 exact to degree 2p; a fit needs a design matrix of full rank Z on the actual points; a selection (sparse)
@@ -22,9 +11,8 @@ needs only a candidate set within the term limit, and refuses at the fit when no
 leave-one-out error.
 
 What the statistics are when runs failed (`Method.failed_runs`, the sentence in `FAILED_RUNS`) is a
-fact of the method, said once here for every note and report: the statistics of the successful runs
-(conditional on success), a fit extrapolated over the failed region, or a projection of the successful
-runs, which is of neither law. A grid with failed runs accepts only the fits (`validity`).
+fact of the method, said once here for every note and report. A grid with failed runs accepts only the
+fits (`validity`).
 """
 from __future__ import annotations
 

@@ -17,18 +17,27 @@ def parse_methods(methods: list[str], order: int | None = None) -> list[dict]:
         if kind not in METHOD_KINDS:
             raise ValueError(f"expected KIND[:ORDER] with KIND one of {', '.join(METHOD_KINDS)}, got {text!r}")
         method = {"kind": kind}
+        entry = Method.of(kind)
         if sep or order is not None:
-            given = repr(text) if sep else f"--order {order}"
-            try:
-                method["order"] = int(number if sep else order)
-            except ValueError:
-                method["order"] = -1
-            if method["order"] < 0:
-                raise ValueError(f"expected an integer ORDER >= 0 after {kind}:, got {given}")
+            method["order"] = checked_order(number if sep else order, entry, repr(text) if sep else None)
         if more:
-            method.update(_settings(Method.of(kind), pairs, text))
+            method.update(_settings(entry, pairs, text))
         parsed.append(method)
     return parsed
+
+
+def checked_order(value, entry: Method | None = None, text: str | None = None) -> int:
+    """An ORDER, written after KIND: (`text`) or given by --order (`value`), as an integer within the order key's
+    own bound (sparse's max_order: >= 1; any kind: >= 0); the one ValueError for a bad order otherwise."""
+    least = (entry or Method).keys[(entry or Method).order_key].minimum
+    try:
+        order = int(value)
+    except ValueError:
+        order = least - 1
+    if order < least:
+        after = f" after {entry.kind}:" if entry else ""
+        raise ValueError(f"expected an integer ORDER >= {least}{after}, got {text or f'--order {value}'}")
+    return order
 
 
 def _settings(entry: Method, pairs: str, text: str) -> dict:

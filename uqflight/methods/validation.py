@@ -320,10 +320,38 @@ class Auto(Method):
     kind, label, failed_runs, partial, weighted = "auto", "auto", "chosen", True, False
     exported_as = ("least_squares", "pseudo_galerkin")
 
+    def choose(self, xi, weights, basis, scale, germs, order: int, sampled: bool, missing: int = 0, seed: int = 0,
+               name: str = "the runs") -> tuple[str, bool, dict]:
+        """(the kind it takes on the runs Y = basis @ scale, whether its statistics are the runs' own weighted
+        by a grid, the record of what it took and why). Among AUTO_CANDIDATES of `order` that the design and
+        its runs allow (validity), the one whose out-of-sample error over the judged times is the lowest and
+        below VALIDATION_THRESHOLD and whose band stays within the runs' allowed range (`auto_choice`, draws
+        seeded by `seed`); when none validates, the runs' own statistics: monte_carlo on a sampled design, the
+        weighted runs on a grid of weights >= 0; a grid with signed weights has no statistics of its runs
+        alone, so it keeps the expansion of lowest error, flagged by its own check (ValueError naming output
+        `name` when there is none)."""
+        taken, errors, band_outside = auto_choice(xi, weights, basis, scale, germs, order, sampled, missing, seed)
+        record = {"chosen_by": "auto", "order": order, "errors": errors, "threshold": VALIDATION_THRESHOLD,
+                  "band_beyond_runs": band_outside}
+        if taken is not None:
+            return taken, False, {**record, "kind": taken, "why": f"the lowest validated error, {errors[taken]:.3g}, "
+                                                                 "its band within the runs' range"}
+        why, own = "no expansion validates on these runs", Method.of_runs(sampled).kind
+        if sampled or (np.asarray(weights) >= 0).all():
+            return own, not sampled, {**record, "kind": own, "why": f"{why}: the runs' own statistics"
+                                                                   + ("" if sampled else ", weighted by the grid")}
+        if not [e for e in errors.values() if e is not None]:
+            raise ValueError(f"method auto: for {name}, no candidate ({', '.join(AUTO_CANDIDATES)}) of order "
+                             f"{order} can be applied to these runs, and a grid with negative weights gives no "
+                             "statistics of its runs alone: run a sampled design, or choose a method and order")
+        kind = min((e, i, k) for i, (k, e) in enumerate(errors.items()) if e is not None)[2]
+        return kind, False, {**record, "kind": kind, "why": f"{why}, and a grid with negative weights has no "
+                                                           "statistics of its runs alone: the expansion of lowest "
+                                                           "error, flagged; run a sampled design"}
+
     def fit(self, xi, weights, Y, germs, order: int = DEFAULT_ORDER, x0=None, *, scale=None, sampled: bool = False,
             settings: dict | None = None) -> Result:
-        """The fit of the candidate that validates on these runs (`auto_choice`), or the runs' own moments."""
+        """The fit of the kind it takes on these runs (`choose`)."""
         Y = as_runs_by_time(Y)
-        taken = auto_choice(xi, weights, Y, scale, germs, order, sampled)[0]
-        method = METHODS[taken] if taken else Method.of_runs(sampled)
-        return method.fit(xi, weights, Y, germs, order, scale=scale, sampled=sampled or taken is None)
+        kind, runs_only, _ = self.choose(xi, weights, Y, scale, germs, order, sampled)
+        return METHODS[kind].fit(xi, weights, Y, germs, order, scale=scale, sampled=sampled or runs_only)
