@@ -293,7 +293,11 @@ def test_every_kind_builds_and_describes_itself():
         "sparse_grid": {"level": 2},
         "tensor_grid": {"points": 3},
         "pick_freeze": {"samples": 10},
+        "morris": {"trajectories": 3},
         "adaptive_sparse_grid": {"budget": 10, "tolerance": 1e-3},
+        "subset_simulation": {"event": {"of": "y", "above": 1.0}, "samples_per_level": 20, "budget": 100},
+        "importance_sampling": {"event": {"of": "y", "above": 1.0}, "samples": 20, "budget": 100},
+        "active_learning": {"event": {"of": "y", "below": -1.0}, "budget": 500},
     }
     assert set(specs) == set(DESIGN_KINDS)
     for kind, keys in specs.items():

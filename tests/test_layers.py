@@ -18,8 +18,8 @@ LAYERS = [
     ("uqflight.designs",),
     ("uqflight.methods",),
     ("uqflight.store", "uqflight.worker"),
-    ("uqflight.campaign", "uqflight.statistics"),
-    ("uqflight.execution", "uqflight.refinement", "uqflight.check", "uqflight.surrogate", "uqflight.calibration"),
+    ("uqflight.campaign", "uqflight.statistics", "uqflight.rare_statistics"),
+    ("uqflight.execution", "uqflight.refinement", "uqflight.rare_rounds", "uqflight.check", "uqflight.surrogate", "uqflight.calibration"),
     ("uqflight.report",),
     ("uqflight.cli",),
 ]

@@ -38,6 +38,22 @@ def test_the_same_png_bytes_in_a_child(tmp_path):
 
 
 def test_a_figure_that_fails_in_a_child_fails_with_its_error_printed(tmp_path, capfd):
+    parent = os.getpid()
+
+    def draw():
+        if os.getpid() == parent:
+            time.sleep(1.0)
+        else:
+            plots.plot_cov({"y": None}, tmp_path / "cov.png", "CoV")  # no statistics: raises in matplotlib's work
+
+    with pytest.raises(ChildFailed, match="exit 1"):
+        share_work([draw, draw], processes=2)
+    assert "Traceback" in capfd.readouterr().err  # the child's traceback
+    plots.plot_cov(outputs(), tmp_path / "after.png", "CoV")  # drawn in the process again
+    assert (tmp_path / "after.png").is_file()
+
+
+def test_a_file_error_in_a_child_is_raised_here_as_that_error(tmp_path):
     missing, parent = tmp_path / "no-such-folder" / "cov.png", os.getpid()
 
     def draw():
@@ -46,8 +62,5 @@ def test_a_figure_that_fails_in_a_child_fails_with_its_error_printed(tmp_path, c
         else:
             plots.plot_cov(outputs(), missing, "CoV")
 
-    with pytest.raises(ChildFailed, match="exit 1"):
+    with pytest.raises(FileNotFoundError, match="no-such-folder/cov.png"):  # the report says it cannot write
         share_work([draw, draw], processes=2)
-    assert "no-such-folder/cov.png" in capfd.readouterr().err  # the child's traceback
-    plots.plot_cov(outputs(), tmp_path / "after.png", "CoV")  # drawn in the process again
-    assert (tmp_path / "after.png").is_file()

@@ -247,7 +247,7 @@ def _load(path: Path):
 @app.command()
 def plan(campaign_file: Path = typer.Argument(..., metavar="CAMPAIGN", help="Campaign YAML file.")):
     """Validate a campaign and print its design, the number of runs and an estimated time."""
-    from .designs import describe, is_adaptive
+    from .designs import describe, is_adaptive, is_rare
     from .execution import WorkerError, timed_nominal
     from .methods import method_entry
 
@@ -263,8 +263,11 @@ def plan(campaign_file: Path = typer.Argument(..., metavar="CAMPAIGN", help="Cam
              "Cholesky in this order)")
     echo(describe(design))
     kind = campaign.method["kind"]
-    order = campaign.method.get(method_entry(kind).order_key)  # sparse's is max_order
-    echo(f"method: {kind}" + (f" (order {order})" if _has_order(kind, design.kind) else ""))
+    if is_rare(design.kind):  # its own estimator: the runs are not draws of the input law
+        echo(f"method: none (the {design.kind} estimates the probability of its event only)")
+    else:
+        order = campaign.method.get(method_entry(kind).order_key)  # sparse's is max_order
+        echo(f"method: {kind}" + (f" (order {order})" if _has_order(kind, design.kind) else ""))
     runs = campaign.runs or len(design.xi)  # an adaptive grid's budget: its rounds are made from the results
     echo(f"runs: {runs}" + (" at most (design.budget)" if is_adaptive(design.kind) else ""))
     echo(f"results: {Path(campaign.storage['path']).resolve()} (storage.path, from the working directory; "
@@ -407,6 +410,12 @@ def _describe_results(results, store, Status) -> None:
     if state is not None:
         echo(f"index set: {len(state.indices)} multi-indices, {state.rounds} rounds, "
              f"{'stopped by ' + state.stopped if state.stopped else 'refining (resume to go on)'}")
+    record = store.rare_event()  # a rare-event design's estimate (/rare_event), once its rounds finished
+    if record is not None:
+        echo(f"rare event: P({shown(record['of'])} {'>' if record['side'] == 'above' else '<'} {record['threshold']:g})"
+             f" = {record['probability']:.4g} (95 %: {record['lower']:.4g} to {record['upper']:.4g}), cov "
+             f"{record['cov']:.3g}".replace("cov nan", "cov undefined")
+             + f", {record['runs']} runs, stopped by {shown(record['stopped'])}")
     echo(f"parameters: {listed(store.parameter_names)}")
     echo(f"outputs: {listed(store.output_names)} ({store.time.size} times, "
          f"{store.time[0]:g} to {store.time[-1]:g} s)")

@@ -47,10 +47,11 @@ from .campaign import Campaign
 from .campaign.reading import parameters_attribute
 from .campaign.schema import WORKER_BYTES
 from .console import one_line
-from .designs import Design, is_adaptive
+from .designs import Design, is_adaptive, is_rare
 from .parameters import seed_names
 from .stopping import check as check_stop
 from .progress import Progress
+from .rare_rounds import run_rare
 from .refinement import run_rounds
 from .store import ResultStore, Status, compact, open_for_campaign
 from .store.lock import LockHeld, ResultsLock
@@ -338,7 +339,8 @@ def run_campaign(campaign: Campaign, out: Path | None = None, workers: int | Non
                     return _run_pending(store, campaign, pool, spec, chunk, workers, executor, scheduler,
                                         timeout, out, progress)
 
-                summary = run_rounds(store, campaign, fly) if is_adaptive(design.kind) else fly()
+                rounds = run_rare if is_rare(design.kind) else run_rounds if is_adaptive(design.kind) else None
+                summary = rounds(store, campaign, fly) if rounds else fly()
                 complete = store.pending().size == 0
             finally:
                 try:

@@ -49,7 +49,7 @@ from .campaign.attributes import StoredFacts, stored_facts, stored_settings
 from .campaign.schema import CampaignError
 from .console import shown
 from .designs import REGISTRY as DESIGNS
-from .designs import is_sampled
+from .designs import is_rare, is_sampled
 from .designs.adaptive import index_set_summary
 from .labels import name_unit, quantity_unit
 from .methods import (AUTO_CANDIDATES, PCE, METHODS, failed_runs_note, fit, method_entry, method_settings,
@@ -124,6 +124,7 @@ class OutputStatistics:
     pce: PCE | None = None  # the expansion behind the statistics (None: statistics of the runs themselves)
     flags: list[str] = field(default_factory=list)
     unwrapped: bool = False  # an angle whose runs wrap, made continuous before any statistic (analysis.angles)
+    morris: dict | None = None  # a Morris design's measures per parameter: mu_star, mu, sigma, mu_star_ci (screen)
 
     @property
     def std(self) -> np.ndarray:
@@ -153,6 +154,8 @@ class Statistics:
     dependence: dict | None = None  # the inputs' Gaussian copula (parameters.dependence.summary), None: independent
     quantities: dict[str, QuantityStatistics] = field(default_factory=dict)
     index_set: dict | None = None  # an adaptive grid's refinement (designs.adaptive.index_set_summary)
+    rare_event: dict | None = None  # a rare-event design's estimate and rounds (rare_statistics)
+    rare_runs: dict | None = None  # its runs for the report's figures (not in summary.json)
     design_info: dict = field(default_factory=dict)  # the design's recorded facts (replicates, n_base, ...)
     seed: int = 0  # what seeded the analysis's draws (the campaign's seed unless Options said otherwise)
 
@@ -278,6 +281,14 @@ def analyse(path, reference: str | None = None, options: Options | None = None, 
         stats = Statistics(str(path), store.attrs.get("campaign_name", ""), method, design_kind,
                            store.parameter_names, int(status.size), int(ok.sum()), int(np.sum(status > 0)),
                            pending, {}, partial=pending > 0, design_info=facts.design_info, seed=options.seed)
+        if is_rare(design_kind):  # its runs are not draws of the input law: its event's probability only
+            from .rare_statistics import rare_statistics
+
+            if exceedance:
+                raise BadInput(f"{path}: --exceedance: a {design_kind} file estimates the probability of its "
+                               "design.event only (its runs are not draws of the input law); fly a campaign per event")
+            rare_statistics(store, stats)
+            return stats
         _check_runs(store, stats, sampled, partial)
         state = store.index_set()
         stats.index_set = None if state is None else index_set_summary(state, store.parameter_names)
@@ -294,6 +305,8 @@ def analyse(path, reference: str | None = None, options: Options | None = None, 
             raise BadInput(f"{path}: method {method['kind']} order {method['order']}: {problem}")
         _note_runs(store, stats, sampled, allow_aliasing)
         stats.from_runs = method_entry(method["kind"]).runs_on_sampled and sampled
+        if DESIGNS[design_kind].not_draws:
+            stats.notes.append(DESIGNS[design_kind].not_draws)
         if stats.from_runs and DESIGNS[design_kind].sobol_from_runs:
             note = pick_freeze_note(ok, len(store.parameter_names), "pending runs" if not stats.failed else
                                     "failed and pending runs" if stats.pending else "failed runs")
@@ -319,6 +332,9 @@ def analyse(path, reference: str | None = None, options: Options | None = None, 
                 stats.notes.extend(f"output {name}: {flag}" for flag in out.flags)
                 if stats.replicates > 1:
                     out.replicate_moments = _replicate_moments(store, name, stats.replicates)
+                if DESIGNS[design_kind].screening is not None:
+                    basis, scale = output_basis(store, name, ok)
+                    screen(stats, out, store.xi, basis if scale is None else basis @ scale, ok, options, "")
                 if progress is not None:
                     progress.advance()
 
@@ -377,10 +393,7 @@ def _note_runs(store: ResultStore, stats: Statistics, sampled: bool, allow_alias
     else:
         stats.failure_probability = grid_failure_probability(failed, store.weights[done])
     if stats.failed:
-        kappa, reasons, names = store.kappa, store.reasons, store.parameter_names
-        stats.failures = [{"run": int(i), "status": Status(int(status[i])).name.lower(), "reason": reasons[i],
-                           "parameters": dict(zip(names, map(float, kappa[i])))}
-                          for i in np.flatnonzero(status > 0)]
+        stats.failures = failed_runs(store)
         stats.notes.append(failed_runs_note(stats.method["kind"], stats.failed, int(done.sum())))
         if not sampled:
             stats.notes.append("failure probability: " + _grid_failure_note(stats.failure_probability))
@@ -388,6 +401,13 @@ def _note_runs(store: ResultStore, stats: Statistics, sampled: bool, allow_alias
         stats.notes.append(f"partial: {stats.completed} of {stats.runs} runs")
     if allow_aliasing and not sampled and method_entry(stats.method["kind"]).rule == "projection":
         stats.notes.append("aliasing allowed: the projection's order may exceed what the grid integrates exactly")
+
+
+def failed_runs(store: ResultStore) -> list[dict]:
+    """summary.json's failures: every failed run with its status, reason and physical parameters."""
+    status, kappa, reasons, names = store.status, store.kappa, store.reasons, store.parameter_names
+    return [{"run": int(i), "status": Status(int(status[i])).name.lower(), "reason": reasons[i],
+             "parameters": dict(zip(names, map(float, kappa[i])))} for i in np.flatnonzero(status > 0)]
 
 
 def _grid_failure_note(probability: dict) -> str:
@@ -680,6 +700,39 @@ def unresolved_flag(out: OutputStatistics) -> str | None:
             f"{UNRESOLVED_WIDTH:g} or lies outside [0, 1]; run more base samples (design.samples)")
 
 
+def screen(stats: Statistics, out: OutputStatistics, xi: np.ndarray, Y: np.ndarray, ok: np.ndarray, options: Options,
+           what: str) -> None:
+    """Set `out.morris` to the screening measures of the design (DesignKind.screening), if it has one, of the
+    values `Y` (n_ok, T) of the `ok` runs, `xi` every run's germs; its note, after `what`, in stats.notes once.
+
+    Parameters
+    ----------
+    stats : Statistics
+        The file's statistics: its design kind and facts, parameters and notes.
+    out : OutputStatistics
+        The output's or quantity's statistics, given its `morris` measures.
+    xi : numpy.ndarray
+        Every run's germs (N, d), in design order.
+    Y : numpy.ndarray
+        The ok runs' values.
+    ok : numpy.ndarray
+        bool (N,): the runs that give a value.
+    options : Options
+        Its bootstrap resamples and seed.
+    what : str
+        What the note is of ("" for every output).
+    """
+    screening = DESIGNS[stats.design_kind].screening
+    if screening is None:
+        return
+    found, note = screening(xi, Y, ok, stats.design_info, options.bootstrap, options.seed)
+    out.morris = {name: {"mu_star": found["mu_star"][i], "mu": found["mu"][i], "sigma": found["sigma"][i],
+                         "mu_star_ci": {"lower": found["mu_star_ci"][0][i], "upper": found["mu_star_ci"][1][i]}}
+                  for i, name in enumerate(stats.parameter_names)}
+    if note and what + note not in stats.notes:
+        stats.notes.append(what + note)
+
+
 def _pick_freeze_rows(ok: np.ndarray, d: int) -> np.ndarray | None:
     """The ok runs' rows of a pick-freeze design's complete base rows (analysis.sobol.complete_rows), None when
     fewer than 2 are complete (no index can be estimated)."""
@@ -880,15 +933,20 @@ class _QuantityView:
         return None
 
 
+def quantity_units(store: ResultStore, name: str) -> str:
+    """The unit of quantity `name`: the stored campaign text's take and `of` give it (labels.quantity_unit)."""
+    text = store.attrs.get("campaign", "")
+    specs = stored_settings(text).get("quantities") if isinstance(text, str) else None
+    return quantity_unit(specs.get(name) if isinstance(specs, dict) else None, store.units) or name_unit(name)
+
+
 def quantity_statistics(store: ResultStore, stats: Statistics, name: str, germs: list[str], ok: np.ndarray,
                         options: Options, thresholds: list[dict]) -> QuantityStatistics:
     """Statistics of quantity `name` over the successful runs where it is defined. Undefined in some:
     a sampled design's statistics are conditional on the others (noted); a grid's are None (noted:
     a projection needs every run). Exceedance probabilities from the runs or from the PCE."""
     values = store.quantity(name)
-    text = store.attrs.get("campaign", "")  # the stored campaign text: its quantity's take and `of` give the unit
-    specs = stored_settings(text).get("quantities") if isinstance(text, str) else None
-    units = quantity_unit(specs.get(name) if isinstance(specs, dict) else None, store.units) or name_unit(name)
+    units = quantity_units(store, name)
     defined = ok & np.isfinite(values)
     period = angle_period(units)
     shifts = None if period is None else branch_shifts(np.where(defined, values, np.nan), period)
@@ -921,6 +979,8 @@ def quantity_statistics(store: ResultStore, stats: Statistics, name: str, germs:
     view = _QuantityView(store, name, values, units)
     out = _output_statistics(view, name, stats.method, germs, stats.design_kind, defined, options)
     out.unwrapped = shifts is not None and bool(shifts.any())
+    screen(stats, out, store.xi, values[defined][:, None], defined, options,
+           f"quantity {name} (undefined in some runs): " if missing else "")
     if missing and stats.from_runs and DESIGNS[stats.design_kind].sobol_from_runs:
         note = pick_freeze_note(defined, len(store.parameter_names), f"quantity {name} (undefined in some runs)")
         if note:
@@ -985,6 +1045,8 @@ def _quantity_json(quantity: QuantityStatistics, seeds: list[str]) -> dict:
         entry["validation"] = out.validation
     if out.method is not None:
         entry["method"] = out.method
+    if out.morris is not None:
+        entry["morris"] = _at_first_time(out.morris)
     return entry
 
 
@@ -1063,6 +1125,8 @@ def summary_json(stats: Statistics) -> dict:
             entry["validation"] = out.validation
         if out.method is not None:
             entry["method"] = out.method
+        if out.morris is not None:
+            entry["morris"] = out.morris
         if out.errors:
             errors = out.errors
             entry["errors"] = {"eps_m": errors["eps_m"], "eps_v": errors["eps_v"],
@@ -1079,4 +1143,5 @@ def summary_json(stats: Statistics) -> dict:
         **({"dependence": stats.dependence} if stats.dependence else {}),
         "outputs": outputs,
         "quantities": {name: _quantity_json(quantity, stats.seeds) for name, quantity in stats.quantities.items()},
-        **({"index_set": stats.index_set} if stats.index_set else {})})
+        **({"index_set": stats.index_set} if stats.index_set else {}),
+        **({"rare_event": stats.rare_event} if stats.rare_event else {})})

@@ -17,6 +17,8 @@ How the points were drawn (`DesignKind.draws`, with the design's recorded info):
   the t interval keeps a net's own spread in when it is wider than independent draws'.
   A single scrambled net: k/n and the Wilson interval of independent draws, flagged (a scrambled net's variance is usually lower but not bounded by theirs for
   an indicator); unscrambled points are fixed, not random: k/n without an interval.
+- points (morris): the points are fixed trajectories on a grid, not draws of the law: k/n without an
+  interval, the runs' own share.
 """
 from __future__ import annotations
 
@@ -25,7 +27,7 @@ from scipy import special
 
 from .failures import wilson_interval
 
-DRAWS = ("independent", "pick_freeze", "stratified", "net")
+DRAWS = ("independent", "pick_freeze", "stratified", "net", "points")
 
 
 def sampled_proportion(hits, counted, draws: str, info: dict, confidence: float = 0.95, event: str = "") -> dict:
@@ -47,6 +49,10 @@ def sampled_proportion(hits, counted, draws: str, info: dict, confidence: float 
                 "sentence": "no run counts: the probability is undefined"}
     estimate = k / n
     counts = _counts(k, n, event)
+    if draws == "points":
+        return {"estimate": estimate, "lower": None, "upper": None, "n_effective": float(n), "method": "points",
+                "sentence": f"{counts}; no interval: the design's points are not draws of the inputs' law (the "
+                            "runs' own share, not the law's probability)"}
     if draws == "net" and not info.get("scramble", True):
         return {"estimate": estimate, "lower": None, "upper": None, "n_effective": float(n), "method": "points",
                 "sentence": f"{counts}; no interval: unscrambled QMC points are fixed, not random (scramble them, "

@@ -88,12 +88,24 @@ KEYS = {
     "parameters.NAME.upper": "The interval's upper end, > `lower`. `upper: 205`",
     # design
     "design.kind": "Required. The design kind (below).",
-    "design.samples": "Number of points (`pick_freeze`: base rows n, N = n(d + 2) runs), >= 1. `samples: 1024`",
+    "design.samples": "Number of points (`pick_freeze`: base rows n, N = n(d + 2) runs), >= 1; "
+                      "importance_sampling: runs per round, >= 2, default 500. `samples: 1024`",
     "design.scramble": "Scramble the QMC points with the seed. Default true. `scramble: false`",
     "design.replicates": "`sobol`: R independent scrambles of `samples` points (randomised QMC), giving every "
                          "statistic's standard error. Default 1. `replicates: 16`",
-    "design.budget": "adaptive_sparse_grid only, required: the most runs; the refinement stops before a round "
-                     "would pass it (stopped: budget). `budget: 300`",
+    "design.budget": "adaptive_sparse_grid, required: the most runs; the refinement stops before a round "
+                     "would pass it (stopped: budget). subset_simulation, importance_sampling, active_learning: the "
+                     "most runs, default 12000, 5000 and 1500 (see [rare events](../rare-events.md)). `budget: 300`",
+    "design.event": "subset_simulation, importance_sampling, active_learning, required: the event whose "
+                    "probability is estimated, `{of: QUANTITY, above: X}` or `{of: QUANTITY, below: X}`. "
+                    "`event: {of: sink_rate_fps, below: -10}`",
+    "design.event.of": "The quantity (a name under `quantities:`) the event is about.",
+    "design.event.above": "The event is QUANTITY > above (give above or below, not both).",
+    "design.event.below": "The event is QUANTITY < below.",
+    "design.samples_per_level": "subset_simulation: runs per level, >= 2, times p0 at least 1 (the chains). "
+                                "Default 1000. `samples_per_level: 2000`",
+    "design.p0": "subset_simulation: the conditional probability of each level, in (0, 0.5]. Default 0.1. "
+                 "`p0: 0.1`",
     "design.tolerance": "adaptive_sparse_grid only, required: stop when the sum of the active indices' "
                         "indicators (change of mean and variance, normalised like ε_m and ε_v) is at most "
                         "this (stopped: tolerance). `tolerance: 1e-5`",
@@ -107,6 +119,10 @@ KEYS = {
     "design.growth": "Sparse grids: `linear` (default; level i exact to degree 2i−1) or `exponential` (the "
                      "rules' own nested sequences).",
     "design.points": "Tensor grids: points per dimension, >= 1. `points: 5`",
+    "design.trajectories": "`morris` only, required: the trajectories R >= 2, of d + 1 runs each "
+                           "(N = R(d + 1) runs). `trajectories: 20`",
+    "design.levels": "`morris`: the levels p of the grid in the unit cube, even, >= 2; the jump is "
+                     "Δ = p/(2(p − 1)). Default 4. `levels: 6`",
     # method
     "method.kind": "The method (below).",
     "method.order": "Total degree of the PCE, >= 0. Default 2, or the largest a grid's projection allows. "
@@ -293,6 +309,9 @@ def accepted_keys() -> list[Key]:
     keys = dict.fromkeys(k for kind, entry in DESIGNS.items()
                          for k in refused_keys(lambda: entry.build({"kind": kind, "?": 0}, ["normal"], 0)))
     found += [Key(f"design.{k}", "design", design.get(k)) for k in keys]
+    from ..designs.rare import EVENT_KEYS
+
+    found += [Key(p, "design") for p in _paths("design.event", EVENT_KEYS)]
     own = dict.fromkeys(k for entry in METHODS.values() if entry.settings
                         for k in (entry.order_key, *(key for key, _ in entry.settings)))
     found += [Key(p, "method", dict(METHODS) if p == "method.kind" else None)

@@ -10,7 +10,7 @@ from collections.abc import Hashable
 import numpy as np
 import yaml
 
-from ..designs import DESIGN_KINDS, SAMPLED_DESIGNS, Design, design_size, is_sampled
+from ..designs import DESIGN_KINDS, SAMPLED_DESIGNS, Design, design_size, is_rare, is_sampled
 from ..methods import METHOD_KINDS, METHODS, method_entry
 from ..methods.exactness import exact_total_degree, max_projection_order
 from ..methods.validity import MAX_TERMS, method_problem
@@ -362,7 +362,8 @@ def check_seeds(check: Checker, parameters: list[Parameter], design_kind, method
         check.fail(f"parameters.{seeds[1]}.distribution", f"one seed parameter per campaign, but "
                                                           f"{', '.join(seeds)} are seeds")
     where = f"parameters.{seeds[0]}.distribution"
-    if isinstance(design_kind, str) and design_kind in DESIGN_KINDS and not is_sampled(design_kind):
+    if isinstance(design_kind, str) and design_kind in DESIGN_KINDS and not is_sampled(design_kind) \
+            and not is_rare(design_kind):  # a rare-event design redraws a seed (designs.rare)
         check.fail(where, f"a seed needs a sampled design ({', '.join(SAMPLED_DESIGNS)}), not {design_kind}: "
                           "a random stream has no polynomial expansion for a grid to integrate")
     if not method_entry(method["kind"]).runs_on_sampled:  # it would fit a PCE in the seed's ξ

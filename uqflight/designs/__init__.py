@@ -6,8 +6,12 @@ Kinds (keys in braces):
 - sparse_grid {level, rule, nested, growth}: Smolyak combination technique on 1-D rules.
 - tensor_grid {rule, points}: full tensor product.
 - pick_freeze {samples}: Saltelli's [A; B; AB_1; …; AB_d] for Sobol' index estimators.
+- morris {trajectories, levels}: Morris's trajectories for elementary-effects screening.
 - adaptive_sparse_grid {rule, budget, tolerance}: Gerstner–Griebel's dimension-adaptive grid, built
   round by round from the results (`adaptive`; the runner refines it).
+- subset_simulation {event, budget, samples_per_level, p0}, importance_sampling {event, budget, samples},
+  active_learning {event, budget}: the probability of an event, the runs adapted to it round by round
+  (`rare`; the runner replays the algorithm over the stored runs).
 """
 from __future__ import annotations
 
@@ -20,7 +24,9 @@ from ..parameters.germs import check_germs
 from .adaptive import adaptive_design, adaptive_size
 from .montecarlo import (halton_design, latin_hypercube_design, monte_carlo_design, samples_size, sobol_design,
                          sobol_size)
+from .morris import NOT_DRAWS, morris_design, morris_screening, morris_size
 from .pickfreeze import pick_freeze_design, pick_freeze_size
+from .rare import active_learning_design, importance_sampling_design, rare_size, subset_simulation_design
 from .smolyak import sparse_grid_design, sparse_grid_size
 from .spec import is_integer
 from .tensor import tensor_grid_design, tensor_grid_size
@@ -35,7 +41,13 @@ class DesignKind:
     (analysis.proportions), or None for a quadrature grid (its weights are valid only all together);
     `sobol_from_runs`: its runs give Sobol' indices themselves (pick-freeze estimators), without a PCE;
     `adaptive`: the builder gives the first round only; the runner adds the others from the results
-    (designs.adaptive), up to `size` runs."""
+    (designs.adaptive), up to `size` runs; `rare`: an adaptive design that estimates the probability of its
+    `event` (designs.rare): its builder takes the `redrawn` columns (seed parameters), its runs are not draws
+    of the input law (the analysis gives the event's probability only) and `uqflight.rare_rounds` runs it;
+    `screening`: (xi, Y, ok, info, bootstrap, seed) -> (its measures per parameter, a note or None), the
+    screening its runs give per output and quantity (designs.morris), stored under the kind's name;
+    `not_draws`: the note of a design whose points are not draws of the law, so that the runs' own
+    statistics are not the law's."""
 
     build: Callable
     size: Callable
@@ -43,6 +55,9 @@ class DesignKind:
     example: dict  # a small `design:` mapping of this kind (help text and tests)
     sobol_from_runs: bool = False
     adaptive: bool = False
+    rare: bool = False
+    screening: Callable | None = None
+    not_draws: str | None = None
 
     @property
     def sampled(self) -> bool:
@@ -61,9 +76,20 @@ REGISTRY: dict[str, DesignKind] = {
     "tensor_grid": DesignKind(tensor_grid_design, tensor_grid_size, None, {"kind": "tensor_grid", "points": 4}),
     "pick_freeze": DesignKind(pick_freeze_design, pick_freeze_size, "pick_freeze",
                               {"kind": "pick_freeze", "samples": 16}, sobol_from_runs=True),
+    "morris": DesignKind(morris_design, morris_size, "points", {"kind": "morris", "trajectories": 4},
+                         screening=morris_screening, not_draws=NOT_DRAWS),
     "adaptive_sparse_grid": DesignKind(adaptive_design, adaptive_size, None,
                                        {"kind": "adaptive_sparse_grid", "budget": 50, "tolerance": 1e-4},
                                        adaptive=True),
+    "subset_simulation": DesignKind(subset_simulation_design, rare_size, None,
+                                    {"kind": "subset_simulation", "event": {"of": "y", "above": 3.0},
+                                     "samples_per_level": 100, "p0": 0.1, "budget": 1000}, adaptive=True, rare=True),
+    "importance_sampling": DesignKind(importance_sampling_design, rare_size, None,
+                                      {"kind": "importance_sampling", "event": {"of": "y", "above": 3.0},
+                                       "samples": 100, "budget": 1000}, adaptive=True, rare=True),
+    "active_learning": DesignKind(active_learning_design, rare_size, None,
+                                  {"kind": "active_learning", "event": {"of": "y", "above": 3.0}, "budget": 500},
+                                  adaptive=True, rare=True),
 }
 DESIGN_KINDS = tuple(REGISTRY)
 SAMPLED_DESIGNS = tuple(kind for kind, entry in REGISTRY.items() if entry.sampled)
@@ -72,6 +98,11 @@ SAMPLED_DESIGNS = tuple(kind for kind, entry in REGISTRY.items() if entry.sample
 def is_adaptive(kind: str) -> bool:
     """Whether the design kind grows round by round from the results (see DesignKind)."""
     return REGISTRY[kind].adaptive
+
+
+def is_rare(kind: str) -> bool:
+    """Whether the design kind estimates the probability of its event (see DesignKind)."""
+    return REGISTRY[kind].rare
 
 
 def is_sampled(kind: str) -> bool:
@@ -98,8 +129,9 @@ def design_size(spec: dict, germs: list[str]) -> float | None:
     return REGISTRY[kind].size(spec, germs)
 
 
-def build_design(spec: dict, germs: list[str], seed: int) -> Design:
-    """The design a campaign's `design:` mapping asks for, over the given germs."""
+def build_design(spec: dict, germs: list[str], seed: int, redrawn: tuple[int, ...] = ()) -> Design:
+    """The design a campaign's `design:` mapping asks for, over the given germs; `redrawn`: the columns that
+    are random-stream seeds (a rare-event design treats them apart, see designs.rare)."""
     if not isinstance(spec, dict):
         raise ValueError(f"design: expected a mapping with a kind key, got {spec!r}")
     kind = spec.get("kind")
@@ -107,7 +139,9 @@ def build_design(spec: dict, germs: list[str], seed: int) -> Design:
         raise ValueError(f"design.kind: expected one of {', '.join(DESIGN_KINDS)}, got {kind!r}")
     if not is_integer(seed) or seed < 0:
         raise ValueError(f"seed: expected an integer >= 0, got {seed!r}")
-    xi, weights, info = REGISTRY[kind].build(spec, check_germs(germs), int(seed))
+    entry = REGISTRY[kind]
+    extra = {"redrawn": tuple(redrawn)} if entry.rare else {}
+    xi, weights, info = entry.build(spec, check_germs(germs), int(seed), **extra)
     return Design(kind, xi, weights, info)
 
 

@@ -25,6 +25,7 @@ from pathlib import Path
 from ..check import write_baseline
 from ..forking import FORKS, ChildFailed, Standby
 from ..progress import Progress
+from ..statistics import BadInput
 from ..methods.parsing import parse_methods
 from .files import _write_text, write_csv, write_statistics_tables, write_summaries
 from .loading import Entry, bounded, load_entries
@@ -64,6 +65,10 @@ def write_report(paths: list[Path], out_dir: Path | None = None, reference: Path
     try:
         entries, ref = load_entries(paths, reference, method, progress=progress, partial=partial,
                                     allow_aliasing=allow_aliasing, exceedance=exceedance)
+        if baseline and entries[0].stats.rare_runs:
+            raise BadInput(f"{entries[0].stats.path}: --write-baseline: a {entries[0].stats.design_kind} file has no "
+                           "statistics of the input law to keep (its event's probability is in summary.json); "
+                           "write the report without it")
         out_dir.parent.mkdir(parents=True, exist_ok=True)
         staging = make_staging(out_dir)
         try:

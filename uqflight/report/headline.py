@@ -11,6 +11,7 @@ import numpy as np
 from ..labels import shown_time
 from . import plots
 from .loading import Entry
+from .morris import ranked_text
 from .sensitivity import top_contributors
 from .blocks import Section, Table
 
@@ -52,7 +53,8 @@ def _row(name: str, out, i: int, time, flags: list[str]) -> tuple[list, list]:
     """(CSV row, page row) of one output at time index i, shown as `time` (or a quantity: time None), with
     its `flags`; the CSV keeps the recorded time."""
     mean, std, lower, upper = (float(v[i]) for v in (out.mean, out.std, *out.band99))
-    top = top_contributors(out.sobol_first, i, out.sobol_first_ci or None) if out.sobol_first else NO_INDICES
+    top = (ranked_text(out.morris, i) if out.morris else
+           top_contributors(out.sobol_first, i, out.sobol_first_ci or None) if out.sobol_first else NO_INDICES)
     csv = [name, out.units, "" if time is None else float(out.time[i]), mean, std, lower, upper, top, "; ".join(flags)]
     page = [flagged(name, flags), "" if time is None else f"{time:g}", mean_std_text(mean, std, out.units),
             band_text(lower, upper, std), top, "; ".join(flags)]
@@ -123,7 +125,8 @@ def headline_section(entry: Entry, times: list[float]) -> Section:
         csv_row, page_row = _row(name, quantity.output, 0, None, quantity.flags)
         rows.append([entry.label, *csv_row])
         page.append(page_row)
-    contributors = "top contributors (first-order Sobol')"
+    screened = any(out.morris for out in entry.outputs.values())
+    contributors = "inputs ranked by μ* (Morris)" if screened else "top contributors (first-order Sobol')"
     header = ["file", "output or quantity", "unit", "time [s]", "mean", "std", "band99 lower", "band99 upper",
               contributors, "flags"]
     table = Table(f"Key numbers of {entry.label}", header, rows, "tables/headline.csv",
@@ -135,7 +138,9 @@ def headline_section(entry: Entry, times: list[float]) -> Section:
             "at the simulator's noise; with a pick-freeze design each share carries its 95 % bootstrap interval, "
             "and an index whose interval is wider than 0.5 or lies outside [0, 1] reads 'unresolved (its interval, "
             "n too small)'), "
-            "per output at the selected times (--times) and per quantity of interest. "
+            "per output at the selected times (--times) and per quantity of interest"
+            + ("; with a Morris design, the inputs ranked by μ*, the mean absolute elementary effect, instead of "
+               "Sobol' shares" if screened else "") + ". "
             "Rounded to two digits of the std; in full in tables/headline.csv, as in summary.json. "
             f"A row marked {FLAGGED.strip()} is flagged: its flags say what is wrong and what helps.")
     if exceedance is not None:
@@ -144,4 +149,13 @@ def headline_section(entry: Entry, times: list[float]) -> Section:
                 + text[1:])
     if entry.stats.notes:
         text += " Read the notes below before these numbers."
+    from .rare_event import headline_table
+
+    rare = headline_table(entry)
+    if rare is not None:  # a rare-event design: its estimate (c.o.v., runs, β) in place of the exceedance table;
+        exceedance = rare  # its runs have no mean or band of the law
+        text = ("The probability of the design's event with its 95 % interval, c.o.v., runs and reliability index "
+                "β = −Φ⁻¹(p) (in full in tables/rare_event.csv, as in summary.json); below, the quantities' other "
+                "statistics, undefined: the runs were chosen to reach the event, they are not draws of the input "
+                "law. Read the notes below before these numbers.")
     return Section("Headline", "headline", text, [b for b in (exceedance, table) if b is not None], lead=True)

@@ -13,7 +13,7 @@ from ..campaign.attributes import stored_settings
 from ..campaign.reading import parameter_rows, results_campaign
 from ..designs import REGISTRY as DESIGNS
 from ..methods import method_entry
-from ..statistics import Statistics, add_reference_errors, read_statistics
+from ..statistics import BadInput, Statistics, add_reference_errors, read_statistics
 
 
 @dataclass
@@ -60,6 +60,12 @@ def method_label(method: dict) -> str:
     if entry.pce is None:
         return name
     return f"{name} order {method['order']}" + (" split" if method.get("split") else "")
+
+
+def estimator_label(stats) -> str:
+    """What gives a file's numbers: its method's label, or a rare-event design's kind (its runs are not the
+    method's draws: it estimates its event's probability only)."""
+    return stats.design_kind if getattr(stats, "rare_runs", None) else method_label(stats.method)
 
 
 def input_distributions(campaign_text: str) -> str:
@@ -121,7 +127,18 @@ def load_entries(paths: list[Path], reference: Path | None, method: dict | list[
             if ref is not None and not _same_file(path, reference):
                 add_reference_errors(stats, ref.stats)
             entries.append(_entry(path, stats, attrs, stems, file_stems, with_method=len(methods) > 1))
+    _rare_alone(entries, ref)
     return entries, ref
+
+
+def _rare_alone(entries: list[Entry], ref: Entry | None) -> None:
+    """A rare-event design's file is reported alone (BadInput otherwise): its runs are not draws of the input
+    law, so it has no statistics over time to overlay on another file's or to compare with a reference."""
+    rare = [e for e in entries + ([ref] if ref else []) if e.stats.rare_runs]
+    if rare and (len(entries) > 1 or ref is not None):
+        raise BadInput(f"{rare[0].stats.path}: a {rare[0].stats.design_kind} file is reported alone (no other "
+                       "results file, --method or --reference): its runs are not draws of the input law, it has "
+                       "only its event's probability; report it by itself")
 
 
 def _file_stems(paths: list[Path]) -> dict[Path, str]:
@@ -141,7 +158,7 @@ def _entry(path: Path, stats: Statistics, attrs: dict, stems: set[str], file_ste
     name = Path(path).stem + (f"_{stats.method['kind']}{stats.method.get('order', '')}" if with_method else "")
     stem = _unique(file_name(name), stems)
     runs = f"partial: {stats.completed} of {stats.runs} runs" if stats.partial else f"{stats.runs} runs"
-    label = f"{stats.campaign_name or stem}: {method_label(stats.method)}, {runs}"
+    label = f"{stats.campaign_name or stem}: {estimator_label(stats)}, {runs}"
     taken: set[str] = set()
     output_files = {name: _unique(file_name(name), taken) for name in stats.outputs}
     return Entry(stats, stem, label, str(attrs.get("campaign_hash", "")),

@@ -14,7 +14,8 @@ from .formats import shown_path
 from ..analysis.sobol import unresolved
 from ..forking import share_work
 from .sensitivity import N_TOO_SMALL, NEGLIGIBLE, index_text, plot_sensitivity
-from .loading import Entry, _same_file, bounded, campaign_settings, campaign_simulator, flight_facts, method_label
+from .loading import (Entry, _same_file, bounded, campaign_settings, campaign_simulator, estimator_label, flight_facts,
+                      method_label)
 
 BELOW_FLOOR = "below reference resolution"
 UNRESOLVED = "unresolved"
@@ -52,11 +53,12 @@ def section_jobs(entries: list[Entry], ref: Entry | None, times: list[float],
             (0, "writing the notes", lambda: notes_section(entries)),
             (k, "drawing the design", lambda: run_section(entries, out_dir)),
             (0, "writing the inputs", lambda: inputs_section(entries, ref)),
-            (0, "writing the failures", lambda: failures_section(entries)),
-            ((outputs + 1) * k + (outputs if k >= 2 else 0), "drawing the statistics over time",
-             lambda: statistics_section(entries, ref, times, out_dir)),
-            (2 * outputs * k, "drawing the PDFs", lambda: draw_pdfs(entries, times, out_dir)),
-            ((outputs + inputs) * k, "drawing the runs", lambda: trajectories_section(entries, times, out_dir))]
+            (0, "writing the failures", lambda: failures_section(entries))]
+    if outputs:  # none: a rare-event design's runs are not draws of the input law (rare_statistics)
+        jobs += [((outputs + 1) * k + (outputs if k >= 2 else 0), "drawing the statistics over time",
+                  lambda: statistics_section(entries, ref, times, out_dir)),
+                 (2 * outputs * k, "drawing the PDFs", lambda: draw_pdfs(entries, times, out_dir))]
+    jobs.append(((outputs + inputs) * k, "drawing the runs", lambda: trajectories_section(entries, times, out_dir)))
     if any(e.has_errors for e in entries):
         jobs.append((2 * outputs + 2, "drawing the errors against the reference",
                      lambda: accuracy_section(entries, out_dir)))
@@ -70,10 +72,18 @@ def section_jobs(entries: list[Entry], ref: Entry | None, times: list[float],
         from .index_set import index_set_section
 
         jobs.append((k, "drawing the adaptive grid's index set", lambda: index_set_section(entries, out_dir)))
+    if any(getattr(e.stats, "rare_runs", None) for e in entries):
+        from .rare_event import rare_event_section
+
+        jobs.append((2 * k, "drawing the rare event's estimate", lambda: rare_event_section(entries, out_dir)))
     if any(e.stats.seeds for e in entries):
         from .variance_split import variance_split_section
 
         jobs.append((0, "writing the variance split", lambda: variance_split_section(entries, times)))
+    if any(out.morris for e in entries for out in e.outputs.values()):
+        from .morris import morris_section
+
+        jobs.append((outputs * k, "drawing the Morris screening", lambda: morris_section(entries, times, out_dir)))
     if any(e.has_sobol for e in entries):
         jobs.append((3 * outputs * k, "drawing the Sobol' indices",
                      lambda: sensitivity_section(entries, times, out_dir)))
@@ -115,7 +125,7 @@ def run_section(entries: list[Entry], out_dir: Path) -> Section:
     for e in _files(entries):
         text = str(e.attrs.get("campaign", ""))
         settings, simulator = campaign_settings(text), campaign_simulator(text)
-        methods = ", ".join(dict.fromkeys(method_label(x.stats.method) for x in entries
+        methods = ", ".join(dict.fromkeys(estimator_label(x.stats) for x in entries
                                           if (x.path or x.stats.path) == (e.path or e.stats.path)))
         versions = ", ".join(f"{k} {v}" for k, v in json.loads(e.attrs.get("versions", "{}")).items())
         failed = getattr(e.stats, "failed", 0)

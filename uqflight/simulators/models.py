@@ -57,3 +57,18 @@ def anisotropic(p: dict) -> dict:
     Var[y] = exp(2A²) − exp(A²) + (d − 1) B² (1 − e⁻²)/2 + C²."""
     x = np.array(list(p.values()), dtype=float)
     return {"y": np.exp(ANISOTROPIC_A * x[0]) + ANISOTROPIC_B * np.sin(x[1:]).sum() + ANISOTROPIC_C * x[0] * x[1]}
+
+
+def normal_sum(p: dict) -> dict:
+    """y = Σ_k x_k / √d over the parameters in order, each ~ N(0, 1): y ~ N(0, 1), so P(y > t) = Φ(−t)
+    (a linear limit state of reliability index t, for the rare-event designs)."""
+    x = np.array(list(p.values()), dtype=float)
+    return {"y": x.sum() / np.sqrt(x.size)}
+
+
+def seeded_sum(p: dict) -> dict:
+    """y = (x + z)/√2 with x ~ N(0, 1) the parameter `x` and z ~ N(0, 1) drawn from the random stream of the
+    integer seed `seed` (numpy's default generator): y ~ N(0, 1) over x and the seed, P(y > t) = Φ(−t),
+    and y is not smooth in the seed (a rare event with a seed parameter)."""
+    z = np.random.default_rng(int(p["seed"])).standard_normal()
+    return {"y": (float(p["x"]) + z) / np.sqrt(2.0)}

@@ -63,6 +63,7 @@ from .file_end import extend_to_file_end, past_recorded_end
 from .layout import is_time_grid, layout_problems
 from .lock import LockHeld, held_message, is_lock_error
 from .raw import RawStorage
+from .rare import read_rare_event, write_rare_event
 from .rounds import read_index_set, write_index_set
 from .storage import OutputStorage, key_of, name_of
 
@@ -459,6 +460,21 @@ class ResultStore:
     def write_index_set(self, state) -> None:
         """Record an adaptive grid's state in /design (replaced whole, see `rounds`)."""
         write_index_set(self._file, state)
+        self._flush(sync=True)
+
+    def rare_event(self) -> dict | None:
+        """A rare-event design's recorded estimate (`store.rare`), or None when the file holds none (another
+        design, or rounds not finished); CorruptFile when /rare_event is not such a record."""
+        try:
+            return read_rare_event(self._file, int(self._file["samples/status"].shape[0]),
+                                   int(self._file["samples/xi"].shape[1]))
+        except (KeyError, ValueError, TypeError, IndexError, OSError, RuntimeError) as exc:
+            raise CorruptFile(f"{self._file.filename}: /rare_event: the rare-event estimate cannot be read "
+                              f"({one_line(exc)}): the file is damaged or was not written by uqflight") from None
+
+    def write_rare_event(self, record: dict) -> None:
+        """Record a rare-event design's estimate in /rare_event (`store.rare`)."""
+        write_rare_event(self._file, record)
         self._flush(sync=True)
 
     # -- writing ----------------------------------------------------------------------------

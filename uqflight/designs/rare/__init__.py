@@ -1,1 +1,231 @@
-"""Rare-event designs."""
+"""Rare-event designs: the probability of an event `design.event` (a quantity above or below a threshold),
+estimated by an algorithm that adapts its runs to the event round by round.
+
+Kinds (keys in braces; every kind takes `event: {of: QUANTITY, above: X}` or `{of, below: X}` and an
+optional `budget`, the most runs):
+- subset_simulation {samples_per_level, p0}: Au & Beck's subset simulation, conditional levels by
+  Markov chains in standard-normal space (`subset`).
+- importance_sampling {samples}: adaptive importance sampling, `samples` runs per round (`importance`).
+- active_learning {}: a Gaussian-process surrogate learnt where the event's boundary lies, then an
+  importance-sampling correction on true runs (`active`).
+
+The algorithms (`subset`, `importance`, `active`, `estimate`) work in standard-normal space u and call
+`evaluate(u)` once per round with the whole round's points; this module reads the `design:` mapping, maps
+u to the germs ξ (each germ's `from_normal`) and gives the first round's points (the design the results
+file is created with). The runner (`uqflight.rare_rounds`) replays the algorithm over the stored runs.
+The runs of such a design are not draws of the input law: the analysis gives the event's probability
+and refuses every other statistic (`uqflight.rare_statistics`).
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ...parameters.germs import GERMS
+from ..spec import check_keys, is_integer
+
+RARE_KINDS = ("subset_simulation", "importance_sampling", "active_learning")
+# the most runs when `budget` is not given: what each kind needs, with its other defaults, to come within a
+# factor 2 of the exact probability on the issue's closed-form problems (issue 46)
+DEFAULT_BUDGET = {"subset_simulation": 12000, "importance_sampling": 5000, "active_learning": 1500}
+OWN_KEYS = {"subset_simulation": ("samples_per_level", "p0"), "importance_sampling": ("samples",),
+            "active_learning": ()}
+SIDES = ("above", "below")
+EVENT_KEYS = ("of", *SIDES)
+MAX_RUNS = 10**8  # a budget beyond this is no rare-event design's (and limits.max_runs bounds it first)
+
+
+@dataclass(frozen=True)
+class Event:
+    """The event whose probability is estimated: quantity `of` above (or below) `threshold`."""
+
+    of: str
+    side: str  # "above" or "below"
+    threshold: float
+
+    def margin(self, values: np.ndarray) -> np.ndarray:
+        """g = q − X (above) or X − q (below): the event is g > 0; NaN stays NaN (no value)."""
+        values = np.asarray(values, dtype=float)
+        return values - self.threshold if self.side == "above" else self.threshold - values
+
+    def text(self) -> str:
+        return f"{self.of} {'>' if self.side == 'above' else '<'} {self.threshold:g}"
+
+
+@dataclass(frozen=True)
+class RareSettings:
+    """A rare-event `design:` mapping, checked: its kind, event, budget and the algorithm's own settings
+    (only those given: the algorithm's defaults hold for the others)."""
+
+    kind: str
+    event: Event
+    budget: int
+    settings: dict = field(default_factory=dict)
+
+
+def _event(value) -> Event:
+    if not isinstance(value, dict):
+        raise ValueError(f"design.event: expected a mapping {{of: QUANTITY, above: X}} or {{of: QUANTITY, below: X}}, "
+                         f"got {value!r}")
+    for key in value:
+        if key not in EVENT_KEYS:
+            raise ValueError(f"design.event.{key}: unknown key; expected one of of, above, below")
+    of = value.get("of")
+    if not isinstance(of, str) or not of:
+        raise ValueError(f"design.event.of: expected the name of one of the campaign's quantities, got {of!r}")
+    sides = [side for side in SIDES if side in value]
+    if len(sides) != 1:
+        raise ValueError("design.event: expected exactly one of above or below (the threshold), got "
+                         f"{' and '.join(sides) or 'neither'}")
+    threshold = value[sides[0]]
+    if isinstance(threshold, bool) or not isinstance(threshold, (int, float)) or not math.isfinite(threshold):
+        raise ValueError(f"design.event.{sides[0]}: expected a finite number, got {threshold!r}")
+    return Event(of, sides[0], float(threshold))
+
+
+def _count(spec: dict, key: str, minimum: int, maximum: int = MAX_RUNS) -> int:
+    value = spec[key]
+    if not is_integer(value) or not minimum <= value <= maximum:
+        raise ValueError(f"design.{key}: expected an integer from {minimum} to {maximum}, got {value!r}")
+    return int(value)
+
+
+def rare_settings(spec: dict) -> RareSettings:
+    """The checked settings of a rare-event `design:` mapping; ValueError naming design.KEY otherwise."""
+    kind = spec.get("kind")
+    check_keys(spec, kind, ("event", "budget", *OWN_KEYS[kind]))
+    if "event" not in spec:
+        raise ValueError(f"design.event: missing; kind {kind} estimates the probability of an event "
+                         "{of: QUANTITY, above: X} (or below: X)")
+    event = _event(spec["event"])
+    budget = _count(spec, "budget", 1) if "budget" in spec else DEFAULT_BUDGET[kind]
+    settings = {}
+    if "samples_per_level" in spec:
+        settings["samples_per_level"] = _count(spec, "samples_per_level", 2)
+    if "p0" in spec:
+        p0 = spec["p0"]
+        if isinstance(p0, bool) or not isinstance(p0, (int, float)) or not 0 < p0 <= 0.5:
+            raise ValueError(f"design.p0: expected a number in (0, 0.5], the conditional probability of each "
+                             f"level, got {p0!r}")
+        settings["p0"] = float(p0)
+    if kind == "subset_simulation":
+        samples = settings.get("samples_per_level", 1000)
+        if math.floor(samples * settings.get("p0", 0.1)) < 1:
+            raise ValueError(f"design.samples_per_level: times p0 must give at least one chain (samples_per_level "
+                             f"{samples}, p0 {settings.get('p0', 0.1):g})")
+        if samples > budget:
+            raise ValueError(f"design.budget: {budget} runs cannot hold one level of samples_per_level "
+                             f"= {samples}")
+    if "samples" in spec:
+        settings["samples"] = _count(spec, "samples", 2)
+        if settings["samples"] > budget:
+            raise ValueError(f"design.budget: {budget} runs cannot hold one round of samples = {settings['samples']}")
+    return RareSettings(kind, event, budget, settings)
+
+
+def algorithm(kind: str):
+    """The algorithm of a rare-event kind (imported when first needed: scikit-learn only for active learning)."""
+    if kind == "subset_simulation":
+        from .subset import subset_simulation as found
+    elif kind == "importance_sampling":
+        from .importance import importance_sampling as found
+    else:
+        from .active import active_learning as found
+    return found
+
+
+def run_algorithm(settings: RareSettings, evaluate, dimension: int, seed: int, redrawn=()):
+    """The algorithm's RareEventEstimate: `evaluate(u)` (n, d) -> margins (n,) is called once per round."""
+    return algorithm(settings.kind)(evaluate, dimension, seed=int(seed), budget=settings.budget,
+                                    redrawn=tuple(int(k) for k in redrawn), **settings.settings)
+
+
+def germs_from_normal(u: np.ndarray, germs: list[str]) -> np.ndarray:
+    """ξ (n, d) of standard normals u (n, d): column k through germ k's `from_normal` (the Nataf map)."""
+    u = np.asarray(u, dtype=float)
+    if u.ndim != 2 or u.shape[1] != len(germs):
+        raise ValueError(f"expected points of shape (n, {len(germs)}), got {u.shape}")
+    xi = np.empty_like(u)
+    for k, germ in enumerate(germs):
+        xi[:, k] = GERMS[germ].from_normal(u[:, k])
+    return xi
+
+
+class _FirstRound(BaseException):
+    """Raised by the first `evaluate` call of `first_round` to stop the algorithm there (a BaseException so
+    that no `except Exception` of an algorithm can take it for a failed run)."""
+
+    def __init__(self, u):
+        super().__init__("first round")
+        self.u = np.array(u, dtype=float)
+
+
+def first_round(settings: RareSettings, germs: list[str], seed: int, redrawn=()) -> np.ndarray:
+    """The points u (n, d) of the algorithm's first `evaluate` call: a function of the settings and the seed
+    alone (the algorithm is stopped there, nothing is run)."""
+
+    def stop(u):
+        raise _FirstRound(u)
+
+    try:
+        run_algorithm(settings, stop, len(germs), seed, redrawn)
+    except _FirstRound as first:
+        return first.u
+    raise RuntimeError(f"{settings.kind} asked for no run")
+
+
+def rare_size(spec: dict, germs: list[str]) -> int | None:
+    """Runs of a rare-event design: at most `budget` (its kind's default budget when not given)."""
+    if not isinstance(spec, dict) or spec.get("kind") not in RARE_KINDS:
+        return None
+    budget = spec.get("budget", DEFAULT_BUDGET[spec["kind"]])
+    return budget if is_integer(budget) and budget >= 1 else None
+
+
+def rare_design(spec: dict, germs: list[str], seed: int, redrawn=()):
+    """A rare-event design: the first round of the algorithm's points, mapped to the germs; the runner
+    (`uqflight.rare_rounds`) adds the other rounds from the results, up to `budget` runs. The weights are
+    equal and mean nothing: the runs are not draws of the input law."""
+    settings = rare_settings(spec)
+    xi = germs_from_normal(first_round(settings, germs, seed, redrawn), germs)
+    info = {"event": settings.event.text(), "budget": settings.budget, **settings.settings,
+            "rounds": "adapted to the event from the results, up to the budget"}
+    return xi, np.full(len(xi), 1.0 / len(xi)), info
+
+
+def subset_simulation_design(spec: dict, germs: list[str], seed: int, redrawn=()):
+    """Subset simulation (Au & Beck 2001): the event's probability as a product of conditional probabilities
+    p0 of nested levels, each level's `samples_per_level` runs grown by Markov chains (adaptive conditional
+    sampling) from the p0 share of the runs beyond the previous level, a seed parameter redrawn at each step (keys `event`, `budget`, `samples_per_level`, `p0`)."""
+    return rare_design(spec, germs, seed, redrawn)
+
+
+def importance_sampling_design(spec: dict, germs: list[str], seed: int, redrawn=()):
+    """Adaptive importance sampling: a sampling density moved towards the event round by round (`samples`
+    runs each), the probability weighted by the input law over that density (keys `event`, `budget`,
+    `samples`)."""
+    return rare_design(spec, germs, seed, redrawn)
+
+
+def active_learning_design(spec: dict, germs: list[str], seed: int, redrawn=()):
+    """Active learning: a Gaussian-process surrogate of the event's margin, enriched where the sign is least
+    sure, then an importance-sampling correction on true runs that keeps the estimate unbiased where the
+    surrogate is wrong (keys `event`, `budget`)."""
+    return rare_design(spec, germs, seed, redrawn)
+
+
+def check_rare_campaign(check, campaign) -> None:
+    """What a rare-event design asks of the rest of its campaign (a `campaign.schema.Checker` refuses):
+    its event's quantity is one of the campaign's quantities, and no `analysis.exceedance` (its runs are
+    not draws of the input law: it estimates its own event only)."""
+    settings = rare_settings(campaign.design_spec)
+    names = list(campaign.quantities)
+    if settings.event.of not in names:
+        check.fail("design.event.of", f"expected one of the campaign's quantities ({', '.join(names) or 'none: add '}"
+                                       f"{'' if names else 'one under quantities:'}), got {settings.event.of!r}")
+    if campaign.analysis.get("exceedance"):
+        check.fail("analysis.exceedance", f"a {settings.kind} design's runs are not draws of the input law: it "
+                                          "estimates the probability of its design.event only; give the threshold "
+                                          "there, one campaign per event")
