@@ -82,4 +82,5 @@ class PseudoGalerkin(Projection):
 class Interpolation(Projection):
     """Moments from the weights (Eq. 32–34), PCE by projection."""
 
-    kind, label, quadrature, exported_as = "interpolation", "interpolation", True, ("pseudo_galerkin", "pseudo_galerkin")
+    kind, label, quadrature = "interpolation", "interpolation", True
+    exported_as = ("pseudo_galerkin", "pseudo_galerkin")

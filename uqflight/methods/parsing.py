@@ -46,8 +46,8 @@ def _settings(entry: Method, pairs: str, text: str) -> dict:
     for pair in pairs.split(","):
         key, equals, value = (part.strip() for part in pair.partition("="))
         if not equals or key not in entry.settings:
-            raise ValueError(f"expected KIND:ORDER:KEY=VALUE,... with KEY one of {', '.join(entry.settings) or '(none)'} "
-                             f"for {entry.kind}, got {text!r}")
+            raise ValueError("expected KIND:ORDER:KEY=VALUE,... with KEY one of "
+                             f"{', '.join(entry.settings) or '(none)'} for {entry.kind}, got {text!r}")
         try:
             settings[key] = float(value)
         except ValueError:

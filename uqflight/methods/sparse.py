@@ -25,7 +25,7 @@ import warnings
 import numpy as np
 
 from ..parameters.germs import check_germs
-from . import METHODS, Key, Method
+from . import DEFAULT_ORDER, METHODS, Key, Method
 from .basis import orthonormal_basis, total_degree_indices
 from .pce import PCE
 
@@ -175,12 +175,12 @@ class Sparse(Method):
 
     kind, label, rule, failed_runs, partial, weighted = "sparse", "sparse", "selection", "extrapolated", True, False
     order_key = "max_order"
-    keys = {"max_order": Key(2, "sparse only: the largest total degree of the candidate terms, >= 1. Default 2. "
-                                "`max_order: 5`", minimum=1),
+    keys = {"max_order": Key(DEFAULT_ORDER, "sparse only: the largest total degree of the candidate terms, >= 1. "
+                                            "Default 2. `max_order: 5`", minimum=1),
             "selection": Key("lars", "sparse only: `lars` (least-angle regression, the default) or `omp` (orthogonal "
                                      "matching pursuit) orders the candidate terms.", choices=SELECTIONS),
-            "q": Key(1.0, "sparse only: the hyperbolic truncation ‖α‖_q ≤ max_order, 0 < q ≤ 1; 1 (the default) is "
-                          "total degree, smaller keeps fewer interactions. `q: 0.75`", check=_q_problem)}
+            "q": Key(1.0, "sparse only: the hyperbolic truncation ‖α‖_q ≤ max_order, 0 < q ≤ 1; 1 (the default) "
+                          "is total degree, smaller keeps fewer interactions. `q: 0.75`", check=_q_problem)}
 
     def expansion(self, xi, weights, Y, germs, order: int, x0=None, scale=None, **settings) -> PCE:
         return sparse_pce(xi, weights, Y, germs, order, x0, scale=scale, **settings)
