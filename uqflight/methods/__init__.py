@@ -192,6 +192,11 @@ class Method:
                 return key, why
         return None
 
+    def points_problem(self, order: int, xi, weights, germs: list[str], sampled: bool,
+                       allow_aliasing: bool = False) -> str | None:
+        """Why its rule refuses a PCE of total `order` on the points xi (N, d) with weights, or None."""
+        return None
+
     def expansion(self, xi, weights, Y, germs, order: int, x0=None, scale=None, **settings) -> PCE:
         """Its PCE of Y = rows @ scale (scale None: Y (N, T)) at the points xi (N, d) with weights (N,)."""
         raise NotImplementedError(f"{self.kind} builds no PCE")

@@ -9,6 +9,7 @@ from ..analysis.moments import as_runs_by_time, probability_weights
 from ..parameters.germs import check_germs
 from . import Method, scaled
 from .basis import orthonormal_basis, total_degree_indices
+from .exactness import design_matrix_rank
 from .pce import PCE
 
 
@@ -59,19 +60,38 @@ def least_squares(xi, weights, Y, germs, order: int = 2) -> PCE:
     return PCE(germs, indices, _solve(root_weights * matrix, root_weights * Y, order))
 
 
-class Regression(Method):
+class Fit(Method):
+    """A PCE fitted by least squares on a total-degree basis: the kinds below (no kind of its own)."""
+
+    rule, failed_runs, partial = "fit", "extrapolated", True
+
+    def points_problem(self, order: int, xi, weights, germs: list[str], sampled: bool,
+                       allow_aliasing: bool = False) -> str | None:
+        """A design matrix of full rank Z on the actual points (N >= Z is not enough)."""
+        def rank_and_terms(p: int) -> tuple[int, int]:
+            return design_matrix_rank(xi, germs, p, weights if self.weighted else None)
+
+        rank, terms = rank_and_terms(order)
+        if rank == terms:
+            return None
+        fitting = next((p for p in range(order - 1, -1, -1) if len(set(rank_and_terms(p))) == 1), -1)
+        return (f"{self.kind} of order {order} fits {terms} terms, but the design matrix on the {len(xi)} points has "
+                f"rank {rank}: the coefficients are not determined; the largest order with full rank is {fitting}")
+
+
+class Regression(Fit):
     """Least-squares fit of the PCE, weights ignored (Eq. 35–37)."""
 
-    kind, label, rule, failed_runs, partial, weighted = "regression", "regression", "fit", "extrapolated", True, False
+    kind, label, weighted = "regression", "regression", False
 
     def expansion(self, xi, weights, Y, germs, order: int, x0=None, scale=None, **settings) -> PCE:
         return scaled(regression(xi, Y, germs, order), scale)
 
 
-class LeastSquares(Method):
+class LeastSquares(Fit):
     """Weighted least-squares fit of the PCE (Eq. 43–48)."""
 
-    kind, label, rule, failed_runs, partial = "least_squares", "least squares", "fit", "extrapolated", True
+    kind, label = "least_squares", "least squares"
 
     def expansion(self, xi, weights, Y, germs, order: int, x0=None, scale=None, **settings) -> PCE:
         return scaled(least_squares(xi, weights, Y, germs, order), scale)

@@ -18,6 +18,7 @@ from ..analysis.moments import as_runs_by_time, probability_weights
 from ..parameters.germs import check_germs
 from . import Method, scaled
 from .basis import orthonormal_basis, total_degree_indices
+from .exactness import exact_total_degree, max_projection_order
 from .pce import PCE
 
 
@@ -60,6 +61,16 @@ class Projection(Method):
     """A PCE by projection (Eq. 21), split form with x0 (Eq. 24): the kinds below (no kind of its own)."""
 
     rule, failed_runs, split = "projection", "projected", True
+
+    def points_problem(self, order: int, xi, weights, germs: list[str], sampled: bool,
+                       allow_aliasing: bool = False) -> str | None:
+        """A grid exact to degree 2p (the discrete Gram matrix the identity), unless aliasing is allowed."""
+        degree = 2 * order if sampled or allow_aliasing else exact_total_degree(xi, weights, germs, 2 * order)
+        if degree < 2 * order:
+            return (f"{self.kind} of order {order} needs a grid exact to degree {2 * order}, but this grid is exact "
+                    f"to degree {degree}: the largest order it can project is {max_projection_order(degree)} "
+                    "(or allow aliasing explicitly)")
+        return None
 
     def expansion(self, xi, weights, Y, germs, order: int, x0=None, scale=None, **settings) -> PCE:
         return scaled(pseudo_galerkin(xi, weights, Y, germs, order, x0), scale)

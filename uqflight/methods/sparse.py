@@ -182,6 +182,14 @@ class Sparse(Method):
             "q": Key(1.0, "sparse only: the hyperbolic truncation ‖α‖_q ≤ max_order, 0 < q ≤ 1; 1 (the default) "
                           "is total degree, smaller keeps fewer interactions. `q: 0.75`", check=_q_problem)}
 
+    def points_problem(self, order: int, xi, weights, germs: list[str], sampled: bool,
+                       allow_aliasing: bool = False) -> str | None:
+        """At least 3 points; whether a basis it selects has a defined leave-one-out error is known at the fit."""
+        if len(xi) >= 3:
+            return None
+        return (f"{self.kind} needs at least 3 points to choose a basis by its leave-one-out error, but there are "
+                f"{len(xi)}: add points")
+
     def expansion(self, xi, weights, Y, germs, order: int, x0=None, scale=None, **settings) -> PCE:
         return sparse_pce(xi, weights, Y, germs, order, x0, scale=scale, **settings)
 

@@ -11,7 +11,7 @@
 * Grid weights are a quadrature only all together: a grid with failed or missing runs refuses the
   projections and the weighted sums; the fits are made on the runs that exist, after the rank check.
 
-`method_problem` returns the refusal as one sentence that names the order, what the points allow and
+Each rule is its kind's `Method.points_problem`. `method_problem` returns the refusal as one sentence that names the order, what the points allow and
 what to do, or None.
 """
 from __future__ import annotations
@@ -19,7 +19,6 @@ from __future__ import annotations
 import math
 
 from . import Method
-from .exactness import design_matrix_rank, exact_total_degree, max_projection_order
 
 MAX_TERMS = 100_000  # PCE terms beyond which a fit is refused before any basis is built (campaign: limits.max_pce_terms)
 
@@ -43,31 +42,5 @@ def method_problem(kind: str, order: int, xi, weights, germs: list[str], sampled
         return (f"{kind} needs every run of the grid (its weights are a quadrature only all together), but "
                 f"{missing} of {n + missing} runs are missing; use least_squares or regression on the "
                 "runs that exist, or rerun the campaign")
-    if method.rule == "fit":
-        rank, _ = design_matrix_rank(xi, germs, order, weights if method.weighted else None)
-        if rank < terms:
-            fitting = largest_fitting_order(kind, xi, weights, germs, order)
-            return (f"{kind} of order {order} fits {terms} terms, but the design matrix on the {n} points has "
-                    f"rank {rank}: the coefficients are not determined; the largest order with full rank is "
-                    f"{fitting}")
-    if method.rule == "selection" and n < 3:
-        return (f"{kind} needs at least 3 points to choose a basis by its leave-one-out error, but there are {n}: "
-                "add points")
-    if method.rule == "projection" and not sampled and not allow_aliasing:
-        degree = exact_total_degree(xi, weights, germs, max_degree=2 * order)
-        if degree < 2 * order:
-            return (f"{kind} of order {order} needs a grid exact to degree {2 * order}, but this grid is exact "
-                    f"to degree {degree}: the largest order it can project is {max_projection_order(degree)} "
-                    "(or allow aliasing explicitly)")
-    return None
-
-
-def largest_fitting_order(kind: str, xi, weights, germs: list[str], below: int) -> int:
-    """The largest order < `below` whose design matrix has full rank on the points (−1 if none)."""
-    weighted = Method.of(kind).weighted
-    for order in range(below - 1, -1, -1):
-        rank, terms = design_matrix_rank(xi, germs, order, weights if weighted else None)
-        if rank == terms:
-            return order
-    return -1
+    return method.points_problem(order, xi, weights, germs, sampled, allow_aliasing)
 
