@@ -39,7 +39,6 @@ from .analysis.divergence import kl_divergence
 from .analysis.errors import error_summary, relative_errors
 from .analysis.exceedance import exceedance_from_pce, exceedance_from_runs, unit_slip
 from .analysis.failures import grid_failure_probability
-from .analysis.proportions import sampled_proportion
 from .analysis.floors import central_moments, floors_from_moments, kld_estimator_bias, kld_floor
 from .analysis.moments import (modified_cov, sorted_by_time, standardised_moments, weighted_moments,
                                weighted_quantiles)
@@ -386,8 +385,7 @@ def _note_runs(store: ResultStore, stats: Statistics, sampled: bool, allow_alias
     done = status != Status.PENDING
     failed = status[done] > 0
     if sampled:
-        found = sampled_proportion(status > 0, done, DESIGNS[stats.design_kind].draws, stats.design_info,
-                                   event="failed")
+        found = DESIGNS[stats.design_kind].draws.proportion(status > 0, done, stats.design_info, event="failed")
         stats.failure_probability = {**{k: found[k] for k in ("estimate", "lower", "upper", "n_effective")},
                                      "method": found["sentence"]}
     else:
@@ -901,7 +899,7 @@ def _reference_floor(reference: Statistics, ref: OutputStatistics, out: OutputSt
                 "kld_floor": _kld_floor(reference, ref, out), "floor_note": note + KLD_FLOOR_NOTE}
     if reference.from_runs and ref.fourth_central is not None:
         floors = floors_from_moments(ref.mean, ref.variance, ref.fourth_central, reference.completed)
-        qmc = reference.design_kind != "monte_carlo"
+        qmc = not getattr(DESIGNS[reference.design_kind].draws, "independent", False)  # a grid's too
         note = (f"reference: {reference.completed} {reference.design_kind} runs; floor = its standard errors "
                 "(σ/√N for the mean, the distribution-free s.e. of the variance)"
                 + ("; QMC converges faster than this Monte Carlo floor, so it is an upper bound" if qmc else ""))

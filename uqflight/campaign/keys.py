@@ -266,7 +266,7 @@ def _paths(prefix: str, keys) -> list[str]:
 def refused_keys(call) -> tuple[str, ...]:
     """The keys a check accepts, as it lists them when it refuses an unknown key: `call()` feeds it one
     ('... unknown key; expected one of a, b' from the schema's Checker, '... accepted keys: a, b' from
-    designs.spec.check_keys) and must raise."""
+    designs.DesignKind.settings) and must raise."""
     try:
         call()
     except ValueError as exc:  # CampaignError too
@@ -306,8 +306,7 @@ def accepted_keys() -> list[Key]:
     found += [Key(p, "parameters", dict(DISTRIBUTIONS) if p.endswith(".distribution") else None)
               for p in _paths("parameters.NAME", schema.PARAMETER_KEYS)]
     design = {"kind": dict(DESIGNS), "rule": dict(RULE_TABLE)}
-    keys = dict.fromkeys(k for kind, entry in DESIGNS.items()
-                         for k in refused_keys(lambda: entry.build({"kind": kind, "?": 0}, ["normal"], 0)))
+    keys = dict.fromkeys(k for entry in DESIGNS.values() for k in ("kind", *entry.keys))
     found += [Key(f"design.{k}", "design", design.get(k)) for k in keys]
     from ..designs.rare import EVENT_KEYS
 
@@ -332,12 +331,11 @@ def accepted_keys() -> list[Key]:
 
 
 def kind_description(path: str, kind: str, entry) -> str | None:
-    """A kind's meaning: VALUES, else the first paragraph of its registry entry's docstring (a design's
-    builder, a distribution's class)."""
+    """A kind's meaning: VALUES, else the first paragraph of its registry entry's docstring (a design
+    kind's or a distribution's class)."""
     if kind in VALUES.get(path, {}):
         return VALUES[path][kind]
-    target = getattr(entry, "build", None) or (entry if inspect.isclass(entry) else None)
-    doc = inspect.getdoc(target) if target is not None else None
+    doc = inspect.getdoc(entry) if inspect.isclass(entry) else None
     return " ".join(doc.split("\n\n")[0].split()) if doc else None
 
 
