@@ -28,8 +28,8 @@ from scipy import special
 from .failures import wilson_interval
 
 class Independent:
-    """Independent draws (monte_carlo): how a sampled design's runs count for a proportion. Each design kind
-    carries one of these strategies (`designs.DesignKind.draws`); the subclasses below are the others."""
+    """Independent draws (monte_carlo): how a sampled design's runs count for a proportion; each design kind
+    carries one of these strategies (`designs.DesignKind.draws`), the subclasses below being the others."""
 
     independent = True  # the runs are independent draws of the law
 
@@ -38,8 +38,7 @@ class Independent:
         (N,), in design order) where `hits` (bool (N,)) holds. lower/upper are None without an interval;
         `method`: "wilson", "replicates" or "points"; `sentence` says how, for a note, counting the runs
         `event` names ("failed", "above 5"). `info`: the design's recorded info (n_base, replicates, scramble)."""
-        hits, counted = np.asarray(hits, dtype=bool), np.asarray(counted, dtype=bool)
-        counted = self.counted(counted, info)
+        hits, counted = np.asarray(hits, dtype=bool), self.counted(np.asarray(counted, dtype=bool), info)
         k, n = int((hits & counted).sum()), int(counted.sum())
         if n == 0:
             return {"estimate": None, "lower": None, "upper": None, "n_effective": 0.0, "method": None,
@@ -50,55 +49,46 @@ class Independent:
         """The runs that count among those `counted` (all of them here)."""
         return counted
 
-    def interval(self, k: int, n: int, info: dict, confidence: float, counts: str, n_interval: int | None = None,
-                 how: str = "") -> dict:
-        """k/n and the Wilson score interval of `n_interval` (default n) draws; `how` ends the sentence."""
-        n_interval = n if n_interval is None else n_interval
-        lower, upper = wilson_interval(k / n, n_interval, confidence) if n_interval > 0 else (0.0, 1.0)
-        return {"estimate": k / n, "lower": lower, "upper": upper, "n_effective": float(n_interval),
-                "method": "wilson", "sentence": how or f"{counts}; {100 * confidence:g} % Wilson score interval"}
+    def interval(self, k: int, n: int, info: dict, confidence: float, counts: str) -> dict:
+        """The proportion k/n of the counted runs with its interval (here Wilson's); `counts` begins the sentence."""
+        return _wilson(k, n, n, confidence, f"{counts}; {100 * confidence:g} % Wilson score interval")
 
 
 class Points(Independent):
-    """Fixed points, not draws of the law (morris): k/n without an interval, the runs' own share."""
+    """Fixed points, not draws of the law (morris)."""
 
     independent = False
     why = "the design's points are not draws of the inputs' law (the runs' own share, not the law's probability)"
 
-    def interval(self, k, n, info, confidence, counts, n_interval=None, how=""):
+    def interval(self, k, n, info, confidence, counts):
         return {"estimate": k / n, "lower": None, "upper": None, "n_effective": float(n), "method": "points",
                 "sentence": f"{counts}; no interval: {self.why}"}
 
 
-class PickFreeze(Independent):
-    """Saltelli's rows [A; B; AB_1 … AB_d]: the rows A and B alone count (module docstring)."""
-
-    independent = False
+class PickFreeze(Points):
+    """Saltelli's rows [A; B; AB_1 … AB_d]: the rows A and B alone count."""
 
     def counted(self, counted, info):
         return counted & (np.arange(counted.size) < 2 * int(info["n_base"]))
 
-    def interval(self, k, n, info, confidence, counts, n_interval=None, how=""):
-        return super().interval(k, n, info, confidence, counts, how=(
-            f"{counts} (the rows A and B of the pick-freeze design, which the other rows repeat); "
-            f"{100 * confidence:g} % Wilson score interval of independent draws, unverified for their "
-            "scrambled Sobol' points (usually wider than their own)"))
+    def interval(self, k, n, info, confidence, counts):
+        return _wilson(k, n, n, confidence, f"{counts} (the rows A and B of the pick-freeze design, which the other "
+                                            f"rows repeat); {100 * confidence:g} % Wilson score interval of "
+                                            "independent draws, unverified for their scrambled Sobol' points "
+                                            "(usually wider than their own)")
 
 
-class Stratified(Independent):
-    """A Latin hypercube: the Wilson interval of n − 1 draws, conservative (module docstring)."""
+class Stratified(Points):
+    """A Latin hypercube: the Wilson interval of n − 1 draws, conservative."""
 
-    independent = False
-
-    def interval(self, k, n, info, confidence, counts, n_interval=None, how=""):
-        return super().interval(k, n, info, confidence, counts, n - 1, (
-            f"{counts}; {100 * confidence:g} % Wilson score interval of {n - 1} draws (conservative: a Latin "
-            "hypercube's variance is at most n/(n-1) times that of independent draws)"))
+    def interval(self, k, n, info, confidence, counts):
+        return _wilson(k, n, n - 1, confidence, f"{counts}; {100 * confidence:g} % Wilson score interval of {n - 1} "
+                                                "draws (conservative: a Latin hypercube's variance is at most "
+                                                "n/(n-1) times that of independent draws)")
 
 
 class Net(Points):
-    """A QMC net (sobol, halton): replicates' hull interval, one scrambled net's flagged Wilson interval, or
-    unscrambled fixed points without an interval (module docstring)."""
+    """A QMC net (sobol, halton): replicates, one scrambled net, or unscrambled fixed points."""
 
     why = "unscrambled QMC points are fixed, not random (scramble them, with replicates, for an interval)"
 
@@ -109,13 +99,18 @@ class Net(Points):
                                confidence, event)
         return super().proportion(hits, counted, info, confidence, event)
 
-    def interval(self, k, n, info, confidence, counts, n_interval=None, how=""):
+    def interval(self, k, n, info, confidence, counts):
         if not info.get("scramble", True):
             return super().interval(k, n, info, confidence, counts)
-        return Independent.interval(self, k, n, info, confidence, counts, how=(
-            f"{counts}; {100 * confidence:g} % Wilson score interval of independent draws, unverified for one "
-            "scrambled QMC net (usually wider than its own); set design.replicates for an interval from the "
-            "design itself"))
+        return _wilson(k, n, n, confidence, f"{counts}; {100 * confidence:g} % Wilson score interval of independent "
+                                            "draws, unverified for one scrambled QMC net (usually wider than its "
+                                            "own); set design.replicates for an interval from the design itself")
+
+
+def _wilson(k: int, n: int, n_interval: int, confidence: float, sentence: str) -> dict:
+    lower, upper = wilson_interval(k / n, n_interval, confidence) if n_interval > 0 else (0.0, 1.0)
+    return {"estimate": k / n, "lower": lower, "upper": upper, "n_effective": float(n_interval), "method": "wilson",
+            "sentence": sentence}
 
 
 def _counts(k: int, n: int, event: str) -> str:

@@ -332,10 +332,14 @@ def accepted_keys() -> list[Key]:
 
 def kind_description(path: str, kind: str, entry) -> str | None:
     """A kind's meaning: VALUES, else the first paragraph of its registry entry's docstring (a design
-    kind's or a distribution's class)."""
+    kind's or a distribution's class, a scenario's builder)."""
     if kind in VALUES.get(path, {}):
         return VALUES[path][kind]
-    doc = inspect.getdoc(entry) if inspect.isclass(entry) else None
+    from ..designs import DesignKind
+
+    target = type(entry) if isinstance(entry, DesignKind) else getattr(entry, "build", None) or (
+        entry if inspect.isclass(entry) else None)
+    doc = inspect.getdoc(target) if target is not None else None
     return " ".join(doc.split("\n\n")[0].split()) if doc else None
 
 

@@ -1,17 +1,9 @@
 """Designs: the points ξ_j in standard variables and their weights w_j, from a campaign's `design:`.
 
-Kinds (keys in braces):
-- monte_carlo {samples}; sobol {samples, scramble}; halton {samples, scramble};
-  latin_hypercube {samples}: samples mapped to the germs, equal weights.
-- sparse_grid {level, rule, nested, growth}: Smolyak combination technique on 1-D rules.
-- tensor_grid {rule, points}: full tensor product.
-- pick_freeze {samples}: Saltelli's [A; B; AB_1; …; AB_d] for Sobol' index estimators.
-- morris {trajectories, levels}: Morris's trajectories for elementary-effects screening.
-- adaptive_sparse_grid {rule, budget, tolerance}: Gerstner–Griebel's dimension-adaptive grid, built
-  round by round from the results (`adaptive`; the runner refines it).
-- subset_simulation {event, budget, samples_per_level, p0}, importance_sampling {event, budget, samples},
-  active_learning {event, budget}: the probability of an event, the runs adapted to it round by round
-  (`rare`; the runner replays the algorithm over the stored runs).
+Each kind is a `DesignKind` subclass (designs.base) in its module, registered in REGISTRY by its name: montecarlo
+(monte_carlo, sobol, halton, latin_hypercube), smolyak (sparse_grid), tensor (tensor_grid), pickfreeze
+(pick_freeze), morris, adaptive (adaptive_sparse_grid), rare (subset_simulation, importance_sampling,
+active_learning).
 """
 from __future__ import annotations
 

@@ -247,13 +247,11 @@ class AdaptiveSparseGrid(DesignKind):
     draws = None
     adaptive = True
 
-    @classmethod
-    def size(cls, spec, germs):
+    def size(self, spec, germs):
         """At most `budget` (a refinement that would pass it is not made)."""
-        return cls.given(spec, "budget")
+        return self.given(spec, "budget")
 
-    @classmethod
-    def points(cls, settings, germs, seed):
+    def points(self, settings, germs, seed):
         grid = Grid(adaptive_rules(settings, germs))
         points = grid_points(grid, IndexSet.initial(len(germs)))
         info = {"rule": rule_catalog.rule_names(grid.rules), "budget": settings["budget"],
@@ -263,7 +261,7 @@ class AdaptiveSparseGrid(DesignKind):
 
 def adaptive_settings(spec: dict, germs: list[str]) -> tuple[Grid, int, float]:
     """(the grid's rules, budget, tolerance) of an `adaptive_sparse_grid` spec, checked."""
-    settings = AdaptiveSparseGrid.settings(spec)
+    settings = AdaptiveSparseGrid().settings(spec)
     return Grid(adaptive_rules(settings, germs)), settings["budget"], float(settings["tolerance"])
 
 

@@ -48,7 +48,7 @@ def choice(choices: tuple[str, ...], default) -> Key:
     return Key(f"one of {', '.join(choices)}", default, lambda value: value in choices)
 
 
-REGISTRY: dict[str, type[DesignKind]] = {}
+REGISTRY: dict[str, DesignKind] = {}  # kind name -> the kind (its class's one instance)
 
 
 class DesignKind:
@@ -108,10 +108,9 @@ class DesignKind:
         super().__init_subclass__(**kwargs)
         cls.sampled = cls.draws is not None
         if "kind" in vars(cls):
-            REGISTRY[cls.kind] = cls
+            REGISTRY[cls.kind] = cls()
 
-    @classmethod
-    def settings(cls, spec: dict) -> dict:
+    def settings(self, spec: dict) -> dict:
         """The spec's values of `keys`, checked, defaults filled in; ValueError "design.KEY: ..." otherwise.
 
         Parameters
@@ -125,44 +124,39 @@ class DesignKind:
             {key: value} for every declared key.
         """
         for key in spec:
-            if key != "kind" and key not in cls.keys:
-                raise ValueError(f"design.{key}: unknown key for kind {cls.kind}; accepted keys: "
-                                 f"{', '.join(('kind', *cls.keys))}")
+            if key != "kind" and key not in self.keys:
+                raise ValueError(f"design.{key}: unknown key for kind {self.kind}; accepted keys: "
+                                 f"{', '.join(('kind', *self.keys))}")
         found = {}
-        for key, declared in cls.keys.items():
+        for key, declared in self.keys.items():
             if key not in spec and declared.default is REQUIRED:
-                raise ValueError(f"design.{key}: missing; kind {cls.kind} expects {declared.expects}")
+                raise ValueError(f"design.{key}: missing; kind {self.kind} expects {declared.expects}")
             value = spec.get(key, declared.default)
             if key in spec and declared.test is not None and not declared.test(value):
                 raise ValueError(f"design.{key}: expected {declared.expects}, got {value!r}")
             found[key] = value
         return found
 
-    @classmethod
-    def given(cls, spec: dict, key: str) -> int | None:
+    def given(self, spec: dict, key: str) -> int | None:
         """spec[key] (or its default) when it is an integer >= 1, else None (the builder's own checks speak)."""
-        value = spec.get(key, cls.keys[key].default)
+        value = spec.get(key, self.keys[key].default)
         return value if is_integer(value) and value >= 1 else None
 
-    @classmethod
-    def size(cls, spec: dict, germs: list[str]) -> float | None:
+    def size(self, spec: dict, germs: list[str]) -> float | None:
         """The runs `spec` builds, from the spec alone and without building anything (for the campaign's
         limits); None when the spec is malformed, so that the builder's own checks speak. Here `samples`."""
-        return cls.given(spec, "samples")
+        return self.given(spec, "samples")
 
-    @classmethod
-    def build(cls, spec: dict, germs: list[str], seed: int, redrawn: tuple[int, ...] = ()) -> tuple:
+    def build(self, spec: dict, germs: list[str], seed: int, redrawn: tuple[int, ...] = ()) -> tuple:
         """(ξ (N, d), weights (N,), info) of the checked `spec` over `germs`; `redrawn`: the columns that are
         random-stream seeds (a rare-event design's)."""
-        return cls.points(cls.settings(spec), germs, seed)
+        return self.points(self.settings(spec), germs, seed)
 
-    @classmethod
-    def points(cls, settings: dict, germs: list[str], seed: int) -> tuple:
+    def points(self, settings: dict, germs: list[str], seed: int) -> tuple:
         """(ξ, weights, info) of checked `settings`."""
-        raise NotImplementedError(f"design kind {cls.kind} gives no points")
+        raise NotImplementedError(f"design kind {self.kind} gives no points")
 
-    @classmethod
-    def info_problem(cls, info: dict, runs: int, d: int) -> tuple[str, str] | None:
+    def info_problem(self, info: dict, runs: int, d: int) -> tuple[str, str] | None:
         """(the key of `info`, what it expects) when a results file's recorded design `info` does not fit its
         `runs` of `d` parameters, for what the analysis reads of it; None when it fits."""
         return None

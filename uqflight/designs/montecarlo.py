@@ -32,8 +32,7 @@ class MonteCarlo(DesignKind):
     keys = {"samples": count(1)}
     example = {"kind": "monte_carlo", "samples": 64}
 
-    @classmethod
-    def points(cls, settings, germs, seed):
+    def points(self, settings, germs, seed):
         n = settings["samples"]
         return draw_germs(germs, n, seed), equal_weights(n), {"samples": n, "generator": "numpy default_rng", "seed": seed}
 
@@ -49,13 +48,11 @@ class Sobol(DesignKind):
     example = {"kind": "sobol", "samples": 64}
     draws = Net()
 
-    @classmethod
-    def size(cls, spec, germs):
-        n, replicates = cls.given(spec, "samples"), cls.given(spec, "replicates")
+    def size(self, spec, germs):
+        n, replicates = self.given(spec, "samples"), self.given(spec, "replicates")
         return None if n is None or replicates is None else n * replicates
 
-    @classmethod
-    def points(cls, settings, germs, seed):
+    def points(self, settings, germs, seed):
         n, scramble, replicates = settings["samples"], settings["scramble"], settings["replicates"]
         if replicates == 1:
             xi = germ_quantiles(sobol_points(n, len(germs), scramble, seed), germs)
@@ -76,8 +73,7 @@ class Halton(DesignKind):
     example = {"kind": "halton", "samples": 64}
     draws = Net()
 
-    @classmethod
-    def points(cls, settings, germs, seed):
+    def points(self, settings, germs, seed):
         from scipy.stats import qmc
 
         n, scramble = settings["samples"], settings["scramble"]
@@ -96,8 +92,7 @@ class LatinHypercube(DesignKind):
     example = {"kind": "latin_hypercube", "samples": 64}
     draws = Stratified()
 
-    @classmethod
-    def points(cls, settings, germs, seed):
+    def points(self, settings, germs, seed):
         from scipy.stats import qmc
 
         n = settings["samples"]

@@ -228,14 +228,12 @@ class Morris(DesignKind):
     not_draws = NOT_DRAWS
     screening = staticmethod(morris_screening)
 
-    @classmethod
-    def size(cls, spec, germs):
+    def size(self, spec, germs):
         """R (d + 1)."""
-        r = cls.given(spec, "trajectories")
+        r = self.given(spec, "trajectories")
         return None if r is None else r * (len(germs) + 1)
 
-    @classmethod
-    def points(cls, settings, germs, seed):
+    def points(self, settings, germs, seed):
         r, levels = settings["trajectories"], settings["levels"]
         if levels % 2:
             raise ValueError(f"design.levels: expected an even number of levels (the jump Δ = p/(2(p−1)) is then "

@@ -31,21 +31,18 @@ class PickFreeze(DesignKind):
     draws = proportions.PickFreeze()
     sobol_from_runs = True
 
-    @classmethod
-    def size(cls, spec, germs):
-        n = cls.given(spec, "samples")
+    def size(self, spec, germs):
+        n = self.given(spec, "samples")
         return None if n is None else n * (len(germs) + 2)
 
-    @classmethod
-    def points(cls, settings, germs, seed):
+    def points(self, settings, germs, seed):
         n, d = settings["samples"], len(germs)
         ab = germ_quantiles(sobol_points(n, 2 * d, scramble=True, seed=seed), germs + germs)
         xi = pick_freeze_rows(ab[:, :d], ab[:, d:])
         info = {"n_base": n, "samples": len(xi), "base_sequence": "scrambled Sobol'", "seed": seed}
         return xi, equal_weights(len(xi)), info
 
-    @classmethod
-    def info_problem(cls, info, runs, d):
+    def info_problem(self, info, runs, d):
         if not (is_integer(info.get("n_base")) and info["n_base"] * (d + 2) == runs):
             return "n_base", f"expected the base rows n of the {runs} runs, n ({d} parameters + 2)"
         return None

@@ -113,8 +113,7 @@ class SparseGrid(DesignKind):
     example = {"kind": "sparse_grid", "level": 2}
     draws = None
 
-    @classmethod
-    def size(cls, spec, germs):
+    def size(self, spec, germs):
         """The points the combination technique builds before merging the tensor rules' shared points
         (an upper bound on the runs, and the size of the arrays built), computed without building anything:
         Σ over the multi-indices of Π_k size_k(j_k), a polynomial product over the dimensions."""
@@ -125,7 +124,7 @@ class SparseGrid(DesignKind):
             raise ValueError(f"design.level: expected at most {MAX_LEVEL}, got {level}")
         try:
             rules = rule_catalog.rules_by_dimension(spec.get("rule"), germs, spec.get("nested"))
-            sizes = cls._sizes(rules, spec.get("growth") or "linear", level)
+            sizes = self._sizes(rules, spec.get("growth") or "linear", level)
         except (ValueError, KeyError, TypeError):
             return None
         # coefficient s of the product polynomial = the points of all tensor rules with |j| = s
@@ -146,11 +145,10 @@ class SparseGrid(DesignKind):
             sizes[rule] = rule_catalog.level_sizes(rule, growth, level + 1)
         return sizes
 
-    @classmethod
-    def points(cls, settings, germs, seed):
+    def points(self, settings, germs, seed):
         level, growth = settings["level"], settings["growth"]
         rules = rule_catalog.rules_by_dimension(settings["rule"], germs, settings["nested"])
-        sizes = cls._sizes(rules, growth, level)
+        sizes = self._sizes(rules, growth, level)
         one_dimensional = {rule: [rule_catalog.nodes_weights(rule, size) for size in sizes[rule]] for rule in sizes}
         points, weights = smolyak_rule([one_dimensional[rule] for rule in rules], level)
         degree = smolyak_degree([[rule_catalog.degree(rule, size) for size in sizes[rule]] for rule in rules], level)

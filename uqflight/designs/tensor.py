@@ -14,14 +14,12 @@ class TensorGrid(DesignKind):
     example = {"kind": "tensor_grid", "points": 4}
     draws = None
 
-    @classmethod
-    def size(cls, spec, germs):
+    def size(self, spec, germs):
         """points^d (a float: it may be far beyond any integer a run could reach)."""
-        n = cls.given(spec, "points")
+        n = self.given(spec, "points")
         return None if n is None else float(n) ** len(germs)
 
-    @classmethod
-    def points(cls, settings, germs, seed):
+    def points(self, settings, germs, seed):
         size = settings["points"]
         rules = rule_catalog.rules_by_dimension(settings["rule"], germs, nested=None)
         for rule in dict.fromkeys(rules):

@@ -141,21 +141,18 @@ class RareDesign(DesignKind):
     draws = None
     adaptive = rare = True
 
-    @classmethod
-    def size(cls, spec, germs):
+    def size(self, spec, germs):
         """At most `budget`."""
-        return cls.given(spec, "budget")
+        return self.given(spec, "budget")
 
-    @classmethod
-    def build(cls, spec, germs, seed, redrawn=()):
+    def build(self, spec, germs, seed, redrawn=()):
         settings = rare_settings(spec)
         xi = germs_from_normal(first_round(settings, germs, seed, redrawn), germs)
         info = {"event": settings.event.text(), "budget": settings.budget, **settings.settings,
                 "rounds": "adapted to the event from the results, up to the budget"}
         return xi, np.full(len(xi), 1.0 / len(xi)), info
 
-    @classmethod
-    def check_round(cls, settings: dict, budget: int) -> None:
+    def check_round(self, settings: dict, budget: int) -> None:
         """ValueError naming design.KEY when one round of `settings` does not fit the `budget`."""
         if settings.get("samples", 0) > budget:
             raise ValueError(f"design.budget: {budget} runs cannot hold one round of samples = {settings['samples']}")
@@ -178,8 +175,7 @@ class SubsetSimulation(RareDesign):
         from .subset import subset_simulation
         return subset_simulation
 
-    @classmethod
-    def check_round(cls, settings, budget):
+    def check_round(self, settings, budget):
         samples = settings.get("samples_per_level", 1000)
         if math.floor(samples * settings.get("p0", 0.1)) < 1:
             raise ValueError(f"design.samples_per_level: times p0 must give at least one chain (samples_per_level "
@@ -219,7 +215,7 @@ class ActiveLearning(RareDesign):
         return active_learning
 
 
-RARE = {design.kind: design for design in (SubsetSimulation, ImportanceSampling, ActiveLearning)}
+RARE = {design.kind: design() for design in (SubsetSimulation, ImportanceSampling, ActiveLearning)}
 
 
 def check_rare_campaign(check, campaign) -> None:
