@@ -247,7 +247,8 @@ def _load(path: Path):
 @app.command()
 def plan(campaign_file: Path = typer.Argument(..., metavar="CAMPAIGN", help="Campaign YAML file.")):
     """Validate a campaign and print its design, the number of runs and an estimated time."""
-    from .designs import describe, is_adaptive, is_rare
+    from .designs import REGISTRY as DESIGNS
+    from .designs import describe
     from .execution import WorkerError, timed_nominal
     from .methods import method_entry
 
@@ -263,13 +264,13 @@ def plan(campaign_file: Path = typer.Argument(..., metavar="CAMPAIGN", help="Cam
              "Cholesky in this order)")
     echo(describe(design))
     kind = campaign.method["kind"]
-    if is_rare(design.kind):  # its own estimator: the runs are not draws of the input law
+    if DESIGNS[design.kind].rare:  # its own estimator: the runs are not draws of the input law
         echo(f"method: none (the {design.kind} estimates the probability of its event only)")
     else:
         order = campaign.method.get(method_entry(kind).order_key)  # sparse's is max_order
         echo(f"method: {kind}" + (f" (order {order})" if _has_order(kind, design.kind) else ""))
     runs = campaign.runs or len(design.xi)  # an adaptive grid's budget: its rounds are made from the results
-    echo(f"runs: {runs}" + (" at most (design.budget)" if is_adaptive(design.kind) else ""))
+    echo(f"runs: {runs}" + (" at most (design.budget)" if DESIGNS[design.kind].adaptive else ""))
     echo(f"results: {Path(campaign.storage['path']).resolve()} (storage.path, from the working directory; "
          "--out to choose)")
     try:
@@ -290,11 +291,11 @@ CORES = os.cpu_count() or 1
 
 def _has_order(kind: str, design_kind: str) -> bool:
     """Whether method `kind` builds a PCE on this design, so that its order means something."""
-    from .designs import is_sampled
+    from .designs import REGISTRY as DESIGNS
     from .methods import method_entry
 
     entry = method_entry(kind)
-    return entry.pce is not None and not (entry.runs_on_sampled and is_sampled(design_kind))
+    return entry.pce is not None and not (entry.runs_on_sampled and DESIGNS[design_kind].sampled)
 
 
 @app.command()

@@ -48,7 +48,6 @@ from .campaign.attributes import StoredFacts, stored_facts, stored_settings
 from .campaign.schema import CampaignError
 from .console import shown
 from .designs import REGISTRY as DESIGNS
-from .designs import is_rare, is_sampled
 from .designs.adaptive import index_set_summary
 from .labels import name_unit, quantity_unit
 from .methods import (AUTO_CANDIDATES, PCE, METHODS, failed_runs_note, fit, method_entry, method_settings,
@@ -274,13 +273,13 @@ def analyse(path, reference: str | None = None, options: Options | None = None, 
         status, design_kind = store.status, facts.design_kind
         if method["kind"] not in METHODS:
             raise BadInput(f"{path}: unknown method {method['kind']!r}: expected one of {', '.join(METHODS)}")
-        sampled = is_sampled(design_kind)
+        sampled = DESIGNS[design_kind].sampled
         ok = status == Status.OK
         pending = int(np.sum(status == Status.PENDING))
         stats = Statistics(str(path), store.attrs.get("campaign_name", ""), method, design_kind,
                            store.parameter_names, int(status.size), int(ok.sum()), int(np.sum(status > 0)),
                            pending, {}, partial=pending > 0, design_info=facts.design_info, seed=options.seed)
-        if is_rare(design_kind):  # its runs are not draws of the input law: its event's probability only
+        if DESIGNS[design_kind].rare:  # its runs are not draws of the input law: its event's probability only
             from .rare_statistics import rare_statistics
 
             if exceedance:
@@ -518,7 +517,7 @@ def auto_method(store: ResultStore, name: str, method: dict, germs: list[str], d
     if method["kind"] != "auto":
         return method, False, None
     xi, weights, order = store.xi[ok], store.weights[ok], method["order"]
-    sampled, missing = is_sampled(design_kind), int(ok.size - ok.sum())
+    sampled, missing = DESIGNS[design_kind].sampled, int(ok.size - ok.sum())
     basis, scale = output_basis(store, name, ok)
     taken, errors, band_outside = validation.auto_choice(xi, weights, basis, scale, germs, order, sampled, missing,
                                                          seed)
@@ -603,7 +602,7 @@ def _start_output(store: ResultStore, name: str, method: dict, germs: list[str],
     unwrapped: list[str] = []
     basis, scale = output_basis(store, name, ok, unwrapped)
     truncation = _tsvd_resolution(store, scale, int(ok.sum()))
-    sampled = is_sampled(design_kind) or runs_only
+    sampled = DESIGNS[design_kind].sampled or runs_only
     x0 = None
     # x = x0 + S with each run's initial value (needs the runs themselves); only the projections use
     # it: the other kinds fit the constant term themselves, where the split would change nothing
@@ -952,7 +951,7 @@ def quantity_statistics(store: ResultStore, stats: Statistics, name: str, germs:
         values = values + shifts
         stats.notes.append(unwrapped_note(f"quantity {name}", units))
     missing = int(ok.sum() - defined.sum())
-    sampled = is_sampled(stats.design_kind)
+    sampled = DESIGNS[stats.design_kind].sampled
     why = None
     huge = too_large("quantity", name, float(np.abs(values[defined]).max(initial=0.0)))
     if huge:

@@ -17,22 +17,6 @@ from . import montecarlo, smolyak, tensor, pickfreeze, morris, adaptive, rare  #
 from .base import REGISTRY, DesignKind, is_integer
 
 DESIGN_KINDS = tuple(REGISTRY)
-SAMPLED_DESIGNS = tuple(kind for kind, entry in REGISTRY.items() if entry.sampled)
-
-
-def is_adaptive(kind: str) -> bool:
-    """Whether the design kind grows round by round from the results (see DesignKind)."""
-    return REGISTRY[kind].adaptive
-
-
-def is_rare(kind: str) -> bool:
-    """Whether the design kind estimates the probability of its event (see DesignKind)."""
-    return REGISTRY[kind].rare
-
-
-def is_sampled(kind: str) -> bool:
-    """Whether the design kind draws random points (see DesignKind)."""
-    return REGISTRY[kind].sampled
 
 
 @dataclass
