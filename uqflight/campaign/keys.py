@@ -246,21 +246,19 @@ def accepted_keys() -> list[Key]:
     from ..quantities import REGISTRY as TAKES
     from ..quantities.spec import KEYS as QUANTITY_KEYS
     from ..quantities.spec import WHEN_KEYS
-    from ..simulators.base import field_descriptions, field_paths
+    from ..simulators.base import field_descriptions
     from ..simulators.kinds import REGISTRY as SIMULATORS
     from ..simulators.scenarios import REGISTRY as SCENARIOS
     from . import schema
 
     found = [Key(k, "Top level") for k in schema.TOP_KEYS]
-    described = {p: d for entry in SIMULATORS.values() for p, d in field_descriptions("simulator", entry.fields).items()}
-    found += [Key(p, "simulator", dict(SIMULATORS) if p == "simulator.kind" else None, described[p])
-              for p in dict.fromkeys(p for entry in SIMULATORS.values() for p in field_paths("simulator", entry.fields))]
+    described = {p: d for kind in SIMULATORS.values() for p, d in field_descriptions("simulator", kind.fields).items()}
+    found += [Key(p, "simulator", dict(SIMULATORS) if p == "simulator.kind" else None, d) for p, d in described.items()]
     found.append(Key("simulator.scenario.kind", "simulator", dict(SCENARIOS)))
     for name, scenario in SCENARIOS.items():
-        described = {**field_descriptions("simulator", scenario.fields),
-                     **field_descriptions("simulator.scenario", scenario.scenario_fields)}
-        found += [Key(p, f"simulator, scenario `{name}`", None, described[p]) for p in
-                  field_paths("simulator", scenario.fields) + field_paths("simulator.scenario", scenario.scenario_fields)]
+        found += [Key(p, f"simulator, scenario `{name}`", None, d) for p, d in {
+            **field_descriptions("simulator", scenario.fields),
+            **field_descriptions("simulator.scenario", scenario.scenario_fields)}.items()]
     found += [Key(p, "parameters", dict(DISTRIBUTIONS) if p.endswith(".distribution") else None)
               for p in _paths("parameters.NAME", schema.PARAMETER_KEYS)]
     design = {"kind": dict(DESIGNS), "rule": dict(RULE_TABLE)}

@@ -7,6 +7,7 @@ once, and each error class carries its own code.
 from __future__ import annotations
 
 import enum
+from abc import ABC, abstractmethod
 from dataclasses import dataclass
 from pathlib import Path
 from typing import ClassVar
@@ -90,14 +91,8 @@ def check_fields(check, mapping: dict, path: str, fields: dict[str, Field]) -> N
             check.string(mapping[name], at, spec.choices)
 
 
-def field_paths(prefix: str, fields: dict[str, Field]) -> list[str]:
-    """The paths of `fields` under `prefix`, each mapping's own keys after every key of its level."""
-    paths = [f"{prefix}.{name}" for name in fields]
-    return paths + [p for name, spec in fields.items() if spec.keys for p in field_paths(f"{prefix}.{name}", spec.keys)]
-
-
 def field_descriptions(prefix: str, fields: dict[str, Field]) -> dict[str, str]:
-    """{path: description} of `fields` under `prefix`, nested ones included."""
+    """{path: description} of `fields` under `prefix`, each mapping's own keys after every key of its level."""
     found = {f"{prefix}.{name}": spec.description for name, spec in fields.items()}
     for name, spec in fields.items():
         if spec.keys:
@@ -105,7 +100,7 @@ def field_descriptions(prefix: str, fields: dict[str, Field]) -> dict[str, str]:
     return found
 
 
-class SimulatorKind:
+class SimulatorKind(ABC):
     """A simulator kind (`simulator.kind`): what runs a sample. Defining a subclass with `kind = "NAME"`
     registers one instance of it in `SimulatorKind.registry`.
 
@@ -150,21 +145,20 @@ class SimulatorKind:
 
     @property
     def keys(self) -> tuple[str, ...]:
-        """Its `simulator:` keys."""
         return tuple(self.fields)
 
+    @abstractmethod
     def check(self, check, value: dict) -> dict:
         """The mapping checked as written (`check` is the campaign's Checker); nothing imported or located."""
-        raise NotImplementedError
 
+    @abstractmethod
     def resolve(self, check, sim: dict, source: str) -> None:
         """Find what it runs relative to the campaign file `source` (a python module is imported, an aircraft
         located); only for campaigns about to be planned or run."""
-        raise NotImplementedError
 
+    @abstractmethod
     def make(self, config: dict, parameter_names: list[str], properties: list[str], base: Path):
         """The simulator a worker flies."""
-        raise NotImplementedError
 
     def bundle(self, config: dict, properties, base) -> dict | None:
         """The files a worker that shares no disk with the client needs, or None."""
@@ -179,9 +173,9 @@ class SimulatorKind:
         written elsewhere, e.g. calibrate's calibrated.yaml, reads the same files)."""
         return dict(config)
 
+    @abstractmethod
     def recorded(self, config: dict) -> tuple[int, int]:
         """(times, outputs) a run records, from the campaign alone (1 where known only once a sample has run)."""
-        raise NotImplementedError
 
     def span(self, config: dict) -> float | None:
         """The flight's last time [s] when the campaign fixes it, else None."""
@@ -191,16 +185,16 @@ class SimulatorKind:
         """A JSBSim aircraft trimmed in level flight (its modes are those of that trim)."""
         return False
 
+    @abstractmethod
     def check_source(self, check, name, path: str, config: dict, aircraft) -> None:
         """Refuse (check.fail at `path`) a name a quantity reads that the simulator does not record."""
-        raise NotImplementedError
 
     def facts(self, config: dict) -> dict[str, str]:
         """{"flight": text, "excitation": text}: what is flown, defaults resolved (the report; {} for a model)."""
         return {}
 
 
-class ScenarioKind:
+class ScenarioKind(ABC):
     """How a JSBSim run is flown (`simulator.scenario.kind`). Defining a subclass with `kind = "NAME"`
     registers one instance of it in `ScenarioKind.registry`.
 
@@ -252,25 +246,25 @@ class ScenarioKind:
     def scenario_keys(self) -> tuple[str, ...]:
         return tuple(self.scenario_fields)
 
+    @abstractmethod
     def check(self, check, sim: dict, folder: Path) -> dict:
         """`sim` checked (`check.fail(field, message)` refuses), its files resolved against `folder`."""
-        raise NotImplementedError
 
+    @abstractmethod
     def setup(self, config: dict, root: Path | None = None, base: Path | None = None, properties=()):
         """The setup (aircraft, root, aircraft_file, time, outputs) of a checked `simulator:` mapping."""
-        raise NotImplementedError
 
+    @abstractmethod
     def flight(self, setup, preflight: bool = True):
         """The flight: `fly(settings, observers=()) -> FlightResult`."""
-        raise NotImplementedError
 
+    @abstractmethod
     def times(self, config: dict) -> int:
         """The number of recorded times, from the campaign alone."""
-        raise NotImplementedError
 
+    @abstractmethod
     def span(self, config: dict) -> float | None:
         """The flight's last time [s] from the campaign alone, or None."""
-        raise NotImplementedError
 
     def files(self, config: dict) -> dict[str, bytes]:
         """{name: bytes}: files beyond the aircraft's that a worker needs."""
@@ -292,6 +286,6 @@ class ScenarioKind:
         """{output: (T,)}: the simulator's own resolution at `settings`, or None."""
         return None
 
+    @abstractmethod
     def facts(self, config: dict) -> dict[str, str]:
         """{"flight": text, "excitation": text}: what is flown, defaults resolved (the report)."""
-        raise NotImplementedError

@@ -453,8 +453,8 @@ class Script(ScenarioKind):
         if "end_s" in scenario:
             end = check.number(scenario["end_s"], "simulator.scenario.end_s")
             if not script.start_s < end <= script.end_s:
-                check.fail("simulator.scenario.end_s", f"expected a time after the script's start {script.start_s:g} s and "
-                                                       f"at most its end {script.end_s:g} s, got {end:g}")
+                check.fail("simulator.scenario.end_s", f"expected a time after the script's start {script.start_s:g} "
+                                                       f"s and at most its end {script.end_s:g} s, got {end:g}")
         try:
             script.bounded_steps(end)
         except ScriptError as exc:
@@ -472,8 +472,9 @@ class Script(ScenarioKind):
         except AircraftNotFound as exc:
             check.fail("simulator.aircraft", str(exc))
         if location.name != script.aircraft:
-            check.fail("simulator.aircraft", f"{named!r} is not the script's aircraft {script.aircraft!r} (<use aircraft=> "
-                                             f"in {script.path.name}); leave simulator.aircraft out, or name that aircraft")
+            check.fail("simulator.aircraft", f"{named!r} is not the script's aircraft {script.aircraft!r} (<use "
+                                             f"aircraft=> in {script.path.name}); leave simulator.aircraft out, or "
+                                             "name that aircraft")
         try:
             script.initfile(location.folder)
         except ScriptError as exc:
