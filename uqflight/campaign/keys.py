@@ -292,10 +292,10 @@ def kind_description(path: str, kind: str, entry) -> str | None:
     builder, a distribution's class, a simulator's or scenario's kind class)."""
     if kind in VALUES.get(path, {}):
         return VALUES[path][kind]
-    from ..simulators.base import ScenarioKind, SimulatorKind
+    from ..simulators.base import Kind
 
     target = (getattr(entry, "build", None) or (entry if inspect.isclass(entry) else None)
-              or (type(entry) if isinstance(entry, (SimulatorKind, ScenarioKind)) else None))
+              or (type(entry) if isinstance(entry, Kind) else None))
     doc = inspect.getdoc(target) if target is not None else None
     return " ".join(doc.split("\n\n")[0].split()) if doc else None
 

@@ -100,7 +100,26 @@ def field_descriptions(prefix: str, fields: dict[str, Field]) -> dict[str, str]:
     return found
 
 
-class SimulatorKind(ABC):
+class Kind(ABC):
+    """What simulator and scenario kinds share: a `kind` name, its keys as `fields`, and registration: a
+    subclass of SimulatorKind or ScenarioKind (the classes that hold a `registry`) registers one instance
+    of itself under its `kind` when it is defined."""
+
+    registry: ClassVar[dict]
+    kind: ClassVar[str]
+    fields: ClassVar[dict[str, Field]]
+
+    def __init_subclass__(cls, **kwargs):
+        super().__init_subclass__(**kwargs)
+        if "registry" not in cls.__dict__:
+            cls.registry[cls.kind] = cls()
+
+    @property
+    def keys(self) -> tuple[str, ...]:
+        return tuple(self.fields)
+
+
+class SimulatorKind(Kind):
     """A simulator kind (`simulator.kind`): what runs a sample. Defining a subclass with `kind = "NAME"`
     registers one instance of it in `SimulatorKind.registry`.
 
@@ -133,19 +152,9 @@ class SimulatorKind(ABC):
     """
 
     registry: ClassVar[dict[str, "SimulatorKind"]] = {}
-    kind: ClassVar[str]
-    fields: ClassVar[dict[str, Field]]
     aircraft: ClassVar[bool] = False
     integer_seeds: ClassVar[bool] = False
     example: ClassVar[tuple[dict, dict]]
-
-    def __init_subclass__(cls, **kwargs):
-        super().__init_subclass__(**kwargs)
-        SimulatorKind.registry[cls.kind] = cls()
-
-    @property
-    def keys(self) -> tuple[str, ...]:
-        return tuple(self.fields)
 
     @abstractmethod
     def check(self, check, value: dict) -> dict:
@@ -194,7 +203,7 @@ class SimulatorKind(ABC):
         return {}
 
 
-class ScenarioKind(ABC):
+class ScenarioKind(Kind):
     """How a JSBSim run is flown (`simulator.scenario.kind`). Defining a subclass with `kind = "NAME"`
     registers one instance of it in `ScenarioKind.registry`.
 
@@ -227,20 +236,10 @@ class ScenarioKind(ABC):
     """
 
     registry: ClassVar[dict[str, "ScenarioKind"]] = {}
-    kind: ClassVar[str]
-    fields: ClassVar[dict[str, Field]]
     scenario_fields: ClassVar[dict[str, Field]] = {}
     default_aircraft: ClassVar[str | None] = None
     level_trim: ClassVar[bool] = False
     example: ClassVar[dict]
-
-    def __init_subclass__(cls, **kwargs):
-        super().__init_subclass__(**kwargs)
-        ScenarioKind.registry[cls.kind] = cls()
-
-    @property
-    def keys(self) -> tuple[str, ...]:
-        return tuple(self.fields)
 
     @property
     def scenario_keys(self) -> tuple[str, ...]:
