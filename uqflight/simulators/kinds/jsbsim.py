@@ -52,7 +52,7 @@ class JSBSimSimulator:
 
     def resolution(self, kappa: np.ndarray, ours: dict[str, np.ndarray] | None = None) -> dict[str, np.ndarray] | None:
         """{output: (T,)}: the simulator's own resolution at `kappa` as its scenario states it (level
-        flight: the drift between its two valid trims; see `level_flight.resolution`), or None."""
+        flight: the drift between its two valid trims; see `LevelFlight.resolution`), or None."""
         return self.scenario.resolution(self.setup, self.settings(kappa), ours)
 
     def restart(self) -> None:
