@@ -40,7 +40,8 @@ from .progress import Progress
 from .methods import METHOD_KINDS
 from .simulators.base import FlightError
 from .simulators.aircraft import default_condition
-from .simulators.jsbsim import DEFAULT_OUTPUTS, Excitation, FlightSetup, JSBSimFlight
+from .simulators.jsbsim import DEFAULT_OUTPUTS
+from .simulators.scenarios.level_flight import Excitation, FlightSetup, JSBSimFlight
 
 CONTEXT = {"help_option_names": ["-h", "--help"]}
 # simulate's CSV and plot, beside the campaigns' results (results/ is in .gitignore)

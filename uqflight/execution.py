@@ -197,7 +197,7 @@ def nominal_kappa(campaign: Campaign) -> np.ndarray:
 
 
 def worker_spec(campaign: Campaign) -> WorkerSpec:
-    from .simulators.bundle import make_bundle
+    from .simulators.kinds import make_bundle
 
     properties = tuple(p.property for p in campaign.parameters)
     base = str(Path(campaign.source).resolve().parent)

@@ -142,12 +142,11 @@ def trajectories_section(entries: list, times: list[float], out_dir: Path):
     quantities against the inputs, seeded by the campaign's seed (the same runs on every report); None
     when there is nothing to draw (no output and no quantity)."""
     from ..designs import REGISTRY as DESIGNS
-    from .loading import bounded, campaign_settings
+    from .loading import bounded, campaign_settings, one_per_file
     from .blocks import Figure, Section, _rel
-    from .sections import _files
 
     blocks = []
-    for e in _files(entries):
+    for e in one_per_file(entries):
         results, stem = Path(e.path or e.stats.path), e.file_stem
         seed = int(campaign_settings(str(e.attrs.get("campaign", ""))).get("seed", 0) or 0)
         nodes = ("" if DESIGNS[e.stats.design_kind].sampled else
