@@ -16,7 +16,7 @@ import time
 import numpy as np
 
 from uqflight.paper import TABLE1
-from uqflight.simulators.jsbsim import FlightSetup, JSBSimFlight
+from uqflight.simulators.scenarios.level_flight import FlightSetup, JSBSimFlight
 
 
 def main():

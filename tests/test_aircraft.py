@@ -7,9 +7,9 @@ import numpy as np
 import pytest
 
 from uqflight.paper import TABLE1
-from uqflight.simulators.base import FlightError
-from uqflight.simulators.jsbsim import (REPO_ROOT, Excitation, FlightSetup, JSBSimFlight,
-                                        TrimError, quiet_jsbsim)
+from uqflight.simulators.base import FlightError, TrimError
+from uqflight.simulators.jsbsim import REPO_ROOT, quiet_jsbsim
+from uqflight.simulators.scenarios.level_flight import Excitation, FlightSetup, JSBSimFlight
 
 UQ = list(TABLE1)
 TABLE1_PCT = {name: pct for name, (_, pct) in TABLE1.items()}

@@ -6,7 +6,7 @@ import re
 import pytest
 from conftest import cli_in_process
 
-from uqflight.simulators.jsbsim import Excitation, FlightSetup, JSBSimFlight
+from uqflight.simulators.scenarios.level_flight import Excitation, FlightSetup, JSBSimFlight
 from uqflight.simulators.trim import level_speed_range
 
 
@@ -55,8 +55,8 @@ def test_a_trim_above_the_ceiling_says_to_fly_lower():
 
 def test_the_speed_range_is_scanned_once_per_condition():
     setup = _setup(altitude_ft=4000.0, airspeed_ktas=100.0)
-    first = level_speed_range(setup)
-    assert first[0] < 100.0 < first[1] and level_speed_range(setup) is first
+    first = level_speed_range(setup, JSBSimFlight)
+    assert first[0] < 100.0 < first[1] and level_speed_range(setup, JSBSimFlight) is first
 
 
 def test_a_pulse_that_never_moves_the_elevator_is_warned_about():

@@ -307,3 +307,12 @@ def test_every_kind_builds_and_describes_itself():
         text = describe(design)
         assert text.startswith(f"{kind}: {len(design.xi)} points in 3 dimensions")
     assert "degree: 5" in describe(build_design({"kind": "sparse_grid", "level": 2}, GERMS, 0))
+
+
+def test_the_design_kind_docstring_example_runs():
+    import doctest
+
+    from uqflight.designs import base
+
+    result = doctest.testmod(base)
+    assert result.attempted >= 3 and result.failed == 0

@@ -66,7 +66,7 @@ def test_results_do_not_depend_on_workers_or_executor(tmp_path):
 
 
 def test_stored_runs_match_a_fresh_flight(tmp_path):
-    from uqflight.simulators.jsbsim import FlightSetup, JSBSimFlight
+    from uqflight.simulators.scenarios.level_flight import FlightSetup, JSBSimFlight
 
     campaign = jsbsim_campaign(samples=3)
     run_campaign(campaign, out=tmp_path / "r.h5")

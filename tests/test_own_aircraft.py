@@ -11,7 +11,9 @@ from conftest import cli_in_process
 
 from uqflight.campaign import CampaignError, load_campaign
 from uqflight.simulators.aircraft import AircraftFiles, AircraftNotFound, locate
-from uqflight.simulators.jsbsim import REPO_ROOT, JSBSimFlight, flight_setup_from, quiet_jsbsim
+from uqflight.simulators.jsbsim import REPO_ROOT, quiet_jsbsim
+from uqflight.simulators.scenarios import flight_setup_from
+from uqflight.simulators.scenarios.level_flight import JSBSimFlight
 from uqflight.simulators.validation_view import validation_view
 from uqflight.simulators.patch import PreparedAircraft
 

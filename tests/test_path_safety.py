@@ -18,7 +18,8 @@ from conftest import cli_in_process
 from uqflight.execution import Task, WorkerError, WorkerPool
 from uqflight.simulators.aircraft import (MAX_BYTES, MAX_FILES, AircraftFiles, AircraftLocation, AircraftUnsafe,
                                           cache_dir, jsbsim_root, locate, unsafe_key)
-from uqflight.simulators.bundle import BundleRefused, _unzip, _zip, localized, make_bundle
+from uqflight.simulators.bundle import BundleRefused, _unzip, _zip
+from uqflight.simulators.kinds import localized, make_bundle
 from uqflight.simulators.jsbsim import quiet_jsbsim
 from uqflight.worker import WorkerSpec
 

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from uqflight.analysis.failures import wilson_interval
-from uqflight.analysis.proportions import sampled_proportion
+from uqflight.analysis.proportions import Independent, Net
 from uqflight.designs import REGISTRY, build_design
 
 TRUE = np.pi / 8
@@ -18,7 +18,7 @@ SEEDS = range(300)
 def _found(spec: dict, d: int, seed: int) -> tuple[dict, np.ndarray]:
     design = build_design(spec, ["uniform"] * d, seed)
     hits = design.xi[:, 0] ** 2 + design.xi[:, 1] ** 2 < 0.5
-    return sampled_proportion(hits, np.ones(hits.size, bool), REGISTRY[spec["kind"]].draws, design.info), hits
+    return REGISTRY[spec["kind"]].draws.proportion(hits, np.ones(hits.size, bool), design.info), hits
 
 
 def _coverage(spec: dict, d: int) -> float:
@@ -63,7 +63,7 @@ def test_randomised_qmc_covers_at_a_few_exceedances():
     for seed in SEEDS:
         design = build_design({"kind": "sobol", "samples": 64, "replicates": 8}, ["uniform"] * 3, seed)
         hits = design.xi[:, 0] ** 2 + design.xi[:, 1] ** 2 < radius**2
-        found = sampled_proportion(hits, np.ones(hits.size, bool), "net", design.info)
+        found = Net().proportion(hits, np.ones(hits.size, bool), design.info)
         covered.append(found["lower"] <= 6 / 512 <= found["upper"])
     assert np.mean(covered) >= 0.95
 
@@ -86,12 +86,12 @@ def test_one_scrambled_net_is_flagged_and_fixed_points_get_no_interval():
 def test_replicates_that_all_agree_get_the_pooled_wilson_interval():
     # no exceedance in any of 4 replicates: their spread is 0, the pooled runs' Wilson interval remains
     hits, counted = np.zeros(32, bool), np.ones(32, bool)
-    found = sampled_proportion(hits, counted, "net", {"replicates": 4, "scramble": True})
+    found = Net().proportion(hits, counted, {"replicates": 4, "scramble": True})
     assert found["estimate"] == 0.0 and (found["lower"], found["upper"]) == wilson_interval(0.0, 32)
     assert "Wilson" in found["sentence"]
 
 
 def test_only_counted_runs_count():
     hits = np.array([True, True, False, False])
-    found = sampled_proportion(hits, np.array([True, False, True, True]), "independent", {})
+    found = Independent().proportion(hits, np.array([True, False, True, True]), {})
     assert found["estimate"] == pytest.approx(1 / 3) and found["n_effective"] == 3

@@ -293,7 +293,7 @@ def _simulator_campaign(simulator: dict, parameters: dict) -> str:
 def test_a_simulator_kind_builds_what_it_checks_and_counts_what_it_records(kind, tmp_path):
     from uqflight.campaign import parse_campaign
     from uqflight.simulators import make_simulator
-    from uqflight.simulators.bundle import make_bundle
+    from uqflight.simulators.kinds import make_bundle
     from uqflight.simulators.validation_view import validation_view
 
     entry = SIMULATORS[kind]

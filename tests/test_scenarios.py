@@ -17,8 +17,10 @@ from test_distributed_aircraft import cluster  # noqa: F401 - the separately sta
 from uqflight.campaign import CampaignError, load_campaign, parse_campaign
 from uqflight.execution import run_campaign, worker_spec
 from uqflight.simulators import make_simulator
-from uqflight.simulators.bundle import AircraftMismatch, localized
-from uqflight.simulators.jsbsim import FlightSetup, JSBSimFlight, quiet_jsbsim
+from uqflight.simulators.bundle import AircraftMismatch
+from uqflight.simulators.kinds import localized
+from uqflight.simulators.jsbsim import quiet_jsbsim
+from uqflight.simulators.scenarios.level_flight import FlightSetup, JSBSimFlight
 from uqflight.simulators.validation_view import validation_view
 from uqflight.simulators.scenarios.script import ScriptFile, jsbsim_scripts
 

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from uqflight.simulators.jsbsim import quiet_jsbsim
-from uqflight.simulators.scenarios.script import ScriptFile, jsbsim_scripts, setup as script_setup, ScriptFlight
+from uqflight.simulators.scenarios.script import Script, ScriptFile, ScriptFlight, jsbsim_scripts
 from uqflight.simulators.base import TrimError
 
 CRUISE = jsbsim_scripts() / "c172_cruise_8K.xml"
@@ -20,7 +20,7 @@ def _flight(end_s=2.0, outputs=("atmosphere/wind-north-fps", SEVERITY, "h_ft")):
     quiet_jsbsim()
     config = {"scenario": {"kind": "script", "script": "c172_cruise_8K", "end_s": end_s}, "script_path": str(CRUISE),
               "output_rate_hz": 120.0, "outputs": list(outputs)}
-    return ScriptFlight(script_setup(config))
+    return ScriptFlight(Script().setup(config))
 
 
 def test_the_script_counts_its_trim_events():
@@ -71,9 +71,9 @@ def test_a_later_trim_that_fails_says_the_campaigns_air_was_active():
     config = {"scenario": {"kind": "script", "script": "c172_elevator_doublet", "end_s": 21.0},
               "script_path": str(script), "output_rate_hz": 20.0, "outputs": ["h_ft"]}
     assert ScriptFile.read(script).trims == 2
-    ScriptFlight(script_setup(config)).fly({})  # the re-trim in still air succeeds
+    ScriptFlight(Script().setup(config)).fly({})  # the re-trim in still air succeeds
     with pytest.raises(TrimError) as failed:
-        ScriptFlight(script_setup(config)).fly({"atmosphere/gust-down-fps": 80.0})
+        ScriptFlight(Script().setup(config)).fly({"atmosphere/gust-down-fps": 80.0})
     assert str(failed.value) == (
         "a trim in the script failed at t = 20.01 s: Trim Failed; active at the trim from the campaign "
         "(simulator.properties or parameters, set after the script's first trim): atmosphere/gust-down-fps = 80")

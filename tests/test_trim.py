@@ -14,7 +14,7 @@ import pytest
 
 import uqflight.simulators.trim as trim_module
 from uqflight.paper import TABLE1
-from uqflight.simulators.jsbsim import FlightSetup, JSBSimFlight
+from uqflight.simulators.scenarios.level_flight import FlightSetup, JSBSimFlight
 from uqflight.simulators.trim import FRACTION, JSBSIM_TOLERANCE, LATERAL
 
 UQ = list(TABLE1)

@@ -160,7 +160,8 @@ def simulate(settings: dict | None = None, *, aircraft: str = "bacm", altitude_f
     from pathlib import Path
 
     from .simulators.aircraft import default_condition
-    from .simulators.jsbsim import DEFAULT_OUTPUTS, Excitation, FlightSetup, JSBSimFlight
+    from .simulators.jsbsim import DEFAULT_OUTPUTS
+    from .simulators.scenarios.level_flight import Excitation, FlightSetup, JSBSimFlight
     from .simulators.patch import PreparedAircraft
 
     located = PreparedAircraft(aircraft, Path.cwd())

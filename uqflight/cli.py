@@ -40,7 +40,8 @@ from .progress import Progress
 from .methods import METHOD_KINDS
 from .simulators.base import FlightError
 from .simulators.aircraft import default_condition
-from .simulators.jsbsim import DEFAULT_OUTPUTS, Excitation, FlightSetup, JSBSimFlight
+from .simulators.jsbsim import DEFAULT_OUTPUTS
+from .simulators.scenarios.level_flight import Excitation, FlightSetup, JSBSimFlight
 
 CONTEXT = {"help_option_names": ["-h", "--help"]}
 # simulate's CSV and plot, beside the campaigns' results (results/ is in .gitignore)
@@ -247,7 +248,8 @@ def _load(path: Path):
 @app.command()
 def plan(campaign_file: Path = typer.Argument(..., metavar="CAMPAIGN", help="Campaign YAML file.")):
     """Validate a campaign and print its design, the number of runs and an estimated time."""
-    from .designs import describe, is_adaptive, is_rare, is_sampled
+    from .designs import REGISTRY as DESIGNS
+    from .designs import describe
     from .execution import WorkerError, timed_nominal
     from .methods import METHODS
 
@@ -263,15 +265,15 @@ def plan(campaign_file: Path = typer.Argument(..., metavar="CAMPAIGN", help="Cam
              "Cholesky in this order)")
     echo(describe(design))
     kind = campaign.method["kind"]
-    if is_rare(design.kind):  # its own estimator: the runs are not draws of the input law
+    if DESIGNS[design.kind].rare:  # its own estimator: the runs are not draws of the input law
         echo(f"method: none (the {design.kind} estimates the probability of its event only)")
     else:
         entry = METHODS[kind]
         order = campaign.method.get(entry.order_key)
         echo(f"method: {kind}" + (f" ({entry.order_key.replace('_', ' ')} {order})"
-                                  if entry.builds_pce(is_sampled(design.kind)) else ""))
+                                  if entry.builds_pce(DESIGNS[design.kind].sampled) else ""))
     runs = campaign.runs or len(design.xi)  # an adaptive grid's budget: its rounds are made from the results
-    echo(f"runs: {runs}" + (" at most (design.budget)" if is_adaptive(design.kind) else ""))
+    echo(f"runs: {runs}" + (" at most (design.budget)" if DESIGNS[design.kind].adaptive else ""))
     echo(f"results: {Path(campaign.storage['path']).resolve()} (storage.path, from the working directory; "
          "--out to choose)")
     try:

@@ -47,7 +47,8 @@ from .campaign import Campaign
 from .campaign.reading import parameters_attribute
 from .campaign.schema import WORKER_BYTES
 from .console import one_line
-from .designs import Design, is_adaptive, is_rare
+from .designs import REGISTRY as DESIGNS
+from .designs import Design
 from .parameters import seed_names
 from .stopping import check as check_stop
 from .progress import Progress
@@ -151,7 +152,7 @@ def prepare_store(campaign: Campaign, design: Design, out: Path, force: bool, no
         parameter_names=[p.name for p in campaign.parameters], outputs=nominal.outputs, time=nominal.time,
         raw=campaign.storage["raw"], tsvd=campaign.storage.get("tsvd"), attrs=attrs, units=nominal.units,
         batch_rows=campaign.execution["chunk"], resolution=nominal.resolution,
-        quantities=list(campaign.quantities), capacity=campaign.runs if is_adaptive(design.kind) else None)
+        quantities=list(campaign.quantities), capacity=campaign.runs if DESIGNS[design.kind].adaptive else None)
 
 
 def simulate(campaign: Campaign, kappa: np.ndarray, outputs: list[str], processes: int = 1, meanwhile=None):
@@ -196,7 +197,7 @@ def nominal_kappa(campaign: Campaign) -> np.ndarray:
 
 
 def worker_spec(campaign: Campaign) -> WorkerSpec:
-    from .simulators.bundle import make_bundle
+    from .simulators.kinds import make_bundle
 
     properties = tuple(p.property for p in campaign.parameters)
     base = str(Path(campaign.source).resolve().parent)
@@ -339,7 +340,8 @@ def run_campaign(campaign: Campaign, out: Path | None = None, workers: int | Non
                     return _run_pending(store, campaign, pool, spec, chunk, workers, executor, scheduler,
                                         timeout, out, progress)
 
-                rounds = run_rare if is_rare(design.kind) else run_rounds if is_adaptive(design.kind) else None
+                entry = DESIGNS[design.kind]
+                rounds = run_rare if entry.rare else run_rounds if entry.adaptive else None
                 summary = rounds(store, campaign, fly) if rounds else fly()
                 complete = store.pending().size == 0
             finally:

@@ -39,7 +39,6 @@ from .analysis.divergence import kl_divergence
 from .analysis.errors import error_summary, relative_errors
 from .analysis.exceedance import exceedance_from_pce, exceedance_from_runs, unit_slip
 from .analysis.failures import grid_failure_probability
-from .analysis.proportions import sampled_proportion
 from .analysis.floors import central_moments, floors_from_moments, kld_estimator_bias, kld_floor
 from .analysis.moments import (modified_cov, sorted_by_time, standardised_moments, weighted_moments,
                                weighted_quantiles)
@@ -49,7 +48,6 @@ from .campaign.attributes import StoredFacts, stored_facts, stored_settings
 from .campaign.schema import CampaignError
 from .console import shown
 from .designs import REGISTRY as DESIGNS
-from .designs import is_rare, is_sampled
 from .designs.adaptive import index_set_summary
 from .labels import name_unit, quantity_unit
 from .methods import DEFAULT_ORDER, PCE, METHODS, Auto, Method, normalised
@@ -274,13 +272,13 @@ def analyse(path, reference: str | None = None, options: Options | None = None, 
         status, design_kind = store.status, facts.design_kind
         if method["kind"] not in METHODS:
             raise BadInput(f"{path}: unknown method {method['kind']!r}: expected one of {', '.join(METHODS)}")
-        sampled = is_sampled(design_kind)
+        sampled = DESIGNS[design_kind].sampled
         ok = status == Status.OK
         pending = int(np.sum(status == Status.PENDING))
         stats = Statistics(str(path), store.attrs.get("campaign_name", ""), method, design_kind,
                            store.parameter_names, int(status.size), int(ok.sum()), int(np.sum(status > 0)),
                            pending, {}, partial=pending > 0, design_info=facts.design_info, seed=options.seed)
-        if is_rare(design_kind):  # its runs are not draws of the input law: its event's probability only
+        if DESIGNS[design_kind].rare:  # its runs are not draws of the input law: its event's probability only
             from .rare_statistics import rare_statistics
 
             if exceedance:
@@ -385,8 +383,7 @@ def _note_runs(store: ResultStore, stats: Statistics, sampled: bool, allow_alias
     done = status != Status.PENDING
     failed = status[done] > 0
     if sampled:
-        found = sampled_proportion(status > 0, done, DESIGNS[stats.design_kind].draws, stats.design_info,
-                                   event="failed")
+        found = DESIGNS[stats.design_kind].draws.proportion(status > 0, done, stats.design_info, event="failed")
         stats.failure_probability = {**{k: found[k] for k in ("estimate", "lower", "upper", "n_effective")},
                                      "method": found["sentence"]}
     else:
@@ -513,7 +510,7 @@ def auto_method(store: ResultStore, name: str, method: dict, germs: list[str], d
         return method, False, None
     basis, scale = output_basis(store, name, ok)
     kind, runs_only, record = METHODS[method["kind"]].choose(
-        store.xi[ok], store.weights[ok], basis, scale, germs, method["order"], is_sampled(design_kind),
+        store.xi[ok], store.weights[ok], basis, scale, germs, method["order"], DESIGNS[design_kind].sampled,
         int(ok.size - ok.sum()), seed, name)
     return {**method, "kind": kind}, runs_only, record
 
@@ -576,7 +573,7 @@ def _start_output(store: ResultStore, name: str, method: dict, germs: list[str],
     unwrapped: list[str] = []
     basis, scale = output_basis(store, name, ok, unwrapped)
     truncation = _tsvd_resolution(store, scale, int(ok.sum()))
-    sampled = is_sampled(design_kind) or runs_only
+    sampled = DESIGNS[design_kind].sampled or runs_only
     x0 = None
     # x = x0 + S with each run's initial value (needs the runs themselves); only the projections use
     # it: the other kinds fit the constant term themselves, where the split would change nothing
@@ -871,7 +868,7 @@ def _reference_floor(reference: Statistics, ref: OutputStatistics, out: OutputSt
                 "kld_floor": _kld_floor(reference, ref, out), "floor_note": note + KLD_FLOOR_NOTE}
     if reference.from_runs and ref.fourth_central is not None:
         floors = floors_from_moments(ref.mean, ref.variance, ref.fourth_central, reference.completed)
-        qmc = reference.design_kind != "monte_carlo"
+        qmc = not getattr(DESIGNS[reference.design_kind].draws, "independent", False)  # a grid's too
         note = (f"reference: {reference.completed} {reference.design_kind} runs; floor = its standard errors "
                 "(σ/√N for the mean, the distribution-free s.e. of the variance)"
                 + ("; QMC converges faster than this Monte Carlo floor, so it is an upper bound" if qmc else ""))
@@ -924,7 +921,7 @@ def quantity_statistics(store: ResultStore, stats: Statistics, name: str, germs:
         values = values + shifts
         stats.notes.append(unwrapped_note(f"quantity {name}", units))
     missing = int(ok.sum() - defined.sum())
-    sampled = is_sampled(stats.design_kind)
+    sampled = DESIGNS[stats.design_kind].sampled
     why = None
     huge = too_large("quantity", name, float(np.abs(values[defined]).max(initial=0.0)))
     if huge:

@@ -28,7 +28,7 @@ from .quantities import quantity_key
 from .quantities.recorder import QuantityRecorder
 from .simulators import FlightError, make_simulator
 from .simulators.base import NominalFailed
-from .simulators.bundle import localized
+from .simulators.kinds import localized
 
 
 @dataclass(frozen=True)

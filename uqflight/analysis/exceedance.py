@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .proportions import sampled_proportion
+from .proportions import Independent
 
 RARE_COUNT = 10
 CONFIDENCE = 0.95
@@ -43,7 +43,7 @@ def unit_slip(runs: np.ndarray, threshold: float, units: str = "") -> str | None
             "more runs would resolve")
 
 
-def exceedance_from_runs(values: np.ndarray, defined: np.ndarray, thresholds: list[dict], draws: str = "independent",
+def exceedance_from_runs(values: np.ndarray, defined: np.ndarray, thresholds: list[dict], draws: Independent = Independent(),
                          info: dict | None = None, units: str = "") -> list[dict]:
     """[{above|below, probability, lower, upper, method, note}] over the runs where `defined` (bool (N,),
     design order) holds; `draws`, `info`: how the design drew its points (analysis.proportions); `units`:
@@ -52,7 +52,7 @@ def exceedance_from_runs(values: np.ndarray, defined: np.ndarray, thresholds: li
     for item in thresholds:
         (bound, threshold), = item.items()
         beyond = _beyond(values, bound, threshold) & defined
-        p = sampled_proportion(beyond, defined, draws, info or {}, CONFIDENCE, event=f"{bound} {threshold:g}")
+        p = draws.proportion(beyond, defined, info or {}, CONFIDENCE, event=f"{bound} {threshold:g}")
         note = p["sentence"]
         slip = unit_slip(values[defined], threshold, units)
         if slip:

@@ -1,7 +1,7 @@
 """The probability that a run does something (fails; a quantity exceeds a threshold), from a sampled
 design's runs, with an interval only where one holds for how the design drew its points.
 
-How the points were drawn (`DesignKind.draws`, with the design's recorded info):
+How the points were drawn (`DesignKind.draws`, one of the strategies below, with the design's recorded info):
 - independent (monte_carlo): k/n and the Wilson score interval.
 - pick_freeze: Saltelli's rows [A; B; AB_1 … AB_d] repeat each other's coordinates (AB_i is A with B's
   i-th column), so the proportion and its Wilson interval are those of the 2n rows A and B alone; they
@@ -27,51 +27,90 @@ from scipy import special
 
 from .failures import wilson_interval
 
-DRAWS = ("independent", "pick_freeze", "stratified", "net", "points")
+class Independent:
+    """Independent draws (monte_carlo): how a sampled design's runs count for a proportion; each design kind
+    carries one of these strategies (`designs.DesignKind.draws`), the subclasses below being the others."""
+
+    independent = True  # the runs are independent draws of the law
+
+    def proportion(self, hits, counted, info: dict, confidence: float = 0.95, event: str = "") -> dict:
+        """{"estimate", "lower", "upper", "n_effective", "method", "sentence"} of the runs `counted` (bool
+        (N,), in design order) where `hits` (bool (N,)) holds. lower/upper are None without an interval;
+        `method`: "wilson", "replicates" or "points"; `sentence` says how, for a note, counting the runs
+        `event` names ("failed", "above 5"). `info`: the design's recorded info (n_base, replicates, scramble)."""
+        hits, counted = np.asarray(hits, dtype=bool), self.counted(np.asarray(counted, dtype=bool), info)
+        k, n = int((hits & counted).sum()), int(counted.sum())
+        if n == 0:
+            return {"estimate": None, "lower": None, "upper": None, "n_effective": 0.0, "method": None,
+                    "sentence": "no run counts: the probability is undefined"}
+        return self.interval(k, n, info, confidence, _counts(k, n, event))
+
+    def counted(self, counted: np.ndarray, info: dict) -> np.ndarray:
+        """The runs that count among those `counted` (all of them here)."""
+        return counted
+
+    def interval(self, k: int, n: int, info: dict, confidence: float, counts: str) -> dict:
+        """The proportion k/n of the counted runs with its interval (here Wilson's); `counts` begins the sentence."""
+        return _wilson(k, n, n, confidence, f"{counts}; {100 * confidence:g} % Wilson score interval")
 
 
-def sampled_proportion(hits, counted, draws: str, info: dict, confidence: float = 0.95, event: str = "") -> dict:
-    """{"estimate", "lower", "upper", "n_effective", "method", "sentence"} of the runs `counted` (bool
-    (N,), in design order) where `hits` (bool (N,)) holds. lower/upper are None without an interval;
-    `method`: "wilson", "replicates" or "points"; `sentence` says how, for a note, counting the runs
-    `event` names ("failed", "above 5"). `info`: the design's recorded info (n_base, replicates, scramble)."""
-    hits, counted = np.asarray(hits, dtype=bool), np.asarray(counted, dtype=bool)
-    if draws not in DRAWS:
-        raise ValueError(f"draws must be one of {', '.join(DRAWS)}, got {draws!r}")
-    replicates = int(info.get("replicates", 1))
-    if draws == "net" and replicates > 1:
-        return _replicated(hits, counted, replicates, confidence, event)
-    if draws == "pick_freeze":
-        counted = counted & (np.arange(hits.size) < 2 * int(info["n_base"]))
-    k, n = int((hits & counted).sum()), int(counted.sum())
-    if n == 0:
-        return {"estimate": None, "lower": None, "upper": None, "n_effective": 0.0, "method": None,
-                "sentence": "no run counts: the probability is undefined"}
-    estimate = k / n
-    counts = _counts(k, n, event)
-    if draws == "points":
-        return {"estimate": estimate, "lower": None, "upper": None, "n_effective": float(n), "method": "points",
-                "sentence": f"{counts}; no interval: the design's points are not draws of the inputs' law (the "
-                            "runs' own share, not the law's probability)"}
-    if draws == "net" and not info.get("scramble", True):
-        return {"estimate": estimate, "lower": None, "upper": None, "n_effective": float(n), "method": "points",
-                "sentence": f"{counts}; no interval: unscrambled QMC points are fixed, not random (scramble them, "
-                            "with replicates, for an interval)"}
-    n_interval = n - 1 if draws == "stratified" else n
-    lower, upper = wilson_interval(estimate, n_interval, confidence) if n_interval > 0 else (0.0, 1.0)
-    sentence = f"{counts}; {100 * confidence:g} % Wilson score interval"
-    if draws == "pick_freeze":
-        sentence = (f"{counts} (the rows A and B of the pick-freeze design, which the other rows repeat); "
-                    f"{100 * confidence:g} % Wilson score interval of independent draws, unverified for their "
-                    "scrambled Sobol' points (usually wider than their own)")
-    elif draws == "stratified":
-        sentence += f" of {n_interval} draws (conservative: a Latin hypercube's variance is at most n/(n-1) " \
-                    "times that of independent draws)"
-    elif draws == "net":
-        sentence += (" of independent draws, unverified for one scrambled QMC net (usually wider than its own); "
-                     "set design.replicates for an interval from the design itself")
-    return {"estimate": estimate, "lower": lower, "upper": upper, "n_effective": float(n_interval),
-            "method": "wilson", "sentence": sentence}
+class Points(Independent):
+    """Fixed points, not draws of the law (morris)."""
+
+    independent = False
+    why = "the design's points are not draws of the inputs' law (the runs' own share, not the law's probability)"
+
+    def interval(self, k, n, info, confidence, counts):
+        return {"estimate": k / n, "lower": None, "upper": None, "n_effective": float(n), "method": "points",
+                "sentence": f"{counts}; no interval: {self.why}"}
+
+
+class PickFreeze(Points):
+    """Saltelli's rows [A; B; AB_1 … AB_d]: the rows A and B alone count."""
+
+    def counted(self, counted, info):
+        return counted & (np.arange(counted.size) < 2 * int(info["n_base"]))
+
+    def interval(self, k, n, info, confidence, counts):
+        return _wilson(k, n, n, confidence, f"{counts} (the rows A and B of the pick-freeze design, which the other "
+                                            f"rows repeat); {100 * confidence:g} % Wilson score interval of "
+                                            "independent draws, unverified for their scrambled Sobol' points "
+                                            "(usually wider than their own)")
+
+
+class Stratified(Points):
+    """A Latin hypercube: the Wilson interval of n − 1 draws, conservative."""
+
+    def interval(self, k, n, info, confidence, counts):
+        return _wilson(k, n, n - 1, confidence, f"{counts}; {100 * confidence:g} % Wilson score interval of {n - 1} "
+                                                "draws (conservative: a Latin hypercube's variance is at most "
+                                                "n/(n-1) times that of independent draws)")
+
+
+class Net(Points):
+    """A QMC net (sobol, halton): replicates, one scrambled net, or unscrambled fixed points."""
+
+    why = "unscrambled QMC points are fixed, not random (scramble them, with replicates, for an interval)"
+
+    def proportion(self, hits, counted, info, confidence=0.95, event=""):
+        replicates = int(info.get("replicates", 1))
+        if replicates > 1:
+            return _replicated(np.asarray(hits, dtype=bool), np.asarray(counted, dtype=bool), replicates,
+                               confidence, event)
+        return super().proportion(hits, counted, info, confidence, event)
+
+    def interval(self, k, n, info, confidence, counts):
+        if not info.get("scramble", True):
+            return super().interval(k, n, info, confidence, counts)
+        return _wilson(k, n, n, confidence, f"{counts}; {100 * confidence:g} % Wilson score interval of independent "
+                                            "draws, unverified for one scrambled QMC net (usually wider than its "
+                                            "own); set design.replicates for an interval from the design itself")
+
+
+def _wilson(k: int, n: int, n_interval: int, confidence: float, sentence: str) -> dict:
+    lower, upper = wilson_interval(k / n, n_interval, confidence) if n_interval > 0 else (0.0, 1.0)
+    return {"estimate": k / n, "lower": lower, "upper": upper, "n_effective": float(n_interval), "method": "wilson",
+            "sentence": sentence}
 
 
 def _counts(k: int, n: int, event: str) -> str:

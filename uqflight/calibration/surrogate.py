@@ -19,7 +19,7 @@ from ..bounded import Refused, read_bounded
 from ..campaign.schema import MAX_FILE_BYTES
 from ..campaign.reading import campaign_folder, check_campaign_text, portable_mapping, results_campaign
 from ..console import listed
-from ..designs import is_sampled
+from ..designs import REGISTRY as DESIGNS
 from ..execution import simulate
 from ..methods import DEFAULT_ORDER, METHOD_KINDS, normalised
 from ..methods.basis import Basis, orthonormal_basis
@@ -152,7 +152,7 @@ def calibration_surrogate(results, method: str | None = None, order: int | None 
         except BadInput as exc:
             raise SurrogateError(str(exc)) from exc
         stored, germs = normalised(facts.method), facts.germs
-        sampled = is_sampled(facts.design_kind)
+        sampled = DESIGNS[facts.design_kind].sampled
         kind = method or stored["kind"]
         order = stored.get("order", DEFAULT_ORDER) if order is None else order
         if kind not in METHOD_KINDS:

@@ -13,7 +13,8 @@ from typing import Callable
 import numpy as np
 import yaml
 
-from ..designs import DESIGN_KINDS, SAMPLED_DESIGNS, Design, build_design, design_size, is_adaptive, is_rare
+from ..designs import REGISTRY as DESIGNS
+from ..designs import Design, build_design, design_size
 from ..methods import METHODS, Method
 from ..parameters import Parameter, germs_of, seed_names, to_physical
 from ..parameters.dependence import GaussianCopula
@@ -118,13 +119,13 @@ def parse_campaign(text: str, source: str = "<campaign>", view: ValidationView |
         if sep and (field_path.startswith("design") or field_path == "seed"):
             raise CampaignError(source, field_path, rest) from exc
         raise CampaignError(source, "design", message) from exc
-    if is_rare(design.kind):  # its rounds are made from the results; it estimates its event only
+    if DESIGNS[design.kind].rare:  # its rounds are made from the results; it estimates its event only
         from ..designs.rare import check_rare_campaign
 
         check_rare_campaign(check, campaign)
         campaign.runs = int(design_size(campaign.design_spec, campaign.germs))
         return campaign
-    if is_adaptive(design.kind):  # its grid is made from the results: its points are checked on analysis
+    if DESIGNS[design.kind].adaptive:  # its grid is made from the results: its points are checked on analysis
         entry = METHODS[campaign.method["kind"]]
         campaign.method.setdefault(entry.order_key, entry.keys[entry.order_key].default)
         if entry.sampled_only:
@@ -160,8 +161,8 @@ def build_campaign(check: Checker, data: dict, simulator: dict, parameters: list
     (the design is not built: `runs` stays None)."""
     name = data["name"]
     design_kind = data["design"].get("kind") if isinstance(data["design"], dict) else None
-    rare = isinstance(design_kind, str) and design_kind in DESIGN_KINDS and is_rare(design_kind)
-    default_method = Method.of_runs(design_kind in SAMPLED_DESIGNS or rare).kind
+    entry = DESIGNS.get(design_kind) if isinstance(design_kind, str) else None
+    default_method = Method.of_runs(entry is not None and (entry.sampled or entry.rare)).kind
     method = schema.method(check, data.get("method", {"kind": default_method}))
     schema.check_seeds(check, parameters, design_kind, method)
     seeds = seed_names(parameters)

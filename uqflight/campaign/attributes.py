@@ -11,7 +11,8 @@ import json
 from dataclasses import dataclass
 
 from ..designs import DESIGN_KINDS
-from ..designs.spec import is_integer
+from ..designs import REGISTRY as DESIGNS
+from ..designs.base import is_integer
 from ..parameters.germs import GERMS
 from ..store.resume import campaign_mapping
 from . import schema
@@ -108,9 +109,9 @@ def _design_info(check: Checker, info, kind: str, runs: int, d: int) -> dict:
     if not is_integer(replicates) or not 1 <= replicates <= max(runs, 1) or runs % replicates:
         check.fail("design_info.replicates", f"expected an integer >= 1 dividing the {runs} runs, "
                                              f"got {shown(replicates)}")
-    if kind == "pick_freeze" and not (is_integer(info.get("n_base")) and info["n_base"] * (d + 2) == runs):
-        check.fail("design_info.n_base", f"expected the base rows n of the {runs} runs, n ({d} parameters + 2), "
-                                         f"got {shown(info.get('n_base'))}")
+    problem = DESIGNS[kind].info_problem(info, runs, d)
+    if problem:
+        check.fail(f"design_info.{problem[0]}", f"{problem[1]}, got {shown(info.get(problem[0]))}")
     if not isinstance(info.get("scramble", True), bool):
         check.fail("design_info.scramble", f"expected true or false, got {shown(info['scramble'])}")
     return info

@@ -34,44 +34,7 @@ KEYS = {
               "`limits: {max_runs: 1000000}`",
     "quantities": "Quantities of interest, one number per run, stored in `/quantities/NAME`: "
                   "`quantities: {peak_alpha: {of: alpha_deg, take: max}}` (see [quantities](../quantities.md))",
-    # simulator (both kinds)
-    "simulator.kind": "Required. `jsbsim` (a JSBSim flight) or `python` (a Python function).",
-    "simulator.outputs": "The recorded outputs. JSBSim: named outputs (`alpha_deg`, `theta_deg`, `h_ft`, "
-                         "`q_degps`, `vtas_kt`, the default) and/or any JSBSim property; python: the names of the "
-                         "function's outputs (default: all it returns). `outputs: [alpha_deg, h_ft]`",
-    "simulator.function": "python only, required. `package.module:callable` or `file.py:callable` (relative "
-                          "to the campaign file); called with {parameter: value}, returns {output: array or "
-                          "scalar} and optionally `time`. `function: \"uqflight.simulators.models:linear\"`",
-    # jsbsim
-    "simulator.aircraft": "A project or JSBSim aircraft name, or a folder (relative to the campaign file). "
-                          "Default `bacm` (level flight); a script names its own. `aircraft: c172p`",
-    "simulator.scenario": "How a JSBSim run is flown: `{kind: level_flight}` (the default) or `{kind: script, "
-                          "script: NAME_OR_PATH}`.",
     "simulator.scenario.kind": "The scenario kind (below). Default `level_flight`.",
-    "simulator.properties": "`{PROPERTY: VALUE}` set for every run (`ic/...` before the reset, the others "
-                            "after it; level flight applies `atmosphere/...` after the trim). "
-                            "`properties: {atmosphere/turb-type: 3}`",
-    "simulator.output_rate_hz": "Recording rate [Hz]; must divide the integration rate (120 Hz for level "
-                                "flight, the script's own). Default 20. `output_rate_hz: 10`",
-    # level_flight
-    "simulator.trim": "`newton` (uqflight's trim, JSBSim's as fallback; the default) or `jsbsim` (JSBSim's "
-                      "own trim for every sample).",
-    "simulator.flight": "The trim condition; default: the aircraft's (bacm 15,000 ft, 200 KTAS). "
-                        "`flight: {altitude_ft: 15000, airspeed_ktas: 200}`",
-    "simulator.flight.altitude_ft": "Trim altitude [ft], >= 0. `altitude_ft: 8000`",
-    "simulator.flight.airspeed_ktas": "Trim true airspeed [kt], > 0. `airspeed_ktas: 150`",
-    "simulator.excitation": "The elevator excitation after the trim. Default a 1° pulse at 1 s for 1 s. "
-                            "`excitation: {kind: doublet, amplitude_deg: 2}`",
-    "simulator.excitation.kind": "`pulse` (default), `step`, `doublet` or `none`.",
-    "simulator.excitation.amplitude_deg": "Amplitude [deg], positive trailing edge down. Default 1.",
-    "simulator.excitation.start_s": "Start [s] after the trim, >= 0. Default 1.",
-    "simulator.excitation.duration_s": "Duration [s] of a pulse or doublet, >= 0. Default 1.",
-    "simulator.duration_s": "Flight time after the trim [s], > 0. Default 50.",
-    # script
-    "simulator.scenario.script": "Required for `script`: a JSBSim run script, a file relative to the campaign "
-                                 "file or the name of one shipped with JSBSim (without `.xml`). "
-                                 "`script: c172_cruise_8K`",
-    "simulator.scenario.end_s": "Ends the run before the script's `<run end=>` [s]. `end_s: 20`",
     # parameters
     "parameters.NAME.property": "The property the parameter sets (JSBSim: before the trim, `ic/...` too; "
                                 "python: the function's argument). Default for python: NAME. "
@@ -192,14 +155,6 @@ KEYS.update({f"method.{key}": spec.description for entry in (Method, *METHODS.va
 VALUES = {
     "dependence.kind": {"gaussian_copula": "The Nataf transform: correlated standard normals z = Lξ, then Φ, then "
                                            "each marginal's inverse CDF."},
-    "simulator.kind": {"jsbsim": "A JSBSim flight (scenario below).",
-                       "python": "A Python function (see `simulator.function`); it is code: see "
-                                 "[security](../security.md)."},
-    "simulator.scenario.kind": {
-        "level_flight": "Trim in unaccelerated level flight, elevator excitation, record (keys `flight`, "
-                        "`excitation`, `duration_s`, `output_rate_hz`, `trim`).",
-        "script": "Fly a JSBSim run script as JSBSim does, its events included (keys `scenario.script`, "
-                  "`scenario.end_s`, `output_rate_hz`)."},
     "design.rule": {
         "gauss_hermite": "Gauss–Hermite (normal inputs; nested: Genz–Keister).",
         "genz_keister": "Genz–Keister, nested (normal inputs).",
@@ -231,12 +186,17 @@ VALUES = {
 
 @dataclass(frozen=True)
 class Key:
-    """A key the schema accepts: its path, the section of the reference it belongs to, and for a key
-    that names a kind, the kinds {name: registry object or None}."""
+    """A key the schema accepts: its path, the section of the reference it belongs to, for a key that
+    names a kind, the kinds {name: registry object or None}, and the description a kind's field gives."""
 
     path: str
     section: str
     kinds: dict | None = None
+    description: str | None = None  # a kind's field's own (else KEYS)
+
+    @property
+    def meaning(self) -> str | None:
+        return self.description or KEYS.get(self.path)
 
 
 def _paths(prefix: str, keys) -> list[str]:
@@ -246,7 +206,7 @@ def _paths(prefix: str, keys) -> list[str]:
 def refused_keys(call) -> tuple[str, ...]:
     """The keys a check accepts, as it lists them when it refuses an unknown key: `call()` feeds it one
     ('... unknown key; expected one of a, b' from the schema's Checker, '... accepted keys: a, b' from
-    designs.spec.check_keys) and must raise."""
+    designs.DesignKind.settings) and must raise."""
     try:
         call()
     except ValueError as exc:  # CampaignError too
@@ -265,28 +225,23 @@ def accepted_keys() -> list[Key]:
     from ..quantities import REGISTRY as TAKES
     from ..quantities.spec import KEYS as QUANTITY_KEYS
     from ..quantities.spec import WHEN_KEYS
+    from ..simulators.base import field_descriptions
+    from ..simulators.kinds import REGISTRY as SIMULATORS
     from ..simulators.scenarios import REGISTRY as SCENARIOS
-    from ..simulators.scenarios.level_flight import EXCITATION_KEYS, FLIGHT_KEYS
     from . import schema
 
     found = [Key(k, "Top level") for k in schema.TOP_KEYS]
-    own = {k for scenario in SCENARIOS.values() for k in scenario.keys}  # listed with their scenario
-    keys = dict.fromkeys(k for kind in schema.SIMULATOR_KINDS for k in refused_keys(
-        lambda: schema.simulator(schema.Checker("<reference>"), {"kind": kind, "?": 0})) if k not in own)
-    found += [Key(p, "simulator", {k: None for k in schema.SIMULATOR_KINDS} if p == "simulator.kind" else None)
-              for p in _paths("simulator", keys)]
+    described = {p: d for kind in SIMULATORS.values() for p, d in field_descriptions("simulator", kind.fields).items()}
+    found += [Key(p, "simulator", dict(SIMULATORS) if p == "simulator.kind" else None, d) for p, d in described.items()]
     found.append(Key("simulator.scenario.kind", "simulator", dict(SCENARIOS)))
     for name, scenario in SCENARIOS.items():
-        section = f"simulator, scenario `{name}`"
-        found += [Key(p, section) for p in _paths("simulator", scenario.keys)]
-        found += [Key(p, section) for p in _paths("simulator.scenario", scenario.scenario_keys)]
-    found += [Key(p, "simulator, scenario `level_flight`") for p in
-              _paths("simulator.flight", FLIGHT_KEYS) + _paths("simulator.excitation", EXCITATION_KEYS)]
+        found += [Key(p, f"simulator, scenario `{name}`", None, d) for p, d in {
+            **field_descriptions("simulator", scenario.fields),
+            **field_descriptions("simulator.scenario", scenario.scenario_fields)}.items()]
     found += [Key(p, "parameters", dict(DISTRIBUTIONS) if p.endswith(".distribution") else None)
               for p in _paths("parameters.NAME", schema.PARAMETER_KEYS)]
     design = {"kind": dict(DESIGNS), "rule": dict(RULE_TABLE)}
-    keys = dict.fromkeys(k for kind, entry in DESIGNS.items()
-                         for k in refused_keys(lambda: entry.build({"kind": kind, "?": 0}, ["normal"], 0)))
+    keys = dict.fromkeys(k for entry in DESIGNS.values() for k in ("kind", *entry.keys))
     found += [Key(f"design.{k}", "design", design.get(k)) for k in keys]
     from ..designs.rare import EVENT_KEYS
 
@@ -311,11 +266,15 @@ def accepted_keys() -> list[Key]:
 
 
 def kind_description(path: str, kind: str, entry) -> str | None:
-    """A kind's meaning: VALUES, else the first paragraph of its registry entry's docstring (a design's
-    builder, a distribution's class)."""
+    """A kind's meaning: VALUES, else the first paragraph of its registry entry's docstring (a design kind's,
+    a distribution's, a simulator's or scenario's kind class)."""
     if kind in VALUES.get(path, {}):
         return VALUES[path][kind]
-    target = getattr(entry, "build", None) or (entry if inspect.isclass(entry) else None)
+    from ..designs import DesignKind
+    from ..simulators.base import Kind
+
+    target = (type(entry) if isinstance(entry, (DesignKind, Kind)) else getattr(entry, "build", None)
+              or (entry if inspect.isclass(entry) else None))
     doc = inspect.getdoc(target) if target is not None else None
     return " ".join(doc.split("\n\n")[0].split()) if doc else None
 
@@ -323,7 +282,7 @@ def kind_description(path: str, kind: str, entry) -> str | None:
 def missing_descriptions() -> list[str]:
     """Keys and kinds the reference cannot describe, and descriptions of keys the schema no longer has."""
     keys = accepted_keys()
-    missing = [k.path for k in keys if not KEYS.get(k.path)]
+    missing = [k.path for k in keys if not k.meaning]
     missing += [f"{k.path}: {kind}" for k in keys for kind, entry in (k.kinds or {}).items()
                 if not kind_description(k.path, kind, entry)]
     paths = {k.path for k in keys}
@@ -351,7 +310,7 @@ def reference_page() -> str:
     for section in dict.fromkeys(k.section for k in keys):
         inside = [k for k in keys if k.section == section]
         lines += ["", f"## {section}", "", "| key | meaning |", "|---|---|"]
-        lines += [f"| `{k.path}` | {_cell(KEYS[k.path])} |" for k in inside]
+        lines += [f"| `{k.path}` | {_cell(k.meaning)} |" for k in inside]
         for k in (k for k in inside if k.kinds):
             lines += ["", f"### `{k.path}`", "", "| kind | meaning |", "|---|---|"]
             lines += [f"| `{kind}` | {_cell(kind_description(k.path, kind, entry))} |"

@@ -10,7 +10,8 @@ from collections.abc import Hashable
 import numpy as np
 import yaml
 
-from ..designs import DESIGN_KINDS, SAMPLED_DESIGNS, Design, design_size, is_rare, is_sampled
+from ..designs import REGISTRY as DESIGNS
+from ..designs import Design, design_size
 from ..methods import DEFAULT_ORDER, METHOD_KINDS, METHODS, Method
 from ..methods.exactness import exact_total_degree, max_projection_order
 from ..methods.validity import MAX_TERMS, method_problem
@@ -220,7 +221,7 @@ def yaml_error(exc: yaml.YAMLError) -> str:
 def check_method_fits_design(check: Checker, method: dict, design: Design, germs: list[str]) -> None:
     """Refuse, before anything runs, a method the design's points cannot carry (methods.validity).
     Without `order`, the order is 2, or the largest a grid's projection allows when that is lower."""
-    sampled = is_sampled(design.kind)
+    sampled = DESIGNS[design.kind].sampled
     entry = METHODS[method["kind"]]
     key = entry.order_key
     if key not in method:
@@ -360,9 +361,10 @@ def check_seeds(check: Checker, parameters: list[Parameter], design_kind, method
         check.fail(f"parameters.{seeds[1]}.distribution", f"one seed parameter per campaign, but "
                                                           f"{', '.join(seeds)} are seeds")
     where = f"parameters.{seeds[0]}.distribution"
-    if isinstance(design_kind, str) and design_kind in DESIGN_KINDS and not is_sampled(design_kind) \
-            and not is_rare(design_kind):  # a rare-event design redraws a seed (designs.rare)
-        check.fail(where, f"a seed needs a sampled design ({', '.join(SAMPLED_DESIGNS)}), not {design_kind}: "
+    entry = DESIGNS.get(design_kind) if isinstance(design_kind, str) else None
+    if entry is not None and not entry.sampled and not entry.rare:  # a rare-event design redraws a seed
+        sampled = ", ".join(name for name, kind in DESIGNS.items() if kind.sampled)
+        check.fail(where, f"a seed needs a sampled design ({sampled}), not {design_kind}: "
                           "a random stream has no polynomial expansion for a grid to integrate")
     if not METHODS[method["kind"]].runs_on_sampled:  # it would fit a PCE in the seed's ξ
         check.fail(where, f"{SEED_REFUSAL} ({method['kind']})")

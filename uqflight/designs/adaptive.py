@@ -25,8 +25,8 @@ import numpy as np
 
 from ..analysis.errors import relative_errors
 from . import rules as rule_catalog
+from .base import DesignKind, Key, count, number
 from .smolyak import _indexed_nodes
-from .spec import check_keys, given_count, integer
 
 ADAPTIVE_RULES = ("genz_keister", "gauss_patterson", "clenshaw_curtis")
 MAX_LEVELS = 10  # 1-D levels of a rule without a tabulated end (Clenshaw–Curtis: up to 513 points)
@@ -237,35 +237,32 @@ def adaptive_rules(spec: dict, germs: list[str]) -> list[str]:
     return rules
 
 
-def _tolerance(spec: dict) -> float:
-    value = spec.get("tolerance")
-    if isinstance(value, bool) or not isinstance(value, (int, float)) or not 0 <= value < float("inf"):
-        raise ValueError(f"design.tolerance: expected a number >= 0, got {value!r}")
-    return float(value)
+class AdaptiveSparseGrid(DesignKind):
+    """`adaptive_sparse_grid` {rule, budget, tolerance}: round 0, the centre point; the rounds that follow
+    are made by the runner from the results (`execution`); seed unused."""
+
+    kind = "adaptive_sparse_grid"
+    keys = {"rule": Key(), "budget": count(1), "tolerance": number("a number >= 0", lambda v: 0 <= v < float("inf"))}
+    example = {"kind": "adaptive_sparse_grid", "budget": 50, "tolerance": 1e-4}
+    draws = None
+    adaptive = True
+
+    def size(self, spec, germs):
+        """At most `budget` (a refinement that would pass it is not made)."""
+        return self.given(spec, "budget")
+
+    def points(self, settings, germs, seed):
+        grid = Grid(adaptive_rules(settings, germs))
+        points = grid_points(grid, IndexSet.initial(len(germs)))
+        info = {"rule": rule_catalog.rule_names(grid.rules), "budget": settings["budget"],
+                "tolerance": float(settings["tolerance"]), "rounds": "refined from the results, up to the budget"}
+        return points.xi, np.ones(1), info
 
 
 def adaptive_settings(spec: dict, germs: list[str]) -> tuple[Grid, int, float]:
     """(the grid's rules, budget, tolerance) of an `adaptive_sparse_grid` spec, checked."""
-    check_keys(spec, "adaptive_sparse_grid", ("rule", "budget", "tolerance"))
-    budget = integer(spec, "budget", "adaptive_sparse_grid", minimum=1)
-    if "tolerance" not in spec:
-        raise ValueError("design.tolerance: missing; kind adaptive_sparse_grid expects a number >= 0")
-    return Grid(adaptive_rules(spec, germs)), budget, _tolerance(spec)
-
-
-def adaptive_size(spec: dict, germs: list[str]) -> int | None:
-    """Runs of `adaptive_sparse_grid`: at most `budget` (a refinement that would pass it is not made)."""
-    return given_count(spec, "budget")
-
-
-def adaptive_design(spec: dict, germs: list[str], seed: int):
-    """`adaptive_sparse_grid` {rule, budget, tolerance}: round 0, the centre point; the rounds that follow
-    are made by the runner from the results (`execution`); seed unused."""
-    grid, budget, tolerance = adaptive_settings(spec, germs)
-    points = grid_points(grid, IndexSet.initial(len(germs)))
-    info = {"rule": rule_catalog.rule_names(grid.rules), "budget": budget, "tolerance": tolerance,
-            "rounds": "refined from the results, up to the budget"}
-    return points.xi, np.ones(1), info
+    settings = AdaptiveSparseGrid().settings(spec)
+    return Grid(adaptive_rules(settings, germs)), settings["budget"], float(settings["tolerance"])
 
 
 def index_set_summary(state: IndexSet, parameter_names: list[str]) -> dict:

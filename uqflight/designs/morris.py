@@ -17,11 +17,10 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..analysis.proportions import Points
 from ..parameters.germs import GERMS
-from .montecarlo import equal_weights
-from .spec import check_keys, given_count, integer, is_integer
+from .base import DesignKind, count, equal_weights, is_integer
 
-DEFAULT_LEVELS = 4
 NOT_DRAWS = ("morris design: its runs are points of trajectories on a grid, not draws of the inputs' law: the "
              "mean, variance, band, quantiles, densities and failure share are the runs' own, not the law's; its "
              "runs give no Sobol' indices themselves; their elementary effects screen the inputs "
@@ -103,26 +102,6 @@ def morris_germs(u: np.ndarray, germs: list[str], levels: int) -> np.ndarray:
         column = u[:, k] if bounded else (np.rint(u[:, k] * (levels - 1)) + 0.5) / levels
         xi[:, k] = germ.quantile(column)
     return xi
-
-
-def morris_size(spec: dict, germs: list[str]) -> int | None:
-    """Runs of `morris`: R (d + 1)."""
-    r = given_count(spec, "trajectories")
-    return None if r is None else r * (len(germs) + 1)
-
-
-def morris_design(spec: dict, germs: list[str], seed: int):
-    """`morris` {trajectories: R >= 2, levels: p (even, >= 2, default 4)}: N = R (d + 1) runs, trajectory
-    after trajectory, equal weights (the runs' own average, not of draws of the law)."""
-    check_keys(spec, "morris", ("trajectories", "levels"))
-    r = integer(spec, "trajectories", "morris", minimum=2)
-    levels = integer(spec, "levels", "morris", minimum=2) if "levels" in spec else DEFAULT_LEVELS
-    if levels % 2:
-        raise ValueError(f"design.levels: expected an even number of levels (the jump Δ = p/(2(p−1)) is then "
-                         f"p/2 grid steps), got {levels}")
-    u = morris_unit_points(r, len(germs), levels, seed)
-    info = {"trajectories": r, "levels": levels, "jump": morris_jump(levels), "samples": len(u), "seed": seed}
-    return morris_germs(u, germs, levels), equal_weights(len(u)), info
 
 
 def elementary_effects(xi: np.ndarray, Y: np.ndarray, ok: np.ndarray, levels: int) -> tuple[np.ndarray, int]:
@@ -236,3 +215,29 @@ def morris_screening(xi: np.ndarray, Y: np.ndarray, ok: np.ndarray, info: dict, 
                 f"(a trajectory with a failed or undefined run has no elementary effect of the inputs after it): "
                 f"{dropped} dropped" + ("; σ is undefined with fewer than 2" if kept < 2 else ""))
     return morris_measures(effects, n_boot, seed), note
+
+
+class Morris(DesignKind):
+    """`morris` {trajectories: R >= 2, levels: p (even, >= 2, default 4)}: N = R (d + 1) runs, trajectory
+    after trajectory, equal weights (the runs' own average, not of draws of the law)."""
+
+    kind = "morris"
+    keys = {"trajectories": count(2), "levels": count(2, default=4)}
+    example = {"kind": "morris", "trajectories": 4}
+    draws = Points()
+    not_draws = NOT_DRAWS
+    screening = staticmethod(morris_screening)
+
+    def size(self, spec, germs):
+        """R (d + 1)."""
+        r = self.given(spec, "trajectories")
+        return None if r is None else r * (len(germs) + 1)
+
+    def points(self, settings, germs, seed):
+        r, levels = settings["trajectories"], settings["levels"]
+        if levels % 2:
+            raise ValueError(f"design.levels: expected an even number of levels (the jump Δ = p/(2(p−1)) is then "
+                             f"p/2 grid steps), got {levels}")
+        u = morris_unit_points(r, len(germs), levels, seed)
+        info = {"trajectories": r, "levels": levels, "jump": morris_jump(levels), "samples": len(u), "seed": seed}
+        return morris_germs(u, germs, levels), equal_weights(len(u)), info

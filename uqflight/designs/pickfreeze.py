@@ -3,9 +3,10 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..analysis import proportions
 from ..parameters.germs import germ_quantiles
-from .montecarlo import equal_weights, sobol_points
-from .spec import check_keys, given_count, integer
+from .base import DesignKind, count, equal_weights, is_integer
+from .montecarlo import sobol_points
 
 
 def pick_freeze_rows(a: np.ndarray, b: np.ndarray) -> np.ndarray:
@@ -17,22 +18,31 @@ def pick_freeze_rows(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     return np.concatenate([a, b, ab.reshape(d * n, d)])
 
 
-def pick_freeze_size(spec: dict, germs: list[str]) -> int | None:
-    """Runs of `pick_freeze`: n(d + 2)."""
-    n = given_count(spec, "samples")
-    return None if n is None else n * (len(germs) + 2)
-
-
-def pick_freeze_design(spec: dict, germs: list[str], seed: int):
+class PickFreeze(DesignKind):
     """`pick_freeze` {samples: n}: N = n(d + 2) rows.
 
     A and B are the two halves of one scrambled Sobol' sequence in 2d dimensions (seeded), mapped
     to the germs; QMC keeps the estimators' variance below that of plain Monte Carlo.
     """
-    check_keys(spec, "pick_freeze", ("samples",))
-    n = integer(spec, "samples", "pick_freeze", minimum=1)
-    d = len(germs)
-    ab = germ_quantiles(sobol_points(n, 2 * d, scramble=True, seed=seed), germs + germs)
-    xi = pick_freeze_rows(ab[:, :d], ab[:, d:])
-    info = {"n_base": n, "samples": len(xi), "base_sequence": "scrambled Sobol'", "seed": seed}
-    return xi, equal_weights(len(xi)), info
+
+    kind = "pick_freeze"
+    keys = {"samples": count(1)}
+    example = {"kind": "pick_freeze", "samples": 16}
+    draws = proportions.PickFreeze()
+    sobol_from_runs = True
+
+    def size(self, spec, germs):
+        n = self.given(spec, "samples")
+        return None if n is None else n * (len(germs) + 2)
+
+    def points(self, settings, germs, seed):
+        n, d = settings["samples"], len(germs)
+        ab = germ_quantiles(sobol_points(n, 2 * d, scramble=True, seed=seed), germs + germs)
+        xi = pick_freeze_rows(ab[:, :d], ab[:, d:])
+        info = {"n_base": n, "samples": len(xi), "base_sequence": "scrambled Sobol'", "seed": seed}
+        return xi, equal_weights(len(xi)), info
+
+    def info_problem(self, info, runs, d):
+        if not (is_integer(info.get("n_base")) and info["n_base"] * (d + 2) == runs):
+            return "n_base", f"expected the base rows n of the {runs} runs, n ({d} parameters + 2)"
+        return None

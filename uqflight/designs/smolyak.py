@@ -10,17 +10,25 @@ cancel are kept: they belong to the grid, and interpolation or regression on it 
 """
 from __future__ import annotations
 
+from functools import reduce
 from itertools import combinations
 from math import comb
 
 import numpy as np
 
 from . import rules as rule_catalog
-from .spec import check_keys, integer, is_integer, optional_boolean, optional_choice
-from .tensor import tensor_product
+from .base import DesignKind, Key, choice, count, flag, is_integer
 
 MERGE_TOLERANCE = 1e-12  # relative: 1-D nodes closer than this are one point
 MAX_LEVEL = 1000  # levels beyond this are refused before any size is estimated
+
+
+def tensor_product(node_sets, weight_sets) -> tuple[np.ndarray, np.ndarray]:
+    """All combinations of the 1-D nodes (rows, last dimension fastest) and their weight products."""
+    grids = np.meshgrid(*node_sets, indexing="ij")
+    points = np.stack([grid.ravel() for grid in grids], axis=1)
+    weights = reduce(np.multiply.outer, weight_sets).ravel()
+    return points, weights
 
 
 def multi_indices(d: int, level: int) -> np.ndarray:
@@ -92,67 +100,60 @@ def smolyak_degree(degrees, level: int) -> int:
     return int(evens[np.argmax(worst > level)]) - 1
 
 
-def sparse_grid_size(spec: dict, germs: list[str]) -> float | None:
-    """The points the combination technique builds before merging the tensor rules' shared points
-    (an upper bound on the runs, and the size of the arrays built), computed without building anything:
-    Σ over the multi-indices of Π_k size_k(j_k), a polynomial product over the dimensions."""
-    level = spec.get("level")
-    if not is_integer(level) or level < 0:
-        return None
-    if level > MAX_LEVEL:
-        raise ValueError(f"design.level: expected at most {MAX_LEVEL}, got {level}")
-    try:
-        rules = rule_catalog.rules_by_dimension(spec.get("rule"), germs, spec.get("nested"))
-        growth = spec.get("growth") or "linear"
-        sizes = {}
-        for rule in dict.fromkeys(rules):
-            top = rule_catalog.max_level(rule, growth)
-            if top is not None and level + 1 > top:
-                return None
-            sizes[rule] = np.array(rule_catalog.level_sizes(rule, growth, level + 1), dtype=float)
-    except (ValueError, KeyError, TypeError):
-        return None
-    # coefficient s of the product polynomial = the points of all tensor rules with |j| = s
-    total = np.array([1.0])
-    for rule in rules:
-        total = np.convolve(total, sizes[rule])[: level + 1]
-    return float(total[max(0, level - len(germs) + 1): level + 1].sum())
-
-
-def sparse_grid_design(spec: dict, germs: list[str], seed: int):
+class SparseGrid(DesignKind):
     """`sparse_grid` {level, rule, nested, growth (default linear)}; deterministic, seed unused.
 
     With linear growth every rule's level L is exact to total degree >= 2L + 1, so nested and
     non-nested grids of one level compare at equal accuracy (the nested one has fewer points
     from level 2 on).
     """
-    check_keys(spec, "sparse_grid", ("level", "rule", "nested", "growth"))
-    level = integer(spec, "level", "sparse_grid", minimum=0)
-    nested = optional_boolean(spec, "nested", default=None)
-    rules = rule_catalog.rules_by_dimension(spec.get("rule"), germs, nested)
-    growth = optional_choice(spec, "growth", rule_catalog.GROWTHS) or "linear"
-    sizes, one_dimensional = {}, {}
-    for rule in dict.fromkeys(rules):
-        top = rule_catalog.max_level(rule, growth)
-        if top is not None and level + 1 > top:
-            raise ValueError(
-                f"design.level: rule {rule} with {growth} growth reaches level {top - 1} at most, "
-                f"got {level}"
-            )
-        sizes[rule] = rule_catalog.level_sizes(rule, growth, level + 1)
-        one_dimensional[rule] = [rule_catalog.nodes_weights(rule, size) for size in sizes[rule]]
-    points, weights = smolyak_rule([one_dimensional[rule] for rule in rules], level)
-    degree = smolyak_degree(
-        [[rule_catalog.degree(rule, size) for size in sizes[rule]] for rule in rules], level
-    )
-    info = {
-        "level": level,
-        "rule": rule_catalog.rule_names(rules),
-        "nested": all(rule in rule_catalog.NESTED_RULES for rule in rules),
-        "growth": growth,
-        "points_per_level": "; ".join(
-            f"{rule}: {', '.join(map(str, counts))}" for rule, counts in sizes.items()
-        ),
-        "degree": degree,
-    }
-    return points, weights, info
+
+    kind = "sparse_grid"
+    keys = {"level": count(0), "rule": Key(), "nested": flag(None), "growth": choice(rule_catalog.GROWTHS, "linear")}
+    example = {"kind": "sparse_grid", "level": 2}
+    draws = None
+
+    def size(self, spec, germs):
+        """The points the combination technique builds before merging the tensor rules' shared points
+        (an upper bound on the runs, and the size of the arrays built), computed without building anything:
+        Σ over the multi-indices of Π_k size_k(j_k), a polynomial product over the dimensions."""
+        level = spec.get("level")
+        if not is_integer(level) or level < 0:
+            return None
+        if level > MAX_LEVEL:
+            raise ValueError(f"design.level: expected at most {MAX_LEVEL}, got {level}")
+        try:
+            rules = rule_catalog.rules_by_dimension(spec.get("rule"), germs, spec.get("nested"))
+            sizes = self._sizes(rules, spec.get("growth") or "linear", level)
+        except (ValueError, KeyError, TypeError):
+            return None
+        # coefficient s of the product polynomial = the points of all tensor rules with |j| = s
+        total = np.array([1.0])
+        for rule in rules:
+            total = np.convolve(total, np.array(sizes[rule], dtype=float))[: level + 1]
+        return float(total[max(0, level - len(germs) + 1): level + 1].sum())
+
+    @staticmethod
+    def _sizes(rules: list[str], growth: str, level: int) -> dict:
+        """{rule: its 1-D sizes at levels 1 … level + 1}; ValueError naming design.level beyond a rule's end."""
+        sizes = {}
+        for rule in dict.fromkeys(rules):
+            top = rule_catalog.max_level(rule, growth)
+            if top is not None and level + 1 > top:
+                raise ValueError(f"design.level: rule {rule} with {growth} growth reaches level {top - 1} at most, "
+                                 f"got {level}")
+            sizes[rule] = rule_catalog.level_sizes(rule, growth, level + 1)
+        return sizes
+
+    def points(self, settings, germs, seed):
+        level, growth = settings["level"], settings["growth"]
+        rules = rule_catalog.rules_by_dimension(settings["rule"], germs, settings["nested"])
+        sizes = self._sizes(rules, growth, level)
+        one_dimensional = {rule: [rule_catalog.nodes_weights(rule, size) for size in sizes[rule]] for rule in sizes}
+        points, weights = smolyak_rule([one_dimensional[rule] for rule in rules], level)
+        degree = smolyak_degree([[rule_catalog.degree(rule, size) for size in sizes[rule]] for rule in rules], level)
+        info = {"level": level, "rule": rule_catalog.rule_names(rules),
+                "nested": all(rule in rule_catalog.NESTED_RULES for rule in rules), "growth": growth,
+                "points_per_level": "; ".join(f"{rule}: {', '.join(map(str, counts))}" for rule, counts in sizes.items()),
+                "degree": degree}
+        return points, weights, info

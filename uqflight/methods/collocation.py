@@ -7,7 +7,7 @@ import numpy as np
 
 from ..analysis.moments import as_runs_by_time, probability_weights
 from ..parameters.germs import check_germs
-from . import Method, scaled
+from .kind import Method, scaled
 from .basis import orthonormal_basis, total_degree_indices
 from .exactness import design_matrix_rank
 from .pce import PCE

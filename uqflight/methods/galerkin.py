@@ -16,7 +16,7 @@ import numpy as np
 
 from ..analysis.moments import as_runs_by_time, probability_weights
 from ..parameters.germs import check_germs
-from . import Method, scaled
+from .kind import Method, scaled
 from .basis import orthonormal_basis, total_degree_indices
 from .exactness import exact_total_degree, max_projection_order
 from .pce import PCE

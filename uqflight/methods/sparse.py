@@ -25,7 +25,7 @@ import warnings
 import numpy as np
 
 from ..parameters.germs import check_germs
-from . import DEFAULT_ORDER, METHODS, Key, Method
+from .kind import DEFAULT_ORDER, METHODS, Key, Method
 from .basis import orthonormal_basis, total_degree_indices
 from .pce import PCE
 

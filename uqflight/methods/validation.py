@@ -31,7 +31,7 @@ import numpy as np
 
 from ..analysis.moments import as_runs_by_time
 from ..parameters.germs import draw_germs
-from . import DEFAULT_ORDER, METHODS, Method, Result
+from .kind import DEFAULT_ORDER, METHODS, Method, Result
 from .basis import orthonormal_basis
 from .loo import relative_loo_error
 from .pce import PCE

@@ -18,7 +18,7 @@ from __future__ import annotations
 
 import math
 
-from . import Method
+from .kind import Method
 
 MAX_TERMS = 100_000  # PCE terms beyond which a fit is refused before any basis is built (campaign: limits.max_pce_terms)
 

@@ -9,8 +9,6 @@ import math
 import re
 
 from ..simulators.kinds import simulator_entry
-from ..simulators.scenarios import DEFAULT as LEVEL_FLIGHT
-from ..simulators.scenarios import scenario_kind
 from . import REGISTRY, TAKES, WINDOW
 
 KEYS = ("of", "take", "at_s", "when", "after_s", "before_s")
@@ -28,7 +26,7 @@ def flight_span(simulator: dict) -> float | None:
 
 def is_level_flight(simulator: dict) -> bool:
     """A JSBSim aircraft trimmed in level flight (its modes are those of that trim)."""
-    return simulator_entry(simulator).aircraft and scenario_kind(simulator) == LEVEL_FLIGHT
+    return simulator_entry(simulator).trims_level(simulator)
 
 
 def check_quantities(check, value, simulator: dict, aircraft=None) -> dict[str, dict]:

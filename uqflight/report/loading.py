@@ -203,6 +203,17 @@ def bounded(name: str, limit: int = NAME_BYTES) -> str:
     return keep + tag + ext
 
 
+def one_per_file(entries: list[Entry]) -> list[Entry]:
+    """One entry per results file (several --method give several entries of one file)."""
+    seen, unique = set(), []
+    for e in entries:
+        key = str(Path(e.path or e.stats.path).resolve())
+        if key not in seen:
+            seen.add(key)
+            unique.append(e)
+    return unique
+
+
 def _same_file(a, b) -> bool:
     return Path(a).resolve() == Path(b).resolve()
 

@@ -15,7 +15,7 @@ from ..analysis.sobol import unresolved
 from ..forking import share_work
 from .sensitivity import N_TOO_SMALL, NEGLIGIBLE, index_text, plot_sensitivity
 from .loading import (Entry, _same_file, bounded, campaign_settings, campaign_simulator, estimator_label, flight_facts,
-                      method_label)
+                      method_label, one_per_file)
 
 BELOW_FLOOR = "below reference resolution"
 UNRESOLVED = "unresolved"
@@ -106,23 +106,12 @@ def notes_section(entries: list[Entry]) -> Section | None:
     return Section("Notes", "notes", "\n".join(f"- {line}" for line in dict.fromkeys(lines)), notes=True)
 
 
-def _files(entries: list[Entry]) -> list[Entry]:
-    """One entry per results file (several --method give several entries of one file)."""
-    seen, unique = set(), []
-    for e in entries:
-        key = str(Path(e.path or e.stats.path).resolve())
-        if key not in seen:
-            seen.add(key)
-            unique.append(e)
-    return unique
-
-
 def run_section(entries: list[Entry], out_dir: Path) -> Section:
     """What was run: per results file its parameters, flight condition, excitation, design, method,
     seed, versions, aircraft hash and date; its campaign text; the design scatter (Fig. 9)."""
     blocks = []
     facts, parameter_rows = [], []
-    for e in _files(entries):
+    for e in one_per_file(entries):
         text = str(e.attrs.get("campaign", ""))
         settings, simulator = campaign_settings(text), campaign_simulator(text)
         methods = ", ".join(dict.fromkeys(estimator_label(x.stats) for x in entries
@@ -156,7 +145,7 @@ def run_section(entries: list[Entry], out_dir: Path) -> Section:
     blocks.append(Table("Uncertain parameters: distribution, interval and nominal value",
                         ["file", "parameter", "property", "distribution", "lower", "upper", "nominal", "interval"],
                         parameter_rows, "tables/parameters.csv"))
-    for e in _files(entries):
+    for e in one_per_file(entries):
         path = plots.plot_design_pairs(e.path or e.stats.path,
                                        out_dir / "plots" / bounded(f"design_{e.file_stem}.png"),
                                        f"Design: {e.stats.design_kind}, "
@@ -166,14 +155,14 @@ def run_section(entries: list[Entry], out_dir: Path) -> Section:
                                  "of inputs in physical values (paper Fig. 9); a symmetric grid once, in ξ, with "
                                  "the inputs' values at its levels; negative weights orange, failed runs red crosses."))
     texts = "\n\n".join(f"# {e.path or e.stats.path}\n{str(e.attrs.get('campaign', '')).strip()}"
-                          for e in _files(entries))
+                          for e in one_per_file(entries))
     return Section("What was run", "run", texts, blocks, preformatted=True)
 
 
 def failures_section(entries: list[Entry]) -> Section | None:
     """Each failed run's parameters and reason (Statistics.failures), when any."""
     rows, parameters = [], []
-    for e in _files(entries):
+    for e in one_per_file(entries):
         for failure in getattr(e.stats, "failures", None) or []:
             values = failure.get("parameters") or {}
             parameters += [p for p in values if p not in parameters]
@@ -183,7 +172,7 @@ def failures_section(entries: list[Entry]) -> Section | None:
     table = [[stem, f.get("run", ""), f.get("status", ""), f.get("reason", ""), *(v.get(p, "") for p in parameters)]
              for stem, f, v in rows]
     text = "; ".join(f"{e.stem}: failure probability {_probability(e.stats.failure_probability)}"
-                     for e in _files(entries) if getattr(e.stats, "failure_probability", None))
+                     for e in one_per_file(entries) if getattr(e.stats, "failure_probability", None))
     return Section("Failed runs", "failures", text or "The runs that failed, with their parameters.",
                    [Table("Failed runs: parameters and reason", ["file", "run", "status", "reason", *parameters],
                           table, "tables/failures.csv")])

@@ -141,16 +141,15 @@ def trajectories_section(entries: list, times: list[float], out_dir: Path):
     """Per results file: the spaghetti plot and the scatter of the outputs at the last of `times` and of the
     quantities against the inputs, seeded by the campaign's seed (the same runs on every report); None
     when there is nothing to draw (no output and no quantity)."""
-    from ..designs import is_sampled
-    from .loading import bounded, campaign_settings
+    from ..designs import REGISTRY as DESIGNS
+    from .loading import bounded, campaign_settings, one_per_file
     from .blocks import Figure, Section, _rel
-    from .sections import _files
 
     blocks = []
-    for e in _files(entries):
+    for e in one_per_file(entries):
         results, stem = Path(e.path or e.stats.path), e.file_stem
         seed = int(campaign_settings(str(e.attrs.get("campaign", ""))).get("seed", 0) or 0)
-        nodes = ("" if is_sampled(e.stats.design_kind) else
+        nodes = ("" if DESIGNS[e.stats.design_kind].sampled else
                  f" The points are the {e.stats.design_kind}'s nodes, not random draws: how they spread says "
                  "nothing of the inputs' distribution.")
         if any(out.time.size > 1 for out in e.outputs.values()):

@@ -1,11 +1,11 @@
 """What travels with a task to workers that share no disk with the client.
 
-`make_bundle` packs, on the client, the files a simulator needs: the aircraft's XML files (the
+`kinds.make_bundle` packs, on the client, the files a simulator needs: the aircraft's XML files (the
 patched copy when parameters scale or offset its functions; engines and systems included) or a
 `file.py` python simulator, as bytes, with their sha256; and the files of a script scenario (the
-script, its initialisation file: `scenarios.ScenarioKind.files`). `localized` unpacks them on the worker
+script, its initialisation file: `ScenarioKind.files`). `unpacked` unpacks them on the worker
 into its own cache (`$UQFLIGHT_CACHE`, else `$XDG_CACHE_HOME/uqflight`, else ~/.cache/uqflight),
-keyed by the hash, and returns the spec's simulator mapping pointing there. Before a worker
+keyed by the hash, and `kinds.localized` points the spec's simulator mapping there. Before a worker
 flies, it hashes the aircraft files it is about to load; files that differ from the client's
 (a stale or edited copy in its cache) are refused with an `AircraftMismatch`.
 
@@ -23,13 +23,11 @@ import re
 import shutil
 import zipfile
 import zlib
-from dataclasses import replace
 from pathlib import Path
 
 from ..bounded import Refused, read_bounded
 from .aircraft import MAX_BYTES, MAX_FILES, AircraftFiles, AircraftUnsafe, cache_dir, unsafe_key
 from .safe_paths import relative_name, single_name
-from .scenarios import scenario_entry
 
 SHA256 = re.compile(r"[0-9a-f]{64}")
 
@@ -91,32 +89,23 @@ def _unzip(data: bytes, unsafe) -> dict[str, bytes]:
 
 def _checked(bundle) -> dict:
     """The bundle, once its kind, name and hash are ones the worker can use as names in its cache."""
-    if not isinstance(bundle, dict) or bundle.get("kind") not in ("aircraft", "python"):
-        raise _refuse("expected a bundle of kind 'aircraft' or 'python'")
+    if not isinstance(bundle, dict) or bundle.get("kind") not in UNPACK:
+        raise _refuse(f"expected a bundle of kind {' or '.join(map(repr, UNPACK))}")
     if not isinstance(bundle.get("hash"), str) or not SHA256.fullmatch(bundle["hash"]):
         raise _refuse(f"hash {bundle.get('hash')!r}: expected 64 lowercase hexadecimal digits (a sha256)")
-    name, suffix = bundle.get("name"), ".py" if bundle["kind"] == "python" else ""
+    name, suffix = bundle.get("name"), SUFFIX[bundle["kind"]]
     if not single_name(name) or not name.endswith(suffix):
-        raise _refuse(f"name {name!r}: expected a single file name{' ending in .py' if suffix else ''} "
+        raise _refuse(f"name {name!r}: expected a single file name{' ending in ' + suffix if suffix else ''} "
                       "(no /, \\, :, NUL, . or ..)")
-    if bundle["kind"] == "python" and not (isinstance(bundle.get("attribute"), str)
-                                           and bundle["attribute"].isidentifier()):
-        raise _refuse(f"attribute {bundle.get('attribute')!r}: expected a Python name")
     if not isinstance(bundle.get("zip"), bytes):
         raise _refuse("expected the files as zip bytes")
     return bundle
 
 
-def make_bundle(simulator: dict, properties, base: str | Path) -> dict | None:
-    """{"kind", "name", "hash", "zip"} for the simulator's files, or None when there is nothing to send."""
-    from .kinds import simulator_entry
-
-    return simulator_entry(simulator).bundle(simulator, properties, base)
-
-
-def aircraft_bundle(simulator: dict, properties, base: str | Path) -> dict | None:
+def aircraft_bundle(simulator: dict, properties, base: str | Path, scenario_files) -> dict | None:
     """A JSBSim simulator's aircraft (the patched copy when `properties` perturb its functions) and its
-    scenario's files; None when the simulator already reads a worker's local copy (`root`)."""
+    scenario's files (`scenario_files(simulator)`); None when the simulator already reads a worker's local
+    copy (`root`)."""
     from .patch import PreparedAircraft
 
     if "root" in simulator:
@@ -124,7 +113,7 @@ def aircraft_bundle(simulator: dict, properties, base: str | Path) -> dict | Non
     prepared = PreparedAircraft(simulator.get("aircraft_path", simulator.get("aircraft", "bacm")), Path(base),
                                 properties)
     bundle = {"kind": "aircraft", "name": prepared.name, "hash": prepared.hash, "zip": _zip(prepared.files.files)}
-    files = scenario_entry(simulator).files(simulator)  # a script scenario's script and initialisation
+    files = scenario_files(simulator)  # a script scenario's script and initialisation
     if files:
         bundle["scenario"] = {"hash": AircraftFiles("", files).hash(), "zip": _zip(files)}
     return bundle
@@ -144,49 +133,59 @@ def python_bundle(simulator: dict, base: str | Path) -> dict | None:
             "hash": hashlib.sha256(data).hexdigest(), "zip": _zip({file.name: data})}
 
 
-def localized(spec):
-    """The WorkerSpec with its simulator reading the bundle's files from this worker's cache
-    (unpacked on first use); raises BundleRefused when the bundle's names, hash, size or file count
-    are unsafe (before unpacking anything), AircraftMismatch when the files differ from its hash."""
-    bundle = getattr(spec, "bundle", None)
-    if not bundle:
-        return spec
+def unpacked(bundle, simulator: dict) -> tuple[dict, Path | None]:
+    """The simulator mapping reading the bundle's files from this worker's cache (unpacked on first use),
+    and the folder of its scenario's files (None: none travel). Raises BundleRefused when the bundle's
+    names, hash, size or file count are unsafe (before unpacking anything), AircraftMismatch when the
+    files differ from its hash."""
     bundle = _checked(bundle)
-    simulator = dict(spec.simulator)
+    return UNPACK[bundle["kind"]](bundle, dict(simulator))
+
+
+def _unpacked_aircraft(bundle: dict, simulator: dict) -> tuple[dict, Path | None]:
     name, digest = bundle["name"], bundle["hash"]
-    if bundle["kind"] == "aircraft":
-        files = AircraftFiles(name, _unzip(bundle["zip"], unsafe_key))
-        if f"{name}.xml" not in files.files or files.hash() != digest:
-            raise _refuse(f"the files of {name!r} do not hash to the bundle's sha256 {digest[:12]} "
-                          f"(or lack {name}.xml)")
-        try:
-            root = files.write_root(cache_dir("aircraft", digest[:24]))
-        except AircraftUnsafe as exc:
-            raise _refuse(str(exc)) from None
-        check_aircraft(root, name, digest)
-        simulator.update(root=str(root), aircraft=name)
-        simulator.pop("aircraft_path", None)
-        if bundle.get("scenario"):
-            scenario = bundle["scenario"]
-            if not (isinstance(scenario, dict) and isinstance(scenario.get("hash"), str)
-                    and SHA256.fullmatch(scenario["hash"]) and isinstance(scenario.get("zip"), bytes)):
-                raise _refuse("scenario: expected a sha256 and the files as zip bytes")
-            folder = _unpacked(scenario, cache_dir("scenario", scenario["hash"][:24]))
-            simulator = scenario_entry(simulator).localize(simulator, folder)
-    else:
-        data = _unzip(bundle["zip"], lambda key: None if key == name else f"expected only {name!r}")
-        if name not in data or hashlib.sha256(data[name]).hexdigest() != digest:
-            raise _refuse(f"{name!r} does not hash to the bundle's sha256 {digest[:12]}")
-        folder = cache_dir("python", digest[:24])
-        file = folder / name
-        if not file.is_file():
-            folder.mkdir(parents=True, exist_ok=True)
-            file.write_bytes(data[name])
-        if hashlib.sha256(file.read_bytes()).hexdigest() != digest:
-            raise AircraftMismatch(f"worker: {file} differs from the client's {name} "
-                                   f"(sha256 {digest[:12]}): refusing to run it; delete {folder}")
-        simulator["function"] = f"{file}:{bundle['attribute']}"
-    return replace(spec, simulator=simulator, bundle=None)
+    files = AircraftFiles(name, _unzip(bundle["zip"], unsafe_key))
+    if f"{name}.xml" not in files.files or files.hash() != digest:
+        raise _refuse(f"the files of {name!r} do not hash to the bundle's sha256 {digest[:12]} "
+                      f"(or lack {name}.xml)")
+    try:
+        root = files.write_root(cache_dir("aircraft", digest[:24]))
+    except AircraftUnsafe as exc:
+        raise _refuse(str(exc)) from None
+    check_aircraft(root, name, digest)
+    simulator.update(root=str(root), aircraft=name)
+    simulator.pop("aircraft_path", None)
+    scenario = bundle.get("scenario")
+    if not scenario:
+        return simulator, None
+    if not (isinstance(scenario, dict) and isinstance(scenario.get("hash"), str)
+            and SHA256.fullmatch(scenario["hash"]) and isinstance(scenario.get("zip"), bytes)):
+        raise _refuse("scenario: expected a sha256 and the files as zip bytes")
+    return simulator, _unpacked(scenario, cache_dir("scenario", scenario["hash"][:24]))
+
+
+def _unpacked_python(bundle: dict, simulator: dict) -> tuple[dict, None]:
+    if not (isinstance(bundle.get("attribute"), str) and bundle["attribute"].isidentifier()):
+        raise _refuse(f"attribute {bundle.get('attribute')!r}: expected a Python name")
+    name, digest = bundle["name"], bundle["hash"]
+    data = _unzip(bundle["zip"], lambda key: None if key == name else f"expected only {name!r}")
+    if name not in data or hashlib.sha256(data[name]).hexdigest() != digest:
+        raise _refuse(f"{name!r} does not hash to the bundle's sha256 {digest[:12]}")
+    folder = cache_dir("python", digest[:24])
+    file = folder / name
+    if not file.is_file():
+        folder.mkdir(parents=True, exist_ok=True)
+        file.write_bytes(data[name])
+    if hashlib.sha256(file.read_bytes()).hexdigest() != digest:
+        raise AircraftMismatch(f"worker: {file} differs from the client's {name} "
+                               f"(sha256 {digest[:12]}): refusing to run it; delete {folder}")
+    simulator["function"] = f"{file}:{bundle['attribute']}"
+    return simulator, None
+
+
+# the bundles' kinds: how each unpacks, and the suffix of its name
+UNPACK = {"aircraft": _unpacked_aircraft, "python": _unpacked_python}
+SUFFIX = {"aircraft": "", "python": ".py"}
 
 
 def _unsafe_scenario_key(key: str) -> str | None:

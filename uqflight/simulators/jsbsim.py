@@ -1,11 +1,6 @@
-"""One trimmed, excited JSBSim flight per sample, on an aircraft loaded once and reused: the
-`level_flight` scenario (see scenarios/), and what every JSBSim scenario shares.
-
-`JSBSimFlight` is the worker-side object: it loads the aircraft once, then for every sample
-resets the model, sets the sample's properties, trims in unaccelerated level flight, applies
-the elevator excitation and records the outputs. A reused instance gives the same
-trajectories as a freshly loaded one (the reset restores every property the previous sample
-touched and the controls' values at load time).
+"""The JSBSim engine every scenario flies on (scenarios/): the named outputs, a loaded model's cached
+property nodes (`PropertyAccess`), the observers that watch every integration step (`Watch`), what a
+flight returns (`FlightResult`), the check before loading an aircraft and its provenance hash.
 
 Every scenario's flight loop accepts observers (`Observer`): the quantities of interest are
 computed by one, at every integration step.
@@ -13,7 +8,6 @@ computed by one, at every integration step.
 from __future__ import annotations
 
 import math
-import os
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -22,8 +16,7 @@ from typing import Protocol
 import jsbsim
 import numpy as np
 
-from .base import DivergenceError, FlightError, TrimError
-from .engines import prepare_engines
+from .base import DivergenceError, Field
 from .preflight import check_loads
 
 REPO_ROOT = Path(__file__).resolve().parents[2]  # the source tree (aircraft/bacm)
@@ -45,132 +38,19 @@ NAMED_OUTPUTS = {
     "q_degps": ("velocities/q-rad_sec", 180.0 / math.pi),
     "vtas_kt": ("velocities/vtrue-kts", 1.0),
 }
+# every scenario's recording rate
+OUTPUT_RATE = Field("Recording rate [Hz]; must divide the integration rate (120 Hz for level flight, the script's "
+                    "own). Default 20. `output_rate_hz: 10`", number=True, minimum=0.0, strict=True)
 UNITS = {"alpha_deg": "deg", "theta_deg": "deg", "h_ft": "ft", "q_degps": "deg/s", "vtas_kt": "kt"}
 
-# Controls the trim writes: restored to their load-time values before every sample.
-TRIM_CONTROLS = (
-    "fcs/throttle-cmd-norm[0]", "fcs/throttle-cmd-norm[1]", "fcs/elevator-cmd-norm",
-    "fcs/pitch-trim-cmd-norm", "fcs/aileron-cmd-norm", "fcs/roll-trim-cmd-norm",
-    "fcs/rudder-cmd-norm", "fcs/yaw-trim-cmd-norm", "fcs/elevator-excitation-deg",
-)
-# Trim acceptance: JSBSim's own tolerances (FGTrim.cpp) with a margin of 10.
-TRIM_TOLERANCES = {
-    "accelerations/udot-ft_sec2": 1e-2,
-    "accelerations/wdot-ft_sec2": 1e-2,
-    "accelerations/qdot-rad_sec2": 1e-3,
-}
 ATMOSPHERE = "atmosphere/"  # settings applied after the trim (still air), at t = 0 of the recorded flight
-RANDOM_SEED = "atmosphere/randomseed"  # the wind and turbulence generator's seed (jsbsim >= 1.3)
-STALL_PROPERTY = "aero/coefficient/CL-stall"  # non-zero past the stall (bacm)
-DIVERGENCE_LIMITS = {"aero/alpha-deg": 30.0, "attitude/phi-deg": 60.0}
-
-
-@dataclass(frozen=True)
-class Excitation:
-    """Elevator excitation added to the trimmed elevator: pulse, step, doublet or none.
-
-    Positive amplitude is trailing edge down (JSBSim's sign: nose-down moment). A doublet is
-    +amplitude for the first half of `duration_s` and -amplitude for the second half.
-    """
-
-    kind: str = "pulse"
-    amplitude_deg: float = 1.0
-    start_s: float = 1.0
-    duration_s: float = 1.0
-
-    KINDS = ("pulse", "step", "doublet", "none")
-
-    def __post_init__(self):
-        if self.kind not in self.KINDS:
-            raise ValueError(f"excitation.kind: expected one of {', '.join(self.KINDS)}, got {self.kind!r}")
-        if self.duration_s < 0 or self.start_s < 0:
-            raise ValueError("excitation.start_s and duration_s must be >= 0")
-
-    def values(self, t: np.ndarray) -> np.ndarray:
-        """Elevator increment [deg] at times `t` [s]."""
-        t = np.asarray(t, dtype=float)
-        after = t >= self.start_s
-        if self.kind == "none":
-            return np.zeros_like(t)
-        if self.kind == "step":
-            return self.amplitude_deg * after
-        end = self.start_s + self.duration_s
-        if self.kind == "pulse":
-            return self.amplitude_deg * (after & (t < end))
-        mid = self.start_s + 0.5 * self.duration_s
-        return self.amplitude_deg * ((after & (t < mid)).astype(float) - ((t >= mid) & (t < end)))
-
-
-@dataclass(frozen=True)
-class FlightSetup:
-    """Everything that is the same for every sample of a campaign."""
-
-    aircraft: str = "bacm"
-    root: Path = field(default_factory=default_root)
-    altitude_ft: float = 15000.0
-    airspeed_ktas: float = 200.0
-    excitation: Excitation = field(default_factory=Excitation)
-    duration_s: float = 50.0
-    rate_hz: float = 120.0
-    output_rate_hz: float = 20.0
-    outputs: tuple[str, ...] = DEFAULT_OUTPUTS
-    trim: str = "newton"
-
-    TRIMS = ("newton", "jsbsim")
-
-    def __post_init__(self):
-        if self.trim not in self.TRIMS:
-            raise ValueError(f"trim: expected one of {', '.join(self.TRIMS)}, got {self.trim!r}")
-        ratio = self.rate_hz / self.output_rate_hz if self.output_rate_hz > 0 else 0.0
-        if abs(ratio - round(ratio)) > 1e-9 or round(ratio) < 1:
-            divisors = ", ".join(f"{self.rate_hz / k:g}" for k in range(1, 7))
-            raise ValueError(f"output_rate_hz: expected a divisor of the {self.rate_hz:g} Hz integration rate "
-                             f"({divisors}, ...), got {self.output_rate_hz:g}")
-        if self.duration_s <= 0:
-            raise ValueError(f"duration_s: expected a positive number, got {self.duration_s:g}")
-
-    @property
-    def steps_per_output(self) -> int:
-        return int(round(self.rate_hz / self.output_rate_hz))
-
-    @property
-    def n_times(self) -> int:
-        """The number of recorded times (without building them: a size estimate reads it)."""
-        return int(round(self.duration_s * self.output_rate_hz)) + 1
-
-    @property
-    def time(self) -> np.ndarray:
-        """Recorded times [s]: 0 (the trimmed state) to duration_s at the output rate."""
-        return np.arange(self.n_times) / self.output_rate_hz
-
-    @property
-    def aircraft_file(self) -> Path:
-        return Path(self.root) / "aircraft" / self.aircraft / f"{self.aircraft}.xml"
-
-
-@dataclass
-class TrimResult:
-    """The trimmed state and controls, and the residual accelerations that prove it."""
-
-    alpha_deg: float
-    theta_deg: float
-    throttle: tuple[float, ...]
-    elevator_deg: float
-    residuals: dict[str, float]
-
-    def describe(self) -> str:
-        res = ", ".join(f"{k.split('/')[-1]} = {v:.2e}" for k, v in self.residuals.items())
-        thr = ", ".join(f"{x:.4f}" for x in self.throttle)
-        return (f"trim: alpha = {self.alpha_deg:.4f} deg, theta = {self.theta_deg:.4f} deg, "
-                f"throttle = [{thr}], elevator = {self.elevator_deg:.4f} deg\n"
-                f"residuals: {res}")
 
 
 @dataclass
 class FlightResult:
     time: np.ndarray
     outputs: dict[str, np.ndarray]
-    trim: TrimResult | None  # None: the scenario has no trim of its own (a script trims itself, if at all)
+    trim: object  # a level flight's TrimResult; None: the scenario has no trim of its own (a script trims itself)
     warnings: list[str] = field(default_factory=list)  # what the reader must know, e.g. an unmoved surface
 
 
@@ -198,7 +78,7 @@ class Watch:
             step(t, [node.get_double_value() for node in nodes])
 
 
-def aircraft_hash(setup: FlightSetup) -> str:
+def aircraft_hash(setup) -> str:
     """sha256 over the aircraft's XML files (airframe, engines, systems), for provenance."""
     from .aircraft import AircraftFiles, AircraftLocation
 
@@ -259,257 +139,8 @@ class PropertyAccess:
         return self.node(prop), scale
 
 
-SURFACE = "fcs/elevator-pos-deg"  # the surface the excitation must move
-UNMOVED_FRACTION = 0.1  # a surface that moves less than this share of the commanded amplitude is unmoved
-
-
-class JSBSimFlight(PropertyAccess):
-    """A loaded aircraft that flies any number of samples: reset, set, trim, excite, record."""
-
-    diagnose_trim_failures = True  # a failed trim says why (stall, speed range); false: the state only
-    surface_warning: str | None = None  # after a flight: the excitation left the elevator unmoved (why), or None
-
-    def __init__(self, setup: FlightSetup = FlightSetup(), preflight: bool = True):
-        """`preflight` false: the caller reloads an aircraft this process has already loaded (and so
-        checked, see preflight.py); the check would only hash its files again."""
-        ready_to_load(setup, preflight)
-        self.setup = setup
-        self._bind(jsbsim.FGFDMExec(str(setup.root)), setup.aircraft)
-        self.fdm.set_debug_level(0)
-        self.fdm.set_output_path(os.devnull)  # no state file (directives.py)
-        if not self.fdm.load_model(setup.aircraft):
-            raise RuntimeError(f"JSBSim could not load aircraft {setup.aircraft!r} from {setup.root}")
-        self.fdm.set_dt(1.0 / setup.rate_hz)
-        self._engines = self.fdm.get_propulsion().get_num_engines()
-        self._load_values = {p: self.node(p).get_double_value() for p in TRIM_CONTROLS if self.has_property(p)}
-        self._touched: dict[str, float] = {}
-        self._random_seed = self.node(RANDOM_SEED).get_double_value() if self.has_property(RANDOM_SEED) else 0.0
-        self._recorded = [self._output_source(name) for name in setup.outputs]
-
-    # -- properties -------------------------------------------------------------------------
-    def property_value(self, name: str) -> float | None:
-        """The value of `name` as loaded (None when the aircraft has no such property)."""
-        if name in self._touched:
-            return self._touched[name]
-        return self.node(name).get_double_value() if self.has_property(name) else None
-
-    def prepare_validation_view(self) -> None:
-        """The state campaign validation reads nominal values in: the flight condition's initial
-        conditions set, as `trim` sets them (so `ic/vc-kts` reads the matching calibrated airspeed)."""
-        self.fdm["ic/h-sl-ft"] = self.setup.altitude_ft
-        self.fdm["ic/vt-kts"] = self.setup.airspeed_ktas
-
-    # -- one sample -------------------------------------------------------------------------
-    def fly(self, settings: dict[str, float] | None = None, observers: Sequence[Observer] = ()) -> FlightResult:
-        """Fly one sample with the given property values, watched by `observers`; raises a FlightError subclass.
-        The trim is flown in still air: `atmosphere/...` settings (turbulence, gusts, winds, the random
-        seed) are applied after it, so that they start at t = 0 of the recorded flight."""
-        settings = settings or {}
-        trim = self.trim({k: v for k, v in settings.items() if not k.startswith(ATMOSPHERE)})
-        for observer in observers:
-            if hasattr(observer, "at_trim"):
-                observer.at_trim(self.fdm)
-        self._apply({k: v for k, v in settings.items() if k.startswith(ATMOSPHERE)})
-        return self.run_trimmed(trim, observers)
-
-    def trim(self, settings: dict[str, float]) -> TrimResult:
-        """Reset, apply `settings`, trim in unaccelerated level flight and settle the engines.
-
-        `setup.trim` chooses the trim: "newton" (uqflight.simulators.trim, falling back to
-        JSBSim's when it does not converge) or "jsbsim" (`simulation/do_simple_trim`).
-        """
-        level = self._level_trim() if self.setup.trim == "newton" else None
-        if level is not None:
-            self._reset(settings, settle_engines=False)
-            if level.solve(level.nominal) is not None:
-                return self._checked_trim()
-            level.fallbacks += 1
-        return self._jsbsim_trim(settings)
-
-    def _level_trim(self):
-        """The Newton trim, with the nominal it starts every sample from (see LevelTrim.prepare);
-        None when the nominal itself cannot be trimmed (then JSBSim's trim does every sample)."""
-        if not hasattr(self, "_level"):
-            from .trim import LevelTrim
-            level = LevelTrim(self)
-            try:
-                level.prepare()
-            except (FlightError, RuntimeError):
-                level = None
-            self._level = level
-        return self._level
-
-    def _jsbsim_trim(self, settings: dict[str, float]) -> TrimResult:
-        fdm = self.fdm
-        self._reset(settings)
-        try:
-            fdm["simulation/do_simple_trim"] = 1
-        except jsbsim.TrimFailureError as exc:
-            raise TrimError(self._trim_failure(exc)) from exc
-        fdm.get_propulsion().get_steady_state()
-        return self._checked_trim()
-
-    def _reset(self, settings: dict[str, float], settle_engines: bool = True) -> None:
-        """Controls as loaded, the flight condition's ICs, reset, `settings`, engines running
-        (and at their steady state at full throttle, unless `settle_engines` is false: the
-        Newton trim runs its own steady states)."""
-        fdm, s = self.fdm, self.setup
-        for name, value in self._load_values.items():
-            self.node(name).set_double_value(value)
-        for name, value in self._touched.items():
-            self.node(name).set_double_value(value)
-        if self.has_property(RANDOM_SEED) and RANDOM_SEED not in settings:
-            # the wind generator restarts its stream at every run: without a seed parameter every run flies
-            # the same turbulence, whatever it flew before on this model
-            self.node(RANDOM_SEED).set_double_value(self._random_seed)
-        fdm["ic/h-sl-ft"] = s.altitude_ft
-        fdm["ic/vt-kts"] = s.airspeed_ktas
-        # ic/alpha-deg first: the Newton trim leaves its alpha there, the reset must not see it.
-        for ic in ("ic/alpha-deg", "ic/gamma-deg", "ic/beta-deg", "ic/phi-deg", "ic/psi-true-deg"):
-            fdm[ic] = 0.0
-        # Initial conditions are read by the reset; every other property must be set after
-        # it, because the reset restores the values declared in the aircraft's XML.
-        initial = {k: v for k, v in settings.items() if k.startswith("ic/")}
-        self._apply(initial)
-        fdm.reset_to_initial_conditions(0)
-        self._apply({k: v for k, v in settings.items() if k not in initial})
-        prepare_engines(fdm, settle=settle_engines)  # per engine kind (engines.py)
-
-    def _trim_failure(self, exc) -> str:
-        """Why the trim failed: the axis furthest outside its tolerance, and the state and
-        controls JSBSim leaves after the failure (it restores the pre-trim controls)."""
-        fdm = self.fdm
-        ratios = {name: abs(fdm[name]) / tol for name, tol in TRIM_TOLERANCES.items()}
-        worst = max(ratios, key=ratios.get)
-        acc = ", ".join(f"{k.split('/')[-1].split('-')[0]} = {fdm[k]:.3g}" for k in TRIM_TOLERANCES)
-        thr = ", ".join(f"{fdm[f'fcs/throttle-cmd-norm[{i}]']:.3f}" for i in range(self._engines))
-        left = (f"{acc}; alpha = {fdm['aero/alpha-deg']:.2f} deg, throttle = [{thr}], "
-                f"pitch trim = {fdm['fcs/pitch-trim-cmd-norm']:.3f}, elevator = {fdm['fcs/elevator-pos-deg']:.2f} deg")
-        where = (f"JSBSim trim failed ({str(exc).strip() or 'no convergence'}) at {self.setup.altitude_ft:g} ft, "
-                 f"{self.setup.airspeed_ktas:g} KTAS")
-        if not self.diagnose_trim_failures:
-            return f"{where} ({left})"
-        from .trim import lift_shortfall, speed_range_shortfall  # trim imports this module
-
-        stall = lift_shortfall(self) or speed_range_shortfall(self)
-        if stall:
-            return f"{where}: {stall} (JSBSim's trim left {left})"
-        return f"{where}: {worst.split('/')[-1].split('-')[0]} not trimmable ({left})"
-
-    def _apply(self, settings: dict[str, float]) -> None:
-        for name, value in settings.items():
-            node = self.node(name)
-            self._touched.setdefault(name, node.get_double_value())
-            node.set_double_value(float(value))
-
-    def _checked_trim(self) -> TrimResult:
-        fdm = self.fdm
-        residuals = {name: fdm[name] for name in TRIM_TOLERANCES}
-        result = TrimResult(
-            alpha_deg=fdm["aero/alpha-deg"],
-            theta_deg=fdm["attitude/theta-deg"],
-            throttle=tuple(fdm[f"fcs/throttle-cmd-norm[{i}]"] for i in range(self._engines)),
-            elevator_deg=fdm["fcs/elevator-pos-deg"],
-            residuals=residuals,
-        )
-        bad = [f"{k} = {v:.3g} (tolerance {TRIM_TOLERANCES[k]:g})"
-               for k, v in residuals.items() if not abs(v) <= TRIM_TOLERANCES[k]]
-        if bad:
-            raise TrimError("trim residual too large: " + "; ".join(bad))
-        if not all(0.0 <= x <= 1.0 for x in result.throttle):
-            raise TrimError(f"trim throttle outside [0, 1]: {result.throttle}")
-        if self.has_property("fcs/pitch-trim-sum") and abs(fdm["fcs/pitch-trim-sum"]) >= 1.0:
-            raise TrimError(f"trim elevator saturated at {result.elevator_deg:.2f} deg")
-        if self.has_property(STALL_PROPERTY) and fdm[STALL_PROPERTY] != 0.0:
-            raise TrimError(f"trim angle of attack {result.alpha_deg:.2f} deg is past the stall")
-        return result
-
-    def run_trimmed(self, trim: TrimResult, observers: Sequence[Observer] = ()) -> FlightResult:
-        """Excite and integrate from the trimmed state, recording at the output rate; `observers` see
-        t = 0 and every step (t = steps / rate_hz)."""
-        s = self.setup
-        time = s.time
-        k = s.steps_per_output
-        n_steps = (len(time) - 1) * k
-        step_times = np.arange(n_steps) / s.rate_hz
-        excitation = s.excitation.values(step_times)
-        changes = np.flatnonzero(np.diff(excitation, prepend=0.0))
-        change_at = dict(zip(changes.tolist(), excitation[changes].tolist()))
-        exc_node, exc_base, exc_per_deg = self._excitation_input()
-        run = self.fdm.run
-        data = np.empty((len(time), len(self._recorded)))
-        data[0] = [node.get_double_value() for node, _ in self._recorded]
-        watch = Watch(self, observers) if observers else None
-        if watch:
-            watch(0.0)
-        surface = self.node(SURFACE) if changes.size and self.has_property(SURFACE) else None
-        excited = np.flatnonzero(excitation) if surface is not None else ()
-        first, last = (int(excited[0]), int(excited[-1])) if len(excited) else (n_steps, -1)
-        trimmed_surface, moved = (surface.get_double_value() if surface is not None else 0.0), 0.0
-        for i in range(n_steps):
-            if i in change_at:
-                exc_node.set_double_value(exc_base + exc_per_deg * change_at[i])
-            run()
-            if first <= i <= last:  # the excitation is on: how far has the surface gone from its trim
-                moved = max(moved, abs(surface.get_double_value() - trimmed_surface))
-            if watch:
-                watch((i + 1) / s.rate_hz)
-            if (i + 1) % k == 0:
-                data[(i + 1) // k] = [node.get_double_value() for node, _ in self._recorded]
-        exc_node.set_double_value(exc_base)
-        commanded = float(np.max(np.abs(excitation))) if len(excited) else 0.0
-        self.surface_warning = None if not commanded or moved >= UNMOVED_FRACTION * commanded else (
-            f"the {s.excitation.kind} of {s.excitation.amplitude_deg:g} deg never moved the elevator: {SURFACE} "
-            f"went {moved:.3g} deg from its trimmed {trimmed_surface:.3g} deg while it was commanded (below "
-            f"{UNMOVED_FRACTION:.0%} of the amplitude: a dead band or hysteresis in the aircraft's actuator, e.g. "
-            "c172x's 2.9 deg), so the flight is not excited: give a larger amplitude (excitation.amplitude_deg in "
-            "a campaign, --amplitude-deg on the command line)")
-        data *= np.array([scale for _, scale in self._recorded])
-        self._check_envelope(data)
-        return FlightResult(time=time, outputs=dict(zip(s.outputs, data.T.copy())), trim=trim,
-                            warnings=[self.surface_warning] if self.surface_warning else [])
-
-    def _excitation_input(self):
-        """(node, trimmed value, command per degree) of the elevator excitation: the aircraft's
-        `fcs/elevator-excitation-deg` (degrees added to the elevator) when it has one; otherwise
-        `fcs/elevator-cmd-norm` (added to the pitch command, which the trim leaves at its value and
-        trims with fcs/pitch-trim-cmd-norm), converted by the elevator's travel read from the
-        aircraft's flight controls (its down travel for a positive amplitude, up travel for a negative one)."""
-        if self.has_property("fcs/elevator-excitation-deg"):
-            return self.node("fcs/elevator-excitation-deg"), 0.0, 1.0
-        node = self.node("fcs/elevator-cmd-norm")
-        travel = self.elevator_travel_deg
-        per_deg = 1.0 / (travel[0] if self.setup.excitation.amplitude_deg >= 0 else travel[1])
-        return node, node.get_double_value(), per_deg
-
-    @property
-    def elevator_travel_deg(self) -> tuple[float, float]:
-        """(down, up) elevator travel [deg] from the aircraft's flight controls (20 deg if not found)."""
-        if not hasattr(self, "_travel"):
-            from .aircraft import elevator_travel_deg
-
-            self._travel = elevator_travel_deg(self.setup.aircraft_file.read_bytes()) or (20.0, 20.0)
-        return self._travel
-
-    def _check_envelope(self, data: np.ndarray) -> None:
-        check_finite(data)
-        for name, limit in DIVERGENCE_LIMITS.items():
-            value = self.fdm[name]
-            if not abs(value) <= limit:
-                raise DivergenceError(f"{name} = {value:.1f} at the end of the flight (limit {limit:g})")
-
-
 def check_finite(data: np.ndarray) -> None:
     """DivergenceError when the recorded outputs hold a NaN or an infinity."""
     if not np.all(np.isfinite(data)):
         raise DivergenceError("NaN or infinite value in the recorded outputs")
 
-
-def flight_setup_from(config: dict, root: Path | None = None, base: Path | None = None, properties=()):
-    """The setup of a campaign's `simulator:` mapping (keys already validated), built by its scenario
-    kind (scenarios/): the aircraft located (a path relative to `base`, the project's, JSBSim's; see
-    `aircraft.locate`) and patched when `properties` scale or offset its functions, unless `root` or
-    config["root"] is given."""
-    from .scenarios import scenario_entry
-
-    return scenario_entry(config).setup(config, root, base, properties)

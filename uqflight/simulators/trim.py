@@ -46,6 +46,7 @@ import numpy as np
 
 from .jsbsim import aircraft_hash
 
+STALL_PROPERTY = "aero/coefficient/CL-stall"  # non-zero past the stall (bacm)
 RESIDUALS = ("accelerations/udot-ft_sec2", "accelerations/wdot-ft_sec2", "accelerations/qdot-rad_sec2")
 LATERAL = ("accelerations/vdot-ft_sec2", "accelerations/pdot-rad_sec2", "accelerations/rdot-rad_sec2")
 # JSBSim's trim tolerances (FGTrim.cpp: Tolerance 1e-3, A_Tolerance 1e-4).
@@ -257,8 +258,6 @@ def lift_shortfall(flight) -> str | None:
     (q̇ is linear in it: one secant step), since the elevator's own lift is a few % of CL. CL is
     JSBSim's stability-axis aerodynamic force over q̄ S. The slowest level flight is then
     V √(CL needed / CL max) at this altitude and weight."""
-    from .jsbsim import STALL_PROPERTY
-
     fdm = flight.fdm
     fdm["ic/alpha-deg"] = 0.0
     fdm.run_ic()
@@ -297,9 +296,10 @@ SPEED_SCAN_KTAS = np.arange(20.0, 601.0, 20.0)  # JSBSim's trim at each: ~60 ms 
 _SPEED_RANGES: dict[tuple, tuple[float, float] | None] = {}
 
 
-def level_speed_range(setup) -> tuple[float, float] | None:
+def level_speed_range(setup, flight_type) -> tuple[float, float] | None:
     """(slowest, fastest) true airspeed [KTAS] of SPEED_SCAN_KTAS (every 20 kt) at which the aircraft, as
-    loaded, trims in level flight at `setup.altitude_ft` with JSBSim's trim; None when none does. Computed
+    loaded, trims in level flight at `setup.altitude_ft` with JSBSim's trim (flown on `flight_type`, a
+    JSBSimFlight); None when none does. Computed
     once per process and flight condition, on fresh copies of the aircraft, so the flight that failed is
     left as it was. (A trim near the range's edges can take a second each: no finer search.)"""
     from .base import FlightError
@@ -307,10 +307,8 @@ def level_speed_range(setup) -> tuple[float, float] | None:
     key = (aircraft_hash(setup), str(setup.aircraft_file), setup.altitude_ft, setup.rate_hz)
     if key in _SPEED_RANGES:
         return _SPEED_RANGES[key]
-    from .jsbsim import JSBSimFlight
-
     def trims(speed: float) -> bool:
-        flight = JSBSimFlight(replace(setup, airspeed_ktas=float(speed), trim="jsbsim"), preflight=False)
+        flight = flight_type(replace(setup, airspeed_ktas=float(speed), trim="jsbsim"), preflight=False)
         flight.diagnose_trim_failures = False  # a failure is an answer here, not a question
         try:
             flight.trim({})
@@ -327,7 +325,7 @@ def speed_range_shortfall(flight) -> str | None:
     """When the flight condition's airspeed lies outside the speeds the aircraft trims level at at its
     altitude (`level_speed_range`), or none trims there: the reason and what to do, else None."""
     setup = flight.setup
-    speeds = level_speed_range(setup)
+    speeds = level_speed_range(setup, type(flight))
     scanned = (f"{SPEED_SCAN_KTAS[0]:g} to {SPEED_SCAN_KTAS[-1]:g} KTAS scanned every "
                f"{SPEED_SCAN_KTAS[1] - SPEED_SCAN_KTAS[0]:g} kt with JSBSim's trim, the aircraft as loaded")
     if speeds is None:

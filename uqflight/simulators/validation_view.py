@@ -5,7 +5,7 @@ from __future__ import annotations
 import jsbsim
 
 from .directives import LINEARIZATION
-from .jsbsim import flight_setup_from
+from .scenarios import flight_setup_from
 
 
 class AircraftProperties:

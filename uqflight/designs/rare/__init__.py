@@ -24,19 +24,10 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ...parameters.germs import GERMS
-from ..spec import check_keys, is_integer
+from ..base import REQUIRED, DesignKind, Key, count, number
 
-RARE_KINDS = ("subset_simulation", "importance_sampling", "active_learning")
-# the most runs when `budget` is not given: what each kind needs, with its other defaults, to come within a
-# factor 2 of the exact probability on the issue's closed-form problems (issue 46)
-DEFAULT_BUDGET = {"subset_simulation": 12000, "importance_sampling": 5000, "active_learning": 1500}
-OWN_KEYS = {"subset_simulation": ("samples_per_level", "p0"), "importance_sampling": ("samples",),
-            "active_learning": ()}
 SIDES = ("above", "below")
 EVENT_KEYS = ("of", *SIDES)
-MAX_RUNS = 10**8  # a budget beyond this is no rare-event design's (and limits.max_runs bounds it first)
-
-
 @dataclass(frozen=True)
 class Event:
     """The event whose probability is estimated: quantity `of` above (or below) `threshold`."""
@@ -85,61 +76,21 @@ def _event(value) -> Event:
     return Event(of, sides[0], float(threshold))
 
 
-def _count(spec: dict, key: str, minimum: int, maximum: int = MAX_RUNS) -> int:
-    value = spec[key]
-    if not is_integer(value) or not minimum <= value <= maximum:
-        raise ValueError(f"design.{key}: expected an integer from {minimum} to {maximum}, got {value!r}")
-    return int(value)
-
-
 def rare_settings(spec: dict) -> RareSettings:
     """The checked settings of a rare-event `design:` mapping; ValueError naming design.KEY otherwise."""
-    kind = spec.get("kind")
-    check_keys(spec, kind, ("event", "budget", *OWN_KEYS[kind]))
-    if "event" not in spec:
-        raise ValueError(f"design.event: missing; kind {kind} estimates the probability of an event "
-                         "{of: QUANTITY, above: X} (or below: X)")
-    event = _event(spec["event"])
-    budget = _count(spec, "budget", 1) if "budget" in spec else DEFAULT_BUDGET[kind]
-    settings = {}
-    if "samples_per_level" in spec:
-        settings["samples_per_level"] = _count(spec, "samples_per_level", 2)
-    if "p0" in spec:
-        p0 = spec["p0"]
-        if isinstance(p0, bool) or not isinstance(p0, (int, float)) or not 0 < p0 <= 0.5:
-            raise ValueError(f"design.p0: expected a number in (0, 0.5], the conditional probability of each "
-                             f"level, got {p0!r}")
-        settings["p0"] = float(p0)
-    if kind == "subset_simulation":
-        samples = settings.get("samples_per_level", 1000)
-        if math.floor(samples * settings.get("p0", 0.1)) < 1:
-            raise ValueError(f"design.samples_per_level: times p0 must give at least one chain (samples_per_level "
-                             f"{samples}, p0 {settings.get('p0', 0.1):g})")
-        if samples > budget:
-            raise ValueError(f"design.budget: {budget} runs cannot hold one level of samples_per_level "
-                             f"= {samples}")
-    if "samples" in spec:
-        settings["samples"] = _count(spec, "samples", 2)
-        if settings["samples"] > budget:
-            raise ValueError(f"design.budget: {budget} runs cannot hold one round of samples = {settings['samples']}")
-    return RareSettings(kind, event, budget, settings)
-
-
-def algorithm(kind: str):
-    """The algorithm of a rare-event kind (imported when first needed: scikit-learn only for active learning)."""
-    if kind == "subset_simulation":
-        from .subset import subset_simulation as found
-    elif kind == "importance_sampling":
-        from .importance import importance_sampling as found
-    else:
-        from .active import active_learning as found
-    return found
+    design = RARE[spec.get("kind")]
+    found = design.settings(spec)
+    event = _event(found.pop("event"))
+    budget = found.pop("budget")
+    settings = {key: float(value) if key == "p0" else value for key, value in found.items() if value is not None}
+    design.check_round(settings, budget)
+    return RareSettings(design.kind, event, budget, settings)
 
 
 def run_algorithm(settings: RareSettings, evaluate, dimension: int, seed: int, redrawn=()):
     """The algorithm's RareEventEstimate: `evaluate(u)` (n, d) -> margins (n,) is called once per round."""
-    return algorithm(settings.kind)(evaluate, dimension, seed=int(seed), budget=settings.budget,
-                                    redrawn=tuple(int(k) for k in redrawn), **settings.settings)
+    return RARE[settings.kind].algorithm()(evaluate, dimension, seed=int(seed), budget=settings.budget,
+                                           redrawn=tuple(int(k) for k in redrawn), **settings.settings)
 
 
 def germs_from_normal(u: np.ndarray, germs: list[str]) -> np.ndarray:
@@ -176,44 +127,95 @@ def first_round(settings: RareSettings, germs: list[str], seed: int, redrawn=())
     raise RuntimeError(f"{settings.kind} asked for no run")
 
 
-def rare_size(spec: dict, germs: list[str]) -> int | None:
-    """Runs of a rare-event design: at most `budget` (its kind's default budget when not given)."""
-    if not isinstance(spec, dict) or spec.get("kind") not in RARE_KINDS:
-        return None
-    budget = spec.get("budget", DEFAULT_BUDGET[spec["kind"]])
-    return budget if is_integer(budget) and budget >= 1 else None
+MAX_RUNS = 10**8  # a budget beyond this is no rare-event design's (and limits.max_runs bounds it first)
+EVENT = Key("an event {of: QUANTITY, above: X} (or below: X) whose probability it estimates", REQUIRED)
 
 
-def rare_design(spec: dict, germs: list[str], seed: int, redrawn=()):
+class RareDesign(DesignKind):
     """A rare-event design: the first round of the algorithm's points, mapped to the germs; the runner
-    (`uqflight.rare_rounds`) adds the other rounds from the results, up to `budget` runs. The weights are
-    equal and mean nothing: the runs are not draws of the input law."""
-    settings = rare_settings(spec)
-    xi = germs_from_normal(first_round(settings, germs, seed, redrawn), germs)
-    info = {"event": settings.event.text(), "budget": settings.budget, **settings.settings,
-            "rounds": "adapted to the event from the results, up to the budget"}
-    return xi, np.full(len(xi), 1.0 / len(xi)), info
+    (`uqflight.rare_rounds`) adds the other rounds from the results, up to `budget` runs (its kind's default
+    budget when not given: what each kind needs, with its other defaults, to come within a factor 2 of the
+    exact probability on the issue's closed-form problems, issue 46). The weights are equal and mean nothing:
+    the runs are not draws of the input law."""
+
+    draws = None
+    adaptive = rare = True
+
+    def size(self, spec, germs):
+        """At most `budget`."""
+        return self.given(spec, "budget")
+
+    def build(self, spec, germs, seed, redrawn=()):
+        settings = rare_settings(spec)
+        xi = germs_from_normal(first_round(settings, germs, seed, redrawn), germs)
+        info = {"event": settings.event.text(), "budget": settings.budget, **settings.settings,
+                "rounds": "adapted to the event from the results, up to the budget"}
+        return xi, np.full(len(xi), 1.0 / len(xi)), info
+
+    def check_round(self, settings: dict, budget: int) -> None:
+        """ValueError naming design.KEY when one round of `settings` does not fit the `budget`."""
+        if settings.get("samples", 0) > budget:
+            raise ValueError(f"design.budget: {budget} runs cannot hold one round of samples = {settings['samples']}")
 
 
-def subset_simulation_design(spec: dict, germs: list[str], seed: int, redrawn=()):
+class SubsetSimulation(RareDesign):
     """Subset simulation (Au & Beck 2001): the event's probability as a product of conditional probabilities
     p0 of nested levels, each level's `samples_per_level` runs grown by Markov chains (adaptive conditional
     sampling) from the p0 share of the runs beyond the previous level, a seed parameter redrawn at each step (keys `event`, `budget`, `samples_per_level`, `p0`)."""
-    return rare_design(spec, germs, seed, redrawn)
+
+    kind = "subset_simulation"
+    keys = {"event": EVENT, "budget": count(1, MAX_RUNS, 12000), "samples_per_level": count(2, MAX_RUNS, None),
+            "p0": number("a number in (0, 0.5], the conditional probability of each level", lambda v: 0 < v <= 0.5,
+                         None)}
+    example = {"kind": "subset_simulation", "event": {"of": "y", "above": 3.0}, "samples_per_level": 100, "p0": 0.1,
+               "budget": 1000}
+
+    @staticmethod
+    def algorithm():
+        from .subset import subset_simulation
+        return subset_simulation
+
+    def check_round(self, settings, budget):
+        samples = settings.get("samples_per_level", 1000)
+        if math.floor(samples * settings.get("p0", 0.1)) < 1:
+            raise ValueError(f"design.samples_per_level: times p0 must give at least one chain (samples_per_level "
+                             f"{samples}, p0 {settings.get('p0', 0.1):g})")
+        if samples > budget:
+            raise ValueError(f"design.budget: {budget} runs cannot hold one level of samples_per_level "
+                             f"= {samples}")
 
 
-def importance_sampling_design(spec: dict, germs: list[str], seed: int, redrawn=()):
+class ImportanceSampling(RareDesign):
     """Adaptive importance sampling: a sampling density moved towards the event round by round (`samples`
     runs each), the probability weighted by the input law over that density (keys `event`, `budget`,
     `samples`)."""
-    return rare_design(spec, germs, seed, redrawn)
+
+    kind = "importance_sampling"
+    keys = {"event": EVENT, "budget": count(1, MAX_RUNS, 5000), "samples": count(2, MAX_RUNS, None)}
+    example = {"kind": "importance_sampling", "event": {"of": "y", "above": 3.0}, "samples": 100, "budget": 1000}
+
+    @staticmethod
+    def algorithm():
+        from .importance import importance_sampling
+        return importance_sampling
 
 
-def active_learning_design(spec: dict, germs: list[str], seed: int, redrawn=()):
+class ActiveLearning(RareDesign):
     """Active learning: a Gaussian-process surrogate of the event's margin, enriched where the sign is least
     sure, then an importance-sampling correction on true runs that keeps the estimate unbiased where the
     surrogate is wrong (keys `event`, `budget`)."""
-    return rare_design(spec, germs, seed, redrawn)
+
+    kind = "active_learning"
+    keys = {"event": EVENT, "budget": count(1, MAX_RUNS, 1500)}
+    example = {"kind": "active_learning", "event": {"of": "y", "above": 3.0}, "budget": 500}
+
+    @staticmethod
+    def algorithm():
+        from .active import active_learning
+        return active_learning
+
+
+RARE = {design.kind: design() for design in (SubsetSimulation, ImportanceSampling, ActiveLearning)}
 
 
 def check_rare_campaign(check, campaign) -> None:

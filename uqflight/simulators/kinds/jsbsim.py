@@ -7,68 +7,14 @@ from pathlib import Path
 import numpy as np
 
 from ...labels import name_unit
+from ..aircraft import AircraftNotFound, locate
+from ..base import Field, SimulatorKind
+from ..bundle import aircraft_bundle
 from ..jsbsim import DEFAULT_OUTPUTS, NAMED_OUTPUTS, UNITS, aircraft_hash
 from ..scenarios import DEFAULT as DEFAULT_SCENARIO
 from ..scenarios import REGISTRY as SCENARIOS
-from ..scenarios import SCENARIO_KINDS, scenario_entry, scenario_kind
-from .outputs import check_outputs
-
-KEYS = ("kind", "aircraft", "scenario", "outputs", "properties")
-DEFAULT_AIRCRAFT = "bacm"
-
-
-def check(check, value: dict) -> dict:
-    """The keys as written (the scenario's by its entry); the aircraft is not located yet (`resolve`)."""
-    kind = DEFAULT_SCENARIO
-    if "scenario" in value:
-        scenario = value["scenario"]
-        if not isinstance(scenario, dict):
-            check.fail("simulator.scenario", f"expected a mapping with a kind key, got {check.shown(scenario)}")
-        if "kind" not in scenario:
-            check.fail("simulator.scenario.kind", f"is required; expected one of {', '.join(SCENARIO_KINDS)}")
-        kind = check.string(scenario["kind"], "simulator.scenario.kind", SCENARIO_KINDS)
-        check.mapping(scenario, "simulator.scenario", ("kind", *SCENARIOS[kind].scenario_keys))
-    sim = dict(check.mapping(value, "simulator", (*KEYS, *SCENARIOS[kind].keys)))
-    if kind == DEFAULT_SCENARIO:  # a script names its aircraft itself (resolved with the script)
-        sim.setdefault("aircraft", DEFAULT_AIRCRAFT)
-    if "aircraft" in sim:
-        check.string(sim["aircraft"], "simulator.aircraft")
-    if "properties" in sim:
-        check_fixed_properties(check, sim["properties"])
-    if "outputs" in sim:
-        check_outputs(check, sim["outputs"])
-    return sim
-
-
-def check_fixed_properties(check, value) -> dict:
-    """`simulator.properties`: {PROPERTY: VALUE} set for every run (a turbulence model, a steady wind)."""
-    if not isinstance(value, dict) or not value:
-        check.fail("simulator.properties", "expected a mapping of JSBSim properties to numbers, got "
-                                           f"{check.shown(value)}")
-    for name, number in value.items():
-        check.string(name, "simulator.properties")
-        check.number(number, f"simulator.properties.{name}")
-    return value
-
-
-def resolve(check, sim: dict, source: str) -> None:
-    """The scenario's files resolved and the aircraft located (`sim["aircraft_path"]`, the folder that
-    travels with the simulator), relative to the campaign file `source`."""
-    folder = Path(source).resolve().parent
-    sim.update(SCENARIOS[scenario_kind(sim)].check(check, sim, folder))
-    check.string(sim.setdefault("aircraft", DEFAULT_AIRCRAFT), "simulator.aircraft")
-    locate_aircraft(check, sim, source)
-
-
-def locate_aircraft(check, sim: dict, source: str) -> None:
-    """sim["aircraft_path"]: the folder of the aircraft, relative to the campaign file `source` (or the
-    project's, JSBSim's; see `aircraft.locate`). Reads folders only."""
-    from ..aircraft import AircraftNotFound, locate
-
-    try:
-        sim["aircraft_path"] = str(locate(sim["aircraft"], Path(source).resolve().parent).folder)
-    except AircraftNotFound as exc:
-        check.fail("simulator.aircraft", str(exc))
+from ..scenarios import SCENARIO_KINDS, scenario_entry
+from .outputs import KIND, OUTPUTS, check_outputs
 
 
 class JSBSimSimulator:
@@ -106,7 +52,7 @@ class JSBSimSimulator:
 
     def resolution(self, kappa: np.ndarray, ours: dict[str, np.ndarray] | None = None) -> dict[str, np.ndarray] | None:
         """{output: (T,)}: the simulator's own resolution at `kappa` as its scenario states it (level
-        flight: the drift between its two valid trims; see `level_flight.resolution`), or None."""
+        flight: the drift between its two valid trims; see `LevelFlight.resolution`), or None."""
         return self.scenario.resolution(self.setup, self.settings(kappa), ours)
 
     def restart(self) -> None:
@@ -119,55 +65,126 @@ class JSBSimSimulator:
             self._flown = False
 
 
-def make(config: dict, parameter_names: list[str], properties: list[str], base: Path) -> JSBSimSimulator:
-    return JSBSimSimulator(config, properties, base)
+
+class JSBSim(SimulatorKind):
+    """A JSBSim flight (scenario below).
+
+    Examples
+    --------
+    >>> JSBSim().span({"kind": "jsbsim", "duration_s": 3.0})
+    3.0
+    """
+
+    kind = "jsbsim"
+    aircraft = True
+    fields = {
+        "kind": KIND,
+        "aircraft": Field("A project or JSBSim aircraft name, or a folder (relative to the campaign file). Default "
+                          "`bacm` (level flight); a script names its own. `aircraft: c172p`"),
+        "scenario": Field("How a JSBSim run is flown: `{kind: level_flight}` (the default) or `{kind: script, "
+                          "script: NAME_OR_PATH}`."),
+        "outputs": OUTPUTS,
+        "properties": Field("`{PROPERTY: VALUE}` set for every run (`ic/...` before the reset, the others after it; "
+                            "level flight applies `atmosphere/...` after the trim). "
+                            "`properties: {atmosphere/turb-type: 3}`"),
+    }
+    example = ({"kind": "jsbsim", "duration_s": 1.0, "output_rate_hz": 10.0},
+               {"CL0": {"property": "aero/uq/CL0", "distribution": "normal", "interval_pct": 20}})
+
+    def check(self, check, value: dict) -> dict:
+        """The keys as written (the scenario's by its kind); the aircraft is not located yet (`resolve`)."""
+        scenario = SCENARIOS[DEFAULT_SCENARIO]
+        if "scenario" in value:
+            written = value["scenario"]
+            if not isinstance(written, dict):
+                check.fail("simulator.scenario", f"expected a mapping with a kind key, got {check.shown(written)}")
+            if "kind" not in written:
+                check.fail("simulator.scenario.kind", f"is required; expected one of {', '.join(SCENARIO_KINDS)}")
+            scenario = SCENARIOS[check.string(written["kind"], "simulator.scenario.kind", SCENARIO_KINDS)]
+            check.mapping(written, "simulator.scenario", ("kind", *scenario.scenario_keys))
+        sim = dict(check.mapping(value, "simulator", (*self.keys, *scenario.keys)))
+        if scenario.default_aircraft is not None:  # a script names its aircraft itself (resolved with the script)
+            sim.setdefault("aircraft", scenario.default_aircraft)
+        if "aircraft" in sim:
+            check.string(sim["aircraft"], "simulator.aircraft")
+        if "properties" in sim:
+            check_fixed_properties(check, sim["properties"])
+        if "outputs" in sim:
+            check_outputs(check, sim["outputs"])
+        return sim
+
+    def resolve(self, check, sim: dict, source: str) -> None:
+        """The scenario's files resolved and the aircraft located (`sim["aircraft_path"]`, the folder that
+        travels with the simulator), relative to the campaign file `source`."""
+        scenario = scenario_entry(sim)
+        sim.update(scenario.check(check, sim, Path(source).resolve().parent))
+        check.string(sim.setdefault("aircraft", SCENARIOS[DEFAULT_SCENARIO].default_aircraft), "simulator.aircraft")
+        locate_aircraft(check, sim, source)
+
+    def make(self, config: dict, parameter_names: list[str], properties: list[str], base: Path) -> JSBSimSimulator:
+        return JSBSimSimulator(config, properties, base)
+
+    def bundle(self, config: dict, properties, base) -> dict | None:
+        """The aircraft (the patched copy when `properties` perturb its functions) and its scenario's files."""
+        return aircraft_bundle(config, properties, base, scenario_entry(config).files)
+
+    def provenance(self, config: dict, base: Path | None = None, properties=()) -> dict:
+        """The aircraft's hash (the patched copy's when `properties` scale or offset its functions), and what
+        its scenario kind adds (nothing for level flight)."""
+        scenario = scenario_entry(config)
+        return {"aircraft_hash": aircraft_hash(scenario.setup(config, base=base, properties=properties)),
+                **scenario.provenance(config)}
+
+    def relocated(self, config: dict, folder: Path) -> dict:
+        """An aircraft given as a folder relative to `folder` made absolute (a project or JSBSim aircraft
+        keeps its name), and the scenario's files as its kind says."""
+        sim = dict(config)
+        if "aircraft" in sim:
+            try:
+                location = locate(sim["aircraft"], Path(folder))
+            except AircraftNotFound:  # not there (any more): as written, for the campaign's checks to name it
+                location = None
+            if location is not None and location.origin == "path":
+                sim["aircraft"] = str(location.folder)
+        return scenario_entry(sim).relocated(sim, Path(folder))
+
+    def recorded(self, config: dict) -> tuple[int, int]:
+        return scenario_entry(config).times(config), len(config.get("outputs", DEFAULT_OUTPUTS))
+
+    def span(self, config: dict) -> float | None:
+        return scenario_entry(config).span(config)
+
+    def trims_level(self, config: dict) -> bool:
+        return scenario_entry(config).level_trim
+
+    def facts(self, config: dict) -> dict[str, str]:
+        return scenario_entry(config).facts(config)
+
+    def check_source(self, check, name, path: str, config: dict, aircraft) -> None:
+        """A named output or, when the aircraft is known, one of its properties."""
+        check.string(name, path)
+        if aircraft is not None and name not in NAMED_OUTPUTS and aircraft.value(name) is None:
+            check.fail(path, f"expected one of {', '.join(NAMED_OUTPUTS)} or a JSBSim property of aircraft "
+                             f"{aircraft.aircraft!r}, got {name!r}{aircraft.hint(name)}")
 
 
-def bundle(config: dict, properties, base) -> dict | None:
-    from ..bundle import aircraft_bundle
-
-    return aircraft_bundle(config, properties, base)
-
-
-def provenance(config: dict, base: Path | None = None, properties=()) -> dict:
-    """The aircraft's hash (the patched copy's when `properties` scale or offset its functions), and what
-    its scenario kind adds (nothing for level flight)."""
-    entry = scenario_entry(config)
-    return {"aircraft_hash": aircraft_hash(entry.setup(config, base=base, properties=properties)),
-            **entry.provenance(config)}
+def check_fixed_properties(check, value) -> dict:
+    """`simulator.properties`: {PROPERTY: VALUE} set for every run (a turbulence model, a steady wind)."""
+    if not isinstance(value, dict) or not value:
+        check.fail("simulator.properties", "expected a mapping of JSBSim properties to numbers, got "
+                                           f"{check.shown(value)}")
+    for name, number in value.items():
+        check.string(name, "simulator.properties")
+        check.number(number, f"simulator.properties.{name}")
+    return value
 
 
-def relocated(config: dict, folder: Path) -> dict:
-    """An aircraft given as a folder relative to `folder` made absolute (a project or JSBSim aircraft
-    keeps its name), and the scenario's files as its kind says."""
-    from ..aircraft import AircraftNotFound, locate
-
-    sim = dict(config)
-    if "aircraft" in sim:
-        try:
-            location = locate(sim["aircraft"], Path(folder))
-        except AircraftNotFound:  # not there (any more): as written, for the campaign's checks to name it
-            location = None
-        if location is not None and location.origin == "path":
-            sim["aircraft"] = str(location.folder)
-    return SCENARIOS[scenario_kind(sim)].relocated(sim, Path(folder))
+def locate_aircraft(check, sim: dict, source: str) -> None:
+    """sim["aircraft_path"]: the folder of the aircraft, relative to the campaign file `source` (or the
+    project's, JSBSim's; see `aircraft.locate`). Reads folders only."""
+    try:
+        sim["aircraft_path"] = str(locate(sim["aircraft"], Path(source).resolve().parent).folder)
+    except AircraftNotFound as exc:
+        check.fail("simulator.aircraft", str(exc))
 
 
-def recorded(config: dict) -> tuple[int, int]:
-    return scenario_entry(config).times(config), len(config.get("outputs", DEFAULT_OUTPUTS))
-
-
-def span(config: dict) -> float | None:
-    return scenario_entry(config).span(config)
-
-
-def facts(config: dict) -> dict[str, str]:
-    return scenario_entry(config).facts(config)
-
-
-def check_source(check, name, path: str, config: dict, aircraft) -> None:
-    """A named output or, when the aircraft is known, one of its properties."""
-    check.string(name, path)
-    if aircraft is not None and name not in NAMED_OUTPUTS and aircraft.value(name) is None:
-        check.fail(path, f"expected one of {', '.join(NAMED_OUTPUTS)} or a JSBSim property of aircraft "
-                         f"{aircraft.aircraft!r}, got {name!r}{aircraft.hint(name)}")

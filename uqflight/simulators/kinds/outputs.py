@@ -1,5 +1,12 @@
-"""`simulator.outputs`, the same key for every simulator kind."""
+"""The `simulator:` keys every simulator kind has: `kind` and `outputs`."""
 from __future__ import annotations
+
+from ..base import Field
+
+KIND = Field("Required. `jsbsim` (a JSBSim flight) or `python` (a Python function).")
+OUTPUTS = Field("The recorded outputs. JSBSim: named outputs (`alpha_deg`, `theta_deg`, `h_ft`, `q_degps`, `vtas_kt`, "
+                "the default) and/or any JSBSim property; python: the names of the function's outputs (default: all "
+                "it returns). `outputs: [alpha_deg, h_ft]`")
 
 
 def check_outputs(check, value) -> list[str]:

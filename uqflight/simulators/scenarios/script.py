@@ -35,11 +35,10 @@ import numpy as np
 
 from ..aircraft import AircraftFiles, cache_dir
 from ..directives import checked, parsed, without_io
-from ..base import FlightError, TrimError
-from ..jsbsim import ATMOSPHERE, DEFAULT_OUTPUTS, FlightResult, PropertyAccess, Watch, check_finite, ready_to_load
+from ..base import Field, FlightError, ScenarioKind, TrimError, check_fields
+from ..jsbsim import (ATMOSPHERE, DEFAULT_OUTPUTS, OUTPUT_RATE, FlightResult, PropertyAccess, Watch, check_finite,
+                      ready_to_load)
 
-KEYS = ("output_rate_hz",)
-SCENARIO_KEYS = ("script", "end_s")
 DEFAULT_OUTPUT_RATE_HZ = 20.0
 MAX_SCRIPT_BYTES = 1 << 20
 MAX_STEPS = 10**7  # integration steps (80 MB of step times; 23 h at 120 Hz), as many as a results file holds times
@@ -243,72 +242,6 @@ def _script_file(config: dict, base: Path | None) -> ScriptFile:
     return ScriptFile.read(Path(path))
 
 
-def check(check, sim: dict, folder: Path) -> dict:
-    """Resolve and read the script, check end_s, the output rate against the script's dt and the
-    campaign's aircraft against the script's (`check` is the campaign's Checker)."""
-    from ..aircraft import AircraftNotFound, locate
-
-    scenario = sim["scenario"]
-    if "script" not in scenario:
-        check.fail("simulator.scenario.script", "is required: a run script relative to the campaign file, or the "
-                                                "name of one shipped with JSBSim (e.g. c172_cruise_8K)")
-    text = check.string(scenario["script"], "simulator.scenario.script")
-    try:
-        script = ScriptFile.read(resolve(text, folder))
-    except (ScriptError, OSError) as exc:
-        check.fail("simulator.scenario.script", str(exc))
-    sim["script_path"] = str(script.path)
-    end = None
-    if "end_s" in scenario:
-        end = check.number(scenario["end_s"], "simulator.scenario.end_s")
-        if not script.start_s < end <= script.end_s:
-            check.fail("simulator.scenario.end_s", f"expected a time after the script's start {script.start_s:g} s and "
-                                                   f"at most its end {script.end_s:g} s, got {end:g}")
-    try:
-        script.bounded_steps(end)
-    except ScriptError as exc:
-        check.fail("simulator.scenario.end_s" if end is not None else "simulator.scenario.script", str(exc))
-    rate = DEFAULT_OUTPUT_RATE_HZ
-    if "output_rate_hz" in sim:
-        rate = check.number(sim["output_rate_hz"], "simulator.output_rate_hz", 0.0, strict=True)
-    if script.steps_per_output(rate) is None:
-        divisors = ", ".join(f"{script.rate_hz / k:.4g}" for k in range(1, 7))
-        check.fail("simulator.output_rate_hz", f"expected a divisor of the script's {script.rate_hz:.7g} Hz rate "
-                                               f"(dt = {script.dt_text} s: {divisors}, ...), got {rate:g}")
-    named = sim.get("aircraft", script.aircraft)
-    check.string(named, "simulator.aircraft")
-    try:
-        location = locate(named, folder)
-    except AircraftNotFound as exc:
-        check.fail("simulator.aircraft", str(exc))
-    if location.name != script.aircraft:
-        check.fail("simulator.aircraft", f"{named!r} is not the script's aircraft {script.aircraft!r} (<use aircraft=> "
-                                         f"in {script.path.name}); leave simulator.aircraft out, or name that aircraft")
-    try:
-        script.initfile(location.folder)
-    except ScriptError as exc:
-        check.fail("simulator.scenario.script", str(exc))
-    sim["aircraft"] = named
-    return sim
-
-
-def span(config: dict) -> float | None:
-    """end_s when given, else the script's own end once it is resolved (`script_path`), else None: no
-    file is read before the campaign is resolved."""
-    end = config.get("scenario", {}).get("end_s")
-    if isinstance(end, (int, float)) and not isinstance(end, bool):
-        return float(end)
-    return ScriptFile.read(Path(config["script_path"])).end_s if config.get("script_path") else None
-
-
-def times(config: dict) -> int:
-    """The number of recorded times, from the script's timing and the output rate alone."""
-    script = _script_file(config, None)
-    end_s = config.get("scenario", {}).get("end_s")
-    steps = script.steps(None if end_s is None else float(end_s))
-    return steps // script.steps_per_output(float(config.get("output_rate_hz", DEFAULT_OUTPUT_RATE_HZ))) + 1
-
-
 @dataclass(frozen=True)
 class ScriptSetup:
     """Everything that is the same for every sample of a script campaign."""
@@ -342,28 +275,6 @@ class ScriptSetup:
     @property
     def aircraft_file(self) -> Path:
         return Path(self.root) / "aircraft" / self.aircraft / f"{self.aircraft}.xml"
-
-
-def setup(config: dict, root: Path | None = None, base: Path | None = None, properties=()) -> ScriptSetup:
-    """A ScriptSetup from a campaign's `simulator:` mapping (keys already validated): the script's
-    aircraft located and patched as for level flight (see `level_flight.setup`)."""
-    from ..patch import PreparedAircraft
-
-    script = _script_file(config, base)
-    name = config.get("aircraft", script.aircraft)
-    root = config.get("root", root)
-    if root is None:
-        prepared = PreparedAircraft(config.get("aircraft_path", name), base, properties)
-        name, root = prepared.name, prepared.root
-    root = Path(root)
-    scenario = config.get("scenario", {})
-    return ScriptSetup(
-        aircraft=name, root=root, script=script,
-        initfile=script.initfile(root / "aircraft" / name) if (root / "aircraft" / name).is_dir() else None,
-        end_s=float(scenario["end_s"]) if "end_s" in scenario else None,
-        output_rate_hz=float(config.get("output_rate_hz", DEFAULT_OUTPUT_RATE_HZ)),
-        outputs=tuple(config.get("outputs", DEFAULT_OUTPUTS)),
-    )
 
 
 class ScriptFlight(PropertyAccess):
@@ -504,50 +415,147 @@ class ScriptFlight(PropertyAccess):
         return data, times
 
 
-def flight(setup: ScriptSetup, preflight: bool = True) -> ScriptFlight:
-    return ScriptFlight(setup, preflight=preflight)
+class Script(ScenarioKind):
+    """Fly a JSBSim run script as JSBSim does, its events included (keys `scenario.script`, `scenario.end_s`,
+    `output_rate_hz`).
 
+    Examples
+    --------
+    >>> Script().facts({"kind": "jsbsim", "scenario": {"kind": "script", "script": "c172_cruise_8K", "end_s": 20}})
+    {'flight': 'script c172_cruise_8K, cut at 20 s', 'excitation': "the script's events"}
+    """
 
-def files(config: dict) -> dict[str, bytes]:
-    """The script, its initialisation file when beside it, and the output files it names (keys relative
-    to the script's folder): what a worker needs beyond the aircraft's files."""
-    script = ScriptFile.read(Path(config["script_path"]))
-    folder = script.path.parent
-    names = [script.path.name, *script.outputs_files]
-    for name in (script.initialize, f"{script.initialize}.xml"):
-        if _inside(folder, name).is_file():
-            names.append(name)
-            break
-    return {name: _inside(folder, name).read_bytes() for name in dict.fromkeys(names)}
+    kind = "script"
+    fields = {"output_rate_hz": OUTPUT_RATE}
+    scenario_fields = {
+        "script": Field("Required for `script`: a JSBSim run script, a file relative to the campaign file or the "
+                        "name of one shipped with JSBSim (without `.xml`). `script: c172_cruise_8K`"),
+        "end_s": Field("Ends the run before the script's `<run end=>` [s]. `end_s: 20`")}
+    example = {"kind": "jsbsim", "scenario": {"kind": "script", "script": "c172_cruise_8K", "end_s": 2.0},
+               "output_rate_hz": 10.0}
 
+    def check(self, check, sim: dict, folder: Path) -> dict:
+        """Resolve and read the script, check end_s, the output rate against the script's dt and the
+        campaign's aircraft against the script's (`check` is the campaign's Checker)."""
+        from ..aircraft import AircraftNotFound, locate
 
-def localize(config: dict, folder: Path) -> dict:
-    """The mapping reading the script (and the files beside it) from `folder`, where `files` were written."""
-    return {**config, "script_path": str(Path(folder) / Path(config["script_path"]).name)}
+        scenario = sim["scenario"]
+        if "script" not in scenario:
+            check.fail("simulator.scenario.script", "is required: a run script relative to the campaign file, or the "
+                                                    "name of one shipped with JSBSim (e.g. c172_cruise_8K)")
+        text = check.string(scenario["script"], "simulator.scenario.script")
+        try:
+            script = ScriptFile.read(resolve(text, folder))
+        except (ScriptError, OSError) as exc:
+            check.fail("simulator.scenario.script", str(exc))
+        sim["script_path"] = str(script.path)
+        end = None
+        if "end_s" in scenario:
+            end = check.number(scenario["end_s"], "simulator.scenario.end_s")
+            if not script.start_s < end <= script.end_s:
+                check.fail("simulator.scenario.end_s", f"expected a time after the script's start {script.start_s:g} "
+                                                       f"s and at most its end {script.end_s:g} s, got {end:g}")
+        try:
+            script.bounded_steps(end)
+        except ScriptError as exc:
+            check.fail("simulator.scenario.end_s" if end is not None else "simulator.scenario.script", str(exc))
+        check_fields(check, sim, "simulator", self.fields)
+        rate = float(sim.get("output_rate_hz", DEFAULT_OUTPUT_RATE_HZ))
+        if script.steps_per_output(rate) is None:
+            divisors = ", ".join(f"{script.rate_hz / k:.4g}" for k in range(1, 7))
+            check.fail("simulator.output_rate_hz", f"expected a divisor of the script's {script.rate_hz:.7g} Hz rate "
+                                                   f"(dt = {script.dt_text} s: {divisors}, ...), got {rate:g}")
+        named = sim.get("aircraft", script.aircraft)
+        check.string(named, "simulator.aircraft")
+        try:
+            location = locate(named, folder)
+        except AircraftNotFound as exc:
+            check.fail("simulator.aircraft", str(exc))
+        if location.name != script.aircraft:
+            check.fail("simulator.aircraft", f"{named!r} is not the script's aircraft {script.aircraft!r} (<use "
+                                             f"aircraft=> in {script.path.name}); leave simulator.aircraft out, or "
+                                             "name that aircraft")
+        try:
+            script.initfile(location.folder)
+        except ScriptError as exc:
+            check.fail("simulator.scenario.script", str(exc))
+        sim["aircraft"] = named
+        return sim
 
+    def span(self, config: dict) -> float | None:
+        """end_s when given, else the script's own end once it is resolved (`script_path`), else None: no
+        file is read before the campaign is resolved."""
+        end = config.get("scenario", {}).get("end_s")
+        if isinstance(end, (int, float)) and not isinstance(end, bool):
+            return float(end)
+        return ScriptFile.read(Path(config["script_path"])).end_s if config.get("script_path") else None
 
-def relocated(config: dict, folder: Path) -> dict:
-    """A script given as a file relative to `folder` made absolute (a JSBSim script keeps its name)."""
-    scenario = dict(config["scenario"])
-    candidate = Path(folder) / str(scenario["script"])
-    if not Path(str(scenario["script"])).is_absolute() and candidate.is_file():
-        scenario["script"] = str(candidate.resolve())
-    return {**config, "scenario": scenario}
+    def times(self, config: dict) -> int:
+        """The number of recorded times, from the script's timing and the output rate alone."""
+        script = _script_file(config, None)
+        end_s = config.get("scenario", {}).get("end_s")
+        steps = script.steps(None if end_s is None else float(end_s))
+        return steps // script.steps_per_output(float(config.get("output_rate_hz", DEFAULT_OUTPUT_RATE_HZ))) + 1
 
+    def setup(self, config: dict, root: Path | None = None, base: Path | None = None, properties=()) -> ScriptSetup:
+        """A ScriptSetup from a campaign's `simulator:` mapping (keys already validated): the script's
+        aircraft located and patched as for level flight (see `LevelFlight.setup`)."""
+        from ..patch import PreparedAircraft
 
-def provenance(config: dict) -> dict:
-    """The scenario and the sha256 of the script's files, for the results file."""
-    return {"scenario": json.dumps({"kind": "script", "script": Path(config["script_path"]).name,
-                                    "sha256": AircraftFiles("", files(config)).hash()})}
+        script = _script_file(config, base)
+        name = config.get("aircraft", script.aircraft)
+        root = config.get("root", root)
+        if root is None:
+            prepared = PreparedAircraft(config.get("aircraft_path", name), base, properties)
+            name, root = prepared.name, prepared.root
+        root = Path(root)
+        scenario = config.get("scenario", {})
+        return ScriptSetup(
+            aircraft=name, root=root, script=script,
+            initfile=script.initfile(root / "aircraft" / name) if (root / "aircraft" / name).is_dir() else None,
+            end_s=float(scenario["end_s"]) if "end_s" in scenario else None,
+            output_rate_hz=float(config.get("output_rate_hz", DEFAULT_OUTPUT_RATE_HZ)),
+            outputs=tuple(config.get("outputs", DEFAULT_OUTPUTS)),
+        )
 
+    def flight(self, setup: ScriptSetup, preflight: bool = True) -> ScriptFlight:
+        return ScriptFlight(setup, preflight=preflight)
 
-def facts(config: dict) -> dict[str, str]:
-    """The script flown, as the campaign names it (the report's campaign table)."""
-    scenario = config.get("scenario") or {}
-    end = f", cut at {scenario['end_s']:g} s" if isinstance(scenario.get("end_s"), (int, float)) else ""
-    return {"flight": f"script {scenario.get('script', '?')}{end}", "excitation": "the script's events"}
+    def files(self, config: dict) -> dict[str, bytes]:
+        """The script, its initialisation file when beside it, and the output files it names (keys relative
+        to the script's folder): what a worker needs beyond the aircraft's files."""
+        script = ScriptFile.read(Path(config["script_path"]))
+        folder = script.path.parent
+        names = [script.path.name, *script.outputs_files]
+        for name in (script.initialize, f"{script.initialize}.xml"):
+            if _inside(folder, name).is_file():
+                names.append(name)
+                break
+        return {name: _inside(folder, name).read_bytes() for name in dict.fromkeys(names)}
 
+    def localize(self, config: dict, folder: Path) -> dict:
+        """The mapping reading the script (and the files beside it) from `folder`, where `files` were written."""
+        return {**config, "script_path": str(Path(folder) / Path(config["script_path"]).name)}
 
-def resolution(setup: ScriptSetup, settings, ours=None) -> None:
-    """A script has no second way of flying it: no resolution of its own."""
-    return None
+    def relocated(self, config: dict, folder: Path) -> dict:
+        """A script given as a file relative to `folder` made absolute (a JSBSim script keeps its name)."""
+        scenario = dict(config["scenario"])
+        candidate = Path(folder) / str(scenario["script"])
+        if not Path(str(scenario["script"])).is_absolute() and candidate.is_file():
+            scenario["script"] = str(candidate.resolve())
+        return {**config, "scenario": scenario}
+
+    def provenance(self, config: dict) -> dict:
+        """The scenario and the sha256 of the script's files, for the results file."""
+        return {"scenario": json.dumps({"kind": "script", "script": Path(config["script_path"]).name,
+                                        "sha256": AircraftFiles("", self.files(config)).hash()})}
+
+    def facts(self, config: dict) -> dict[str, str]:
+        """The script flown, as the campaign names it (the report's campaign table)."""
+        scenario = config.get("scenario") or {}
+        end = f", cut at {scenario['end_s']:g} s" if isinstance(scenario.get("end_s"), (int, float)) else ""
+        return {"flight": f"script {scenario.get('script', '?')}{end}", "excitation": "the script's events"}
+
+    def resolution(self, setup: ScriptSetup, settings, ours=None) -> None:
+        """A script has no second way of flying it: no resolution of its own."""
+        return None
