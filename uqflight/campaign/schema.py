@@ -491,7 +491,7 @@ def method(check: Checker, value) -> dict:
     if "order" in method:
         check.integer(method["order"], "method.order", 0)
     method["split"] = check.boolean(method.get("split", False), "method.split")
-    if "allow_aliasing" in method:  # kept only when given, so that files of older campaigns stay identical
+    if "allow_aliasing" in method:  # kept only when given: summary.json's method names it only then
         check.boolean(method["allow_aliasing"], "method.allow_aliasing")
     return method
 
