@@ -373,7 +373,7 @@ class ResultStore:
 
     def resolution(self, name: str) -> np.ndarray | None:
         """(T,) the simulator's own resolution of output `name` (level flight: its two trims' drift), None when the
-        file holds none (a Python simulator, a file from before it was recorded)."""
+        file holds none (a Python simulator)."""
         group = self._file.get("resolution")
         return None if group is None or key_of(name) not in group else group[key_of(name)][()]
 
