@@ -196,9 +196,9 @@ def simulate(
 
 def _offset_lines(located, flight) -> list[str]:
     """What each --offset added at the trimmed state: ΔC, the reference factor and their product."""
-    from .simulators.reference import references
+    from .simulators.aero_factors import aero_factors
 
-    refs = references(located.files.main)
+    refs = aero_factors(located.files.main)
     lines = []
     for function, kind, prop, value in located.pairs:
         if kind == "offset":
@@ -706,7 +706,7 @@ def aircraft_command(
     flying it; with --trim its nominal trim too."""
     from .simulators.aircraft import AircraftFiles, aero_functions, known_aircraft
     from .simulators.engines import engine_kinds
-    from .simulators.reference import factor_values, references
+    from .simulators.aero_factors import aero_factors, factor_values
 
     if list_ or aircraft is None:
         for origin, names in known_aircraft().items():
@@ -721,7 +721,7 @@ def aircraft_command(
     echo(f"aircraft: {located.name} ({located.location.origin}: {located.location.folder})")
     echo(f"files: {len(files.files)} XML, sha256 {files.hash()}")
     functions = aero_functions(files.main)
-    refs = references(files.main)
+    refs = aero_factors(files.main)
     echo(f"aerodynamic functions ({len(functions)}; perturb with function: NAME, perturbation: "
          "scale|offset|offset_value; unit, and the factor an offset ΔC is multiplied by):")
     for f in functions:
