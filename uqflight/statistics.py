@@ -45,7 +45,7 @@ from .analysis.moments import (modified_cov, sorted_by_time, standardised_moment
                                weighted_quantiles)
 from .analysis.resolution import RESOLUTION_RTOL, resolved_variance
 from .analysis.sobol import NEGLIGIBLE, UNRESOLVED_WIDTH, complete_rows, pick_freeze_indices, unresolved
-from .campaign.attributes import StoredFacts, stored_facts, stored_settings
+from .campaign.attributes import RecordedSetup, recorded_setup, stored_settings
 from .campaign.schema import CampaignError
 from .console import shown
 from .designs import REGISTRY as DESIGNS
@@ -215,11 +215,11 @@ class QuantityStatistics:
         return {} if self.output is None else self._first("sobol_total")
 
 
-def campaign_facts(store: ResultStore, path) -> StoredFacts:
+def file_setup(store: ResultStore, path) -> RecordedSetup:
     """The method, germs, analysis options, seeds and copula the results file `path` was made with, checked
     as its campaign was: BadInput naming the file, the attribute and the field."""
     try:
-        return stored_facts(store.attrs, str(path), store.parameter_names, store.quantity_names, store.status.size)
+        return recorded_setup(store.attrs, str(path), store.parameter_names, store.quantity_names, store.status.size)
     except CampaignError as exc:
         raise BadInput(str(exc)) from exc
 
@@ -264,15 +264,15 @@ def analyse(path, reference: str | None = None, options: Options | None = None, 
     # one BLAS thread: the matrices are tall and thin (runs or draws × terms), where several threads are no
     # faster, and 10-20x slower on a loaded machine; the time blocks run in threads instead
     with ResultStore.open(path) as store, threadpool_limits(limits=1):
-        facts = campaign_facts(store, path)
-        germs, analysis = facts.germs, facts.analysis
-        method = {"order": 2, **normalised(facts.method), **normalised(method or {})}
+        setup = file_setup(store, path)
+        germs, analysis = setup.germs, setup.analysis
+        method = {"order": 2, **normalised(setup.method), **normalised(method or {})}
         allow_aliasing = allow_aliasing or bool(method.get("allow_aliasing"))
         options = options or Options(**{k: (tuple(v) if k == "quantiles" else v) for k, v in analysis.items()
                                         if k in ("band_samples", "bootstrap", "quantiles")})
         if options.seed is None:
-            options = replace(options, seed=facts.seed)
-        status, design_kind = store.status, facts.design_kind
+            options = replace(options, seed=setup.seed)
+        status, design_kind = store.status, setup.design_kind
         if method["kind"] not in METHODS:
             raise BadInput(f"{path}: unknown method {method['kind']!r}: expected one of {', '.join(METHODS)}")
         sampled = is_sampled(design_kind)
@@ -280,7 +280,7 @@ def analyse(path, reference: str | None = None, options: Options | None = None, 
         pending = int(np.sum(status == Status.PENDING))
         stats = Statistics(str(path), store.attrs.get("campaign_name", ""), method, design_kind,
                            store.parameter_names, int(status.size), int(ok.sum()), int(np.sum(status > 0)),
-                           pending, {}, partial=pending > 0, design_info=facts.design_info, seed=options.seed)
+                           pending, {}, partial=pending > 0, design_info=setup.design_info, seed=options.seed)
         if is_rare(design_kind):  # its runs are not draws of the input law: its event's probability only
             from .rare_statistics import rare_statistics
 
@@ -294,9 +294,9 @@ def analyse(path, reference: str | None = None, options: Options | None = None, 
         stats.index_set = None if state is None else index_set_summary(state, store.parameter_names)
         problem = method_problem(method["kind"], method["order"], store.xi[ok], store.weights[ok], germs, sampled,
                                  missing=int(status.size - ok.sum()), allow_aliasing=allow_aliasing)
-        if facts.seeds and not (sampled and method_entry(method["kind"]).runs_on_sampled):
-            problem = f"parameter {facts.seeds[0]} is a seed: {SEED_REFUSAL}"
-        stats.seeds, stats.dependence = facts.seeds, facts.dependence
+        if setup.seeds and not (sampled and method_entry(method["kind"]).runs_on_sampled):
+            problem = f"parameter {setup.seeds[0]} is a seed: {SEED_REFUSAL}"
+        stats.seeds, stats.dependence = setup.seeds, setup.dependence
         if stats.dependence:
             stats.notes.append(f"dependent inputs: {', '.join(stats.dependence['parameters'])} are correlated by a "
                                "Gaussian copula (Nataf); the mean, variance, bands and densities are those of the "
@@ -312,7 +312,7 @@ def analyse(path, reference: str | None = None, options: Options | None = None, 
                                     "failed and pending runs" if stats.pending else "failed runs")
             if note:
                 stats.notes.append(note)
-        replicates = facts.design_info.get("replicates", 1)
+        replicates = setup.design_info.get("replicates", 1)
         stats.replicates = replicates if stats.from_runs and ok.all() else 1
         if progress is not None:
             progress.stage(f"analysing {Path(path).name} ({method['kind']} order {method['order']})",

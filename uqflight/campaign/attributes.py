@@ -1,4 +1,4 @@
-"""The campaign facts a results file keeps as root attributes (see execution.py): of JSON text (`method`,
+"""The campaign setup a results file keeps as root attributes (see execution.py): of JSON text (`method`,
 `germs`, `analysis`, `seeds`, `dependence`, `design_info`, `versions`) or plain text (`design_kind`, the
 provenance in TEXT), checked when the file is read, by the checks its campaign file passed (schema) where
 there are some, so that a damaged or hand-edited attribute is one line naming the file, the attribute and
@@ -22,7 +22,7 @@ TEXT = ("campaign_name", "campaign_hash", "campaign_path", "created", "aircraft_
 
 
 @dataclass(frozen=True)
-class StoredFacts:
+class RecordedSetup:
     """What a results file was made with: its method, germs, analysis options, the parameters that are
     seeds, the copula of dependent inputs (GaussianCopula.summary; None: independent), and its design's kind
     and recorded facts (designs.Design.info), and the campaign's `seed`, which seeds the analysis's draws."""
@@ -46,8 +46,8 @@ class AttributeChecker(Checker):
         raise CampaignError(f"{self.source}: attribute {attribute}", inside, message)
 
 
-def stored_facts(attrs: dict, source: str, parameters: list[str], quantities: list[str], runs: int) -> StoredFacts:
-    """The checked facts of a results file's root attributes (`source` names it, `parameters` and
+def recorded_setup(attrs: dict, source: str, parameters: list[str], quantities: list[str], runs: int) -> RecordedSetup:
+    """The checked setup of a results file's root attributes (`source` names it, `parameters` and
     `quantities` are its names, `runs` its design's size); CampaignError naming the file, the attribute
     and the field."""
     check = AttributeChecker(source)
@@ -78,7 +78,7 @@ def stored_facts(attrs: dict, source: str, parameters: list[str], quantities: li
         dependence = {key: value for key, value in dependence.items() if key != "sobol_of"}
     copula = schema.dependence(check, dependence, parameters, seeds)
     seed = _checked_seed(check, attrs.get("campaign", ""))
-    return StoredFacts(method, germs, analysis, seeds, None if copula is None else copula.summary(), kind, info, seed)
+    return RecordedSetup(method, germs, analysis, seeds, None if copula is None else copula.summary(), kind, info, seed)
 
 
 @functools.lru_cache(maxsize=8)
