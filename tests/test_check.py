@@ -12,7 +12,7 @@ from test_quantities import python_campaign
 from test_report import pg  # noqa: F401 - the closed-form campaign the baseline is of
 
 from uqflight.campaign import parse_campaign
-from uqflight.check import baseline_json, compare, write_baseline
+from uqflight.check import compare, write_baseline
 from uqflight.execution import run_campaign
 from uqflight.statistics import analyse, read_statistics
 
