@@ -34,7 +34,7 @@ from .arguments import check_campaign_file, check_output, check_results_file
 from .calibration.command import register as register_calibrate
 from .console import echo, listed, one_line, shown
 from . import stopping
-from .leaving import leave
+from .fast_exit import exit_fast
 from .progress import Progress
 
 from .methods import METHOD_KINDS
@@ -55,14 +55,14 @@ app.add_typer(surrogate_app, name="surrogate")
 
 
 def main() -> None:
-    """The `uqflight` console script: `app`, then an exit without the interpreter's teardown (uqflight.leaving)."""
+    """The `uqflight` console script: `app`, then an exit without the interpreter's teardown (uqflight.fast_exit)."""
     try:
         app()
     except SystemExit as done:
         if done.code == 130 and isinstance(getattr(done.__context__, "__cause__", None), KeyboardInterrupt):
             echo("\ninterrupted", err=True)  # a Ctrl-C no command caught (typer exits 130 silently): say so
-        leave(done.code)
-    leave(0)
+        exit_fast(done.code)
+    exit_fast(0)
 
 
 def _calibration_page(out: Path) -> Path:
