@@ -66,16 +66,18 @@ def _method_design_cases():
 def test_plan_plans_every_method_and_design_kind(tmp_path, method, design):
     entry, spec = METHODS[method], dict(DESIGNS[design].example)
     settings = f", {entry.order_key}: 1" if entry.pce is not None else ""
-    body = ", ".join(f"{k}: {v}" for k, v in spec.items())
+    body = ", ".join(f"{k}: {v}" for k, v in spec.items())  # a rare-event design's event: the quantity below
     (tmp_path / "c.yaml").write_text(
         f"name: every\nseed: 5\nsimulator: {{kind: python, function: \"{DATA / 'trust_models.py'}:sum_of_squares\"}}\n"
         "parameters:\n  x1: {distribution: normal, lower: -3, upper: 3}\n"
         "  x2: {distribution: normal, lower: -3, upper: 3}\n"
-        f"design: {{{body}}}\nmethod: {{kind: {method}{settings}}}\n")
+        f"design: {{{body}}}\nmethod: {{kind: {method}{settings}}}\n"
+        + (f"quantities: {{{spec['event']['of']}: {{of: y, take: final}}}}\n" if "event" in spec else ""))
     planned = cli_in_process("plan", tmp_path / "c.yaml")
     assert planned.returncode == 0, planned.stderr
     assert "Traceback" not in planned.stderr
-    assert f"method: {method}" in planned.stdout and "estimated time: " in planned.stdout
+    assert "estimated time: " in planned.stdout
+    assert ("event: " if "event" in spec else f"method: {method}") in planned.stdout  # a rare design: its event
 
 
 def test_a_reason_on_several_lines_is_summarised_on_one_as_plain_text(tmp_path):

@@ -12,24 +12,28 @@
    set {μ > 0} ∪ {U < 2} where the event is plausible, or, if that set is below 1e-12, where μ + 2σ is
    largest. Each round flies the `batch` candidates of smallest U = |μ|/σ (each one farther than 0.2
    from those already picked). It stops when every candidate has U ≥ 2 after at least `min_rounds`
-   rounds, or when the first design and the enrichment have spent `learning` of the budget.
+   rounds, after `max_rounds` rounds (a seed input's noise keeps U small at the boundary), or when the
+   first design and the enrichment have spent `learning` of the budget.
 4. Correction on true runs (a control variate): an importance-sampling density h is fitted on the
-   candidates (a Gaussian kernel mixture, `importance.KernelMixture`, mixed with 10 % of N(0, I)), the
+   candidates (a Gaussian kernel mixture, `importance.KernelMixture`, mixed with 10 % of N(0, I); its
+   bandwidth twice as wide with a seed input, whose noise blurs the boundary the candidates draw), the
    surrogate's probability P̂_μ = E_h[1{μ > 0} φ/h] is computed from 20,000 draws of h on the surrogate
    alone, and rounds of `batch_is` fresh true runs drawn from h correct it:
 
-       P̂ = P̂_μ + mean((1{g > 0} − 1{μ > 0}) φ/h),
+       P̂ = mean(Y − c X) + c P̂_μ,   Y = 1{g > 0} φ/h,   X = 1{μ > 0} φ/h,
 
-   until its c.o.v. reaches `target_cov` (after two rounds) or the budget ends.
+   c = cov(Y, X)/var(X) from the runs, until its c.o.v. reaches `target_cov` (after two rounds) or the
+   budget ends.
 
-Both terms are unbiased whatever the surrogate, since h > 0 everywhere: P̂ is unbiased even where the
-surrogate is wrong, and the better the surrogate the fewer fresh runs disagree with it and the smaller
-the correction's variance. That variance is taken at least (P̂_μ/n)², as if one of the n fresh runs had
-disagreed: agreement on 200 runs is no proof. The fresh runs are the final check of the surrogate: how
-many it classified wrongly is in the notes. Should the correction take P̂ to 0 or below (a surrogate
-far off), the estimate is plain importance sampling of the fresh runs, mean(1{g > 0} φ/h). When none of
-them reaches the event it is 0 and the upper bound is the exact bound of 0 events among them, scaled by
-the largest ratio φ/h (10, from the defensive part): never 0.
+Y alone is an unbiased importance-sampling estimate whatever the surrogate, since h > 0 everywhere, and
+X − P̂_μ has mean 0: P̂ stays unbiased where the surrogate is wrong (up to the O(1/n) of an estimated c),
+and the better the surrogate the smaller its variance (c near 1 and Y − X nearly always 0). That
+variance is taken at least (P̂/n)², as if one of the n fresh runs had disagreed with the surrogate:
+agreement on 200 runs is no proof. The fresh runs are the final check of the surrogate: how many it
+classified wrongly is in the notes. Should P̂ come out at 0 or below (a surrogate far off), the estimate
+is plain importance sampling of the fresh runs, mean(Y). When none of them reaches the event it is 0
+and the upper bound is the exact bound of 0 events among them, scaled by the largest ratio φ/h (10,
+from the defensive part): never 0.
 
 Random-stream seed dimensions (`redrawn`) are not inputs of the surrogate (their effect is the white
 noise) and keep their N(0, 1) law in every run.
@@ -44,7 +48,7 @@ from sklearn.gaussian_process import GaussianProcessRegressor
 from sklearn.gaussian_process.kernels import RBF, ConstantKernel, WhiteKernel
 
 from .estimate import Evaluations, RareEventEstimate, RoundRecord, single_threaded, zero_count_upper
-from .importance import KernelMixture, draw, likelihood_ratios, pooled_mean, weighted_mean
+from .importance import WIDENING, KernelMixture, draw, likelihood_ratios, pooled_mean, weighted_mean
 from .subset import run_levels
 
 FIRST_RADIUS = 5.5
@@ -53,6 +57,7 @@ SURROGATE_FLOOR = 1e-12
 SPACING = 0.2
 STOP_U = 2.0
 DEFENSIVE = 0.1
+WIDENING_NOISY = 3.0
 MAX_CENTRES = 400
 SURROGATE_DRAWS, SURROGATE_CHUNK = 20_000, 5_000
 
@@ -130,8 +135,8 @@ def surrogate_levels(surrogate: Surrogate, k: int, rng: np.random.Generator):
 
 @single_threaded
 def active_learning(evaluate, dimension, *, seed: int, budget: int, redrawn: tuple[int, ...] = (),
-                    first: int | None = None, batch: int = 5, min_rounds: int = 10, learning: float = 0.4,
-                    batch_is: int = 100, target_cov: float = 0.05) -> RareEventEstimate:
+                    first: int | None = None, batch: int = 5, min_rounds: int = 10, max_rounds: int = 40,
+                    learning: float = 0.4, batch_is: int = 100, target_cov: float = 0.05) -> RareEventEstimate:
     """Estimate P[g(U) > 0], U ~ N(0, I_d), by a Gaussian-process surrogate and importance sampling.
 
     Parameters
@@ -152,6 +157,8 @@ def active_learning(evaluate, dimension, *, seed: int, budget: int, redrawn: tup
         Runs per enrichment round.
     min_rounds : int
         Enrichment rounds before the U criterion may stop it.
+    max_rounds : int
+        The most enrichment rounds (a noisy margin, from a seed input, never makes every U ≥ 2).
     learning : float
         The largest share of the budget the first design and the enrichment may spend.
     batch_is : int
@@ -197,10 +204,9 @@ def active_learning(evaluate, dimension, *, seed: int, budget: int, redrawn: tup
         if enrichments >= min_rounds and reached and score.min() >= STOP_U:
             learned = f"the surrogate's boundary was learned (min U ≥ {STOP_U:g}) after {enrichments} rounds"
             break
-        if runs.runs + batch > learning_runs:
-            learned = (f"the enrichment stopped at {learning:.0%} of the budget after {enrichments} rounds, "
-                       f"with min U = {score.min():.2g} (the boundary is not sure everywhere: noise, or too "
-                       "few runs)")
+        if runs.runs + batch > learning_runs or enrichments == max_rounds:
+            learned = (f"the enrichment stopped after {enrichments} rounds ({runs.runs} runs) with min U = "
+                       f"{score.min():.2g}: the boundary is not sure everywhere (noise, or too few runs)")
             break
         chosen = candidates[pick(candidates, score, batch)]
         u = rng.standard_normal((chosen.shape[0], dimension))
@@ -214,10 +220,11 @@ def active_learning(evaluate, dimension, *, seed: int, budget: int, redrawn: tup
                      "of 1e-12: the importance sampling looks where μ + 2σ is largest")
     # the density: the surrogate's samples of {μ + 2σ > 0} (or of its top level when it has none)
     centres = candidates[rng.permutation(candidates.shape[0])[:MAX_CENTRES]]
-    density = KernelMixture(centres, np.ones(centres.shape[0]), defensive=DEFENSIVE)
+    density = KernelMixture(centres, np.ones(centres.shape[0]), defensive=DEFENSIVE,
+                            widening=WIDENING if active.all() else WIDENING_NOISY)
     surrogate_mean, surrogate_variance = surrogate_probability(surrogate, density, k, rng)
-    differences: list[np.ndarray] = []
     plain: list[np.ndarray] = []
+    controls: list[np.ndarray] = []
     wrong = checked = 0
     stopped = "budget"
     while runs.left > 0:
@@ -225,14 +232,14 @@ def active_learning(evaluate, dimension, *, seed: int, budget: int, redrawn: tup
         g = runs(u)
         ratios = likelihood_ratios(u[:, active], density)
         says = surrogate.mean(u[:, active]) > 0.0
-        differences.append(ratios * ((g > 0.0).astype(float) - says))
         plain.append(ratios * (g > 0.0))
+        controls.append(ratios * says)
         valid = np.isfinite(g)
         wrong += int((says[valid] != (g[valid] > 0.0)).sum())
         checked += int(valid.sum())
-        probability, cov = corrected(surrogate_mean, surrogate_variance, differences)
+        probability, cov = corrected(surrogate_mean, surrogate_variance, plain, controls)
         rounds.append(RoundRecord(runs=runs.runs, probability=probability, cov=cov))
-        if len(differences) > 1 and cov <= target_cov:
+        if len(plain) > 1 and cov <= target_cov:
             stopped = "converged"
             break
     draws = sum(t.size for t in plain)
@@ -262,18 +269,24 @@ def surrogate_probability(surrogate: Surrogate, density: KernelMixture, k: int,
     return pooled_mean([np.concatenate(terms)])
 
 
-def corrected(surrogate_mean: float, surrogate_variance: float,
-              differences: list[np.ndarray]) -> tuple[float, float]:
-    """(P̂, c.o.v.) of P̂ = P̂_μ + mean of (1{g > 0} − 1{μ > 0}) φ/h over the fresh runs.
+def corrected(surrogate_mean: float, surrogate_variance: float, plain: list[np.ndarray],
+              says: list[np.ndarray]) -> tuple[float, float]:
+    """(P̂, c.o.v.) of the control-variate estimate P̂ = mean(Y − c X) + c P̂_μ.
 
-    The variance is that of P̂_μ plus that of the mean of differences, the latter at least (P̂_μ/n)², as if
-    one disagreement of the typical weight had been seen: a run of agreements is no proof that the
-    surrogate is right everywhere.
+    Y = 1{g > 0} φ/h and X = 1{μ > 0} φ/h on the fresh runs, P̂_μ = E_h[X] from the surrogate alone, and
+    c = cov(Y, X)/var(X) estimated from the runs: about 1 where the surrogate classifies well, less where
+    a seed input's noise makes it right only on average (c = 1 would then add the noise's variance).
+    The variance, var(Y − c X)/n + c² var(P̂_μ), is taken at least (P̂/n)², as if one of the n runs had
+    disagreed with the surrogate: a run of agreements is no proof that it is right everywhere.
     """
-    mean, variance = pooled_mean(differences)
-    draws = sum(t.size for t in differences)
-    probability = surrogate_mean + mean
+    y, x = np.concatenate(plain), np.concatenate(says)
+    n = y.size
+    spread = x.var(ddof=1) if n > 1 else 0.0
+    c = float(np.cov(y, x)[0, 1] / spread) if spread > 0.0 else 0.0
+    residual = y - c * x
+    probability = float(residual.mean() + c * surrogate_mean)
     if probability <= 0.0:
         return probability, float("nan")
-    variance = surrogate_variance + max(variance, (surrogate_mean / draws) ** 2)
+    variance = max(residual.var(ddof=1) / n if n > 1 else np.inf, (probability / n) ** 2) \
+        + c * c * surrogate_variance
     return probability, float(np.sqrt(variance) / probability)

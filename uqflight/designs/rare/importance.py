@@ -51,9 +51,12 @@ class KernelMixture:
         (m,) their weights, >= 0, not all 0.
     defensive : float
         η in [0, 1).
+    widening : float
+        The bandwidth as a multiple of Silverman's.
     """
 
-    def __init__(self, centres: np.ndarray, weights: np.ndarray, defensive: float = 0.0):
+    def __init__(self, centres: np.ndarray, weights: np.ndarray, defensive: float = 0.0,
+                 widening: float = WIDENING):
         self.weights = weights / weights.sum()
         keep = self.weights > 0.0
         self.centres, self.weights = centres[keep], self.weights[keep]
@@ -64,7 +67,7 @@ class KernelMixture:
         spread = np.sqrt(self.weights @ np.square(self.centres - mean))
         # a single centre (or centres equal in a dimension) has no spread there: a unit one keeps h > 0
         spread = np.where(spread > 0.0, spread, 1.0)
-        self.bandwidth = WIDENING * spread * (4.0 / ((k + 2.0) * effective)) ** (1.0 / (k + 4.0))
+        self.bandwidth = widening * spread * (4.0 / ((k + 2.0) * effective)) ** (1.0 / (k + 4.0))
 
     def sample(self, n: int, rng: np.random.Generator) -> np.ndarray:
         """n draws (n, k)."""
