@@ -48,6 +48,9 @@ MALFORMED = {  # name: (attribute, value, what the message says after "FILE: att
     "design_kind unknown": ("design_kind", "spiral", "expected one of monte_carlo, sobol, halton"),
     "design_kind missing": ("design_kind", None, "expected one of monte_carlo, sobol, halton"),
     "versions 5": ("versions", "5", "expected a mapping of package versions, got 5"),
+    "versions missing": ("versions", None, "is missing: the file is damaged or was not written by uqflight: fly its "
+                                           "campaign again (`uqflight run CAMPAIGN --out FILE --restart`)"),
+    "analysis missing": ("analysis", None, "is missing: the file is damaged or was not written by uqflight"),
     "campaign_name an array": ("campaign_name", np.array([1, 2]), "expected text, got array([1, 2])"),
     "campaign_name an integer": ("campaign_name", np.int64(5), "expected text, got np.int64(5)"),
     "campaign_hash an array": ("campaign_hash", np.array([1, 2]), "expected text, got array([1, 2])"),

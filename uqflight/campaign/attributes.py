@@ -54,15 +54,15 @@ def recorded_setup(attrs: dict, source: str, parameters: list[str], quantities: 
     for name in TEXT:
         if name in attrs and not isinstance(attrs[name], str):
             check.fail(name, f"expected text, got {shown(attrs[name])}")
-    versions = _json(check, attrs, "versions", "{}")
+    versions = _json(check, attrs, "versions")
     if not isinstance(versions, dict):
         check.fail("versions", f"expected a mapping of package versions, got {shown(versions)}")
     kind = attrs.get("design_kind")
     if not isinstance(kind, str) or kind not in DESIGN_KINDS:
         check.fail("design_kind", f"expected one of {', '.join(DESIGN_KINDS)}, got {shown(kind)}")
-    info = _design_info(check, _json(check, attrs, "design_info", "{}"), kind, runs, len(parameters))
+    info = _design_info(check, _json(check, attrs, "design_info"), kind, runs, len(parameters))
     method = schema.method(check, _json(check, attrs, "method"))
-    analysis = schema.analysis(check, _json(check, attrs, "analysis", "{}"), quantities)
+    analysis = schema.analysis(check, _json(check, attrs, "analysis"), quantities)
     germs = _json(check, attrs, "germs")
     if (not isinstance(germs, list) or len(germs) != len(parameters)
             or not all(isinstance(germ, str) and germ in GERMS for germ in germs)):
@@ -117,10 +117,12 @@ def _design_info(check: Checker, info, kind: str, runs: int, d: int) -> dict:
 
 
 def _json(check: Checker, attrs: dict, name: str, default: str | None = None):
-    """The value of the JSON text in attribute `name` (`default` when absent; None: required)."""
+    """The value of the JSON text in attribute `name` (`default` when absent, for the attributes a run writes
+    only when the campaign has them; None: required)."""
     text = attrs.get(name, default)
     if text is None:
-        check.fail(name, "is missing")
+        check.fail(name, "is missing: the file is damaged or was not written by uqflight: fly its campaign again "
+                         "(`uqflight run CAMPAIGN --out FILE --restart`)")
     if not isinstance(text, str):
         check.fail(name, f"expected JSON text, got {shown(text)}")
     try:
