@@ -444,6 +444,27 @@ def test_a_file_with_variable_length_reasons_is_refused_naming_the_dataset_and_t
             "CAMPAIGN --out FILE --restart`)")
 
 
+def test_run_refuses_a_file_with_variable_length_reasons_in_one_line_and_restart_flies_it_again(tmp_path):
+    from conftest import DECAY_TWO_INPUTS, cli_in_process
+
+    (tmp_path / "c.yaml").write_text(DECAY_TWO_INPUTS)
+    out = tmp_path / "r.h5"
+    assert cli_in_process("run", tmp_path / "c.yaml", "--out", out).returncode == 0
+    with h5py.File(out, "r+") as f:
+        n = f["samples/status"].shape[0]
+        del f["samples/reason"]
+        f["samples"].create_dataset("reason", shape=(n,), dtype=h5py.string_dtype())
+    refused = cli_in_process("run", tmp_path / "c.yaml", "--out", out)
+    assert refused.returncode == 2 and "Traceback" not in refused.stderr
+    assert refused.stderr.strip().splitlines() == [
+        f"error: {out}: /samples/reason holds variable-length strings, expected fixed-length strings of at most 256 "
+        "bytes: the file is damaged or was not written by uqflight: fly its campaign again (`uqflight run CAMPAIGN "
+        "--out FILE --restart`)"]
+    assert cli_in_process("run", tmp_path / "c.yaml", "--out", out, "--restart").returncode == 0
+    with ResultStore.open(out) as store:
+        assert store.pending().size == 0 and h5py.check_string_dtype(store._file["samples/reason"].dtype).length == 256
+
+
 class Crash(Exception):
     """Stands for a kill at one step of a write."""
 

@@ -335,8 +335,8 @@ def run(
     except DiskFull as exc:
         echo(f"\nerror: {exc.strerror}", err=True)
         _exit_now(2)
-    except CorruptFile as exc:
-        echo(f"error: {exc}; `{resume} --restart` starts it over", err=True)
+    except CorruptFile as exc:  # its message may name the fix already (store.results.REFLY)
+        echo(f"error: {exc}" + ("" if "--restart" in str(exc) else f"; `{resume} --restart` starts it over"), err=True)
         raise typer.Exit(2)
     except IncompleteFile as exc:
         echo(f"error: {exc}", err=True)
