@@ -458,8 +458,8 @@ def test_run_refuses_a_file_with_variable_length_reasons_in_one_line_and_restart
     assert refused.returncode == 2 and "Traceback" not in refused.stderr
     assert refused.stderr.strip().splitlines() == [
         f"error: {out}: /samples/reason holds variable-length strings, expected fixed-length strings of at most 256 "
-        "bytes: the file is damaged or was not written by uqflight: fly its campaign again (`uqflight run CAMPAIGN "
-        "--out FILE --restart`)"]
+        f"bytes: the file is damaged or was not written by uqflight; `uqflight run {tmp_path / 'c.yaml'} --out {out} "
+        "--restart` starts it over"]
     assert cli_in_process("run", tmp_path / "c.yaml", "--out", out, "--restart").returncode == 0
     with ResultStore.open(out) as store:
         assert store.pending().size == 0 and h5py.check_string_dtype(store._file["samples/reason"].dtype).length == 256

@@ -317,6 +317,7 @@ def run(
     (SIGTERM): stopped cleanly, the finished runs are kept, rerun to resume."""
     from .execution import DiskFull, IncompleteFile, WorkerError, run_campaign
     from .store import CorruptFile
+    from .store.results import REFLY
 
     campaign = _load(campaign_file)
     check_output(out or Path(campaign.storage["path"]), "--out" if out else "storage.path", create=True,
@@ -335,8 +336,8 @@ def run(
     except DiskFull as exc:
         echo(f"\nerror: {exc.strerror}", err=True)
         _exit_now(2)
-    except CorruptFile as exc:  # its message may name the fix already (store.results.REFLY)
-        echo(f"error: {exc}" + ("" if "--restart" in str(exc) else f"; `{resume} --restart` starts it over"), err=True)
+    except CorruptFile as exc:  # the fix named with this run's own command
+        echo(f"error: {str(exc).removesuffix(': ' + REFLY)}; `{resume} --restart` starts it over", err=True)
         raise typer.Exit(2)
     except IncompleteFile as exc:
         echo(f"error: {exc}", err=True)
