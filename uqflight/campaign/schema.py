@@ -438,7 +438,7 @@ def patch_nominal(check: Checker, prop: str, path: str, aircraft) -> float:
 
     try:
         function, perturbation = patch_request(prop, aircraft.functions)
-        check_perturbation(function, perturbation, getattr(aircraft, "references", {}))
+        check_perturbation(function, perturbation, getattr(aircraft, "aero_factors", {}))
     except PatchError as exc:
         check.fail(path, f"{exc} (aircraft {aircraft.aircraft!r})")
     return NOMINAL[perturbation]
@@ -470,7 +470,7 @@ def function_property(check: Checker, spec: dict, path: str, kind: str, aircraft
     except PatchError as exc:
         check.fail(f"{path}.function", f"{exc} (aircraft {aircraft.aircraft!r})")
     try:
-        check_perturbation(full, perturbation, getattr(aircraft, "references", {}))
+        check_perturbation(full, perturbation, getattr(aircraft, "aero_factors", {}))
     except PatchError as exc:
         check.fail(f"{path}.perturbation", f"{exc} (aircraft {aircraft.aircraft!r})")
     return patch_property(full, perturbation, functions)
@@ -493,7 +493,7 @@ def method(check: Checker, value) -> dict:
     if "order" in method:
         check.integer(method["order"], "method.order", 0)
     method["split"] = check.boolean(method.get("split", False), "method.split")
-    if "allow_aliasing" in method:  # kept only when given, so that files of older campaigns stay identical
+    if "allow_aliasing" in method:  # kept only when given: summary.json's method names it only then
         check.boolean(method["allow_aliasing"], "method.allow_aliasing")
     return method
 
