@@ -478,12 +478,32 @@ def test_a_byte_order_mark_is_no_part_of_the_header(tmp_path):
 
 def test_a_noise_given_twice_is_refused(one_output, tmp_path):
     with pytest.raises(DataError, match=r"--noise y: given twice \(0\.01 and 5\); give it once"):
-        parse_noise(["y=0.01", "y=5"], ["y"])
+        parse_noise(["y=0.01", "y=5"])
     data = tmp_path / "flight.csv"
     data.write_text("time_s,y\n0,15000\n0.5,15001\n1,15002\n")
     result = cli_in_process("calibrate", one_output, "--data", data, "--out", tmp_path / "out",
                             "--noise", "y=0.01", "--noise", "y=5")
     assert result.returncode == 2 and result.stderr == "error: --noise y: given twice (0.01 and 5); give it once\n"
+
+
+def test_the_python_api_hands_the_noise_to_the_core_as_numbers(one_output, tmp_path):
+    """`uqflight.calibrate(noise={...})` reaches the core as {output: sigma}, checked there as the CLI's is."""
+    import uqflight
+    from uqflight.calibration.likelihood import check_noise
+
+    assert check_noise({"y": 1}, ["y"]) == {"y": 1.0} and parse_noise(["y = 0.5"]) == {"y": 0.5}
+    for noise, message in (({"y": 0.0}, "--noise y: expected SIGMA > 0 (a finite number), got 0.0"),
+                           ({"y": float("nan")}, "--noise y: expected SIGMA > 0 (a finite number), got nan"),
+                           ({"y": "0.5"}, "--noise y: expected SIGMA > 0 (a finite number), got '0.5'"),
+                           ({"w": 0.5}, "--noise w: not one of the calibrated outputs (y)")):
+        with pytest.raises(DataError) as refused:
+            check_noise(noise, ["y"])
+        assert str(refused.value) == message
+    data = tmp_path / "flight.csv"
+    data.write_text("time_s,y\n0,15000\n0.5,15001\n1,15002\n")
+    with pytest.raises(DataError, match=r"^--noise w: not one of the calibrated outputs \(y\)$"):
+        uqflight.calibrate(one_output, data, tmp_path / "out", noise={"w": 0.5})
+    assert not (tmp_path / "out").exists()
 
 
 

@@ -153,7 +153,7 @@ def calibrated_chain(results, tmp_path, seed, noise, steps):
     y = flight(seed)
     data.write_text("time_s,y\n" + "".join(f"{t!r},{v!r}\n" for t, v in zip(TIME.tolist(), y.tolist())))
     out = tmp_path / f"out-{seed}-{bool(noise)}"
-    result = calibrate(results, data, out, noise=[f"y={SIGMA}"] if noise else [], seed=seed, steps=steps,
+    result = calibrate(results, data, out, noise={"y": SIGMA} if noise else None, seed=seed, steps=steps,
                        predictive_draws=5)
     with h5py.File(out / "posterior.h5") as f:
         xi = f["chain"][f["chain"].attrs["burn_in"]:, :, :2]

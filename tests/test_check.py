@@ -12,7 +12,7 @@ from test_quantities import python_campaign
 from test_report import pg  # noqa: F401 - the closed-form campaign the baseline is of
 
 from uqflight.campaign import parse_campaign
-from uqflight.check import baseline_json, compare, write_baseline
+from uqflight.check import compare, write_baseline
 from uqflight.execution import run_campaign
 from uqflight.statistics import analyse, read_statistics
 
@@ -57,14 +57,18 @@ def test_a_quantity_defined_on_one_side_only_drifts(quantity_files):
     assert [(d.output, d.statistic) for d in comparison.drifts] == [("quantity peak_z", "mean")]
 
 
-def test_a_baseline_without_quantities_is_compared_on_its_outputs(quantity_files):
-    results, baseline = quantity_files
+def test_a_baseline_without_quantities_is_refused_naming_the_field_and_the_fix(quantity_files, tmp_path):
+    from uqflight.check import BadInput, load_baseline
+
+    _, baseline = quantity_files
     data = json.loads(baseline.read_text())
-    stats = analyse(results)
-    older = {key: value for key, value in data.items() if key != "quantities"}
-    assert compare(stats, older, 1e-6, 1e-9).compared < compare(stats, data, 1e-6, 1e-9).compared
-    assert not compare(stats, older, 1e-6, 1e-9).drifts
-    assert baseline_json(stats, "")["quantities"].keys() == data["quantities"].keys()
+    path = tmp_path / "b.json"
+    path.write_text(json.dumps({key: value for key, value in data.items() if key != "quantities"}))
+    with pytest.raises(BadInput) as refused:
+        load_baseline(path)
+    assert str(refused.value) == (f"{path}: quantities: expected a mapping of quantity names to statistics ({{}} "
+                                  "without quantities), got nothing; write one with `uqflight report RESULTS.h5 --out "
+                                  "DIR --write-baseline FILE`")
 
 
 # -- baselines that are no baselines, and tolerances that let anything through
@@ -74,7 +78,7 @@ HASH = "0" * 64
 def baseline_text(mean, version="1", campaign_hash=f'"{HASH}"'):
     return ('{"kind": "uqflight-baseline", "version": %s, "campaign_hash": %s, "outputs": {"y": {"time": [0, 1], '
             '"mean": %s, "variance": [1, 1], "band99": {"lower": [0, 0], "upper": [1, 1]}, "sobol_first": {}, '
-            '"sobol_total": {}}}}' % (version, campaign_hash, mean))
+            '"sobol_total": {}}}, "quantities": {}}' % (version, campaign_hash, mean))
 
 
 @pytest.mark.parametrize("mean", ["[Infinity, 1]", "[-Infinity, 1]", "[1e999, 1]", f"[{10 ** 400}, 1]"])

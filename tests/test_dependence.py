@@ -248,7 +248,7 @@ def calibrated(tmp_path_factory):
     results = make_results(folder)
     data = folder / "flight.csv"
     data.write_text("time_s,y\n" + "".join(f"{t!r},{v!r}\n" for t, v in zip(TIME.tolist(), flight(0).tolist())))
-    calibrate(results, data, folder / "out", noise=[f"y={SIGMA}"], seed=0, steps=800, predictive_draws=5)
+    calibrate(results, data, folder / "out", noise={"y": SIGMA}, seed=0, steps=800, predictive_draws=5)
     return folder / "out"
 
 

@@ -4,7 +4,7 @@ import time
 
 import pytest
 
-from uqflight.forking import FORKS, Child, ChildFailed, Standby, share_work, wait_all
+from uqflight.forking import FORKS, Child, ChildFailed, PreparedChild, share_work, wait_all
 
 pytestmark = pytest.mark.skipif(not FORKS, reason="the system cannot fork")
 
@@ -87,23 +87,23 @@ def test_a_standby_gets_ready_then_does_its_work_telling_on_the_way(tmp_path):
             tell(("step", k))
         return {"twice": [2 * x for x in payload], "pid": os.getpid(), "group": os.getpgid(0)}
 
-    standby = Standby(prepare, work)
-    standby.start(list(range(100000)))  # larger than a pipe holds: sent from a thread, this process goes on
-    heard = []
-    result = standby.wait(heard.append)
-    standby.close()  # after a wait: nothing left to do
-    assert heard == [("step", 0), ("step", 1), ("step", 2)]
+    prepared = PreparedChild(prepare, work)
+    prepared.start(list(range(100000)))  # larger than a pipe holds: sent from a thread, this process goes on
+    messages = []
+    result = prepared.wait(messages.append)
+    prepared.close()  # after a wait: nothing left to do
+    assert messages == [("step", 0), ("step", 1), ("step", 2)]
     assert result["twice"] == [2 * x for x in range(100000)]
     assert result["pid"] != os.getpid() and result["group"] == result["pid"]  # a process group of its own
     assert (tmp_path / "ready").read_text() == str(result["pid"])
 
 
 def test_a_standby_closed_before_its_work_ends_without_doing_it(tmp_path):
-    standby = Standby(lambda: None, lambda payload, tell: (tmp_path / "worked").write_text(""))
-    standby.close()
+    prepared = PreparedChild(lambda: None, lambda payload, tell: (tmp_path / "worked").write_text(""))
+    prepared.close()
     assert not (tmp_path / "worked").exists()
     with pytest.raises(ChildProcessError):  # reaped
-        os.waitpid(standby.child.pid, os.WNOHANG)
+        os.waitpid(prepared.child.pid, os.WNOHANG)
 
 
 def test_closing_a_working_standby_ends_it_and_the_children_it_forked(tmp_path):
@@ -112,17 +112,17 @@ def test_closing_a_working_standby_ends_it_and_the_children_it_forked(tmp_path):
         (tmp_path / "helper").write_text(str(helper.pid))
         time.sleep(120)
 
-    standby = Standby(lambda: None, work)
-    standby.start(None)
+    prepared = PreparedChild(lambda: None, work)
+    prepared.start(None)
     for _ in range(3000):
         if (tmp_path / "helper").exists() and (tmp_path / "helper").read_text():
             break
         time.sleep(0.01)
     helper = int((tmp_path / "helper").read_text())
-    standby.close()  # without it this test waits two minutes for the standby
+    prepared.close()  # without it this test waits two minutes for the prepared child
     with pytest.raises(ChildProcessError):
-        os.waitpid(standby.child.pid, os.WNOHANG)
-    for _ in range(3000):  # the helper, the standby's child, ends too (then reaped by init)
+        os.waitpid(prepared.child.pid, os.WNOHANG)
+    for _ in range(3000):  # the helper, the prepared child's own child, ends too (then reaped by init)
         if not alive(helper):
             break
         time.sleep(0.01)
@@ -130,18 +130,18 @@ def test_closing_a_working_standby_ends_it_and_the_children_it_forked(tmp_path):
 
 
 def test_a_standby_whose_work_fails_is_reported_with_its_error(capfd):
-    standby = Standby(lambda: None, lambda payload, tell: payload / 0)
-    standby.start(1)
+    prepared = PreparedChild(lambda: None, lambda payload, tell: payload / 0)
+    prepared.start(1)
     with pytest.raises(ChildFailed, match="exit 1"):
-        standby.wait()
-    standby.close()
+        prepared.wait()
+    prepared.close()
     assert "ZeroDivisionError" in capfd.readouterr().err
 
 
-@pytest.mark.parametrize("kind", ["child", "standby"])
+@pytest.mark.parametrize("kind", ["child", "prepared"])
 def test_a_child_writes_to_stderr_even_when_the_parent_held_it_at_the_fork(kind, monkeypatch, capfd):
     """As for a failing Child, but the child writes through sys.stderr itself (a library's warning while
-    a standby imports, or while a child draws): it gets sys.stderr opened anew on its descriptor."""
+    a prepared child imports, or while a child draws): it gets sys.stderr opened anew on its descriptor."""
     import io
     import sys
     import threading
@@ -169,10 +169,10 @@ def test_a_child_writes_to_stderr_even_when_the_parent_held_it_at_the_fork(kind,
         print(f"warning from the {kind}", file=sys.stderr)
         return "done"
 
-    if kind == "standby":
-        standby = Standby(warn, lambda payload, tell: "done")
-        standby.start(None)
-        child = standby.child
+    if kind == "prepared":
+        prepared = PreparedChild(warn, lambda payload, tell: "done")
+        prepared.start(None)
+        child = prepared.child
     else:
         child = Child(warn)
     done = first_ready(child, 60.0)
@@ -180,10 +180,10 @@ def test_a_child_writes_to_stderr_even_when_the_parent_held_it_at_the_fork(kind,
         os.kill(child.pid, 9)
     try:
         assert done, f"the {kind} hung on sys.stderr's lock"
-        assert (standby.wait() if kind == "standby" else child.wait()) == "done"
+        assert (prepared.wait() if kind == "prepared" else child.wait()) == "done"
     finally:
-        if kind == "standby":
-            standby.close()
+        if kind == "prepared":
+            prepared.close()
         release.set()
     assert f"warning from the {kind}" in capfd.readouterr().err
 
@@ -216,7 +216,7 @@ def queued(fd: int) -> int:
 
 KILLED_PARENT = """
 import os, sys, time
-from uqflight.forking import Child, Standby
+from uqflight.forking import Child, PreparedChild
 
 def work(payload, tell):
     helper = Child(lambda: time.sleep(120))
@@ -225,13 +225,13 @@ def work(payload, tell):
 
 child = Child(lambda: time.sleep(120))
 print(child.pid, flush=True)
-Standby(lambda: None, work).start(None)
+PreparedChild(lambda: None, work).start(None)
 time.sleep(120)
 """
 
 
 def test_children_die_with_a_parent_killed_outright(tmp_path):
-    """A parent killed by SIGKILL (no handler runs) takes its children along: a Child, and a Standby with the
+    """A parent killed by SIGKILL (no handler runs) takes its children along: a Child, and a PreparedChild with the
     helper it forked. Without it they would each sleep on for two minutes."""
     import signal
     import subprocess

@@ -13,7 +13,7 @@ PACKAGE = Path(__file__).resolve().parents[1] / "uqflight"
 LAYERS = [
     ("uqflight.paper", "uqflight.labels", "uqflight.tsvd", "uqflight.simulators.base", "uqflight.parameters.germs",
      "uqflight.console", "uqflight.progress", "uqflight.forking", "uqflight.json_text", "uqflight.stopping",
-     "uqflight.leaving", "uqflight.arguments", "uqflight.bounded"),
+     "uqflight.fast_exit", "uqflight.arguments", "uqflight.bounded"),
     ("uqflight.parameters", "uqflight.analysis", "uqflight.simulators", "uqflight.quantities"),
     ("uqflight.designs",),
     ("uqflight.methods",),

@@ -15,7 +15,7 @@ from uqflight.simulators.aircraft import AircraftFiles
 from uqflight.simulators.jsbsim import REPO_ROOT, quiet_jsbsim
 from uqflight.simulators.validation_view import validation_view
 from uqflight.simulators.patch import PatchError, PreparedAircraft
-from uqflight.simulators.reference import Reference, axis_reference, references
+from uqflight.simulators.aero_factors import AeroFactor, aero_factors, axis_factor
 
 # Floating point: the patched function is fl(fl(ΔC·qbar·S[·l]) + f), so (patched - f) differs from
 # ΔC·qbar·S[·l] by a few ulps of f; with f at most a few times the increment here, 1e-9 relative
@@ -173,13 +173,13 @@ def test_references_of_every_axis_system_and_what_has_none():
     metrics = ET.fromstring("<metrics><wingarea unit='FT2'>100</wingarea><wingspan unit='FT'>30</wingspan></metrics>")
     force = ("aero/qbar-psf", "metrics/Sw-sqft")
     for axis in ("DRAG", "SIDE", "LIFT", "X", "Y", "Z", "AXIAL", "NORMAL"):
-        assert axis_reference(axis, metrics) == Reference(axis, "lbf", force)
-    assert axis_reference("ROLL", metrics).factor == force + ("metrics/bw-ft",)
-    assert axis_reference("YAW", metrics).symbol == "qbar·S·b" and not axis_reference("YAW", metrics).refusal
-    assert "no chord" in axis_reference("PITCH", metrics).refusal  # no <chord>: c̄ is 0 in JSBSim
-    assert "outside the <axis>" in axis_reference("", metrics).refusal
-    assert "none of JSBSim's" in axis_reference("THRUST", metrics).refusal
-    c172p = references(AircraftFiles.read(PreparedAircraft("c172p").location).main)
+        assert axis_factor(axis, metrics) == AeroFactor(axis, "lbf", force)
+    assert axis_factor("ROLL", metrics).factor == force + ("metrics/bw-ft",)
+    assert axis_factor("YAW", metrics).symbol == "qbar·S·b" and not axis_factor("YAW", metrics).refusal
+    assert "no chord" in axis_factor("PITCH", metrics).refusal  # no <chord>: c̄ is 0 in JSBSim
+    assert "outside the <axis>" in axis_factor("", metrics).refusal
+    assert "none of JSBSim's" in axis_factor("THRUST", metrics).refusal
+    c172p = aero_factors(AircraftFiles.read(PreparedAircraft("c172p").location).main)
     assert c172p["aero/coefficient/Cmo"].symbol == "qbar·S·c̄" and c172p["aero/coefficient/Cmo"].unit == "lbf·ft"
 
 

@@ -75,18 +75,18 @@ def test_blocks_of_times_change_nothing_and_a_large_basis_is_left_to_the_draws(m
 
 
 def test_outputs_on_one_basis_share_its_draws_and_triple_products_and_get_the_same_numbers():
-    from uqflight.statistics import Options, Reused
+    from uqflight.statistics import BasisCache, Options
 
-    germs, options, reused = ["normal", "uniform", "normal"], Options(band_samples=500, seed=3), Reused()
+    germs, options, basis_cache = ["normal", "uniform", "normal"], Options(band_samples=500, seed=3), BasisCache()
     indices = total_degree_indices(3, 2)
-    rows = reused.band_rows(germs, indices, options)
-    assert rows is reused.band_rows(germs, indices.copy(), options)  # the same basis: computed once
+    rows = basis_cache.band_rows(germs, indices, options)
+    assert rows is basis_cache.band_rows(germs, indices.copy(), options)  # the same basis: computed once
     assert np.array_equal(rows, orthonormal_basis(germs, indices, draw_germs(germs, 500, 3)))
     with pytest.raises(ValueError):
         rows[0, 0] = 1.0  # shared, so read-only
-    other = reused.band_rows(germs, indices[:-1], options)  # another basis (a sparse selection): its own
-    assert other.shape == (500, len(indices) - 1) and reused.band_rows(germs, indices, options) is not rows
+    other = basis_cache.band_rows(germs, indices[:-1], options)  # another basis (a sparse selection): its own
+    assert other.shape == (500, len(indices) - 1) and basis_cache.band_rows(germs, indices, options) is not rows
     coefficients = np.random.default_rng(0).normal(size=(len(indices), 4))
     for _ in range(2):  # the second expansion on the same basis reads the kept triple products
-        shared = pce_standardised_moments(germs, indices, coefficients, reused.triple_products)
+        shared = pce_standardised_moments(germs, indices, coefficients, basis_cache.triple_products)
         assert all(np.array_equal(a, b) for a, b in zip(shared, pce_standardised_moments(germs, indices, coefficients)))

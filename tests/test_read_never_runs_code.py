@@ -172,7 +172,7 @@ design: {kind: monte_carlo, samples: 2}
 
 
 def without_parameters_attribute(path, copy):
-    """A copy of a results file as uqflight wrote it before the `parameters` attribute."""
+    """A copy of a results file without its `parameters` attribute."""
     import shutil
 
     import h5py
@@ -183,11 +183,15 @@ def without_parameters_attribute(path, copy):
     return copy
 
 
+MISSING = ("parameters: the results file records no parameters attribute (the parameters' laws with the nominal values "
+           "its run read): fly the campaign again (`uqflight run CAMPAIGN --out FILE --restart` starts this file over)")
+
+
 def test_a_jsbsim_run_stores_the_nominal_values_it_read_from_the_aircraft(tmp_path):
-    """Readers take them from the file; a file written before the attribute reads them from its aircraft
-    (JSBSim loading XML, no python code), with the same numbers."""
+    """Readers take them from the file; a file without the attribute is refused naming it and the fix."""
     from uqflight.campaign import parse_campaign
-    from uqflight.campaign.reading import parameter_rows, stored_parameters
+    from uqflight.campaign.reading import parameter_rows, results_campaign, stored_parameters
+    from uqflight.campaign.schema import CampaignError
     from uqflight.execution import run_campaign
     from uqflight.simulators.validation_view import validation_view
     from uqflight.store import ResultStore
@@ -196,20 +200,24 @@ def test_a_jsbsim_run_stores_the_nominal_values_it_read_from_the_aircraft(tmp_pa
     run_campaign(campaign, out=tmp_path / "j.h5")
     expected = parameter_rows(campaign.parameters)
     assert expected[0]["nominal"] == validation_view(campaign.simulator).value("aero/uq/CL0")  # not in the campaign
-    for path in (tmp_path / "j.h5", without_parameters_attribute(tmp_path / "j.h5", tmp_path / "old.h5")):
-        with ResultStore.open(path) as store:
-            assert stored_parameters(store.attrs) == expected
+    with ResultStore.open(tmp_path / "j.h5") as store:
+        assert stored_parameters(store.attrs) == expected
+    with ResultStore.open(without_parameters_attribute(tmp_path / "j.h5", tmp_path / "old.h5")) as store:
+        assert stored_parameters(store.attrs) is None
+        with pytest.raises(CampaignError) as refused:
+            results_campaign(store.attrs, "old.h5")
+    assert str(refused.value) == f"old.h5: {MISSING}"
 
 
-def test_an_older_file_of_a_python_campaign_is_read_without_its_model(world, tmp_path, monkeypatch):
-    from uqflight.campaign.reading import stored_parameters
+def test_a_file_without_its_parameters_attribute_is_refused_without_running_its_model(world, monkeypatch):
+    from uqflight.campaign.reading import results_campaign
+    from uqflight.campaign.schema import CampaignError
     from uqflight.store import ResultStore
 
     old = without_parameters_attribute(world["results"] / "file.h5", world["results"] / "older.h5")
     monkeypatch.chdir(world["cwd"])
     with ResultStore.open(old) as store:
-        rows = stored_parameters(store.attrs)
+        with pytest.raises(CampaignError, match="no parameters attribute"):
+            results_campaign(store.attrs, str(old))
     old.unlink()
-    assert [(r["name"], r["lower"], r["upper"]) for r in rows] == [
-        (n, pytest.approx(lower, rel=1e-15), pytest.approx(upper, rel=1e-15)) for n, (lower, upper) in PARAMETERS.items()]
     assert ran_code(world) == {}

@@ -321,15 +321,15 @@ def test_several_methods_over_the_same_runs(decay_results, tmp_path):
 
 
 def _recording_drawers(monkeypatch, report) -> list:
-    """The Standby drawers write_report forks, recorded (to check they are reaped)."""
+    """The PreparedChild drawers write_report forks, recorded (to check they are reaped)."""
     drawers = []
 
     def recorded(*args):
-        drawers.append(report.Standby.__wrapped__(*args))
+        drawers.append(report.PreparedChild.__wrapped__(*args))
         return drawers[-1]
 
-    recorded.__wrapped__ = report.Standby
-    monkeypatch.setattr(report, "Standby", recorded)
+    recorded.__wrapped__ = report.PreparedChild
+    monkeypatch.setattr(report, "PreparedChild", recorded)
     return drawers
 
 

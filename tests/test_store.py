@@ -23,7 +23,7 @@ import uqflight.store.compressed
 import uqflight.store.results
 from uqflight.analysis.moments import weighted_moments
 from uqflight.statistics import output_basis
-from uqflight.store import ResultStore, Status, open_for_campaign
+from uqflight.store import CorruptFile, ResultStore, Status, open_for_campaign
 from uqflight.store.results import STORAGES
 from uqflight.store.storage import OutputStorage
 
@@ -426,20 +426,43 @@ def test_reasons_of_runs_left_pending_by_a_crash_are_cleared_on_resume(tmp_path,
     assert_same_results(path, reference)
 
 
-def test_a_file_with_variable_length_reasons_still_reads_and_resumes(tmp_path):
-    """Files written before the reasons became fixed-length hold them in HDF5's heap."""
-    path = tmp_path / "old.h5"
+def test_a_file_with_variable_length_reasons_is_refused_naming_the_dataset_and_the_fix(tmp_path):
+    """Reasons are fixed-length strings (variable-length ones live in HDF5's unchecked heap): a file holding
+    variable-length ones is refused on opening, in one line naming the dataset and `run --restart`."""
+    path = tmp_path / "other.h5"
     with ResultStore.create(path, campaign_text=CAMPAIGN, **create_args(tsvd=False)) as store:
         pass
     with h5py.File(path, "r+") as f:
         del f["samples/reason"]
         f["samples"].create_dataset("reason", shape=(N,), dtype=h5py.string_dtype())
-    with ResultStore.open(path, "a") as store:
-        write_runs(store, [np.arange(0, 40)])
-    with ResultStore.open(path, "a") as store:
-        write_runs(store, [store.pending()])
-        status, reasons, _ = expected_runs(np.arange(N))
-        assert store.reasons == reasons and store.pending().size == 0
+    for mode in ("r", "a"):
+        with pytest.raises(CorruptFile) as refused:
+            ResultStore.open(path, mode)
+        assert str(refused.value) == (
+            f"{path}: /samples/reason holds variable-length strings, expected fixed-length strings of at most 256 "
+            "bytes: the file is damaged or was not written by uqflight: fly its campaign again (`uqflight run "
+            "CAMPAIGN --out FILE --restart`)")
+
+
+def test_run_refuses_a_file_with_variable_length_reasons_in_one_line_and_restart_flies_it_again(tmp_path):
+    from conftest import DECAY_TWO_INPUTS, cli_in_process
+
+    (tmp_path / "c.yaml").write_text(DECAY_TWO_INPUTS)
+    out = tmp_path / "r.h5"
+    assert cli_in_process("run", tmp_path / "c.yaml", "--out", out).returncode == 0
+    with h5py.File(out, "r+") as f:
+        n = f["samples/status"].shape[0]
+        del f["samples/reason"]
+        f["samples"].create_dataset("reason", shape=(n,), dtype=h5py.string_dtype())
+    refused = cli_in_process("run", tmp_path / "c.yaml", "--out", out)
+    assert refused.returncode == 2 and "Traceback" not in refused.stderr
+    assert refused.stderr.strip().splitlines() == [
+        f"error: {out}: /samples/reason holds variable-length strings, expected fixed-length strings of at most 256 "
+        f"bytes: the file is damaged or was not written by uqflight; `uqflight run {tmp_path / 'c.yaml'} --out {out} "
+        "--restart` starts it over"]
+    assert cli_in_process("run", tmp_path / "c.yaml", "--out", out, "--restart").returncode == 0
+    with ResultStore.open(out) as store:
+        assert store.pending().size == 0 and h5py.check_string_dtype(store._file["samples/reason"].dtype).length == 256
 
 
 class Crash(Exception):

@@ -48,6 +48,9 @@ MALFORMED = {  # name: (attribute, value, what the message says after "FILE: att
     "design_kind unknown": ("design_kind", "spiral", "expected one of monte_carlo, sobol, halton"),
     "design_kind missing": ("design_kind", None, "expected one of monte_carlo, sobol, halton"),
     "versions 5": ("versions", "5", "expected a mapping of package versions, got 5"),
+    "versions missing": ("versions", None, "is missing: the file is damaged or was not written by uqflight: fly its "
+                                           "campaign again (`uqflight run CAMPAIGN --out FILE --restart`)"),
+    "analysis missing": ("analysis", None, "is missing: the file is damaged or was not written by uqflight"),
     "campaign_name an array": ("campaign_name", np.array([1, 2]), "expected text, got array([1, 2])"),
     "campaign_name an integer": ("campaign_name", np.int64(5), "expected text, got np.int64(5)"),
     "campaign_hash an array": ("campaign_hash", np.array([1, 2]), "expected text, got array([1, 2])"),
@@ -159,11 +162,10 @@ analysis: {band_samples: 500, bootstrap: 0}
 
 
 def test_a_stored_script_campaign_without_its_parameters_names_field_and_fix(decay_results, tmp_path):
-    """D11: a file without the parameters attribute (the older layout) whose stored campaign is a script's, which
-    names no simulator.aircraft: the report died in a plotting child on KeyError 'aircraft' (exit 1) and
-    surrogate export said "cannot export the surrogate ('aircraft')". The campaign reader refuses it naming the
-    field and `run --restart`: surrogate export, which needs the parameters, in one line (exit 2); the report,
-    whose numbers do not depend on them (it shows the stored text, test above), flags it in its notes."""
+    """D11: a file without the parameters attribute whose stored campaign is a script's, which names no
+    simulator.aircraft. The campaign reader refuses it naming the attribute and `run --restart`: surrogate export,
+    which needs the parameters, in one line (exit 2); the report, whose numbers do not depend on them (it shows
+    the stored text, test above), flags it in its notes."""
     import hashlib
 
     from conftest import read_summary
@@ -174,9 +176,9 @@ def test_a_stored_script_campaign_without_its_parameters_names_field_and_fix(dec
         f.attrs["campaign"] = SCRIPT_CAMPAIGN
         f.attrs["campaign_hash"] = hashlib.sha256(SCRIPT_CAMPAIGN.encode()).hexdigest()
         del f.attrs["parameters"]
-    said = ("simulator.aircraft: the campaign stored in the file names no aircraft (its script does), and the file "
-            "records no parameters attribute to take the nominal values from: fly the campaign again (`uqflight run "
-            "CAMPAIGN --out FILE --restart` starts this file over)")
+    said = ("parameters: the results file records no parameters attribute (the parameters' laws with the nominal "
+            "values its run read): fly the campaign again (`uqflight run CAMPAIGN --out FILE --restart` starts this "
+            "file over)")
     done = cli_in_process("surrogate", "export", out, "--out", tmp_path / "s.json")
     assert done.returncode == 2 and not (tmp_path / "s.json").exists(), done.stderr
     errors = [line for line in done.stderr.splitlines() if line.startswith("error:")]

@@ -188,6 +188,5 @@ def calibrate(results, data, out, noise: dict | None = None, outputs: list[str] 
     `.diagnostics["problems"]` says what to change). An example: docs/python.md."""
     from .calibration.run import calibrate as calibration
 
-    given = [f"{name}={sigma!r}" for name, sigma in (noise or {}).items()]
-    return calibration(results, data, out, outputs=outputs, noise=given, seed=seed, walkers=walkers, steps=steps,
+    return calibration(results, data, out, outputs=outputs, noise=noise, seed=seed, walkers=walkers, steps=steps,
                        method=method, order=order, campaign=campaign, predictive_draws=predictive_draws)

@@ -2,8 +2,7 @@
 
 A baseline (written by `uqflight report --write-baseline`) holds, per output and time and per quantity of
 interest, the mean, variance, 99 % band and Sobol' indices of one results file, with that file's campaign
-hash (a quantity undefined in every run is null). A baseline without `quantities` (written before they
-existed) is compared on its outputs.
+hash (a quantity undefined in every run is null).
 `compare` recomputes nothing itself: it takes fresh `Statistics` and lists every value outside
 |value − baseline| <= atol + rtol·|baseline| (NaN matches only NaN).
 """
@@ -126,9 +125,10 @@ def load_baseline(path: Path) -> dict:
         raise BadInput(f"{path}: outputs: expected a non-empty mapping of output names to statistics")
     for name, entry in outputs.items():
         _check_entry(f"{path}: outputs.{shown_name(name)}", entry)
-    quantities = data.get("quantities", {})
+    quantities = data.get("quantities")
     if not isinstance(quantities, dict):
-        raise BadInput(f"{path}: quantities: expected a mapping of quantity names to statistics")
+        raise BadInput(f"{path}: quantities: expected a mapping of quantity names to statistics ({{}} without "
+                       f"quantities), got {shown(quantities)}; {rewrite}")
     for name, entry in quantities.items():
         if entry is not None:  # undefined in every run
             _check_entry(f"{path}: quantities.{shown_name(name)}", entry)
@@ -181,10 +181,8 @@ def compare(stats: Statistics, baseline: dict, rtol: float, atol: float) -> Comp
             raise BadInput(f"{label}: expected a finite number >= 0, got {tol!r}")
     fresh = baseline_json(stats, "")
     compared, drifts = _compare_section("output", fresh["outputs"], baseline["outputs"], rtol, atol)
-    if "quantities" in baseline:
-        counted, more = _compare_section("quantity", fresh["quantities"], baseline["quantities"], rtol, atol)
-        compared, drifts = compared + counted, drifts + more
-    return Comparison(compared, drifts)
+    counted, more = _compare_section("quantity", fresh["quantities"], baseline["quantities"], rtol, atol)
+    return Comparison(compared + counted, drifts + more)
 
 
 def _compare_section(what: str, fresh: dict, expected: dict, rtol: float, atol: float) -> tuple[int, list[Drift]]:

@@ -34,7 +34,7 @@ from .arguments import check_campaign_file, check_output, check_results_file
 from .calibration.command import register as register_calibrate
 from .console import echo, listed, one_line, shown
 from . import stopping
-from .leaving import leave
+from .fast_exit import exit_fast
 from .progress import Progress
 
 from .methods import METHOD_KINDS
@@ -56,14 +56,14 @@ app.add_typer(surrogate_app, name="surrogate")
 
 
 def main() -> None:
-    """The `uqflight` console script: `app`, then an exit without the interpreter's teardown (uqflight.leaving)."""
+    """The `uqflight` console script: `app`, then an exit without the interpreter's teardown (uqflight.fast_exit)."""
     try:
         app()
     except SystemExit as done:
         if done.code == 130 and isinstance(getattr(done.__context__, "__cause__", None), KeyboardInterrupt):
             echo("\ninterrupted", err=True)  # a Ctrl-C no command caught (typer exits 130 silently): say so
-        leave(done.code)
-    leave(0)
+        exit_fast(done.code)
+    exit_fast(0)
 
 
 def _calibration_page(out: Path) -> Path:
@@ -197,9 +197,9 @@ def simulate(
 
 def _offset_lines(located, flight) -> list[str]:
     """What each --offset added at the trimmed state: ΔC, the reference factor and their product."""
-    from .simulators.reference import references
+    from .simulators.aero_factors import aero_factors
 
-    refs = references(located.files.main)
+    refs = aero_factors(located.files.main)
     lines = []
     for function, kind, prop, value in located.pairs:
         if kind == "offset":
@@ -312,6 +312,7 @@ def run(
     (SIGTERM): stopped cleanly, the finished runs are kept, rerun to resume."""
     from .execution import DiskFull, IncompleteFile, WorkerError, run_campaign
     from .store import CorruptFile
+    from .store.results import REFLY
 
     campaign = _load(campaign_file)
     check_output(out or Path(campaign.storage["path"]), "--out" if out else "storage.path", create=True,
@@ -330,8 +331,8 @@ def run(
     except DiskFull as exc:
         echo(f"\nerror: {exc.strerror}", err=True)
         _exit_now(2)
-    except CorruptFile as exc:
-        echo(f"error: {exc}; `{resume} --restart` starts it over", err=True)
+    except CorruptFile as exc:  # the fix named with this run's own command
+        echo(f"error: {str(exc).removesuffix(': ' + REFLY)}; `{resume} --restart` starts it over", err=True)
         raise typer.Exit(2)
     except IncompleteFile as exc:
         echo(f"error: {exc}", err=True)
@@ -699,7 +700,7 @@ def aircraft_command(
     flying it; with --trim its nominal trim too."""
     from .simulators.aircraft import AircraftFiles, aero_functions, known_aircraft
     from .simulators.engines import engine_kinds
-    from .simulators.reference import factor_values, references
+    from .simulators.aero_factors import aero_factors, factor_values
 
     if list_ or aircraft is None:
         for origin, names in known_aircraft().items():
@@ -714,7 +715,7 @@ def aircraft_command(
     echo(f"aircraft: {located.name} ({located.location.origin}: {located.location.folder})")
     echo(f"files: {len(files.files)} XML, sha256 {files.hash()}")
     functions = aero_functions(files.main)
-    refs = references(files.main)
+    refs = aero_factors(files.main)
     echo(f"aerodynamic functions ({len(functions)}; perturb with function: NAME, perturbation: "
          "scale|offset|offset_value; unit, and the factor an offset ΔC is multiplied by):")
     for f in functions:

@@ -1,6 +1,6 @@
 """Work done in a forked child while the parent goes on (runs split over processes, the report's sections
 shared between processes, drawn by a child that got ready during the analysis). The child inherits the
-parent's memory, so nothing is pickled on the way in (but a Standby's payload); its result comes back
+parent's memory, so nothing is pickled on the way in (but a PreparedChild's payload); its result comes back
 pickled through a pipe. It runs no handler of the parent's and leaves with os._exit; a child that fails
 or dies is reported as such when waited for. A child dies with its parent (die_with_parent)."""
 from __future__ import annotations
@@ -181,11 +181,11 @@ def _results_of(jobs: list[Callable[[], object]], indices, starting=None) -> dic
     return results
 
 
-class Standby:
+class PreparedChild:
     """A child forked now that gets ready (`prepare()`, e.g. imports) while this process goes on, then
     waits for its work: `start(payload)` sends it `payload` (pickled, from a thread: this process goes on
     at once) and the child returns `work(payload, tell)`; `tell(message)` sends this process a small
-    picklable message (under 4 kB), which `wait(heard)` passes to `heard` as it comes. The child leads a
+    picklable message (under 4 kB), which `wait(on_message)` passes to `on_message` as it comes. The child leads a
     process group of its own with the children it forks: an interrupt of the terminal reaches this
     process only, and `close()` ends the whole group, whatever it was doing. (Like every Child, it writes
     through sys.stdout and sys.stderr opened anew.)"""
@@ -196,7 +196,7 @@ class Standby:
         self._sender: threading.Thread | None = None
         self._reaped = False
 
-        def standby():
+        def child_main():
             os.setpgid(0, 0)
             os.close(self._payload)
             os.close(self._messages)
@@ -207,7 +207,7 @@ class Standby:
                 return None
             return work(pickle.loads(data), lambda message: _send_message(messages_write, message))
 
-        self.child = Child(standby)
+        self.child = Child(child_main)
         try:
             os.setpgid(self.child.pid, self.child.pid)  # also here: close() may come before the child's own call
         except OSError:  # the child did it first (or has already ended)
@@ -230,15 +230,15 @@ class Standby:
         self._sender = threading.Thread(target=send, daemon=True)
         self._sender.start()
 
-    def wait(self, heard: Callable[[object], None] | None = None):
-        """The child's result, its messages passed to `heard` first; ChildFailed as for a Child."""
+    def wait(self, on_message: Callable[[object], None] | None = None):
+        """The child's result, its messages passed to `on_message` first; ChildFailed as for a Child."""
         if self._sender is not None:
             self._sender.join()
         with os.fdopen(self._messages, "rb", buffering=0) as messages:
             self._messages = None
             while (message := self._next_message(messages)) is not None:
-                if heard is not None:
-                    heard(message)
+                if on_message is not None:
+                    on_message(message)
         try:
             result = self.child.wait()
         except ChildFailed:  # reaped all the same

@@ -44,7 +44,7 @@ from .analysis.moments import (modified_cov, sorted_by_time, standardised_moment
                                weighted_quantiles)
 from .analysis.resolution import RESOLUTION_RTOL, resolved_variance
 from .analysis.sobol import NEGLIGIBLE, UNRESOLVED_WIDTH, complete_rows, pick_freeze_indices, unresolved
-from .campaign.attributes import StoredFacts, stored_facts, stored_settings
+from .campaign.attributes import RecordedSetup, recorded_setup, stored_settings
 from .campaign.schema import CampaignError
 from .console import shown
 from .designs import REGISTRY as DESIGNS
@@ -212,11 +212,11 @@ class QuantityStatistics:
         return {} if self.output is None else self._first("sobol_total")
 
 
-def campaign_facts(store: ResultStore, path) -> StoredFacts:
+def file_setup(store: ResultStore, path) -> RecordedSetup:
     """The method, germs, analysis options, seeds and copula the results file `path` was made with, checked
     as its campaign was: BadInput naming the file, the attribute and the field."""
     try:
-        return stored_facts(store.attrs, str(path), store.parameter_names, store.quantity_names, store.status.size)
+        return recorded_setup(store.attrs, str(path), store.parameter_names, store.quantity_names, store.status.size)
     except CampaignError as exc:
         raise BadInput(str(exc)) from exc
 
@@ -261,15 +261,15 @@ def analyse(path, reference: str | None = None, options: Options | None = None, 
     # one BLAS thread: the matrices are tall and thin (runs or draws × terms), where several threads are no
     # faster, and 10-20x slower on a loaded machine; the time blocks run in threads instead
     with ResultStore.open(path) as store, threadpool_limits(limits=1):
-        facts = campaign_facts(store, path)
-        germs, analysis = facts.germs, facts.analysis
-        method = {"order": DEFAULT_ORDER, **normalised(facts.method), **normalised(method or {})}
+        setup = file_setup(store, path)
+        germs, analysis = setup.germs, setup.analysis
+        method = {"order": DEFAULT_ORDER, **normalised(setup.method), **normalised(method or {})}
         allow_aliasing = allow_aliasing or bool(method.get("allow_aliasing"))
         options = options or Options(**{k: (tuple(v) if k == "quantiles" else v) for k, v in analysis.items()
                                         if k in ("band_samples", "bootstrap", "quantiles")})
         if options.seed is None:
-            options = replace(options, seed=facts.seed)
-        status, design_kind = store.status, facts.design_kind
+            options = replace(options, seed=setup.seed)
+        status, design_kind = store.status, setup.design_kind
         if method["kind"] not in METHODS:
             raise BadInput(f"{path}: unknown method {method['kind']!r}: expected one of {', '.join(METHODS)}")
         sampled = DESIGNS[design_kind].sampled
@@ -277,7 +277,7 @@ def analyse(path, reference: str | None = None, options: Options | None = None, 
         pending = int(np.sum(status == Status.PENDING))
         stats = Statistics(str(path), store.attrs.get("campaign_name", ""), method, design_kind,
                            store.parameter_names, int(status.size), int(ok.sum()), int(np.sum(status > 0)),
-                           pending, {}, partial=pending > 0, design_info=facts.design_info, seed=options.seed)
+                           pending, {}, partial=pending > 0, design_info=setup.design_info, seed=options.seed)
         if DESIGNS[design_kind].rare:  # its runs are not draws of the input law: its event's probability only
             from .rare_statistics import rare_statistics
 
@@ -291,9 +291,9 @@ def analyse(path, reference: str | None = None, options: Options | None = None, 
         stats.index_set = None if state is None else index_set_summary(state, store.parameter_names)
         problem = method_problem(method["kind"], method["order"], store.xi[ok], store.weights[ok], germs, sampled,
                                  missing=int(status.size - ok.sum()), allow_aliasing=allow_aliasing)
-        if facts.seeds and not (sampled and METHODS[method["kind"]].runs_on_sampled):
-            problem = f"parameter {facts.seeds[0]} is a seed: {SEED_REFUSAL}"
-        stats.seeds, stats.dependence = facts.seeds, facts.dependence
+        if setup.seeds and not (sampled and METHODS[method["kind"]].runs_on_sampled):
+            problem = f"parameter {setup.seeds[0]} is a seed: {SEED_REFUSAL}"
+        stats.seeds, stats.dependence = setup.seeds, setup.dependence
         if stats.dependence:
             stats.notes.append(f"dependent inputs: {', '.join(stats.dependence['parameters'])} are correlated by a "
                                "Gaussian copula (Nataf); the mean, variance, bands and densities are those of the "
@@ -309,7 +309,7 @@ def analyse(path, reference: str | None = None, options: Options | None = None, 
                                     "failed and pending runs" if stats.pending else "failed runs")
             if note:
                 stats.notes.append(note)
-        replicates = facts.design_info.get("replicates", 1)
+        replicates = setup.design_info.get("replicates", 1)
         stats.replicates = replicates if stats.from_runs and ok.all() else 1
         if progress is not None:
             progress.stage(f"analysing {Path(path).name} ({method['kind']} order {method['order']})",
@@ -319,7 +319,7 @@ def analyse(path, reference: str | None = None, options: Options | None = None, 
         # most ANALYSIS_THREADS outputs in flight, so that as many outputs' samples are held at once
         with ThreadPoolExecutor(ANALYSIS_THREADS) as pool:
             in_flight: deque = deque()
-            reused = Reused()
+            basis_cache = BasisCache()
 
             def finish_oldest():
                 name, finish = in_flight.popleft()
@@ -337,8 +337,8 @@ def analyse(path, reference: str | None = None, options: Options | None = None, 
 
             for name in store.output_names:
                 chosen, runs_only, record = auto_method(store, name, method, germs, design_kind, ok, options.seed)
-                start = _start_output(store, name, chosen, germs, design_kind, ok, options, pool, reused, runs_only,
-                                      record is not None)
+                start = _start_output(store, name, chosen, germs, design_kind, ok, options, pool, basis_cache,
+                                      runs_only, record is not None)
                 in_flight.append((name, _with_method(record, start)))
                 if len(in_flight) >= ANALYSIS_THREADS:
                     finish_oldest()
@@ -490,7 +490,7 @@ def _output_statistics(store: ResultStore, name: str, method: dict, germs: list[
     chosen, runs_only, record = auto_method(store, name, method, germs, design_kind, ok, options.seed)
     with ThreadPoolExecutor(ANALYSIS_THREADS) as pool:
         return _with_method(record, _start_output(store, name, chosen, germs, design_kind, ok, options, pool,
-                                                  Reused(), runs_only, record is not None))()
+                                                  BasisCache(), runs_only, record is not None))()
 
 
 def _with_method(record: dict | None, finish: Callable[[], OutputStatistics]) -> Callable[[], OutputStatistics]:
@@ -530,7 +530,7 @@ def _note_auto(stats: Statistics) -> None:
                            + " (each output's method in summary.json)")
 
 
-class Reused:
+class BasisCache:
     """What consecutive outputs of one file share when their expansions have the same basis: the band
     draws' basis values and the triple products, each kept for the last basis only (so that the memory
     is one basis's whatever the number of outputs). Used from one thread."""
@@ -561,10 +561,10 @@ class Reused:
 
 
 def _start_output(store: ResultStore, name: str, method: dict, germs: list[str], design_kind: str,
-                  ok: np.ndarray, options: Options, pool: Executor, reused: Reused,
+                  ok: np.ndarray, options: Options, pool: Executor, basis_cache: BasisCache,
                   runs_only: bool = False, auto: bool = False) -> Callable[[], OutputStatistics]:
     """Read and fit output `name` here and hand its time blocks to `pool`; returns what waits for them
-    and gives the output's statistics. `reused`: what the outputs of one analysis share (Reused).
+    and gives the output's statistics. `basis_cache`: what the outputs of one analysis share (BasisCache).
     `runs_only`: the statistics of the (weighted) runs themselves, as on a sampled design; `auto`: `method`
     is what auto took (auto_method)."""
     xi, weights = store.xi[ok], store.weights[ok]
@@ -589,12 +589,12 @@ def _start_output(store: ResultStore, name: str, method: dict, germs: list[str],
     if from_runs:  # bands, PDFs and pick-freeze indices from the runs themselves
         rows, row_scale, band_weights = basis, scale, (None if entry.run_weights(weights) is None else weights / weights.sum())
     else:
-        rows, row_scale, band_weights = reused.band_rows(germs, pce.indices, options), pce.coefficients, None
+        rows, row_scale, band_weights = basis_cache.band_rows(germs, pce.indices, options), pce.coefficients, None
     d = len(store.parameter_names)
     pick_rows = _pick_freeze_rows(ok, d) if from_runs and DESIGNS[design_kind].sobol_from_runs else None
     pick_freeze = pick_rows is not None
     joined_blocks = _over_time_blocks(rows, row_scale, store.time.size, band_weights, d if pick_freeze else 0,
-                                      options, from_runs, pool, pce, reused,
+                                      options, from_runs, pool, pce, basis_cache,
                                       pick_rows=None if pick_freeze and ok.all() else pick_rows)
 
     def finish() -> OutputStatistics:
@@ -772,19 +772,19 @@ def _lower_order_difference(kind, xi, weights, basis, scale, germs, order, x0, p
 
 
 def _over_time_blocks(rows, scale, n_times: int, weights, pick_freeze_dimensions: int, options: Options,
-                      from_runs: bool, pool: Executor, pce: PCE | None, reused: Reused,
+                      from_runs: bool, pool: Executor, pce: PCE | None, basis_cache: BasisCache,
                       pick_rows: np.ndarray | None = None) -> Callable[[], dict]:
     """Quantiles, 99 % band, skewness and kurtosis, PDFs, final-time samples (the runs' fourth central
     moments, pick-freeze indices) of Y = rows @ scale (scale None: Y = rows), rebuilding Y for
     TIME_BLOCK times at once: the memory stays that of one block per thread whatever the number of runs or
     draws. Every statistic here is per time, so blocks change nothing. A `pce`'s skewness and kurtosis are
     its exact ones (methods.pce_moments), not those of its draws; the KDE's std comes from the factors.
-    The blocks are handed to `pool`; returns what waits for them and joins them. `reused`: the triple
-    products of outputs before (Reused). `pick_rows`: the rows of the pick-freeze estimators (the complete
+    The blocks are handed to `pool`; returns what waits for them and joins them. `basis_cache`: the triple
+    products of outputs before (BasisCache). `pick_rows`: the rows of the pick-freeze estimators (the complete
     base rows', analysis.sobol.complete_rows), None for every row."""
     probabilities = (0.5 * (1 - BAND_LEVEL), 0.5 * (1 + BAND_LEVEL), *options.quantiles)
     exact = None if pce is None else pce_standardised_moments(pce.germs, pce.indices, pce.coefficients,
-                                                              reused.triple_products)
+                                                              basis_cache.triple_products)
     std = None if scale is None else np.sqrt(np.maximum(weighted_moments(rows, None, scale, unbiased=True)[1], 0.0))
 
     def block(start: int) -> dict:

@@ -97,12 +97,12 @@ def fit_surrogate(path, method: dict | None = None, partial: bool = False, allow
     does not depend on them, and its bands and PDFs are not exported); `progress`: see analyse."""
     from .designs import REGISTRY as DESIGNS
     from .methods import METHODS, normalised
-    from .statistics import BadInput, Options, analyse, campaign_facts
+    from .statistics import BadInput, Options, analyse, file_setup
     from .store import ResultStore
 
     with ResultStore.open(path) as store:
-        facts = campaign_facts(store, path)
-        stored, design_kind = normalised(facts.method), facts.design_kind
+        setup = file_setup(store, path)
+        stored, design_kind = normalised(setup.method), setup.design_kind
         if DESIGNS[design_kind].rare:
             raise BadInput(f"{path}: a {design_kind} design's runs were chosen to reach its event, they are not "
                            "draws of the input law: no expansion of the law is fitted to them; fly a sampled "

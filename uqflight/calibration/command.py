@@ -63,7 +63,7 @@ def calibrate_command(
 
     Exit 0: done; 2: bad input (data, options, results file, data times outside the surrogate's); 3: the chain did not converge (nothing written; the message says what to change); 130: interrupted (Ctrl-C).
     """  # noqa: E501
-    from .likelihood import DataError
+    from .likelihood import DataError, parse_noise
     from .size import campaign_memory_limit, check_size
 
     check_results_file(results)
@@ -81,6 +81,7 @@ def calibrate_command(
         echo(f"error: --predictive-draws: expected an integer >= 1, got {predictive_draws}", err=True)
         raise typer.Exit(EXIT_BAD_INPUT)
     try:  # before the sampler's and the surrogate's modules are even imported: a refusal is immediate
+        sigmas = parse_noise(list(noise))
         check_size(data, list(output) or None, walkers, steps, predictive_draws, campaign_memory_limit(results))
     except DataError as exc:
         echo(f"error: {exc}", err=True)
@@ -92,7 +93,7 @@ def calibrate_command(
     streams, previous = (sys.stdout, sys.stderr), signal.signal(signal.SIGINT, _interrupted)
     try:
         with Progress(0, label="calibrate") as progress:
-            result = calibrate(results, data, out, outputs=list(output) or None, noise=list(noise), seed=seed,
+            result = calibrate(results, data, out, outputs=list(output) or None, noise=sigmas, seed=seed,
                                walkers=walkers, steps=steps, method=method, order=order, campaign=campaign,
                                predictive_draws=predictive_draws, truth=known, progress=progress)
     except KeyboardInterrupt:
@@ -150,7 +151,7 @@ def calibrate_command(
 def _truth(items: list[str], results: Path) -> dict[str, float] | None:
     """--truth NAME=VALUE items as {name: value}; exit 2 for a malformed item, a repeated or unknown name."""
     from ..store import ResultStore
-    from .likelihood import DataError, name_values
+    from .likelihood import DataError, check_names, parse_pairs
 
     if not items:
         return None
@@ -161,7 +162,8 @@ def _truth(items: list[str], results: Path) -> dict[str, float] | None:
         echo(f"error: {exc}" if str(exc).startswith(str(results)) else f"error: {results}: {exc}", err=True)
         raise typer.Exit(EXIT_BAD_INPUT)
     try:
-        return name_values(items, "--truth", "NAME=VALUE with a finite VALUE", names, f"the parameters of {results}")
+        return check_names(parse_pairs(items, "--truth", "NAME=VALUE with a finite VALUE"), "--truth", names,
+                           f"the parameters of {results}")
     except DataError as exc:
         echo(f"error: {exc}", err=True)
         raise typer.Exit(EXIT_BAD_INPUT)

@@ -99,15 +99,24 @@ def read_flight_csv(path, outputs: list[str] | None, available: list[str]) -> Fl
     return FlightData(str(path), time, values)
 
 
-def parse_noise(pairs: list[str], outputs: list[str]) -> dict[str, float]:
-    """`NAME=SIGMA` pairs (SIGMA > 0, in the output's unit) for outputs among `outputs`."""
-    return name_values(pairs, "--noise", "OUTPUT=SIGMA with SIGMA > 0", outputs, "the calibrated outputs", positive=True)
+def parse_noise(pairs: list[str]) -> dict[str, float]:
+    """`--noise OUTPUT=SIGMA` items as {output: sigma} (SIGMA > 0, in the output's unit); DataError otherwise."""
+    return parse_pairs(pairs, "--noise", "OUTPUT=SIGMA with SIGMA > 0", positive=True)
 
 
-def name_values(pairs: list[str], option: str, form: str, names: list[str], among: str,
-                positive: bool = False) -> dict[str, float]:
-    """`NAME=VALUE` pairs of `option` as {name: value}: VALUE finite (and > 0 when `positive`), NAME
-    one of `names` (`among` says what they are), each once; DataError otherwise."""
+def check_noise(noise: dict, outputs: list[str]) -> dict[str, float]:
+    """The known noise {output: sigma}: each output one of `outputs`, each sigma a finite number > 0;
+    DataError naming the output otherwise."""
+    for name, sigma in noise.items():
+        if isinstance(sigma, bool) or not isinstance(sigma, (int, float)) or not math.isfinite(sigma) or sigma <= 0:
+            raise DataError(f"--noise {shown(name)}: expected SIGMA > 0 (a finite number), got {sigma!r}")
+    return check_names({str(name): float(sigma) for name, sigma in noise.items()}, "--noise", outputs,
+                       "the calibrated outputs")
+
+
+def parse_pairs(pairs: list[str], option: str, form: str, positive: bool = False) -> dict[str, float]:
+    """`NAME=VALUE` items of `option` as {name: value}: VALUE finite (and > 0 when `positive`), each NAME
+    once; DataError (naming `option` and `form`, what the items take) otherwise."""
     values = {}
     for pair in pairs:
         name, sep, text = pair.partition("=")
@@ -118,11 +127,17 @@ def name_values(pairs: list[str], option: str, form: str, names: list[str], amon
             value = float("nan")
         if not sep or not name or not math.isfinite(value) or (positive and not value > 0):
             raise DataError(f"{option}: expected {form}, got {pair!r}")
-        if name not in names:
-            raise DataError(f"{option} {shown(name)}: not one of {among} ({listed(names)})")
         if name in values:
             raise DataError(f"{option} {shown(name)}: given twice ({values[name]:g} and {value:g}); give it once")
         values[name] = value
+    return values
+
+
+def check_names(values: dict[str, float], option: str, names: list[str], among: str) -> dict[str, float]:
+    """`values` when every name is one of `names` (`among` says what they are); DataError otherwise."""
+    for name in values:
+        if name not in names:
+            raise DataError(f"{option} {shown(name)}: not one of {among} ({listed(names)})")
     return values
 
 

@@ -15,7 +15,7 @@ from threadpoolctl import threadpool_limits
 
 from ..parameters.germs import GERMS
 
-from .likelihood import DataError, LogPosterior, interpolate_in_time, parse_noise, read_flight_csv
+from .likelihood import DataError, LogPosterior, check_noise, interpolate_in_time, read_flight_csv
 from .outputs import (OUTPUT_FILES, calibrated_campaign, corner_plot, draw_all, informed, marginal, marginals_plot,
                       predictive_plot, pyplot, write_json, write_posterior)
 from .sampler import sample
@@ -46,11 +46,13 @@ class Calibration:
     written: list[str] = field(default_factory=list)
 
 
-def calibrate(results, data, out, outputs: list[str] | None = None, noise: list[str] = (), seed: int = 0,
-              walkers: int | None = None, steps: int | None = None, method: str | None = None, order: int | None = None,
-              campaign: str | None = None, predictive_draws: int = 50, truth: dict | None = None,
-              progress=None) -> Calibration:
-    """Calibrate the campaign of `results` on flight `data`; see docs/calibration.md. `progress` (a
+def calibrate(results, data, out, outputs: list[str] | None = None, noise: dict[str, float] | None = None,
+              seed: int = 0, walkers: int | None = None, steps: int | None = None, method: str | None = None,
+              order: int | None = None, campaign: str | None = None, predictive_draws: int = 50,
+              truth: dict | None = None, progress=None) -> Calibration:
+    """Calibrate the campaign of `results` on flight `data`; see docs/calibration.md. `outputs`: the
+    calibrated outputs (None: every output the data and the surrogate share); `noise`: {output: known noise
+    std}, the others' inferred; `method` and `order`: the surrogate's, instead of the campaign's. `progress` (a
     uqflight.progress.Progress) is told the stages and counts the sampler's steps. `steps`: exactly that
     many per walker, or None: until converged (calibration.sampler, at most MAX_STEPS).
 
@@ -126,7 +128,7 @@ def _fitted(results, data, outputs, noise, method, order, campaign):
     """The surrogate of `results`, the flight data, the given noise and the log-posterior."""
     surrogate = calibration_surrogate(results, method=method, order=order, campaign_path=campaign)
     flight = read_flight_csv(data, outputs, surrogate.outputs)
-    given = parse_noise(list(noise), list(flight.values))
+    given = check_noise(noise or {}, list(flight.values))
     posterior = LogPosterior.build(surrogate.time, surrogate.coefficients, surrogate.error_factors,
                                    surrogate.germs, surrogate.names, surrogate.basis, flight, given)
     return surrogate, flight, given, posterior

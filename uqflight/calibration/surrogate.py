@@ -29,7 +29,7 @@ from ..parameters import to_physical as _to_physical
 from ..parameters import to_standard as _to_standard
 from ..parameters.summaries import parameter_specs, prior_summaries
 from ..simulators.validation_view import validation_view
-from ..statistics import BadInput, Options, campaign_facts, output_basis
+from ..statistics import BadInput, Options, file_setup, output_basis
 from ..store import ResultStore, Status
 from ..surrogate import SurrogateError, fit_surrogate
 from .likelihood import error_factors_of
@@ -148,11 +148,11 @@ def calibration_surrogate(results, method: str | None = None, order: int | None 
     with store:
         campaign = _campaign_of(store, results, Path(campaign_path) if campaign_path else None)
         try:
-            facts = campaign_facts(store, results)
+            setup = file_setup(store, results)
         except BadInput as exc:
             raise SurrogateError(str(exc)) from exc
-        stored, germs = normalised(facts.method), facts.germs
-        sampled = DESIGNS[facts.design_kind].sampled
+        stored, germs = normalised(setup.method), setup.germs
+        sampled = DESIGNS[setup.design_kind].sampled
         kind = method or stored["kind"]
         order = stored.get("order", DEFAULT_ORDER) if order is None else order
         if kind not in METHOD_KINDS:

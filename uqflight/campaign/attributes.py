@@ -1,4 +1,4 @@
-"""The campaign facts a results file keeps as root attributes (see execution.py): of JSON text (`method`,
+"""The campaign setup a results file keeps as root attributes (see execution.py): of JSON text (`method`,
 `germs`, `analysis`, `seeds`, `dependence`, `design_info`, `versions`) or plain text (`design_kind`, the
 provenance in TEXT), checked when the file is read, by the checks its campaign file passed (schema) where
 there are some, so that a damaged or hand-edited attribute is one line naming the file, the attribute and
@@ -23,7 +23,7 @@ TEXT = ("campaign_name", "campaign_hash", "campaign_path", "created", "aircraft_
 
 
 @dataclass(frozen=True)
-class StoredFacts:
+class RecordedSetup:
     """What a results file was made with: its method, germs, analysis options, the parameters that are
     seeds, the copula of dependent inputs (GaussianCopula.summary; None: independent), and its design's kind
     and recorded facts (designs.Design.info), and the campaign's `seed`, which seeds the analysis's draws."""
@@ -47,23 +47,23 @@ class AttributeChecker(Checker):
         raise CampaignError(f"{self.source}: attribute {attribute}", inside, message)
 
 
-def stored_facts(attrs: dict, source: str, parameters: list[str], quantities: list[str], runs: int) -> StoredFacts:
-    """The checked facts of a results file's root attributes (`source` names it, `parameters` and
+def recorded_setup(attrs: dict, source: str, parameters: list[str], quantities: list[str], runs: int) -> RecordedSetup:
+    """The checked setup of a results file's root attributes (`source` names it, `parameters` and
     `quantities` are its names, `runs` its design's size); CampaignError naming the file, the attribute
     and the field."""
     check = AttributeChecker(source)
     for name in TEXT:
         if name in attrs and not isinstance(attrs[name], str):
             check.fail(name, f"expected text, got {shown(attrs[name])}")
-    versions = _json(check, attrs, "versions", "{}")
+    versions = _json(check, attrs, "versions")
     if not isinstance(versions, dict):
         check.fail("versions", f"expected a mapping of package versions, got {shown(versions)}")
     kind = attrs.get("design_kind")
     if not isinstance(kind, str) or kind not in DESIGN_KINDS:
         check.fail("design_kind", f"expected one of {', '.join(DESIGN_KINDS)}, got {shown(kind)}")
-    info = _design_info(check, _json(check, attrs, "design_info", "{}"), kind, runs, len(parameters))
+    info = _design_info(check, _json(check, attrs, "design_info"), kind, runs, len(parameters))
     method = schema.method(check, _json(check, attrs, "method"))
-    analysis = schema.analysis(check, _json(check, attrs, "analysis", "{}"), quantities)
+    analysis = schema.analysis(check, _json(check, attrs, "analysis"), quantities)
     germs = _json(check, attrs, "germs")
     if (not isinstance(germs, list) or len(germs) != len(parameters)
             or not all(isinstance(germ, str) and germ in GERMS for germ in germs)):
@@ -79,7 +79,7 @@ def stored_facts(attrs: dict, source: str, parameters: list[str], quantities: li
         dependence = {key: value for key, value in dependence.items() if key != "sobol_of"}
     copula = schema.dependence(check, dependence, parameters, seeds)
     seed = _checked_seed(check, attrs.get("campaign", ""))
-    return StoredFacts(method, germs, analysis, seeds, None if copula is None else copula.summary(), kind, info, seed)
+    return RecordedSetup(method, germs, analysis, seeds, None if copula is None else copula.summary(), kind, info, seed)
 
 
 @functools.lru_cache(maxsize=8)
@@ -118,10 +118,12 @@ def _design_info(check: Checker, info, kind: str, runs: int, d: int) -> dict:
 
 
 def _json(check: Checker, attrs: dict, name: str, default: str | None = None):
-    """The value of the JSON text in attribute `name` (`default` when absent; None: required)."""
+    """The value of the JSON text in attribute `name` (`default` when absent, for the attributes a run writes
+    only when the campaign has them; None: required)."""
     text = attrs.get(name, default)
     if text is None:
-        check.fail(name, "is missing")
+        check.fail(name, "is missing: the file is damaged or was not written by uqflight: fly its campaign again "
+                         "(`uqflight run CAMPAIGN --out FILE --restart`)")
     if not isinstance(text, str):
         check.fail(name, f"expected JSON text, got {shown(text)}")
     try:

@@ -5,9 +5,7 @@ Reading never runs campaign code: the stored campaign text is checked as written
 is never resolved (`schema.resolve_simulator` is not called here): no python module is imported,
 whatever files lie in the working directory, beside the results file or at the campaign's recorded
 path. The parameters (with the nominal values a run read from its aircraft) come from the results
-file's `parameters` attribute. Files written before that attribute: the nominal values the
-campaign left to its aircraft are read from the aircraft (JSBSim loading its XML, located from the
-recorded campaign folder); a python simulator's parameters never need its code.
+file's `parameters` attribute; a file without it is refused, naming the attribute and `run --restart`.
 """
 from __future__ import annotations
 
@@ -17,7 +15,6 @@ from pathlib import Path
 
 from ..parameters import Parameter
 from ..simulators.kinds import simulator_entry
-from ..simulators.kinds.jsbsim import locate_aircraft
 from . import Campaign, build_campaign, read_settings, schema
 from .schema import CampaignError, Checker
 
@@ -41,21 +38,16 @@ def results_campaign(attrs: dict, source: str) -> Campaign:
     any of its code; `source` names it in messages and is the folder a later simulator run resolves from.
     CampaignError when it cannot be rebuilt."""
     check, data, simulator = read_settings(str(attrs.get("campaign", "")), source)
-    if attrs.get("parameters") is not None:
-        parameters = _stored(check, data, attrs["parameters"])
-    else:
-        try:
-            parameters = schema.parameters(check, data["parameters"], simulator["kind"], None)
-        except CampaignError:
-            if not simulator_entry(simulator).aircraft:
-                raise
-            parameters = _from_aircraft(check, data, simulator, attrs)
+    if attrs.get("parameters") is None:
+        check.fail("parameters", "the results file records no parameters attribute (the parameters' laws with the "
+                                 f"nominal values its run read): {REFLY}")
+    parameters = _stored(check, data, attrs["parameters"])
     return build_campaign(check, data, simulator, parameters, str(attrs.get("campaign", "")))
 
 
 def stored_parameters(attrs: dict) -> list[dict] | None:
     """The parameters of a results file (root attributes) as dicts (STORED_KEYS); None when they cannot be
-    rebuilt (e.g. an older file whose aircraft is not on this machine)."""
+    rebuilt (a damaged file, or one without the `parameters` attribute)."""
     try:
         campaign = results_campaign(attrs, "<results file>")
     except (CampaignError, OSError):
@@ -86,25 +78,6 @@ def _stored(check: Checker, data: dict, value) -> list[Parameter]:
         except ValueError as exc:
             check.fail(f"parameters.{row['name']}", str(exc))
     return parameters
-
-
-def _from_aircraft(check: Checker, data: dict, simulator: dict, attrs: dict) -> list[Parameter]:
-    """An older file's parameters with nominal values from its JSBSim aircraft, located from the folder
-    of the campaign file the run recorded (`campaign_path`)."""
-    from ..simulators.validation_view import validation_view
-
-    recorded = str(attrs.get("campaign_path", "")) or "<results file>"  # no path: the working directory
-    if not isinstance(simulator.get("aircraft"), str):  # e.g. a script's: only its run resolved it
-        check.fail("simulator.aircraft", "the campaign stored in the file names no aircraft (its script does), and "
-                                         f"the file records no parameters attribute to take the nominal values "
-                                         f"from: {REFLY}")
-    simulator = dict(simulator)
-    locate_aircraft(check, simulator, str(Path(recorded)))
-    try:
-        aircraft = validation_view(simulator)
-    except (FileNotFoundError, RuntimeError) as exc:
-        check.fail("simulator.aircraft", str(exc))
-    return schema.parameters(check, data["parameters"], "jsbsim", aircraft)
 
 
 def campaign_mapping(campaign: Campaign) -> dict:

@@ -436,7 +436,7 @@ def patch_nominal(check: Checker, prop: str, path: str, aircraft) -> float:
 
     try:
         function, perturbation = patch_request(prop, aircraft.functions)
-        check_perturbation(function, perturbation, getattr(aircraft, "references", {}))
+        check_perturbation(function, perturbation, getattr(aircraft, "aero_factors", {}))
     except PatchError as exc:
         check.fail(path, f"{exc} (aircraft {aircraft.aircraft!r})")
     return NOMINAL[perturbation]
@@ -468,7 +468,7 @@ def function_property(check: Checker, spec: dict, path: str, kind: str, aircraft
     except PatchError as exc:
         check.fail(f"{path}.function", f"{exc} (aircraft {aircraft.aircraft!r})")
     try:
-        check_perturbation(full, perturbation, getattr(aircraft, "references", {}))
+        check_perturbation(full, perturbation, getattr(aircraft, "aero_factors", {}))
     except PatchError as exc:
         check.fail(f"{path}.perturbation", f"{exc} (aircraft {aircraft.aircraft!r})")
     return patch_property(full, perturbation, functions)

@@ -13,7 +13,7 @@ Layout of the report directory:
 The report is written into a staging folder beside OUT and swapped into place when complete
 (`replace`): a report that fails or is interrupted leaves OUT as it was (no half-written directory),
 and OUT is never absent. The figures are drawn by a drawer forked before the files are read
-(forking.Standby), which imports matplotlib while they are analysed; this process writes the data
+(forking.PreparedChild), which imports matplotlib while they are analysed; this process writes the data
 files and the page and never imports it.
 """
 from __future__ import annotations
@@ -23,7 +23,7 @@ import shutil
 from pathlib import Path
 
 from ..check import write_baseline
-from ..forking import FORKS, ChildFailed, Standby
+from ..forking import FORKS, ChildFailed, PreparedChild
 from ..progress import Progress
 from ..statistics import BadInput
 from ..methods.parsing import parse_methods
@@ -61,7 +61,7 @@ def write_report(paths: list[Path], out_dir: Path | None = None, reference: Path
         raise ValueError(f"figure format: expected one of {', '.join(FORMATS)}, got {fmt!r}")
     check_replaceable(out_dir)
     progress = progress or Progress(0, quiet=True)
-    drawer = Standby(_ready_to_draw, _draw) if FORKS else None  # gets ready while the files are analysed
+    drawer = PreparedChild(_ready_to_draw, _draw) if FORKS else None  # gets ready while the files are analysed
     try:
         entries, ref = load_entries(paths, reference, method, progress=progress, partial=partial,
                                     allow_aliasing=allow_aliasing, exceedance=exceedance)
@@ -89,12 +89,12 @@ def write_report(paths: list[Path], out_dir: Path | None = None, reference: Path
 
 
 def _write_into(out_dir: Path, entries: list[Entry], ref: Entry | None, times, progress: Progress,
-                drawer: Standby | None) -> None:
-    """The report's files in `out_dir`: the data files written here while `drawer` (a Standby of _draw;
+                drawer: PreparedChild | None) -> None:
+    """The report's files in `out_dir`: the data files written here while `drawer` (a PreparedChild of _draw;
     None: this process) draws the sections, then the page."""
     for sub in ("plots", "tables"):
         (out_dir / sub).mkdir(parents=True, exist_ok=True)
-    heard = _drawing_progress(progress)
+    on_message = _drawing_progress(progress)
     if drawer is not None:
         drawer.start((entries, ref, times, out_dir, export_format()))
     progress.stage("writing summaries and tables")
@@ -102,14 +102,14 @@ def _write_into(out_dir: Path, entries: list[Entry], ref: Entry | None, times, p
     if drawer is None:
         from .sections import build_sections
 
-        sections = build_sections(entries, ref, times, out_dir, heard)
+        sections = build_sections(entries, ref, times, out_dir, on_message)
     else:
         try:
-            sections = drawer.wait(heard)
+            sections = drawer.wait(on_message)
         except ChildFailed as exc:
             raise RuntimeError(f"cannot draw the report's plots: a process drawing them {exc} (any error it "
                                "printed is above)") from None
-    heard(("drawn", None))
+    on_message(("drawn", None))
     from .blocks import Table, files_section
     from .render import render_html, render_markdown
 
@@ -147,7 +147,7 @@ def _drawing_progress(progress: Progress):
     starts; ("drawn", None) ends it."""
     stages, started = [], []
 
-    def heard(message) -> None:
+    def on_message(message) -> None:
         kind, value = message
         if kind == "jobs":
             stages[:] = value
@@ -158,7 +158,7 @@ def _drawing_progress(progress: Progress):
         else:
             progress.advance(len(stages), "drawn")
 
-    return heard
+    return on_message
 
 
 def _data_files(entries: list[Entry], out_dir: Path) -> list[Path]:

@@ -91,8 +91,8 @@ def campaign_simulator(campaign_text: str) -> dict:
 
 def flight_facts(simulator: dict) -> dict[str, str]:
     """What a campaign's simulator flies ({"flight": ..., "excitation": ...}), defaults resolved by its
-    kind (and scenario kind); as written when that fails (a results file of an older version), {} for a
-    python model."""
+    kind (and scenario kind); {} for a python model, and for a stored text that is not a campaign (the
+    report shows the text, and its notes say why its parameters cannot be read)."""
     from ..simulators.kinds import REGISTRY
 
     entry = REGISTRY.get(simulator.get("kind")) if isinstance(simulator, dict) else None
@@ -101,8 +101,7 @@ def flight_facts(simulator: dict) -> dict[str, str]:
     try:
         return entry.facts(simulator)
     except (TypeError, ValueError, KeyError, AttributeError):
-        return {key: ", ".join(f"{k} {v}" for k, v in value.items()) if isinstance(value, dict) else str(value)
-                for key in ("flight", "excitation") if (value := simulator.get(key)) is not None}
+        return {}
 
 
 def load_entries(paths: list[Path], reference: Path | None, method: dict | list[dict] | None = None,

@@ -21,19 +21,19 @@ BELOW_FLOOR = "below reference resolution"
 UNRESOLVED = "unresolved"
 
 def build_sections(entries: list[Entry], ref: Entry | None, times: list[float], out_dir: Path,
-                   heard: Callable[[tuple], None] | None = None) -> list[Section]:
+                   on_message: Callable[[tuple], None] | None = None) -> list[Section]:
     """The report's sections, drawing their plots into out_dir/plots. The sections are built by this
     process and a forked child per further core (forking.share_work), the costliest first: each
-    process draws its sections' figures itself, with the fonts it has loaded. `heard`, when given, is
+    process draws its sections' figures itself, with the fonts it has loaded. `on_message`, when given, is
     told ("jobs", the sections' stage texts) first, then ("starting", k) as this process starts the k-th."""
     jobs = section_jobs(entries, ref, times, out_dir)
     order = sorted(range(len(jobs)), key=lambda k: -jobs[k][0])
-    if heard is not None:
-        heard(("jobs", [stage for _, stage, _ in jobs]))
+    if on_message is not None:
+        on_message(("jobs", [stage for _, stage, _ in jobs]))
     plots.warm_text_caches()  # before the fork: every process inherits the loaded fonts
     with plots.collecting_at_the_end():
         sections = share_work([build for _, _, build in jobs], order,
-                              starting=None if heard is None else lambda k: heard(("starting", k)))
+                              starting=None if on_message is None else lambda k: on_message(("starting", k)))
     return [section for section in sections if section is not None]
 
 

@@ -7,7 +7,7 @@ A patch `(function, kind)` rewrites the aircraft's `<function name="FUNCTION">BO
     offset:       <sum> <product> <property> aero/uq/offset/NAME </property> REFERENCE </product> BODY </sum>
 
 where REFERENCE is the function's reference factor as properties (`aero/qbar-psf`
-`metrics/Sw-sqft`, and `metrics/cbarw-ft` or `metrics/bw-ft` for moments; see reference.py):
+`metrics/Sw-sqft`, and `metrics/cbarw-ft` or `metrics/bw-ft` for moments; see aero_factors.py):
 an `offset` is a coefficient increment ΔC, an `offset_value` a value in the function's own unit
 (lbf, lbf·ft, or whatever a helper function outside the axes holds). `offset` on a function
 without a reference factor is refused. Several kinds nest in the order scale, offset_value,
@@ -27,7 +27,7 @@ import difflib
 import xml.etree.ElementTree as ET
 
 from .aircraft import AircraftFiles, aero_functions
-from .reference import Reference, references
+from .aero_factors import AeroFactor, aero_factors
 
 KINDS = ("scale", "offset_value", "offset")  # the order they nest in, innermost first
 NOMINAL = {"scale": 1.0, "offset_value": 0.0, "offset": 0.0}
@@ -71,7 +71,7 @@ def resolve_function(name: str, functions: list[str]) -> str:
                      f"got {name!r}{function_hint(name, functions)}")
 
 
-def check_perturbation(function: str, kind: str, refs: dict[str, Reference]) -> None:
+def check_perturbation(function: str, kind: str, refs: dict[str, AeroFactor]) -> None:
     """Refuse an unknown kind, and `offset` on a function without a reference factor (naming it)."""
     if kind not in KINDS:
         raise PatchError(f"perturbation: expected one of {', '.join(KINDS)}, got {kind!r}")
@@ -83,7 +83,7 @@ def check_perturbation(function: str, kind: str, refs: dict[str, Reference]) -> 
                          f"(--offset-value on the command line) to add a value in its own unit{unit}")
 
 
-def _wrapper(kind: str, prop: str, ref: Reference) -> ET.Element:
+def _wrapper(kind: str, prop: str, ref: AeroFactor) -> ET.Element:
     """The element that scales or offsets a function body by `prop` (the body is appended after)."""
     wrapper = ET.Element("product" if kind == "scale" else "sum")
     holder = ET.SubElement(wrapper, "product") if kind == "offset" else wrapper
@@ -98,7 +98,7 @@ def patch_xml(xml: bytes, patches: list[tuple[str, str]]) -> bytes:
     root = tree.getroot()
     aero = root.find("aerodynamics")
     names = [f.name for f in aero_functions(xml)]
-    refs = references(xml)
+    refs = aero_factors(xml)
     wanted: dict[str, set[str]] = {}
     for function, kind in patches:
         full = resolve_function(function, names)

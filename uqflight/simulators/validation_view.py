@@ -16,14 +16,14 @@ class AircraftProperties:
 
     def __init__(self, simulator: dict):
         from .aircraft import aero_functions
-        from .reference import references
+        from .aero_factors import aero_factors
         from .scenarios import scenario_entry
 
         setup = flight_setup_from({**simulator, "outputs": []})  # raises AircraftNotFound (a FileNotFoundError)
         self.aircraft = setup.aircraft
         xml = setup.aircraft_file.read_bytes()
         self.functions = [f.name for f in aero_functions(xml)]
-        self.references = references(xml)  # each function's unit and reference factor
+        self.aero_factors = aero_factors(xml)  # each function's unit and reference factor
         self._flight = scenario_entry(simulator).flight(setup)
         self._flight.prepare_validation_view()
 

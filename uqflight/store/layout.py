@@ -91,11 +91,14 @@ def layout_problems(f: h5py.File) -> list[str]:
         _finite(weight, problems)
     reason = _dataset(f, "samples/reason", "string", (n,), problems)
     length = None if reason is None else h5py.check_string_dtype(reason.dtype).length
+    if reason is not None and length is None:
+        return problems + [f"/samples/reason holds variable-length strings, expected fixed-length strings of at most "
+                           f"{MAX_REASON_BYTES} bytes"]
     if length is not None and length > MAX_REASON_BYTES:
         return problems + [f"/samples/reason holds strings of {length} bytes, more than a reason takes "
                            f"({MAX_REASON_BYTES})"]
-    if reason is not None and n * (length or MAX_REASON_BYTES) > 8 * MAX_OUTPUT_VALUES:
-        return problems + [f"/samples/reason declares {n} reasons of {length or MAX_REASON_BYTES} bytes, more than "
+    if reason is not None and n * length > 8 * MAX_OUTPUT_VALUES:
+        return problems + [f"/samples/reason declares {n} reasons of {length} bytes, more than "
                            f"a reader holds ({8 * MAX_OUTPUT_VALUES:.4g} bytes)"]
     time = _dataset(f, "time", "float", (None,), problems)
     if time is not None and time.shape[0] > MAX_TIMES:

@@ -76,6 +76,7 @@ def text_hash(text: str) -> str:
 
 
 REASON_BYTES = 256  # a failure's reason is stored in at most this many UTF-8 bytes, longer ones cut with "…"
+REFLY = "fly its campaign again (`uqflight run CAMPAIGN --out FILE --restart`)"
 REASON_ROWS = 256  # reasons per HDF5 chunk (64 KiB); only chunks holding a failed run are ever written
 QUANTITY_ROWS = 8192  # quantity values per HDF5 chunk (64 KiB)
 CHECKED = {"chunks": True, "fletcher32": True}  # every fixed-size dataset: chunked and checksummed
@@ -159,11 +160,6 @@ def _abandon(f: h5py.File, exc: BaseException) -> None:
         except READ_ERRORS:
             pass
         gc.collect()
-
-
-def _no_reasons(data: h5py.Dataset, n: int):
-    """n empty reasons, in the form the reason dataset takes (fixed-length, or variable in older files)."""
-    return [""] * n if h5py.check_string_dtype(data.dtype).length is None else np.zeros(n, dtype=data.dtype)
 
 
 class ResultStore:
@@ -296,7 +292,7 @@ class ResultStore:
         if problems:
             f.close()
             raise CorruptFile(f"{path}: {'; '.join(problems[:3])}{' (and more)' if len(problems) > 3 else ''}: "
-                              "the file is damaged or was not written by uqflight")
+                              f"the file is damaged or was not written by uqflight: {REFLY}")
         unknown = np.setdiff1d(np.unique(status), [s.value for s in Status])
         if unknown.size:
             f.close()
@@ -377,7 +373,7 @@ class ResultStore:
 
     def resolution(self, name: str) -> np.ndarray | None:
         """(T,) the simulator's own resolution of output `name` (level flight: its two trims' drift), None when the
-        file holds none (a Python simulator, a file from before it was recorded)."""
+        file holds none (a Python simulator)."""
         group = self._file.get("resolution")
         return None if group is None or key_of(name) not in group else group[key_of(name)][()]
 
@@ -544,7 +540,7 @@ class ResultStore:
                     lost[start:stop] |= status[start:stop] == Status.OK
         reasons = self._file["samples/reason"]
         stale = np.zeros(status.size, dtype=bool)
-        for start, stop, values in chunk_blocks(reasons, block, _no_reasons(reasons, 1)[0]):
+        for start, stop, values in chunk_blocks(reasons, block, np.zeros(1, dtype=reasons.dtype)[0]):
             if values is None:
                 lost[start:stop] |= status[start:stop] > Status.OK
             else:
@@ -552,7 +548,7 @@ class ResultStore:
         stale &= (status == Status.PENDING) | lost
         if lost.any() or stale.any():
             self._file["samples/status"][np.flatnonzero(lost)] = Status.PENDING
-            self._file["samples/reason"][np.flatnonzero(stale)] = _no_reasons(reasons, int(stale.sum()))
+            self._file["samples/reason"][np.flatnonzero(stale)] = np.zeros(int(stale.sum()), dtype=reasons.dtype)
             self._flush(sync=True)
         return int(lost.sum())
 
@@ -560,8 +556,7 @@ class ResultStore:
         """Store the reasons of the runs `idx` (ascending), cut to what the dataset holds."""
         data = self._file["samples/reason"]
         length = h5py.check_string_dtype(data.dtype).length
-        data[idx] = [str(r) for r in reasons] if length is None else \
-            np.array([fit_reason(str(r), length) for r in reasons], dtype=data.dtype)
+        data[idx] = np.array([fit_reason(str(r), length) for r in reasons], dtype=data.dtype)
 
     def batch_bytes(self, n: int) -> int:
         """An upper estimate of the bytes the next batch of `n` runs may add to the file: its rows

@@ -2,7 +2,7 @@
 
 After a report's last file is written, a normal exit frees every object one by one and collects
 cycles several times over (matplotlib's figures and caches, the analysis, the modules): 0.4-1 s of a
-6-10 s command, with nothing left to write. `leave(code)` runs what a normal exit runs that reaches
+6-10 s command, with nothing left to write. `exit_fast(code)` runs what a normal exit runs that reaches
 outside the process (the atexit handlers: temporary folders, worker pools, Dask, logging; then stdout
 and stderr flushed) and ends the process with os._exit. Where skipping the teardown could lose
 something it exits normally instead: a thread that is not a daemon still running (a normal exit waits
@@ -17,7 +17,7 @@ import threading
 BROKEN_STDOUT = 120  # Python's own exit status when flushing stdout at exit fails
 
 
-def leave(code) -> None:
+def exit_fast(code) -> None:
     """End the process with `code` (a SystemExit code: None, an int, or a message printed to stderr
     with status 1), quickly where nothing can be lost (see the module's docstring)."""
     if code is not None and not isinstance(code, int):

@@ -29,7 +29,7 @@ METRICS = {AREA: "wingarea", CHORD: "chord", SPAN: "wingspan"}  # the <metrics> 
 
 
 @dataclass(frozen=True)
-class Reference:
+class AeroFactor:
     """A function's unit and the properties whose product multiplies a coefficient increment on
     it; `refusal` says why there is none ("" when there is)."""
 
@@ -53,29 +53,29 @@ def _stated(metrics: ET.Element | None, prop: str) -> bool:
         return False
 
 
-def axis_reference(axis: str, metrics: ET.Element | None) -> Reference:
+def axis_factor(axis: str, metrics: ET.Element | None) -> AeroFactor:
     """The reference of a function in `<axis name="AXIS">` ("" for one outside the axes)."""
     if not axis:
-        return Reference(axis, "", refusal="it lies outside the <axis> elements of <aerodynamics> "
+        return AeroFactor(axis, "", refusal="it lies outside the <axis> elements of <aerodynamics> "
                                                   "(a helper other functions use), so its unit is its own")
     if axis in FORCE_AXES:
         factor, unit = (QBAR, AREA), "lbf"
     elif axis in MOMENT_LENGTH:
         factor, unit = (QBAR, AREA, MOMENT_LENGTH[axis]), "lbf·ft"
     else:
-        return Reference(axis, "", refusal=f"its axis {axis!r} is none of JSBSim's "
+        return AeroFactor(axis, "", refusal=f"its axis {axis!r} is none of JSBSim's "
                                                   f"({', '.join(FORCE_AXES + tuple(MOMENT_LENGTH))})")
     missing = [METRICS[p] for p in factor[1:] if not _stated(metrics, p)]
     if missing:
-        return Reference(axis, unit, factor, refusal=f"the aircraft's <metrics> state no {' or '.join(missing)}, "
+        return AeroFactor(axis, unit, factor, refusal=f"the aircraft's <metrics> state no {' or '.join(missing)}, "
                                                      f"so {'·'.join(SYMBOLS[p] for p in factor)} is 0")
-    return Reference(axis, unit, factor)
+    return AeroFactor(axis, unit, factor)
 
 
-def references(xml: bytes) -> dict[str, Reference]:
+def aero_factors(xml: bytes) -> dict[str, AeroFactor]:
     """Each named function of the aircraft's <aerodynamics> and its reference."""
     metrics = ET.fromstring(xml).find("metrics")
-    return {f.name: axis_reference(f.axis, metrics) for f in aero_functions(xml)}
+    return {f.name: axis_factor(f.axis, metrics) for f in aero_functions(xml)}
 
 
 def factor_values(value) -> list[tuple[str, float, str]]:
