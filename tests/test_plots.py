@@ -121,7 +121,7 @@ def test_cov_draws_offset_datum_outputs_as_std(entries, tmp_path):
     assert {"h_ft", "vtas_kt"} <= datum and not {"theta_deg", "q_degps"} & datum
     texts = svg_texts(draw_svg(plots.plot_cov, outputs, tmp_path / "cov.png", "spread"))
     assert "std(t) in the output's unit (log scale)" in texts and "std(t) / max |mean| [%] (log scale)" in texts
-    assert texts.index("std(t) in the output's unit (log scale)") < texts.index("altitude h")  # in the right panel
+    assert texts.index("std(t) in the output's unit (log scale)") < texts.index("altitude h [ft]")  # in the right panel, with its unit
 
 
 @pytest.mark.slow

@@ -115,8 +115,9 @@ def test_the_calibration_surrogate_imports_no_model(world, name, monkeypatch):
 
 @pytest.mark.slow
 def test_calibrate_imports_the_model_only_for_its_predictive_runs(world, tmp_path):
-    """The model beside the results file is the one the predictive runs call: it is imported there (and
-    fails, being hostile), after the surrogate, the data and the sampling; no other copy is ever imported."""
+    """The model beside the results file is the one the predictive runs call: it is imported there, in their
+    worker processes (and fails, being hostile), after the surrogate, the data and the sampling; no other
+    copy is ever imported."""
     time = np.linspace(0.0, 2.0, 21)
     rng = np.random.default_rng(1)
     y = 1.12 - 0.46 * time + 0.05 * rng.standard_normal(time.size)
@@ -128,7 +129,7 @@ def test_calibrate_imports_the_model_only_for_its_predictive_runs(world, tmp_pat
     assert "cannot import 'model.py': RuntimeError: campaign code ran" in run.stderr
     found = ran_code(world)
     assert set(found) == {"beside"}
-    assert "in _predictive" in found["beside"] and "in simulate" in found["beside"]
+    assert "uqflight/worker.py" in found["beside"]  # in a worker of the predictive runs (execution.simulate)
     (world["sentinels"] / "beside").unlink()
 
 
