@@ -27,6 +27,7 @@ from pathlib import Path
 
 import numpy as np
 
+from uqflight.analysis.angles import angle_period, on_branch
 from uqflight.store import ResultStore, Status
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -107,11 +108,17 @@ def landing_case() -> str:
     return text.replace("scripts/c172p-landing.xml", str(ROOT / "campaigns" / "scripts" / "c172p-landing.xml"))
 
 
-def runs_range(path: Path, name: str, quantity: bool, at: int) -> tuple[float, float]:
-    """The smallest and largest value the completed runs themselves took (an output's at time index `at`)."""
+def runs_range(path: Path, name: str, entry: dict, quantity: bool, at: int) -> tuple[float, float]:
+    """The smallest and largest value the completed runs themselves took (an output's at time index `at`),
+    an angle seen as the statistics see it (analysis.angles.on_branch: unwrapped, on the mean's branch)."""
     with ResultStore.open(path) as store:
         ok = store.status == Status.OK
-        data = store.quantity(name)[ok] if quantity else store.output_matrix(name)[ok][:, at]
+        data = store.quantity(name)[ok][:, None] if quantity else store.output_matrix(name)[ok]
+    period = angle_period(entry.get("units", ""))
+    if period is not None:
+        mean = entry["mean"][0] if isinstance(entry["mean"], list) else entry["mean"]
+        data = on_branch(data, mean, period)
+    data = data[:, at]
     data = data[np.isfinite(data)]
     return (float(data.min()), float(data.max())) if data.size else (float("nan"), float("nan"))
 
@@ -146,7 +153,7 @@ def show(case: str, work: Path) -> None:
         for name, entry in summary.get(group, {}).items():
             if "mean" not in entry:
                 continue
-            lo, hi = runs_range(results, name, quantity, peak_index(entry))
+            lo, hi = runs_range(results, name, entry, quantity, peak_index(entry))
             band = {**(entry.get("band99") or {"lower": None, "upper": None}), "std": entry["std"]}
             lower, upper = peak(band, "lower"), peak(band, "upper")
             fmt = lambda v: "—" if v is None else f"{v:.4g}"  # noqa: E731
