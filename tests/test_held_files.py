@@ -76,10 +76,11 @@ def test_reading_a_file_another_process_writes_names_that_process(decay_results,
             done = cli(*args)
             assert done.returncode == 2, done.stderr
             errors = [line for line in done.stderr.splitlines() if "error" in line]
-            assert errors == [f"error: {out} is open in pid {pid} ({sys.executable} -c import h5py, sys f = h5py.File("
-                              f"'{out}', 'a') print('held', flush=True) sys.stdin.read()) (HDF5's file lock), so it "
-                              "cannot be read now: wait until that process closes it, or stop it, then run again"], \
-                done.stderr
+            assert len(errors) == 1, done.stderr
+            named, _, why = errors[0].partition(" (HDF5's file lock), ")
+            assert why == "so it cannot be read now: wait until that process closes it, or stop it, then run again"
+            assert named.startswith(f"error: {out} is open in pid {pid} ({sys.executable} -c import h5py, sys")
+            assert named.endswith("sys.stdin.read())") or named.endswith(" …)"), named  # the command, whole or cut
         shown = cli("info", out)
         assert shown.returncode == 0 and "locked by another process" in shown.stdout, shown.stderr
 
@@ -96,3 +97,23 @@ def test_calibrating_a_file_another_process_writes_names_that_process(decay_resu
             errors = [line for line in done.stderr.splitlines() if "error" in line]
             assert len(errors) == 1 and f"{out} is open in pid {pid}" in errors[0], done.stderr
             assert "Traceback" not in done.stderr
+
+
+def test_a_long_command_line_is_cut_and_says_so(tmp_path):
+    """The holder's command is shown up to COMMAND_SHOWN bytes; a longer one ends in " …" rather than
+    stopping mid-word as if it were whole (a results file deep in a long path made the line ambiguous)."""
+    from uqflight.store.lock import COMMAND_SHOWN, holders
+    path = tmp_path / "held.h5"
+    h5py.File(path, "w").close()
+    long_argument = "x" * (2 * COMMAND_SHOWN)
+    holder = subprocess.Popen([sys.executable, "-c", f"import sys\nf = open({str(path)!r})\nprint('held', flush=True)\n"
+                               "sys.stdin.read()", long_argument], stdin=subprocess.PIPE, stdout=subprocess.PIPE,
+                              text=True)
+    try:
+        assert holder.stdout.readline().strip() == "held"
+        (shown,) = holders(path)
+    finally:
+        holder.stdin.close()
+        holder.wait(timeout=30)
+    assert shown.startswith(f"pid {holder.pid} ({sys.executable} -c import sys f = open(") and shown.endswith(" …)")
+    assert len(shown.encode()) <= len(f"pid {holder.pid} ( …)".encode()) + COMMAND_SHOWN

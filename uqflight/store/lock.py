@@ -120,6 +120,7 @@ def describe_holder(holder: dict | None) -> str:
 
 
 HOLDERS_SHOWN = 3  # processes named in a message about a file held open
+COMMAND_SHOWN = 200  # bytes of a holder's command line shown; a longer one ends in " …"
 PROCESSES_SCANNED = 100_000  # /proc entries looked at for them (bounded: a message, not a census)
 
 
@@ -179,10 +180,12 @@ def holders(path) -> list[str]:
             if held:
                 try:
                     with open(f"/proc/{entry.name}/cmdline", "rb") as fh:
-                        command = fh.read(200).replace(b"\0", b" ")
+                        command = fh.read(COMMAND_SHOWN + 1).replace(b"\0", b" ")
                 except OSError:
                     command = b""
-                text = " ".join(command.decode("utf-8", "replace").split())
+                text = " ".join(command[:COMMAND_SHOWN].decode("utf-8", "replace").split())
+                if len(command) > COMMAND_SHOWN:
+                    text += " …"
                 found.append(f"pid {entry.name}" + (f" ({text})" if text else ""))
     return found
 
