@@ -35,9 +35,9 @@ import numpy as np
 from uqflight.analysis.errors import relative_errors
 from uqflight.analysis.floors import floors_from_moments
 from uqflight.campaign import load_campaign
-from uqflight.execution import run_campaign
+from uqflight.running.runner import run_campaign
 from uqflight.simulators.validation_view import validation_view
-from uqflight.statistics import BadInput, Options, analyse
+from uqflight.analysis.statistics import BadInput, Options, analyse
 from uqflight.store import ResultStore
 
 OUTPUTS = ("theta_deg", "alpha_deg", "q_degps", "h_ft", "vtas_kt")

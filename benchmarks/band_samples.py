@@ -21,9 +21,9 @@ from pathlib import Path
 import numpy as np
 
 from uqflight.campaign import load_campaign
-from uqflight.execution import run_campaign
+from uqflight.running.runner import run_campaign
 from uqflight.simulators.validation_view import validation_view
-from uqflight.statistics import Options, analyse
+from uqflight.analysis.statistics import Options, analyse
 
 ROOT = Path(__file__).resolve().parents[1]
 AFTER_PULSE_S = 1.5  # the band is compared where the outputs vary: before the pulse every draw is the trim

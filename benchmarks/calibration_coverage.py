@@ -39,7 +39,7 @@ def ensure_results(path: Path) -> Path:
         return path
     from uqflight.campaign import load_campaign
     from uqflight.simulators.validation_view import validation_view
-    from uqflight.execution import run_campaign
+    from uqflight.running.runner import run_campaign
 
     print(f"running campaigns/grid-gh-l2.yaml into {path} (113 flights)")
     run_campaign(load_campaign(ROOT / "campaigns/grid-gh-l2.yaml", view=validation_view), out=path)

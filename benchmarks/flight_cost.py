@@ -11,11 +11,14 @@ Run: .venv/bin/python benchmarks/flight_cost.py [--repeats N]
 """
 import argparse
 import statistics
+import sys
 import time
+from pathlib import Path
 
 import numpy as np
 
-from uqflight.paper import TABLE1
+sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "tests"))  # the study's Table 1 (tests/paper.py)
+from paper import TABLE1  # noqa: E402
 from uqflight.simulators.scenarios.level_flight import FlightSetup, JSBSimFlight
 
 

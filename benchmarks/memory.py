@@ -45,7 +45,7 @@ MEASURE = textwrap.dedent("""
     import resource, sys, time
     from uqflight.campaign import load_campaign
 from uqflight.simulators.validation_view import validation_view
-    from uqflight.execution import run_campaign
+    from uqflight.running.runner import run_campaign
     t0 = time.perf_counter()
     summary = run_campaign(load_campaign(sys.argv[1], validation_view), out=sys.argv[2])
     print(summary.ran, time.perf_counter() - t0,

@@ -7,7 +7,7 @@
 2. The campaign grid-gh-l3 (589 runs, the Newton trim) with 1 and 2 workers (local) and a Dask
    LocalCluster of 2 workers, wall clock including worker start-up. Target: >= 1.9x with 2 workers.
    Beside it, the machine's own ceiling: the same chunks flown by 1 and by 2 bare processes
-   (`uqflight.worker.run_chunk`, no runner, no HDF5), started the same way (a fresh Python each).
+   (`uqflight.running.worker.run_chunk`, no runner, no HDF5), started the same way (a fresh Python each).
 
 On a shared machine single runs scatter by +-10 %: every repeat measures all rows back to back (in
 alternating order), and the tables give the median over the repeats and the best one (the run least
@@ -31,8 +31,9 @@ import numpy as np
 
 from uqflight.campaign import load_campaign, parse_campaign
 from uqflight.simulators.validation_view import validation_view
-from uqflight.execution import run_campaign
-from uqflight.paper import table1_parameters_yaml
+from uqflight.running.runner import run_campaign
+sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "tests"))  # the study's Table 1 (tests/paper.py)
+from paper import table1_parameters_yaml  # noqa: E402
 from uqflight.parameters import to_physical
 from uqflight.simulators.jsbsim import REPO_ROOT
 
@@ -100,7 +101,7 @@ def timed_run(spec, workers: int, executor: str = "local") -> float:
 
 FLY_SHARE = """
 import pickle, sys
-from uqflight.worker import run_chunk
+from uqflight.running.worker import run_chunk
 with open(sys.argv[1], "rb") as f:
     spec, kappa, share, n_times, outputs = pickle.load(f)
 for chunk in share:
@@ -111,8 +112,8 @@ for chunk in share:
 def bare_processes(campaign_spec, processes: int) -> float:
     """Seconds for `processes` fresh Python processes (importing what a worker imports) to fly the
     campaign's chunks, dealt out in turn."""
-    from uqflight.execution import nominal_kappa, pending_chunks, worker_spec
-    from uqflight.worker import nominal_flight
+    from uqflight.running.runner import nominal_kappa, pending_chunks, worker_spec
+    from uqflight.running.worker import nominal_flight
 
     spec, kappa = worker_spec(campaign_spec), to_physical(campaign_spec.parameters, campaign_spec.design().xi)
     nominal = nominal_flight(spec, nominal_kappa(campaign_spec))

@@ -2,7 +2,7 @@
 
 Runs (or resumes) a Monte Carlo campaign of the bacm's angle of attack (default 20,000 runs,
 normal inputs, raw storage, results/tsvd-alpha.h5), then for each tolerance compresses the
-T x N matrix batch by batch with uqflight.tsvd.IncrementalSVD and prints: the number of terms,
+T x N matrix batch by batch with uqflight.store.tsvd.IncrementalSVD and prints: the number of terms,
 the time of the first decomposition, mean and std of the update times, the relative error of the
 mean and of the variance after compression (max over time, relative to the max of the exact one),
 the memory of the factors against the raw data, and the update time against the simulation time
@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import argparse
 import statistics
+import sys
 import time
 from pathlib import Path
 
@@ -21,11 +22,12 @@ import numpy as np
 
 from uqflight.campaign import parse_campaign
 from uqflight.simulators.validation_view import validation_view
-from uqflight.execution import run_campaign
-from uqflight.paper import table1_parameters_yaml
+from uqflight.running.runner import run_campaign
+sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "tests"))  # the study's Table 1 (tests/paper.py)
+from paper import table1_parameters_yaml  # noqa: E402
 from uqflight.store import ResultStore, Status
 from uqflight.analysis.moments import weighted_moments
-from uqflight.tsvd import IncrementalSVD
+from uqflight.store.tsvd import IncrementalSVD
 
 CAMPAIGN = """
 name: tsvd-alpha-{samples}

@@ -29,7 +29,7 @@ def cli_in_process(*args, cwd=None) -> subprocess.CompletedProcess:
     command many times); the same exit code, stdout and stderr as `cli`."""
     from typer.testing import CliRunner
 
-    from uqflight.cli import app
+    from uqflight.cli.commands import app
 
     here = os.getcwd()
     try:
@@ -113,7 +113,7 @@ def run_python_campaign(folder: Path, text: str, name: str = "c"):
     """Write the campaign text to FOLDER/NAME.yaml, run it with one worker into FOLDER/NAME.h5, and
     return the results path (python simulators only: quick)."""
     from uqflight.campaign import load_campaign
-    from uqflight.execution import run_campaign
+    from uqflight.running.runner import run_campaign
 
     source = Path(folder) / f"{name}.yaml"
     source.write_text(text, encoding="utf-8")
@@ -140,7 +140,7 @@ def decay_results(tmp_path_factory) -> Path:
     """The DECAY_TWO_INPUTS campaign flown once per session into its own folder (decay.yaml, decay.h5):
     tests read it and write elsewhere (a test that writes beside it copies it first)."""
     from uqflight.campaign import parse_campaign
-    from uqflight.execution import run_campaign
+    from uqflight.running.runner import run_campaign
 
     root = tmp_path_factory.mktemp("decay")
     (root / "decay.yaml").write_text(DECAY_TWO_INPUTS)

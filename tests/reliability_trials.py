@@ -26,7 +26,7 @@ from test_execution import JSBSIM_CAMPAIGN  # noqa: E402
 from conftest import UQFLIGHT, assert_same_results, hostile_campaign_text as campaign_text  # noqa: E402
 
 from uqflight.campaign import parse_campaign  # noqa: E402
-from uqflight.execution import run_campaign  # noqa: E402
+from uqflight.running.runner import run_campaign  # noqa: E402
 from uqflight.store import ResultStore, Status  # noqa: E402
 
 
@@ -123,7 +123,7 @@ def crash_trials(root: Path, n: int) -> tuple[int, int]:
 
 
 def enospc_trials(root: Path, n: int) -> tuple[int, int]:
-    import uqflight.execution as execution
+    import uqflight.running.runner as execution
 
     identical = 0
     data = Path(__file__).parent / "data"

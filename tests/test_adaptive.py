@@ -16,10 +16,10 @@ from uqflight.campaign import parse_campaign
 from uqflight.designs import build_design, design_size
 from uqflight.designs import rules as rule_catalog
 from uqflight.designs.adaptive import Grid, IndexSet, combination_weights, grid_points, refine
-from uqflight.execution import run_campaign
+from uqflight.running.runner import run_campaign
 from uqflight.report import write_report
 from uqflight.simulators import models
-from uqflight.statistics import analyse, summary_json
+from uqflight.analysis.statistics import analyse, summary_json
 from uqflight.store import CorruptFile, ResultStore
 
 from conftest import UQFLIGHT, assert_same_results, cli_in_process

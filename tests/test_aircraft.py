@@ -6,7 +6,7 @@ import jsbsim
 import numpy as np
 import pytest
 
-from uqflight.paper import TABLE1
+from paper import TABLE1
 from uqflight.simulators.base import FlightError, TrimError
 from uqflight.simulators.jsbsim import REPO_ROOT, quiet_jsbsim
 from uqflight.simulators.scenarios.level_flight import Excitation, FlightSetup, JSBSimFlight

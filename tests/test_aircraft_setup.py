@@ -11,7 +11,7 @@ from uqflight.simulators.trim import level_speed_range
 
 
 def _setup(**condition):
-    from uqflight.cli import _prepared
+    from uqflight.cli.commands import _prepared
 
     located = _prepared("c172x", [], [])
     return FlightSetup(aircraft=located.name, root=located.root, duration_s=4.0, **condition)

@@ -4,7 +4,7 @@ nothing, is the same; the same seed gives the same bits."""
 import numpy as np
 
 from uqflight.campaign.attributes import recorded_setup
-from uqflight.statistics import analyse
+from uqflight.analysis.statistics import analyse
 from uqflight.store import ResultStore
 
 from conftest import run_python_campaign

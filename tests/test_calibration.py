@@ -31,7 +31,7 @@ from uqflight.calibration.sampler import CHECK_EVERY, FIRST_CHECK, sample, split
 from uqflight.calibration.size import MAX_STEPS
 from uqflight.calibration.surrogate import calibration_surrogate, load_campaign_file
 from uqflight.campaign import parse_campaign
-from uqflight.execution import run_campaign
+from uqflight.running.runner import run_campaign
 
 MODEL = '''
 import h5py

@@ -25,7 +25,7 @@ import pytest
 
 from uqflight.calibration.run import calibrate
 from uqflight.campaign import parse_campaign
-from uqflight.execution import run_campaign
+from uqflight.running.runner import run_campaign
 
 MODEL = '''
 import numpy as np

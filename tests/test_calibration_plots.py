@@ -11,8 +11,8 @@ from typer.testing import CliRunner
 from test_calibration import SIGMA, TIME, TRUTH, results, synthetic, write_csv  # noqa: F401 (results: fixture)
 from uqflight.calibration.command import register
 from uqflight.calibration.outputs import corner_figure, marginals_figure, predictive_plot
-from uqflight.cli import app as uqflight_app
-from uqflight.labels import parameter_label, parameter_unit
+from uqflight.cli.commands import app as uqflight_app
+from uqflight.text.labels import parameter_label, parameter_unit
 
 PROPERTIES = ["aero/uq/CL0", "aero/uq/CLalpha", "aero/uq/k1", "aero/uq/Cm0", "aero/uq/Cmq"]
 NAMES = ["CL0", "CLalpha", "k1", "Cm0", "Cmq"]

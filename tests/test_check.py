@@ -12,9 +12,9 @@ from test_quantities import python_campaign
 from test_report import pg  # noqa: F401 - the closed-form campaign the baseline is of
 
 from uqflight.campaign import parse_campaign
-from uqflight.check import compare, write_baseline
-from uqflight.execution import run_campaign
-from uqflight.statistics import analyse, read_statistics
+from uqflight.analysis.check import compare, write_baseline
+from uqflight.running.runner import run_campaign
+from uqflight.analysis.statistics import analyse, read_statistics
 
 
 @pytest.fixture(scope="module")
@@ -58,7 +58,7 @@ def test_a_quantity_defined_on_one_side_only_drifts(quantity_files):
 
 
 def test_a_baseline_without_quantities_is_refused_naming_the_field_and_the_fix(quantity_files, tmp_path):
-    from uqflight.check import BadInput, load_baseline
+    from uqflight.analysis.check import BadInput, load_baseline
 
     _, baseline = quantity_files
     data = json.loads(baseline.read_text())
@@ -83,7 +83,7 @@ def baseline_text(mean, version="1", campaign_hash=f'"{HASH}"'):
 
 @pytest.mark.parametrize("mean", ["[Infinity, 1]", "[-Infinity, 1]", "[1e999, 1]", f"[{10 ** 400}, 1]"])
 def test_check_refuses_infinite_baseline_values(tmp_path, mean):
-    from uqflight.check import BadInput, load_baseline
+    from uqflight.analysis.check import BadInput, load_baseline
 
     path = tmp_path / "b.json"
     path.write_text(baseline_text(mean))
@@ -92,7 +92,7 @@ def test_check_refuses_infinite_baseline_values(tmp_path, mean):
 
 
 def test_check_accepts_nan_and_null_baseline_values(tmp_path):
-    from uqflight.check import load_baseline
+    from uqflight.analysis.check import load_baseline
 
     path = tmp_path / "b.json"
     path.write_text(baseline_text("[NaN, null]"))
@@ -104,7 +104,7 @@ def test_check_accepts_nan_and_null_baseline_values(tmp_path):
     ("1", "null", "campaign_hash"), ("1", '"abc"', "campaign_hash")])
 def test_check_refuses_a_baseline_of_another_version_or_without_its_campaign(tmp_path, version, campaign_hash, field):
     # a baseline without its campaign's hash would let a file of another campaign pass its check
-    from uqflight.check import BadInput, load_baseline
+    from uqflight.analysis.check import BadInput, load_baseline
 
     path = tmp_path / "b.json"
     path.write_text(baseline_text("[1, 1]", version, campaign_hash))
@@ -113,7 +113,7 @@ def test_check_refuses_a_baseline_of_another_version_or_without_its_campaign(tmp
 
 
 def test_check_refuses_deeply_nested_json(tmp_path):
-    from uqflight.check import BadInput, load_baseline
+    from uqflight.analysis.check import BadInput, load_baseline
 
     path = tmp_path / "b.json"
     path.write_text("[" * 100000 + "]" * 100000)
@@ -123,7 +123,7 @@ def test_check_refuses_deeply_nested_json(tmp_path):
 
 @pytest.mark.parametrize("rtol, atol", [(1e-6, float("inf")), (float("nan"), 1e-9), (float("inf"), 0.0)])
 def test_check_refuses_non_finite_tolerances(rtol, atol):
-    from uqflight.check import BadInput, compare
+    from uqflight.analysis.check import BadInput, compare
 
     with pytest.raises(BadInput, match="expected a finite number >= 0"):
         compare(None, {"outputs": {}}, rtol, atol)

@@ -12,7 +12,7 @@ import pytest
 from conftest import ROOT, cli_in_process
 
 from uqflight.campaign import load_campaign
-from uqflight.execution import run_campaign
+from uqflight.running.runner import run_campaign
 from uqflight.simulators.validation_view import validation_view
 
 BASELINES = ROOT / "tests" / "baselines"

@@ -10,7 +10,7 @@ import sys
 import pytest
 from conftest import DATA, ROOT, UQFLIGHT, cli_in_process, hostile_campaign_text
 
-import uqflight.execution
+import uqflight.running.runner
 from uqflight.designs import REGISTRY as DESIGNS
 from uqflight.methods import METHODS
 
@@ -24,7 +24,7 @@ def write(tmp_path, function, **kwargs):
 def test_plan_flies_its_nominal_under_the_campaigns_time_limit(tmp_path, monkeypatch):
     # the model never returns at the nominal: plan ran for ever; now it gives up as run does, after
     # execution.timeout_s plus the worker's start (shortened here from 60 s to 2 s: the same code path)
-    monkeypatch.setattr(uqflight.execution, "STARTUP_GRACE_S", 2.0)
+    monkeypatch.setattr(uqflight.running.runner, "STARTUP_GRACE_S", 2.0)
     campaign = write(tmp_path, "hanging_at_centre", extra=", timeout_s: 1")
     planned = cli_in_process("plan", campaign)
     assert planned.returncode == 2, planned.stderr
@@ -98,7 +98,7 @@ class InterruptOnImport:
     """Ctrl-C (a real SIGINT to this process) as uqflight's command line imports numpy."""
 
     def find_spec(self, name, path=None, target=None):
-        if name == "numpy" and "uqflight.cli" in sys.modules:
+        if name == "numpy" and "uqflight.cli.commands" in sys.modules:
             sys.meta_path.remove(self)
             os.kill(os.getpid(), signal.SIGINT)
         return None
@@ -167,8 +167,8 @@ def forged_lines(done):
 def test_names_from_a_results_file_are_quoted_in_check_calibrate_and_plan(forged, tmp_path):
     import json
 
-    from uqflight.check import baseline_json
-    from uqflight.statistics import read_statistics
+    from uqflight.analysis.check import baseline_json
+    from uqflight.analysis.statistics import read_statistics
 
     results = forged / "c.h5"
     stats, attrs = read_statistics(results)  # the baseline `report --write-baseline` writes
@@ -249,7 +249,7 @@ def test_ctrl_c_while_plan_flies_its_nominal_is_one_line_and_exit_130_and_ends_i
     try:
         for _ in range(600):  # its worker started (a bound, not a speed test)
             workers = [pid for pid in children(planner.pid)
-                       if b"uqflight.worker" in Path(f"/proc/{pid}/cmdline").read_bytes()]
+                       if b"uqflight.running.worker" in Path(f"/proc/{pid}/cmdline").read_bytes()]
             if workers:
                 break
             time.sleep(0.1)

@@ -14,7 +14,7 @@ import pytest
 from conftest import (NORMAL_2D, UQFLIGHT, cli, cli_in_process, closed_form_campaign, hostile_campaign, mounted_tmpfs,
                       run_python_campaign, scheduler_address)
 
-from uqflight.execution import run_campaign
+from uqflight.running.runner import run_campaign
 
 BIN = Path(sys.executable).parent
 TEXT = closed_form_campaign("sq", "sum_of_squares", NORMAL_2D, "{kind: tensor_grid, points: 3}",

@@ -4,9 +4,9 @@ import numpy as np
 import pytest
 
 from uqflight.campaign import parse_campaign
-from uqflight.execution import run_campaign
+from uqflight.running.runner import run_campaign
 from uqflight.simulators.models import DECAY_TIME
-from uqflight.statistics import analyse
+from uqflight.analysis.statistics import analyse
 
 PI = 3.141592653589793
 ISHIGAMI = f"""

@@ -11,7 +11,7 @@ from conftest import DECAY_TWO_INPUTS, NORMAL_2D, cli, cli_in_process, closed_fo
 import uqflight
 from uqflight.calibration.command import _method
 from uqflight.campaign import parse_campaign
-from uqflight.cli import _check_times
+from uqflight.cli.commands import _check_times
 from uqflight.report.loading import flight_facts
 
 GRID = closed_form_campaign("sq", "sum_of_squares", NORMAL_2D, "{kind: tensor_grid, points: 3}",

@@ -10,11 +10,11 @@ import pytest
 from conftest import DATA, cli_in_process, hostile_campaign, run_python_campaign
 
 from uqflight.campaign import parse_campaign
-from uqflight.execution import run_campaign
+from uqflight.running.runner import run_campaign
 from uqflight.report.loading import load_entries
-from uqflight.statistics import BadInput, read_statistics
+from uqflight.analysis.statistics import BadInput, read_statistics
 from uqflight.store import CorruptFile, ResultStore
-from uqflight.surrogate import MAX_FILE_BYTES, SurrogateError, load
+from uqflight.analysis.surrogate import MAX_FILE_BYTES, SurrogateError, load
 
 N, T = 12, 5000
 CAMPAIGN = f"""
@@ -204,7 +204,7 @@ def surrogate_text(tmp_path_factory):
     """The order-2 PCE of y = 15000 + t (x1² + x2²) (5 times) on a 4x4 grid, exported."""
     from conftest import NORMAL_2D, closed_form_campaign
 
-    from uqflight.surrogate import export
+    from uqflight.analysis.surrogate import export
 
     folder = tmp_path_factory.mktemp("surrogate")
     results = run_python_campaign(folder, closed_form_campaign("sq", "sum_of_squares", NORMAL_2D, "{kind: tensor_grid, points: 4}",
@@ -216,7 +216,7 @@ def surrogate_text(tmp_path_factory):
 def test_a_damaged_surrogate_file_is_refused_naming_what_is_wrong(surrogate_text, tmp_path, name):
     import json
 
-    from uqflight.surrogate import SurrogateError, load
+    from uqflight.analysis.surrogate import SurrogateError, load
 
     edit, message = SURROGATE_DAMAGES[name]
     data = json.loads(surrogate_text)
@@ -232,7 +232,7 @@ def test_a_damaged_surrogate_file_is_refused_naming_what_is_wrong(surrogate_text
 
 
 def load_ok(text, folder) -> bool:
-    from uqflight.surrogate import load
+    from uqflight.analysis.surrogate import load
 
     (folder / "sound.json").write_text(text)
     return load(folder / "sound.json").evaluate(xi=[[0.3, -0.2]])["y"].shape == (1, 5)

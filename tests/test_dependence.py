@@ -15,10 +15,10 @@ from scipy import special, stats
 
 from conftest import cli_in_process
 from uqflight.campaign import CampaignError, parse_campaign
-from uqflight.execution import run_campaign
+from uqflight.running.runner import run_campaign
 from uqflight.parameters import make_parameter, to_physical, to_standard
 from uqflight.parameters.dependence import GaussianCopula
-from uqflight.statistics import analyse, summary_json
+from uqflight.analysis.statistics import analyse, summary_json
 
 RHO, SIGMA1, SIGMA2 = 0.6, 1.0, 2.0
 VARIANCE = SIGMA1**2 + 4 * SIGMA2**2 + 2 * 2 * RHO * SIGMA1 * SIGMA2  # 21.8
@@ -116,7 +116,7 @@ def test_correlated_normals_on_a_gauss_hermite_grid_are_exact(tmp_path):
     # the exported surrogate evaluates at physical values through the inverse Nataf transform
     from uqflight.campaign.reading import results_campaign
     from uqflight.store import ResultStore
-    from uqflight.surrogate import SurrogateError, export, load
+    from uqflight.analysis.surrogate import SurrogateError, export, load
 
     pce = load(export(path, tmp_path / "pce.json"))
     kappa = to_physical(result_parameters(path), xi, GaussianCopula(("x1", "x2"), [[1, RHO], [RHO, 1]]))

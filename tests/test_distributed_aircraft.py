@@ -12,7 +12,7 @@ import pytest
 from conftest import scheduler_address
 
 from uqflight.campaign import load_campaign
-from uqflight.execution import run_campaign, worker_spec
+from uqflight.running.runner import run_campaign, worker_spec
 from uqflight.simulators.validation_view import validation_view
 
 REPO = Path(__file__).resolve().parents[1]

@@ -12,7 +12,7 @@ from uqflight.methods.exactness import (
     quadrature_errors,
 )
 from uqflight.methods.basis import orthonormal_basis, total_degree_indices
-from uqflight.statistics import analyse
+from uqflight.analysis.statistics import analyse
 
 
 @pytest.mark.parametrize("points", [1, 2, 3, 5, 8])

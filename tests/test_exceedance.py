@@ -10,8 +10,8 @@ from test_quantities import python_campaign
 
 from uqflight.analysis.exceedance import exceedance_from_runs
 from uqflight.campaign import parse_campaign
-from uqflight.execution import run_campaign
-from uqflight.statistics import analyse, summary_json
+from uqflight.running.runner import run_campaign
+from uqflight.analysis.statistics import analyse, summary_json
 from uqflight.store import ResultStore
 
 # final y = a + 4b with a ~ U(-1, 1), b ~ U(0.5, 1.5): a trapezoidal law on [1, 7], flat on [3, 5];

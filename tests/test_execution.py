@@ -10,7 +10,7 @@ from conftest import DATA, DECAY_TWO_INPUTS, UQFLIGHT, assert_same_results, cli_
 
 from uqflight.campaign import parse_campaign
 from uqflight.simulators.validation_view import validation_view
-from uqflight.execution import run_campaign
+from uqflight.running.runner import run_campaign
 from uqflight.store import ResultStore, Status
 
 
@@ -192,7 +192,7 @@ def test_resuming_with_changed_aircraft_files_is_refused_unless_forced(tmp_path)
 def test_chunks_cover_the_design_and_taper_at_its_end(total, chunk):
     """Design-order chunks of `chunk` samples, the last TAPER x chunk samples in chunks a TAPER-th
     the size (so that the workers finish together); every sample in exactly one chunk."""
-    from uqflight.execution import TAPER, chunk_starts, pending_chunks
+    from uqflight.running.runner import TAPER, chunk_starts, pending_chunks
 
     starts = chunk_starts(total, chunk)
     sizes = np.diff(starts)
@@ -223,7 +223,7 @@ def f(p):
 def test_simulate_split_over_processes_equals_one_process_and_survives_a_dying_or_hung_run(tmp_path):
     # calibrate's predictive runs: the same numbers in 1 or 3 supervised worker processes; a run that kills
     # its worker, or runs past execution.timeout_s, fails with its reason, the other runs stand
-    from uqflight.execution import simulate
+    from uqflight.running.runner import simulate
 
     (tmp_path / "model.py").write_text(CRASHING_MODEL)
     campaign = parse_campaign('''
@@ -275,7 +275,7 @@ def test_restart_starts_a_same_campaign_file_over_and_force_keeps_its_meaning(tm
 def test_an_idle_worker_gets_its_next_chunk_before_the_runner_writes(tmp_path):
     """The pool hands a finished chunk to its caller (who writes it to HDF5) only once the worker
     that flew it has its next chunk: workers never wait for the writer."""
-    from uqflight.execution import Task, WorkerPool, nominal_kappa, worker_spec
+    from uqflight.running.runner import Task, WorkerPool, nominal_kappa, worker_spec
     from uqflight.parameters import to_physical
 
     spec = hostile_campaign("slow", samples=6, chunk=2)

@@ -6,13 +6,13 @@ import pytest
 from conftest import DATA, ROOT, run_python_campaign, strict_json
 
 from uqflight.campaign import load_campaign
-from uqflight.execution import run_campaign
+from uqflight.running.runner import run_campaign
 from uqflight.methods.basis import orthonormal_basis, total_degree_indices
 from uqflight.methods.galerkin import pseudo_galerkin
 from uqflight.methods.pce import PCE
 from uqflight.methods.validation import VALIDATION_THRESHOLD, flags, validate
 from uqflight.simulators.validation_view import validation_view
-from uqflight.statistics import analyse, summary_json
+from uqflight.analysis.statistics import analyse, summary_json
 
 MODELS = DATA / "validation_models.py"
 NORMAL_3D = "".join(f"  x{k}: {{distribution: normal, lower: -3, upper: 3}}\n" for k in (1, 2, 3))

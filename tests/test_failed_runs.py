@@ -10,7 +10,7 @@ from conftest import NORMAL_2D, cli_in_process, closed_form_campaign, run_python
 from data.failure_models import C, P_FAIL, corner_campaign
 
 from uqflight.methods import FAILED_RUNS, METHODS
-from uqflight.statistics import BadInput, analyse
+from uqflight.analysis.statistics import BadInput, analyse
 
 # E[x1 + x2 | success] = −E[(x1 + x2) 1_fail] / 0.87, with x1 + x2 = u of density (2 − |u|)/4 on [−2, 2]:
 # E[u 1_fail] = ∫_C^2 u (2 − u)/4 du = (4/3 − C² + C³/3)/4.

@@ -11,7 +11,7 @@ from data.failure_models import C, P_FAIL, corner_campaign
 
 from uqflight.analysis.failures import grid_failure_probability, kish_effective_runs
 from uqflight.designs import build_design
-from uqflight.statistics import analyse, summary_json
+from uqflight.analysis.statistics import analyse, summary_json
 
 
 @pytest.fixture(scope="module")

@@ -1,4 +1,4 @@
-"""uqflight.fast_exit: the console script ends without the interpreter's teardown only where nothing can be
+"""uqflight.cli.fast_exit: the console script ends without the interpreter's teardown only where nothing can be
 lost; each case runs in a real Python process."""
 import subprocess
 import sys
@@ -26,7 +26,7 @@ def _python(code: str, tmp_path):
 def test_a_finished_command_skips_the_teardown_but_runs_atexit_and_flushes(tmp_path):
     done = _python("""
         import atexit, pathlib
-        from uqflight.fast_exit import exit_fast
+        from uqflight.cli.fast_exit import exit_fast
         atexit.register(lambda: pathlib.Path("atexit-ran").write_text("yes"))
         print("last line", end="")  # buffered: only a flush writes it
         exit_fast(3)
@@ -40,7 +40,7 @@ def test_a_finished_command_skips_the_teardown_but_runs_atexit_and_flushes(tmp_p
 def test_a_running_thread_gets_a_normal_exit_that_waits_for_it(tmp_path):
     done = _python("""
         import pathlib, threading, time
-        from uqflight.fast_exit import exit_fast
+        from uqflight.cli.fast_exit import exit_fast
         def late():
             time.sleep(0.3)
             pathlib.Path("thread-done").write_text("yes")
@@ -55,7 +55,7 @@ def test_a_running_thread_gets_a_normal_exit_that_waits_for_it(tmp_path):
 def test_an_open_hdf5_file_gets_a_normal_exit_that_closes_it(tmp_path):
     done = _python("""
         import h5py, numpy as np
-        from uqflight.fast_exit import exit_fast
+        from uqflight.cli.fast_exit import exit_fast
         f = h5py.File("open.h5", "w")
         f["x"] = np.arange(1000.0)
         exit_fast(0)
@@ -68,7 +68,7 @@ def test_an_open_hdf5_file_gets_a_normal_exit_that_closes_it(tmp_path):
 
 def test_a_message_code_is_printed_with_status_1(tmp_path):
     done = _python("""
-        from uqflight.fast_exit import exit_fast
+        from uqflight.cli.fast_exit import exit_fast
         exit_fast("cannot go on")
     """, tmp_path)
     assert done.returncode == 1

@@ -7,7 +7,7 @@ from conftest import NORMAL_2D, closed_form_campaign, run_python_campaign
 
 from uqflight.analysis import kl_divergence
 from uqflight.analysis.floors import central_moments, floors_from_moments, kld_floor, reference_floors
-from uqflight.statistics import analyse
+from uqflight.analysis.statistics import analyse
 
 
 def test_floors_from_exact_normal_moments_are_the_closed_form():

@@ -1,10 +1,10 @@
-"""Forked children (uqflight.forking): results through the pipe, failures reported, jobs shared."""
+"""Forked children (uqflight.running.forking): results through the pipe, failures reported, jobs shared."""
 import os
 import time
 
 import pytest
 
-from uqflight.forking import FORKS, Child, ChildFailed, PreparedChild, share_work, wait_all
+from uqflight.running.forking import FORKS, Child, ChildFailed, PreparedChild, share_work, wait_all
 
 pytestmark = pytest.mark.skipif(not FORKS, reason="the system cannot fork")
 
@@ -216,7 +216,7 @@ def queued(fd: int) -> int:
 
 KILLED_PARENT = """
 import os, sys, time
-from uqflight.forking import Child, PreparedChild
+from uqflight.running.forking import Child, PreparedChild
 
 def work(payload, tell):
     helper = Child(lambda: time.sleep(120))

@@ -1,11 +1,11 @@
-"""uqflight.json_text: the same JSON values as json.dumps, laid out for reading, strict."""
+"""uqflight.text.json_text: the same JSON values as json.dumps, laid out for reading, strict."""
 import json
 import math
 
 import numpy as np
 import pytest
 
-from uqflight.json_text import json_text
+from uqflight.text.json_text import json_text
 
 VALUE = {"name": "pg2", "empty": {}, "none": [], "flag": True, "missing": None, "count": 113,
          "floats": [0.1, 1e-300, -2.5e17, 1 / 3, 5e-324, 15000.000000000002],

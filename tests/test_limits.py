@@ -4,7 +4,7 @@ import pytest
 from conftest import cli_in_process, hostile_campaign
 
 from uqflight.campaign import parse_campaign
-from uqflight.execution import run_campaign
+from uqflight.running.runner import run_campaign
 
 
 BASE = """
@@ -83,7 +83,7 @@ def test_more_worker_processes_than_memory_allows_are_refused():
 
 
 def test_workers_asked_on_the_command_line_are_refused_beyond_memory_and_capped_at_the_chunks(tmp_path):
-    from uqflight.execution import local_workers
+    from uqflight.running.runner import local_workers
 
     spec = hostile_campaign("slow", samples=15, chunk=16)  # chunks of 4 at the design's end: 0, 4, 8, 12
     assert spec.runs == 15 and local_workers(spec, 50, 16) == 4 and local_workers(spec, 3, 16) == 3

@@ -10,7 +10,7 @@ import time
 import pytest
 from conftest import cli, cli_in_process, hostile_campaign
 
-from uqflight.execution import run_campaign
+from uqflight.running.runner import run_campaign
 from uqflight.store import LockHeld, ResultsLock, ResultStore
 from uqflight.store.lock import start_time, read_holder
 

@@ -6,7 +6,7 @@ import shutil
 import pytest
 from conftest import cli_in_process
 
-from uqflight.console import shown
+from uqflight.text.console import shown
 from uqflight.report.loading import bounded
 
 LONG = "L" * 300

@@ -75,9 +75,9 @@ def test_bacm_nominal_modes_match_the_flight_and_leave_the_flight_as_it_was():
 def test_a_runs_modes_do_not_depend_on_the_run_flown_before_it_in_its_chunk():
     # JSBSim's linearisation of a reused aircraft differs (0.1 % on the phugoid period of one Table 1
     # point) and can take minutes: each run with modes is flown on a freshly loaded one
-    from uqflight.execution import worker_spec
+    from uqflight.running.runner import worker_spec
     from uqflight.parameters import to_physical
-    from uqflight.worker import run_chunk
+    from uqflight.running.worker import run_chunk
 
     campaign = load_campaign(ROOT / "campaigns" / "bacm-modes.yaml", view=validation_view)
     kappa = to_physical(campaign.parameters, campaign.design().xi)[16:18]

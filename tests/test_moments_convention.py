@@ -9,7 +9,7 @@ from data.failure_models import corner_campaign
 from scipy import stats as scipy_stats
 
 from uqflight.analysis.moments import standardised_moments, weighted_quantiles
-from uqflight.statistics import analyse, summary_json
+from uqflight.analysis.statistics import analyse, summary_json
 
 
 def test_closed_forms_of_the_adjusted_and_plug_in_moments():

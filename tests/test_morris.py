@@ -6,7 +6,7 @@ import pytest
 from conftest import DATA, run_python_campaign, strict_json
 from uqflight.designs import build_design
 from uqflight.designs.morris import morris_germs, morris_jump, morris_unit_points
-from uqflight.statistics import analyse, summary_json
+from uqflight.analysis.statistics import analyse, summary_json
 from uqflight.store import ResultStore
 
 MODELS = DATA / "morris_models.py"
@@ -161,7 +161,7 @@ def test_a_design_info_that_does_not_fit_the_runs_is_refused_in_one_line(tmp_pat
 
 def test_measures_without_trajectories_are_null_and_sigma_needs_two():
     from uqflight.designs.morris import morris_measures
-    from uqflight.statistics import json_ready
+    from uqflight.analysis.statistics import json_ready
 
     none = json_ready(morris_measures(np.empty((0, 2, 3)), n_boot=10, seed=0))
     assert none["mu_star"] == [[None] * 3] * 2 and none["sigma"] == [[None] * 3] * 2

@@ -10,7 +10,7 @@ import pytest
 from conftest import cli_in_process
 
 from uqflight.campaign import CampaignError, load_campaign
-from uqflight.execution import run_campaign
+from uqflight.running.runner import run_campaign
 from uqflight.simulators.aircraft import AircraftFiles
 from uqflight.simulators.jsbsim import REPO_ROOT, quiet_jsbsim
 from uqflight.simulators.validation_view import validation_view

@@ -6,7 +6,7 @@ import csv
 import pytest
 from conftest import cli_in_process
 
-from uqflight.console import clean, one_line
+from uqflight.text.console import clean, one_line
 from uqflight.report.files import inert
 from uqflight.report.render import md
 
@@ -104,6 +104,6 @@ def test_the_command_line_prints_only_through_echo():
     import uqflight
 
     package = Path(uqflight.__file__).parent
-    for module in (package / "cli.py", package / "calibration" / "command.py"):
+    for module in (package / "cli" / "commands.py", package / "calibration" / "command.py"):
         text = module.read_text()
         assert "typer.echo(" not in text and "print(" not in text, module

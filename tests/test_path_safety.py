@@ -15,13 +15,13 @@ import numpy as np
 import pytest
 from conftest import cli_in_process
 
-from uqflight.execution import Task, WorkerError, WorkerPool
+from uqflight.running.runner import Task, WorkerError, WorkerPool
 from uqflight.simulators.aircraft import (MAX_BYTES, MAX_FILES, AircraftFiles, AircraftLocation, AircraftUnsafe,
                                           cache_dir, jsbsim_root, locate, unsafe_key)
 from uqflight.simulators.bundle import BundleRefused, _unzip, _zip
 from uqflight.simulators.kinds import localized, make_bundle
 from uqflight.simulators.jsbsim import quiet_jsbsim
-from uqflight.worker import WorkerSpec
+from uqflight.running.worker import WorkerSpec
 
 BACM = Path(__file__).resolve().parents[1] / "uqflight" / "aircraft" / "bacm"
 TRAVERSAL = {  # (tag, the text it replaces in bacm.xml, or None to add the element before </fdm_config>)
@@ -194,7 +194,7 @@ def test_a_hostile_bundle_is_refused_before_anything_is_unpacked(case, tmp_path,
 
 
 def test_a_worker_process_refuses_the_bundle_and_the_runner_reports_it(tmp_path, home):
-    """Through a real `python -m uqflight.worker` process: the refusal reaches the runner as a
+    """Through a real `python -m uqflight.running.worker` process: the refusal reaches the runner as a
     WorkerError (which `run` turns into exit 2), and the worker wrote nothing outside its cache."""
     bundle, message = hostile_bundles(home)["traversal key"]
     before = files_outside_cache(tmp_path)
@@ -222,7 +222,7 @@ def test_a_worker_refuses_to_fly_bundled_xml_whose_file_attribute_leads_out(tmp_
 def test_a_dask_worker_refuses_the_bundle_and_the_client_gets_the_error(tmp_path, home):
     """The same through Dask (a LocalCluster of worker processes): the client's `run` gets the
     WorkerError (exit 2), and nothing was written outside the cache."""
-    from uqflight.execution import _execute_dask
+    from uqflight.running.runner import _execute_dask
 
     bundle, message = hostile_bundles(home)["@root//abs key"]
     before = files_outside_cache(tmp_path)

@@ -75,7 +75,7 @@ def test_blocks_of_times_change_nothing_and_a_large_basis_is_left_to_the_draws(m
 
 
 def test_outputs_on_one_basis_share_its_draws_and_triple_products_and_get_the_same_numbers():
-    from uqflight.statistics import BasisCache, Options
+    from uqflight.analysis.statistics import BasisCache, Options
 
     germs, options, basis_cache = ["normal", "uniform", "normal"], Options(band_samples=500, seed=3), BasisCache()
     indices = total_degree_indices(3, 2)

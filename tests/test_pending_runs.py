@@ -5,8 +5,8 @@ import numpy as np
 import pytest
 from conftest import NORMAL_2D, UNIFORM_X, cli_in_process, closed_form_campaign, read_summary, run_python_campaign
 
-from uqflight.check import write_baseline
-from uqflight.statistics import analyse
+from uqflight.analysis.check import write_baseline
+from uqflight.analysis.statistics import analyse
 
 
 def make_pending(path, runs):

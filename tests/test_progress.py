@@ -1,5 +1,5 @@
 """Off a terminal, `report`, `surrogate export` and `calibrate` log their stages and percentages on
-stderr (uqflight.progress, the mechanism `run` uses): real processes, stderr a pipe."""
+stderr (uqflight.running.progress, the mechanism `run` uses): real processes, stderr a pipe."""
 import io
 import json
 import re
@@ -9,7 +9,7 @@ import pytest
 from conftest import cli, run_python_campaign
 
 from uqflight.calibration.size import MAX_STEPS
-from uqflight.execution import Progress
+from uqflight.running.runner import Progress
 
 MODEL = """
 import numpy as np

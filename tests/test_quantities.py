@@ -10,12 +10,12 @@ import pytest
 from conftest import DATA, assert_same_results, cli_in_process
 
 from uqflight.campaign import parse_campaign
-from uqflight.execution import run_campaign
+from uqflight.running.runner import run_campaign
 from uqflight.quantities import REGISTRY
 from uqflight.quantities.recorder import QuantityRecorder
-from uqflight.statistics import analyse, summary_json
+from uqflight.analysis.statistics import analyse, summary_json
 from uqflight.store import ResultStore
-from uqflight.worker import WorkerSpec, run_chunk
+from uqflight.running.worker import WorkerSpec, run_chunk
 
 MODEL = f"{DATA / 'quantity_model.py'}:ramp"  # y = a + b t, z = a t², w = a − b t, t = 0, 0.25, ..., 4
 

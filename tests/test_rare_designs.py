@@ -13,8 +13,8 @@ import pytest
 from scipy.special import ndtr, ndtri
 
 from uqflight.campaign import CampaignError, parse_campaign
-from uqflight.execution import run_campaign
-from uqflight.statistics import analyse, summary_json
+from uqflight.running.runner import run_campaign
+from uqflight.analysis.statistics import analyse, summary_json
 
 from conftest import UQFLIGHT, assert_same_results, cli_in_process, read_summary
 

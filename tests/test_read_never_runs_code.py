@@ -129,7 +129,7 @@ def test_calibrate_imports_the_model_only_for_its_predictive_runs(world, tmp_pat
     assert "cannot import 'model.py': RuntimeError: campaign code ran" in run.stderr
     found = ran_code(world)
     assert set(found) == {"beside"}
-    assert "uqflight/worker.py" in found["beside"]  # in a worker of the predictive runs (execution.simulate)
+    assert "uqflight/running/worker.py" in found["beside"]  # in a worker of the predictive runs (runner.simulate)
     (world["sentinels"] / "beside").unlink()
 
 
@@ -193,7 +193,7 @@ def test_a_jsbsim_run_stores_the_nominal_values_it_read_from_the_aircraft(tmp_pa
     from uqflight.campaign import parse_campaign
     from uqflight.campaign.reading import parameter_rows, results_campaign, stored_parameters
     from uqflight.campaign.schema import CampaignError
-    from uqflight.execution import run_campaign
+    from uqflight.running.runner import run_campaign
     from uqflight.simulators.validation_view import validation_view
     from uqflight.store import ResultStore
 

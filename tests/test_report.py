@@ -14,11 +14,11 @@ import pytest
 
 from conftest import UQFLIGHT, cli, cli_in_process, read_summary, run_python_campaign
 from uqflight.campaign import parse_campaign
-from uqflight.check import write_baseline
+from uqflight.analysis.check import write_baseline
 from uqflight.simulators.validation_view import validation_view
-from uqflight.execution import run_campaign
+from uqflight.running.runner import run_campaign
 from uqflight.report import write_report
-from uqflight.statistics import analyse, read_statistics
+from uqflight.analysis.statistics import analyse, read_statistics
 
 
 DECAY = """

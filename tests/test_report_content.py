@@ -13,7 +13,7 @@ from uqflight.report.headline import band_text, mean_std_text
 from uqflight.report.sensitivity import index_text, negligible, partial_variances, top_contributors
 from uqflight.report.trajectories import plot_spaghetti, run_subset
 from uqflight.simulators.base import Status
-from uqflight.statistics import analyse
+from uqflight.analysis.statistics import analyse
 
 PHUGOID = """
 name: phugoid-grid

@@ -11,11 +11,11 @@ from test_quantities import python_campaign
 
 import uqflight
 from uqflight.campaign import parse_campaign
-from uqflight.execution import run_campaign
-from uqflight.labels import shown_time
+from uqflight.running.runner import run_campaign
+from uqflight.text.labels import shown_time
 from uqflight.quantities.spec import parse_exceedance_option
 from uqflight.report import write_report
-from uqflight.statistics import summary_json
+from uqflight.analysis.statistics import summary_json
 
 # final y = a + 4b with a ~ U(-1, 1), b ~ U(0.5, 1.5) (test_exceedance): P(final_y > 5) = 1/4
 QUANTITIES = "{final_y: {of: y, take: final}}"
@@ -184,7 +184,7 @@ def test_the_python_api_takes_thresholds_too(campaigns):
     stats = uqflight.analyse(files["mc"], exceedance=["final_y<2", "final_y>6"])
     items = stats.quantities["final_y"].exceedance
     assert [item.get("below", item.get("above")) for item in items] == [2.0, 6.0]
-    with pytest.raises(uqflight.statistics.BadInput, match="--exceedance nothing: no such quantity"):
+    with pytest.raises(uqflight.analysis.statistics.BadInput, match="--exceedance nothing: no such quantity"):
         uqflight.analyse(files["mc"], exceedance="nothing>1")
     with pytest.raises(ValueError, match="NAME>X"):
         uqflight.analyse(files["mc"], exceedance="final_y~1")

@@ -18,7 +18,7 @@ from uqflight.analysis.resolution import (
 )
 from uqflight.designs import build_design
 from uqflight.methods import fit
-from uqflight.statistics import analyse, summary_json
+from uqflight.analysis.statistics import analyse, summary_json
 
 
 def test_the_altitude_example_of_the_issue():

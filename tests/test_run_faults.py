@@ -15,7 +15,7 @@ import pytest
 from conftest import (UQFLIGHT, assert_same_results, cli_in_process, hostile_campaign, hostile_campaign_text,
                       mounted_tmpfs)
 
-from uqflight.execution import run_campaign
+from uqflight.running.runner import run_campaign
 from uqflight.store import ResultStore, Status
 
 
@@ -233,8 +233,8 @@ def test_the_cli_exits_2_when_the_disk_fills_past_the_check(tmp_path, small_disk
     """The free-space check bypassed (another process fills the disk): exit 2, never 0 or 139."""
     out = small_disk / "r.h5"
     yaml = write_hostile_campaign(tmp_path, "long_histories", samples=300, chunk=10, workers=2)
-    script = ("import sys; import uqflight.execution as e; e.ensure_space = lambda *a, **k: None; "
-              "from uqflight.cli import app; sys.argv = ['uqflight', 'run', sys.argv[1], '--out', sys.argv[2]]; app()")
+    script = ("import sys; import uqflight.running.runner as e; e.ensure_space = lambda *a, **k: None; "
+              "from uqflight.cli.commands import app; sys.argv = ['uqflight', 'run', sys.argv[1], '--out', sys.argv[2]]; app()")
     done = subprocess.run([sys.executable, "-c", script, str(yaml), str(out)], capture_output=True, text=True,
                           timeout=300)
     assert done.returncode in (1, 2), done.stderr[-2000:]

@@ -15,7 +15,7 @@ import yaml
 from conftest import ROOT, assert_same_results, cli
 from test_distributed_aircraft import cluster  # noqa: F401 - the separately started Dask workers
 from uqflight.campaign import CampaignError, load_campaign, parse_campaign
-from uqflight.execution import run_campaign, worker_spec
+from uqflight.running.runner import run_campaign, worker_spec
 from uqflight.simulators import make_simulator
 from uqflight.simulators.bundle import AircraftMismatch
 from uqflight.simulators.kinds import localized
@@ -304,7 +304,7 @@ def test_a_quantity_at_a_time_past_the_scripts_end_is_refused_at_plan(tmp_path):
 def test_a_results_file_of_an_edited_script_is_not_resumed(tmp_path):
     """The script's files are part of what a file's runs flew: an edited script refuses the resume."""
     from uqflight.campaign import load_campaign
-    from uqflight.execution import run_campaign
+    from uqflight.running.runner import run_campaign
 
     scripts = Path(__file__).resolve().parents[1] / "campaigns" / "scripts"
     shutil.copytree(scripts, tmp_path / "scripts")

@@ -7,9 +7,9 @@ import pytest
 from conftest import DATA, assert_same_results, cli_in_process
 
 from uqflight.campaign import CampaignError, load_campaign, parse_campaign
-from uqflight.execution import run_campaign
+from uqflight.running.runner import run_campaign
 from uqflight.parameters.distributions import SEED_COUNT
-from uqflight.statistics import analyse, summary_json
+from uqflight.analysis.statistics import analyse, summary_json
 
 MODEL = DATA / "seed_models.py"
 PARAMETERS = ("  x: {distribution: normal, lower: -3, upper: 3}\n"

@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 from conftest import run_python_campaign
 
-from uqflight.statistics import analyse, summary_json
+from uqflight.analysis.statistics import analyse, summary_json
 
 MODELS = Path(__file__).parent / "data" / "sensitivity_models.py"
 PI = math.pi
@@ -79,7 +79,7 @@ def test_an_angle_that_does_not_wrap_is_left_to_the_bit():
 
 
 def test_units_come_from_jsbsim_property_names():
-    from uqflight.labels import name_unit, quantity_unit
+    from uqflight.text.labels import name_unit, quantity_unit
 
     assert [name_unit(n) for n in ("attitude/psi-deg", "velocities/vc-kts", "velocities/u-fps", "aero/qbar-psf",
                                     "position/h-sl-mt", "simulation/sim-time-sec", "inertia/weight-lbs",
@@ -212,7 +212,7 @@ def test_the_variance_split_survives_failed_runs(flown):
 def test_the_unresolved_flag_counts_the_times_of_non_negligible_variance_only():
     from types import SimpleNamespace
 
-    from uqflight.statistics import unresolved_flag
+    from uqflight.analysis.statistics import unresolved_flag
 
     wide, narrow = np.array([[0.0, 0.0, 0.1], [1.0, 1.0, 0.2]]), np.array([[0.0, 0.4, 0.1], [0.1, 0.5, 0.2]])
     # t = 0: variance 1e-6 of the largest (negligible), its wide interval not counted; t = 1: wide, counted

@@ -7,7 +7,7 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 
-from uqflight.forking import FORKS, ChildFailed, share_work
+from uqflight.running.forking import FORKS, ChildFailed, share_work
 from uqflight.report import plots
 
 pytestmark = pytest.mark.skipif(not FORKS, reason="the system cannot fork")

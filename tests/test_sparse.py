@@ -9,14 +9,14 @@ import pytest
 from uqflight.calibration.surrogate import calibration_surrogate
 from uqflight.campaign import CampaignError, parse_campaign
 from uqflight.designs import build_design
-from uqflight.execution import run_campaign
+from uqflight.running.runner import run_campaign
 from uqflight.methods import fit
 from uqflight.methods.basis import orthonormal_basis
 from uqflight.methods.loo import relative_loo_error
 from uqflight.methods.sparse import hyperbolic_indices
 from uqflight.methods.validity import method_problem
 from uqflight.methods.parsing import parse_methods
-from uqflight.statistics import analyse, summary_json
+from uqflight.analysis.statistics import analyse, summary_json
 
 D = 20
 GERMS = ["uniform"] * D
@@ -143,7 +143,7 @@ def test_a_time_dependent_output_gets_one_basis_its_summary_and_its_export(tmp_p
     # truncation error of exp's expansion in 0.1 ξ t is below (0.5)^6/6! ~ 2e-5 of the mean; 1e-4 of the
     # variance is its square's order. raw: False stores the runs as tSVD factors (the fit gets them).
     from uqflight.simulators.models import DECAY_TIME
-    from uqflight.surrogate import export, load
+    from uqflight.analysis.surrogate import export, load
 
     text = DECAY.format(method="{kind: sparse, selection: lars, max_order: 5, q: 1}", 
                         storage="{raw: true}" if raw else "{raw: false, tsvd: {tol: 1.0e-12, batch: 64}}")

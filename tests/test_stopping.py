@@ -1,11 +1,11 @@
-"""uqflight.stopping: a SIGINT or SIGTERM stops a campaign even when the handler's exception is lost."""
+"""uqflight.running.stopping: a SIGINT or SIGTERM stops a campaign even when the handler's exception is lost."""
 import os
 import signal
 import weakref
 
 import pytest
 
-from uqflight import stopping
+from uqflight.running import stopping
 
 
 def _signal_inside_a_weakref_callback(number: int) -> None:

@@ -22,7 +22,7 @@ from conftest import read_results
 import uqflight.store.compressed
 import uqflight.store.results
 from uqflight.analysis.moments import weighted_moments
-from uqflight.statistics import output_basis
+from uqflight.analysis.statistics import output_basis
 from uqflight.store import CorruptFile, ResultStore, Status, open_for_campaign
 from uqflight.store.results import STORAGES
 from uqflight.store.storage import OutputStorage

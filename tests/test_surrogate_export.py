@@ -1,4 +1,4 @@
-"""`uqflight surrogate export`: the PCE written as strict JSON, read back by `uqflight.surrogate.load`,
+"""`uqflight surrogate export`: the PCE written as strict JSON, read back by `uqflight.analysis.surrogate.load`,
 gives the campaign's moments and the fitted expansion at any point, in ξ or in physical values."""
 import json
 
@@ -7,8 +7,8 @@ import pytest
 from conftest import cli_in_process
 
 from uqflight.methods.basis import orthonormal_basis
-from uqflight.statistics import analyse
-from uqflight.surrogate import fit_surrogate, load
+from uqflight.analysis.statistics import analyse
+from uqflight.analysis.surrogate import fit_surrogate, load
 
 
 def test_surrogate_export_round_trip(decay_results, tmp_path):

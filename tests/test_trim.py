@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 import uqflight.simulators.trim as trim_module
-from uqflight.paper import TABLE1
+from paper import TABLE1
 from uqflight.simulators.scenarios.level_flight import FlightSetup, JSBSimFlight
 from uqflight.simulators.trim import FRACTION, JSBSIM_TOLERANCE, LATERAL
 

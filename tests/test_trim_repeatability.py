@@ -8,8 +8,8 @@ from conftest import NORMAL_2D, ROOT, closed_form_campaign, run_python_campaign,
 
 from uqflight.campaign import load_campaign
 from uqflight.simulators.validation_view import validation_view
-from uqflight.execution import nominal_kappa, run_campaign, worker_spec
-from uqflight.statistics import analyse, summary_json
+from uqflight.running.runner import nominal_kappa, run_campaign, worker_spec
+from uqflight.analysis.statistics import analyse, summary_json
 from uqflight.store import ResultStore
 
 

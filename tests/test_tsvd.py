@@ -3,7 +3,7 @@ import numpy as np
 import pytest
 
 from uqflight.analysis.moments import weighted_moments
-from uqflight.tsvd import IncrementalSVD, iter_column_blocks, orthogonality_loss
+from uqflight.store.tsvd import IncrementalSVD, iter_column_blocks, orthogonality_loss
 
 
 def weighted_mean(U, s, V, w):

@@ -5,10 +5,10 @@ import pytest
 from conftest import assert_same_results, cli_in_process
 
 from uqflight.campaign import CampaignError, load_campaign
-from uqflight.execution import run_campaign
+from uqflight.running.runner import run_campaign
 from uqflight.simulators import JSBSimSimulator
 from uqflight.simulators.validation_view import validation_view
-from uqflight.statistics import analyse, summary_json
+from uqflight.analysis.statistics import analyse, summary_json
 
 MODERATE = {"atmosphere/turb-type": 3, "atmosphere/turbulence/milspec/severity": 4,
             "atmosphere/turbulence/milspec/windspeed_at_20ft_AGL-fps": 50}

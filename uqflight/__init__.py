@@ -52,11 +52,11 @@ def run(campaign, out=None, workers: int | None = None, executor: str | None = N
         scheduler: str | None = None, force: bool = False, restart: bool = False, progress: bool = False):
     """Run a campaign (a Campaign, or a campaign file loaded with `load_campaign`) into its results file
     (`out`, default `storage.path`), resuming a file of this campaign begun before, as `uqflight run` does;
-    returns the `uqflight.execution.RunSummary` (`.path`, `.ran`, `.skipped`, `.failures`). The other
+    returns the `uqflight.running.runner.RunSummary` (`.path`, `.ran`, `.skipped`, `.failures`). The other
     arguments are `run`'s options. Raises CampaignError, LockHeld, FileExistsError, DiskFull, WorkerError
-    (`uqflight.execution`). With `executor="dask"` and no scheduler, call it under
+    (`uqflight.running.runner`). With `executor="dask"` and no scheduler, call it under
     `if __name__ == "__main__":` (a LocalCluster starts processes)."""
-    from .execution import run_campaign
+    from .running.runner import run_campaign
 
     if not hasattr(campaign, "design_spec"):
         campaign = load_campaign(campaign)
@@ -85,16 +85,16 @@ def _thresholds(exceedance) -> dict | None:
 
 def analyse(results, method=None, reference=None, partial: bool = False, allow_aliasing: bool = False,
             exceedance=None):
-    """The statistics (`uqflight.statistics.Statistics`) of a results file, as `uqflight report` computes
+    """The statistics (`uqflight.analysis.statistics.Statistics`) of a results file, as `uqflight report` computes
     them: `.outputs[NAME]` (mean, variance, std, band99, quantiles, sobol_first, sobol_total, ... over
     time), `.quantities[NAME]`, `.notes`, `.failure_probability`. `method`: "KIND[:ORDER]" or
     {"kind", "order"} instead of the campaign's; `reference`: a results file for the errors ε_m, ε_v and
     the KLD; `partial`, `allow_aliasing`: as `report --partial`, `--allow-aliasing`; `exceedance`: "NAME>X" /
     "NAME<X" strings (or {NAME: [{above: X}]}) replacing the campaign's thresholds of NAME, as `report
-    --exceedance`. Never runs campaign code. Raises `uqflight.statistics.BadInput` (one line naming the file
+    --exceedance`. Never runs campaign code. Raises `uqflight.analysis.statistics.BadInput` (one line naming the file
     and what to do) when the file cannot give right numbers."""
-    from .statistics import BadInput
-    from .statistics import analyse as statistics
+    from .analysis.statistics import BadInput
+    from .analysis.statistics import analyse as statistics
 
     methods = _methods(method)
     if methods and len(methods) > 1:
@@ -128,17 +128,17 @@ def write_report(results, out=None, reference=None, method=None, times=(10.0, 25
 def export_surrogate(results, out, method=None):
     """Write the PCE of every output of a results file as JSON (`uqflight surrogate export`); returns the
     path. `method`: "KIND[:ORDER]" or a mapping instead of the campaign's. Raises SurrogateError."""
-    from .surrogate import export
+    from .analysis.surrogate import export
 
     methods = _methods(method)
     return export(results, out, methods[0] if methods else None)
 
 
 def load_surrogate(path):
-    """The PCE surrogate of an exported JSON file (`uqflight.surrogate.Surrogate`): `.evaluate(kappa)` or
+    """The PCE surrogate of an exported JSON file (`uqflight.analysis.surrogate.Surrogate`): `.evaluate(kappa)` or
     `.evaluate(xi=...)` gives {output: (M, T)} at M points, `.mean()`, `.variance()` {output: (T,)}. The
     file is checked before anything is evaluated: SurrogateError names the file and the key."""
-    from .surrogate import load
+    from .analysis.surrogate import load
 
     return load(path)
 

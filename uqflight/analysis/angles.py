@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..labels import ANGLE_PERIODS
+from ..text.labels import ANGLE_PERIODS
 
 
 def angle_period(units: str) -> float | None:

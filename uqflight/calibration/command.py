@@ -1,4 +1,4 @@
-"""The `uqflight calibrate` command; `register(app)` adds it to a typer app (the lead wires it into cli.py)."""
+"""The `uqflight calibrate` command; `register(app)` adds it to a typer app (cli/commands.py wires it in)."""
 from __future__ import annotations
 
 import os
@@ -9,9 +9,9 @@ from typing import List, Optional
 
 import typer
 
-from ..arguments import check_campaign_file, check_output, check_results_file
-from ..console import echo, one_line, shown
-from ..progress import Progress
+from ..cli.arguments import check_campaign_file, check_output, check_results_file
+from ..text.console import echo, one_line, shown
+from ..running.progress import Progress
 
 EXIT_BAD_INPUT = 2
 EXIT_NOT_CONVERGED = 3
@@ -87,7 +87,7 @@ def calibrate_command(
         echo(f"error: {exc}", err=True)
         raise typer.Exit(EXIT_BAD_INPUT)
     known = _truth(truth, results)
-    from ..execution import WorkerError
+    from ..running.runner import WorkerError
     from .run import NotConverged, SurrogateError, calibrate
 
     streams, previous = (sys.stdout, sys.stderr), signal.signal(signal.SIGINT, _interrupted)

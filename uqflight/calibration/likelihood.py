@@ -22,8 +22,8 @@ from typing import Callable
 
 import numpy as np
 
-from ..bounded import Refused, read_bounded
-from ..console import listed, shown
+from ..text.bounded import Refused, read_bounded
+from ..text.console import listed, shown
 from ..parameters.germs import GERMS, germ_columns
 
 

@@ -10,9 +10,9 @@ import numpy as np
 import yaml
 
 from ..campaign.schema import LAW_KEYS
-from ..forking import FORKS, Child, ChildFailed, wait_all
-from ..labels import label, parameter_label, short_label
-from ..statistics import json_ready as strict
+from ..running.forking import FORKS, Child, ChildFailed, wait_all
+from ..text.labels import label, parameter_label, short_label
+from ..analysis.statistics import json_ready as strict
 
 OUTPUT_FILES = ("posterior.h5", "summary.json", "calibrated.yaml", "plots/corner.png", "plots/marginals.png",
                 "plots/predictive.png")

@@ -53,7 +53,7 @@ def calibrate(results, data, out, outputs: list[str] | None = None, noise: dict[
     """Calibrate the campaign of `results` on flight `data`; see docs/calibration.md. `outputs`: the
     calibrated outputs (None: every output the data and the surrogate share); `noise`: {output: known noise
     std}, the others' inferred; `method` and `order`: the surrogate's, instead of the campaign's. `progress` (a
-    uqflight.progress.Progress) is told the stages and counts the sampler's steps. `steps`: exactly that
+    uqflight.running.progress.Progress) is told the stages and counts the sampler's steps. `steps`: exactly that
     many per walker, or None: until converged (calibration.sampler, at most MAX_STEPS).
 
     Raises DataError / SurrogateError (bad input, data too large for memory: calibration.size),
@@ -119,7 +119,7 @@ def _calibrate(results, data, out, outputs, noise, seed, walkers, steps, method,
 
 
 def _stage(progress, text: str, total: int = 0, unit: str = "steps") -> None:
-    """A new stage of `progress` (a uqflight.progress.Progress), when there is one."""
+    """A new stage of `progress` (a uqflight.running.progress.Progress), when there is one."""
     if progress:
         progress.stage(text, total, unit)
 
@@ -147,7 +147,7 @@ class Sampling:
     steps: int | None
     seed: int
     out: Path
-    progress: object  # a uqflight.progress.Progress, or None
+    progress: object  # a uqflight.running.progress.Progress, or None
     first_sampled: float = 0.0
 
     def __post_init__(self):

@@ -103,7 +103,7 @@ def sample(log_prob: Callable, ndim: int, labels: list[str], start: np.ndarray, 
     """Run the ensemble (vectorised log_prob: (M, D) → (M,)), seeded; diagnostics in chain.diagnostics.
     `steps`: exactly that many, or None: adaptive (see the module). The first S steps are the same
     either way, so an adaptive chain that stopped at S is the fixed chain of S steps. `moves`: emcee's
-    [(move, weight)] (default MOVES); `progress` (a uqflight.progress.Progress) counts the steps."""
+    [(move, weight)] (default MOVES); `progress` (a uqflight.running.progress.Progress) counts the steps."""
     if walkers < 2 * ndim:
         raise ValueError(f"--walkers: expected at least 2 × {ndim} parameters = {2 * ndim}, got {walkers}")
     if walkers % 2:

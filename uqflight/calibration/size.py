@@ -13,7 +13,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from ..bounded import Refused, open_bounded
+from ..text.bounded import Refused, open_bounded
 from ..campaign.schema import DEFAULT_LIMITS
 from .likelihood import DATA_FORM, MAX_DATA_BYTES, DataError
 

@@ -1,5 +1,5 @@
 """The calibration's view of a results file: the campaign, the PCE surrogate per output and time (the
-export's, `uqflight.surrogate`) with its leave-one-out error model, and the helpers it needs from the
+export's, `uqflight.analysis.surrogate`) with its leave-one-out error model, and the helpers it needs from the
 rest of uqflight (the simulator runs from `execution`, the campaign's text from `campaign.reading`, the
 parameters' summaries from `parameters.summaries`), re-exported here.
 
@@ -15,12 +15,12 @@ from pathlib import Path
 import numpy as np
 
 from ..campaign import Campaign, CampaignError, load_campaign
-from ..bounded import Refused, read_bounded
+from ..text.bounded import Refused, read_bounded
 from ..campaign.schema import MAX_FILE_BYTES
 from ..campaign.reading import campaign_folder, check_campaign_text, portable_mapping, results_campaign
-from ..console import listed
+from ..text.console import listed
 from ..designs import REGISTRY as DESIGNS
-from ..execution import simulate
+from ..running.runner import simulate
 from ..methods import DEFAULT_ORDER, METHOD_KINDS, normalised
 from ..methods.basis import Basis, orthonormal_basis
 from ..methods.loo import loo_residuals, relative_loo_error
@@ -29,9 +29,9 @@ from ..parameters import to_physical as _to_physical
 from ..parameters import to_standard as _to_standard
 from ..parameters.summaries import parameter_specs, prior_summaries
 from ..simulators.validation_view import validation_view
-from ..statistics import BadInput, Options, file_setup, output_basis
+from ..analysis.statistics import BadInput, Options, file_setup, output_basis
 from ..store import ResultStore, Status
-from ..surrogate import SurrogateError, fit_surrogate
+from ..analysis.surrogate import SurrogateError, fit_surrogate
 from .likelihood import error_factors_of
 
 __all__ = ["CalibrationSurrogate", "CampaignError", "SurrogateError", "calibration_surrogate", "campaign_folder",
@@ -41,7 +41,7 @@ __all__ = ["CalibrationSurrogate", "CampaignError", "SurrogateError", "calibrati
 
 @dataclass
 class CalibrationSurrogate:
-    """The surrogate (`uqflight.surrogate.fit_surrogate`, the export's) as the calibration uses it:
+    """The surrogate (`uqflight.analysis.surrogate.fit_surrogate`, the export's) as the calibration uses it:
     x_o(t, ξ) ≈ Σ_α c_α,o(t) Ψ_α(ξ) per output o, with its error variance per time.
 
     `coefficients[o]` is (Z, T) on the results file's `time`. The surrogate error is a random
@@ -137,7 +137,7 @@ def calibration_surrogate(results, method: str | None = None, order: int | None 
                           campaign_path=None, outputs: list[str] | None = None) -> CalibrationSurrogate:
     """The surrogate of every output (or of `outputs`) of a results file, with its error model.
 
-    Default: the file's method and order. The PCE is the export's (`uqflight.surrogate.fit_surrogate`):
+    Default: the file's method and order. The PCE is the export's (`uqflight.analysis.surrogate.fit_surrogate`):
     a method without a PCE of its own is fitted as its registry entry's `exported_as` says.
     """
     results = Path(results)

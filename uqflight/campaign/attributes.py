@@ -1,4 +1,4 @@
-"""The campaign setup a results file keeps as root attributes (see execution.py): of JSON text (`method`,
+"""The campaign setup a results file keeps as root attributes (see running/runner.py): of JSON text (`method`,
 `germs`, `analysis`, `seeds`, `dependence`, `design_info`, `versions`) or plain text (`design_kind`, the
 provenance in TEXT), checked when the file is read, by the checks its campaign file passed (schema) where
 there are some, so that a damaged or hand-edited attribute is one line naming the file, the attribute and

@@ -13,7 +13,7 @@ from __future__ import annotations
 
 from collections.abc import Callable, Sequence
 
-from ..labels import ANGLE_PERIODS, name_unit
+from ..text.labels import ANGLE_PERIODS, name_unit
 from . import take_entry
 from .modes import eigen_modes
 

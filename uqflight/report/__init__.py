@@ -22,10 +22,10 @@ import os
 import shutil
 from pathlib import Path
 
-from ..check import write_baseline
-from ..forking import FORKS, ChildFailed, PreparedChild
-from ..progress import Progress
-from ..statistics import BadInput
+from ..analysis.check import write_baseline
+from ..running.forking import FORKS, ChildFailed, PreparedChild
+from ..running.progress import Progress
+from ..analysis.statistics import BadInput
 from ..methods.parsing import parse_methods
 from .files import _write_text, write_csv, write_statistics_tables, write_summaries
 from .loading import Entry, bounded, load_entries

@@ -5,7 +5,7 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
-from ..labels import parameter_unit
+from ..text.labels import parameter_unit
 from .render import render_html
 from .blocks import Figure, Section, Table
 

@@ -7,8 +7,8 @@ from pathlib import Path
 
 import numpy as np
 
-from ..json_text import json_text
-from ..statistics import summary_json
+from ..text.json_text import json_text
+from ..analysis.statistics import summary_json
 from .loading import Entry, bounded
 
 

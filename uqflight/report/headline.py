@@ -8,7 +8,7 @@ import math
 
 import numpy as np
 
-from ..labels import shown_time
+from ..text.labels import shown_time
 from . import plots
 from .loading import Entry
 from .morris import ranked_text

@@ -13,7 +13,7 @@ from ..campaign.attributes import stored_settings
 from ..campaign.reading import parameter_rows, results_campaign
 from ..designs import REGISTRY as DESIGNS
 from ..methods import METHODS
-from ..statistics import BadInput, Statistics, add_reference_errors, read_statistics
+from ..analysis.statistics import BadInput, Statistics, add_reference_errors, read_statistics
 
 
 @dataclass

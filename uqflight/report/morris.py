@@ -10,7 +10,7 @@ import numpy as np
 from . import plots
 from .blocks import Figure, Section, Table, _rel
 from .loading import Entry, bounded
-from ..labels import shown_time
+from ..text.labels import shown_time
 
 
 def ranked_text(morris: dict, i: int) -> str:

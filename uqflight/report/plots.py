@@ -1,6 +1,6 @@
 """Matplotlib figures (PNG, headless): one flight's time histories and the statistics of campaigns.
 
-The statistics figures take `OutputStatistics` objects (see uqflight.statistics) keyed by output
+The statistics figures take `OutputStatistics` objects (see uqflight.analysis.statistics) keyed by output
 name and draw one panel per output, like the paper's Figs. 6-8, 10-21. A scalar output (one time
 point) is drawn as markers instead of lines.
 """
@@ -25,7 +25,7 @@ from matplotlib.lines import Line2D  # noqa: E402
 from matplotlib.ticker import FixedLocator, FuncFormatter, LogLocator, MaxNLocator, NullFormatter  # noqa: E402
 
 from ..analysis.sobol import unresolved  # noqa: E402
-from ..labels import label, short_label, shown_time  # noqa: E402,F401 (plots.label: the report's captions)
+from ..text.labels import label, short_label, shown_time  # noqa: E402,F401 (plots.label: the report's captions)
 from .formats import export_format, shown_path  # noqa: E402
 from .png import write_png  # noqa: E402
 

@@ -9,10 +9,10 @@ import numpy as np
 
 from . import plots
 from .blocks import Figure, Section, Table, _rel
-from ..labels import shown_time
+from ..text.labels import shown_time
 from .formats import shown_path
 from ..analysis.sobol import unresolved
-from ..forking import share_work
+from ..running.forking import share_work
 from .sensitivity import N_TOO_SMALL, NEGLIGIBLE, index_text, plot_sensitivity
 from .loading import (Entry, _same_file, bounded, campaign_settings, campaign_simulator, estimator_label, flight_facts,
                       method_label, one_per_file)

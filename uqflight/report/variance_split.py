@@ -7,7 +7,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..analysis.sobol import unresolved
-from ..statistics import variance_split
+from ..analysis.statistics import variance_split
 from .sensitivity import N_TOO_SMALL, index_text
 from .loading import Entry
 from .blocks import Section, Table

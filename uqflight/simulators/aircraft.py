@@ -28,7 +28,7 @@ from pathlib import Path
 
 import jsbsim
 
-from ..console import one_line
+from ..text.console import one_line
 from .directives import checked, local_name, parsed, without_io
 from .safe_paths import is_inside, outside_links, relative_name, single_name
 

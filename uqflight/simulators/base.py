@@ -12,7 +12,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import ClassVar
 
-from ..console import one_line, shown
+from ..text.console import one_line, shown
 
 
 class Status(enum.IntEnum):

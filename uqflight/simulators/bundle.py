@@ -25,7 +25,7 @@ import zipfile
 import zlib
 from pathlib import Path
 
-from ..bounded import Refused, read_bounded
+from ..text.bounded import Refused, read_bounded
 from .aircraft import MAX_BYTES, MAX_FILES, AircraftFiles, AircraftUnsafe, cache_dir, unsafe_key
 from .safe_paths import relative_name, single_name
 

@@ -28,7 +28,7 @@ from __future__ import annotations
 
 import xml.etree.ElementTree as ET
 
-from ..console import one_line
+from ..text.console import one_line
 from .safe_paths import relative_name
 
 IO_DIRECTIVES = ("input", "output")

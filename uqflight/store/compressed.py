@@ -18,7 +18,7 @@ import numpy as np
 from threadpoolctl import threadpool_limits
 
 from ..simulators.base import Status
-from ..tsvd import IncrementalSVD, iter_column_blocks
+from .tsvd import IncrementalSVD, iter_column_blocks
 from .chunks import chunk_rows
 from .storage import OutputStorage, key_of, name_of
 

@@ -8,7 +8,7 @@ from pathlib import Path
 import h5py
 import yaml
 
-from ..console import shown
+from ..text.console import shown
 from .file_end import extend_file, past_recorded_end
 from .lock import LockHeld, held_message, is_lock_error, open_elsewhere
 from .results import READ_ERRORS, ResultStore, one_line, text_hash

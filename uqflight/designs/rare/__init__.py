@@ -12,9 +12,9 @@ optional `budget`, the most runs):
 The algorithms (`subset`, `importance`, `active`, `estimate`) work in standard-normal space u and call
 `evaluate(u)` once per round with the whole round's points; this module reads the `design:` mapping, maps
 u to the germs ξ (each germ's `from_normal`) and gives the first round's points (the design the results
-file is created with). The runner (`uqflight.rare_rounds`) replays the algorithm over the stored runs.
+file is created with). The runner (`uqflight.running.rare_rounds`) replays the algorithm over the stored runs.
 The runs of such a design are not draws of the input law: the analysis gives the event's probability
-and refuses every other statistic (`uqflight.rare_statistics`).
+and refuses every other statistic (`uqflight.analysis.rare_statistics`).
 """
 from __future__ import annotations
 
@@ -133,7 +133,7 @@ EVENT = Key("an event {of: QUANTITY, above: X} (or below: X) whose probability i
 
 class RareDesign(DesignKind):
     """A rare-event design: the first round of the algorithm's points, mapped to the germs; the runner
-    (`uqflight.rare_rounds`) adds the other rounds from the results, up to `budget` runs (its kind's default
+    (`uqflight.running.rare_rounds`) adds the other rounds from the results, up to `budget` runs (its kind's default
     budget when not given: what each kind needs, with its other defaults, to come within a factor 2 of the
     exact probability on the issue's closed-form problems, issue 46). The weights are equal and mean nothing:
     the runs are not draws of the input law."""

@@ -6,7 +6,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ...labels import name_unit
+from ...text.labels import name_unit
 from ..aircraft import AircraftNotFound, locate
 from ..base import Field, SimulatorKind
 from ..bundle import aircraft_bundle

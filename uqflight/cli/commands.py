@@ -31,17 +31,17 @@ import numpy as np
 import typer
 
 from .arguments import check_campaign_file, check_output, check_results_file
-from .calibration.command import register as register_calibrate
-from .console import echo, listed, one_line, shown
-from . import stopping
+from ..calibration.command import register as register_calibrate
+from ..text.console import echo, listed, one_line, shown
+from ..running import stopping
 from .fast_exit import exit_fast
-from .progress import Progress
+from ..running.progress import Progress
 
-from .methods import METHOD_KINDS
-from .simulators.base import FlightError
-from .simulators.aircraft import default_condition
-from .simulators.jsbsim import DEFAULT_OUTPUTS
-from .simulators.scenarios.level_flight import Excitation, FlightSetup, JSBSimFlight
+from ..methods import METHOD_KINDS
+from ..simulators.base import FlightError
+from ..simulators.aircraft import default_condition
+from ..simulators.jsbsim import DEFAULT_OUTPUTS
+from ..simulators.scenarios.level_flight import Excitation, FlightSetup, JSBSimFlight
 
 CONTEXT = {"help_option_names": ["-h", "--help"]}
 # simulate's CSV and plot, beside the campaigns' results (results/ is in .gitignore)
@@ -56,7 +56,7 @@ app.add_typer(surrogate_app, name="surrogate")
 
 
 def main() -> None:
-    """The `uqflight` console script: `app`, then an exit without the interpreter's teardown (uqflight.fast_exit)."""
+    """The `uqflight` console script: `app`, then an exit without the interpreter's teardown (uqflight.cli.fast_exit)."""
     try:
         app()
     except SystemExit as done:
@@ -67,7 +67,7 @@ def main() -> None:
 
 
 def _calibration_page(out: Path) -> Path:
-    from .report.calibration_page import write_calibration_page
+    from ..report.calibration_page import write_calibration_page
 
     return write_calibration_page(out)
 
@@ -77,7 +77,7 @@ register_calibrate(app, page=_calibration_page)
 
 def _version(value: bool):
     if value:
-        from . import __version__
+        from .. import __version__
 
         echo(f"uqflight {__version__}")
         raise typer.Exit(0)
@@ -135,7 +135,7 @@ def simulate(
 ):
     """Trim one flight in level flight, excite the elevator and record the outputs (by default into
     results/flight.csv and results/flight.png, from the working directory)."""
-    from .simulators.noise import add_noise, check_noise
+    from ..simulators.noise import add_noise, check_noise
 
     settings = parse_settings(set_)
     sigmas = parse_settings(noise, "--noise")
@@ -187,7 +187,7 @@ def simulate(
             for i, t in enumerate(result.time):
                 writer.writerow([f"{t:g}", *(repr(float(v[i])) for v in outputs.values())])
         echo(f"wrote {out}")
-        from .report.plots import plot_flight
+        from ..report.plots import plot_flight
 
         plot_flight(result.time, outputs, plot,
                     title=f"{setup.aircraft}: {excitation} {amplitude_deg:g} deg at {altitude_ft:g} ft, {airspeed_ktas:g} KTAS"
@@ -197,7 +197,7 @@ def simulate(
 
 def _offset_lines(located, flight) -> list[str]:
     """What each --offset added at the trimmed state: ΔC, the reference factor and their product."""
-    from .simulators.aero_factors import aero_factors
+    from ..simulators.aero_factors import aero_factors
 
     refs = aero_factors(located.files.main)
     lines = []
@@ -214,8 +214,8 @@ def _prepared(aircraft: str, scale: list[str], offset: list[str], offset_value: 
     """The aircraft of `simulate`/`aircraft`, patched for --scale/--offset/--offset-value; `.settings`
     holds the patch properties' values, `.pairs` (function, kind, property, value). Raises ValueError
     (a bad pair or function, an aircraft file that is not XML) or FileNotFoundError."""
-    from .simulators.aircraft import AircraftUnreadable
-    from .simulators.patch import PreparedAircraft, patch_property, resolve_function
+    from ..simulators.aircraft import AircraftUnreadable
+    from ..simulators.patch import PreparedAircraft, patch_property, resolve_function
 
     try:
         plain = PreparedAircraft(aircraft, Path.cwd())
@@ -234,8 +234,8 @@ def _prepared(aircraft: str, scale: list[str], offset: list[str], offset_value: 
 
 def _load(path: Path):
     """The validated campaign, or exit 2 with the validation message (no traceback)."""
-    from .campaign import CampaignError, load_campaign
-    from .simulators.validation_view import validation_view
+    from ..campaign import CampaignError, load_campaign
+    from ..simulators.validation_view import validation_view
 
     check_campaign_file(path)
     try:
@@ -248,10 +248,10 @@ def _load(path: Path):
 @app.command()
 def plan(campaign_file: Path = typer.Argument(..., metavar="CAMPAIGN", help="Campaign YAML file.")):
     """Validate a campaign and print its design, the number of runs and an estimated time."""
-    from .designs import REGISTRY as DESIGNS
-    from .designs import describe
-    from .execution import WorkerError, timed_nominal
-    from .methods import METHODS
+    from ..designs import REGISTRY as DESIGNS
+    from ..designs import describe
+    from ..running.runner import WorkerError, timed_nominal
+    from ..methods import METHODS
 
     campaign = _load(campaign_file)
     design = campaign.design()
@@ -310,9 +310,9 @@ def run(
     Exit 0: done; 1: a run-time failure; 2: refused (bad campaign, a file another run holds, a file
     that is not this campaign's, a full disk: the message says what to do); 130 (SIGINT) or 143
     (SIGTERM): stopped cleanly, the finished runs are kept, rerun to resume."""
-    from .execution import DiskFull, IncompleteFile, WorkerError, run_campaign
-    from .store import CorruptFile
-    from .store.results import REFLY
+    from ..running.runner import DiskFull, IncompleteFile, WorkerError, run_campaign
+    from ..store import CorruptFile
+    from ..store.results import REFLY
 
     campaign = _load(campaign_file)
     check_output(out or Path(campaign.storage["path"]), "--out" if out else "storage.path", create=True,
@@ -364,8 +364,8 @@ def _exit_now(code: int):
 @app.command()
 def info(results: Path = typer.Argument(..., metavar="RESULTS", help="Results file (.h5).")):
     """Show a results file's campaign, design, done and failed runs, storage and versions."""
-    from .store import CorruptFile, LockHeld, ResultStore, Status, read_error
-    from .store.lock import describe_holder, live_holder
+    from ..store import CorruptFile, LockHeld, ResultStore, Status, read_error
+    from ..store.lock import describe_holder, live_holder
 
     check_results_file(results)
     writer = live_holder(results)
@@ -477,8 +477,8 @@ def report(
     plots/*.png, report.html (self-contained, plots embedded) and report.md (linking plots/).
     The report is written to a temporary folder and moved into place when complete.
     """
-    from .report import DEFAULT_TIMES, default_out_dir, parse_methods, write_report
-    from .statistics import BadInput
+    from ..report import DEFAULT_TIMES, default_out_dir, parse_methods, write_report
+    from ..analysis.statistics import BadInput
 
     try:
         selected = (list(DEFAULT_TIMES) if times is None else
@@ -493,7 +493,7 @@ def report(
         overrides = parse_methods(method, order)
     except ValueError as exc:
         raise typer.BadParameter(str(exc), param_hint="--method")
-    from .quantities.spec import parse_exceedance_option
+    from ..quantities.spec import parse_exceedance_option
 
     try:
         thresholds = parse_exceedance_option(exceedance)
@@ -533,7 +533,7 @@ def report(
 def _check_quantities(thresholds: dict, results: list[Path]) -> None:
     """Exit 2 naming --exceedance when a threshold names a quantity some results file does not have (an
     unreadable file is the report's to refuse)."""
-    from .store import ResultStore
+    from ..store import ResultStore
 
     for path in results:
         try:
@@ -552,8 +552,8 @@ def _check_times(text: str, selected: list[float], results: list[Path]) -> None:
     """Exit 2 naming --times and the flight's time range when a time lies outside a file's recorded
     times (more than half a recording step); 'end' is always inside. An unreadable file is the
     report's to refuse."""
-    from .labels import shown_time
-    from .store import ResultStore
+    from ..text.labels import shown_time
+    from ..store import ResultStore
 
     for path in results:
         try:
@@ -615,9 +615,9 @@ def surrogate_export(
 ):
     """Export the PCE of every output over time as JSON: germs, multi-indices, coefficients per output
     and time, the parameters' distributions (name, distribution, lower, upper, nominal), the time
-    grid, method and order. Load it in Python with uqflight.surrogate.load(path).evaluate(kappa)."""
-    from .statistics import BadInput
-    from .surrogate import SurrogateError, export
+    grid, method and order. Load it in Python with uqflight.analysis.surrogate.load(path).evaluate(kappa)."""
+    from ..analysis.statistics import BadInput
+    from ..analysis.surrogate import SurrogateError, export
 
     try:
         override = parse_method_option(method)
@@ -638,7 +638,7 @@ def surrogate_export(
 
 
 def parse_method_option(method: str | None) -> dict | None:
-    from .methods.parsing import parse_methods
+    from ..methods.parsing import parse_methods
 
     return parse_methods([method])[0] if method else None
 
@@ -659,8 +659,8 @@ def check(
     (the worst values per statistic are listed); 2: bad input (missing or malformed baseline, other
     outputs or time grid, unreadable results file).
     """
-    from .check import compare, drift_table, load_baseline
-    from .statistics import BadInput, read_statistics
+    from ..analysis.check import compare, drift_table, load_baseline
+    from ..analysis.statistics import BadInput, read_statistics
 
     if rtol < 0 or atol < 0:
         echo("error: --rtol and --atol must be >= 0", err=True)
@@ -698,9 +698,9 @@ def aircraft_command(
 ):
     """An aircraft's aerodynamic functions (axis, name, description), engines and elevator travel, without
     flying it; with --trim its nominal trim too."""
-    from .simulators.aircraft import AircraftFiles, aero_functions, known_aircraft
-    from .simulators.engines import engine_kinds
-    from .simulators.aero_factors import aero_factors, factor_values
+    from ..simulators.aircraft import AircraftFiles, aero_functions, known_aircraft
+    from ..simulators.engines import engine_kinds
+    from ..simulators.aero_factors import aero_factors, factor_values
 
     if list_ or aircraft is None:
         for origin, names in known_aircraft().items():

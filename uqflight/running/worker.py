@@ -3,7 +3,7 @@
 Kept apart from the runner so that a worker imports only NumPy and the simulator (the
 campaign, designs and HDF5 modules stay in the runner process): workers start faster.
 
-A worker is a separate Python process (`python -m uqflight.worker FD PPID`) that talks to its
+A worker is a separate Python process (`python -m uqflight.running.worker FD PPID`) that talks to its
 runner over a socket (pickled messages, `multiprocessing.connection.Connection`): it receives
 chunks, announces each sample before flying it ("start", row) so that the runner knows which
 sample a dead or hung worker was flying, and returns the chunk's results. It never outlives its
@@ -22,13 +22,13 @@ from pathlib import Path
 
 import numpy as np
 
-from .console import one_line
+from ..text.console import one_line
 from .forking import die_with_parent
-from .quantities import quantity_key
-from .quantities.recorder import QuantityRecorder
-from .simulators import FlightError, make_simulator
-from .simulators.base import NominalFailed
-from .simulators.kinds import localized
+from ..quantities import quantity_key
+from ..quantities.recorder import QuantityRecorder
+from ..simulators import FlightError, make_simulator
+from ..simulators.base import NominalFailed
+from ..simulators.kinds import localized
 
 
 @dataclass(frozen=True)
@@ -181,7 +181,7 @@ def main(argv=None) -> None:
             conn.send(("error", f"{type(exc).__name__}: {one_line(str(exc))}"))
 
 
-if __name__ == "__main__":  # `python -m uqflight.worker`: the imported module's main, so that the
-    from uqflight.worker import main as serve  # records it sends pickle as uqflight.worker.NominalFlight
+if __name__ == "__main__":  # `python -m uqflight.running.worker`: the imported module's main, so that the
+    from uqflight.running.worker import main as serve  # records it sends pickle as uqflight.running.worker.NominalFlight
 
     serve()

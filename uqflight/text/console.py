@@ -42,7 +42,7 @@ def one_line(text: str) -> str:
 
 def echo(message: object = "", err: bool = False, nl: bool = True) -> None:
     """typer.echo of `message` cleaned; a reader gone (closed pipe) exits quietly with 141."""
-    import typer  # here: the quoting helpers above serve modules that never print (uqflight.surrogate)
+    import typer  # here: the quoting helpers above serve modules that never print (uqflight.analysis.surrogate)
 
     try:
         typer.echo(clean(str(message)), err=err, nl=nl)

@@ -9,7 +9,7 @@ from pathlib import Path
 
 import typer
 
-from .console import echo
+from ..text.console import echo
 
 CAMPAIGN_KEYS = ("simulator:", "parameters:", "design:")  # lines a campaign file starts
 

@@ -7,7 +7,7 @@ from __future__ import annotations
 import sys
 import time
 
-from .console import clean
+from ..text.console import clean
 
 
 class Progress:

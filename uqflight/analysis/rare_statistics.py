@@ -8,8 +8,8 @@ import math
 
 import numpy as np
 
-from .designs.rare import Event
-from .store import ResultStore, Status
+from ..designs.rare import Event
+from ..store import ResultStore, Status
 
 
 def _number(value: float) -> float | None:

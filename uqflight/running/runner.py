@@ -9,7 +9,7 @@ loses only the chunks in flight and resumes from there.
 
 Nothing lost, nothing hung:
 - Simulators never run in the runner's process (not even with one worker): each worker is a
-  `python -m uqflight.worker` child (see `WorkerProcess`) that announces every sample before
+  `python -m uqflight.running.worker` child (see `WorkerProcess`) that announces every sample before
   flying it. A worker that dies (exit, signal, out of memory) or runs one sample past the time
   limit is killed and replaced; the sample it was flying is recorded with Status.WORKER_DIED or
   Status.TIMEOUT and its reason, and its chunk is flown again from the start without that sample
@@ -43,19 +43,19 @@ from pathlib import Path
 import numpy as np
 from threadpoolctl import threadpool_limits
 
-from .campaign import Campaign
-from .campaign.reading import parameters_attribute
-from .campaign.schema import WORKER_BYTES
-from .console import one_line
-from .designs import REGISTRY as DESIGNS
-from .designs import Design
-from .parameters import seed_names
+from ..campaign import Campaign
+from ..campaign.reading import parameters_attribute
+from ..campaign.schema import WORKER_BYTES
+from ..text.console import one_line
+from ..designs import REGISTRY as DESIGNS
+from ..designs import Design
+from ..parameters import seed_names
 from .stopping import check as check_stop
 from .progress import Progress
 from .rare_rounds import run_rare
-from .refinement import run_rounds
-from .store import ResultStore, Status, compact, open_for_campaign
-from .store.lock import LockHeld, ResultsLock
+from .adaptive_rounds import run_rounds
+from ..store import ResultStore, Status, compact, open_for_campaign
+from ..store.lock import LockHeld, ResultsLock
 from .worker import NominalFlight, WorkerSpec
 
 DEFAULT_TIMEOUT_FLOOR_S = 60.0   # default timeout: max(this, TIMEOUT_FLIGHTS x one nominal flight)
@@ -142,7 +142,7 @@ def prepare_store(campaign: Campaign, design: Design, out: Path, force: bool, no
         attrs["seeds"] = json.dumps(seeds)
     if campaign.dependence is not None:  # likewise
         attrs["dependence"] = json.dumps(campaign.dependence.summary())
-    from .simulators import simulator_provenance
+    from ..simulators import simulator_provenance
 
     attrs.update(simulator_provenance(campaign.simulator, Path(campaign.source).resolve().parent,
                                       properties=[p.property for p in campaign.parameters]))
@@ -197,7 +197,7 @@ def nominal_kappa(campaign: Campaign) -> np.ndarray:
 
 
 def worker_spec(campaign: Campaign) -> WorkerSpec:
-    from .simulators.kinds import make_bundle
+    from ..simulators.kinds import make_bundle
 
     properties = tuple(p.property for p in campaign.parameters)
     base = str(Path(campaign.source).resolve().parent)
@@ -470,13 +470,13 @@ def death_reason(returncode: int | None) -> str:
 
 
 class WorkerProcess:
-    """One `python -m uqflight.worker` child and its socket."""
+    """One `python -m uqflight.running.worker` child and its socket."""
 
     def __init__(self):
         parent, child = socket.socketpair()
         try:
             self.proc = subprocess.Popen(
-                [sys.executable, "-m", "uqflight.worker", str(child.fileno()), str(os.getpid())],
+                [sys.executable, "-m", "uqflight.running.worker", str(child.fileno()), str(os.getpid())],
                 pass_fds=[child.fileno()], stdin=subprocess.DEVNULL)
         finally:
             child.close()

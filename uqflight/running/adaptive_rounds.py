@@ -11,10 +11,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from .campaign import Campaign
-from .designs.adaptive import IndexSet, adaptive_settings, combination_weights, grid_points, refine
-from .parameters import to_physical
-from .store import ResultStore, Status
+from ..campaign import Campaign
+from ..designs.adaptive import IndexSet, adaptive_settings, combination_weights, grid_points, refine
+from ..parameters import to_physical
+from ..store import ResultStore, Status
 
 
 def stored_values(store: ResultStore) -> list[np.ndarray]:

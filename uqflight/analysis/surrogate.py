@@ -1,7 +1,7 @@
 """The PCE surrogate of a results file: export it as strict JSON, load it back and evaluate it.
 
     uqflight surrogate export RESULTS.h5 --out pce.json
-    >>> from uqflight.surrogate import load
+    >>> from uqflight.analysis.surrogate import load
     >>> pce = load("pce.json")
     >>> pce.evaluate(kappa=[[0.25, 5.1, ...]])["theta_deg"]     # (points, times)
 
@@ -22,9 +22,9 @@ from pathlib import Path
 
 import numpy as np
 
-from .bounded import read_bounded
-from .console import listed
-from .console import shown as shown_name
+from ..text.bounded import read_bounded
+from ..text.console import listed
+from ..text.console import shown as shown_name
 
 FORMAT = "uqflight-pce"
 VERSION = 1
@@ -57,7 +57,7 @@ class Surrogate:
     def to_standard(self, kappa) -> np.ndarray:
         """ξ (M, d) from physical values κ (M, d), column by column through each parameter's law (and the
         inverse Nataf transform of the `dependence`, if any)."""
-        from .parameters import Parameter, to_standard
+        from ..parameters import Parameter, to_standard
 
         kappa = np.atleast_2d(np.asarray(kappa, dtype=float))
         if kappa.shape[1] != len(self.parameters):
@@ -69,7 +69,7 @@ class Surrogate:
 
     def evaluate(self, kappa=None, *, xi=None) -> dict[str, np.ndarray]:
         """{output: (M, T)} at M points given as physical values κ (M, d) or standard variables ξ."""
-        from .methods.basis import orthonormal_basis
+        from ..methods.basis import orthonormal_basis
 
         if (kappa is None) == (xi is None):
             raise ValueError("give exactly one of kappa (physical values) or xi (standard variables)")
@@ -88,17 +88,17 @@ class Surrogate:
 
 def fit_surrogate(path, method: dict | None = None, partial: bool = False, allow_aliasing: bool = False,
                   options=None, progress=None) -> Surrogate:
-    """The PCE of every output of the results file `path`, exactly as `uqflight.statistics.analyse`
+    """The PCE of every output of the results file `path`, exactly as `uqflight.analysis.statistics.analyse`
     fits it (with `method` overriding the campaign's), after the same checks: pending or failed runs,
     a projection the grid cannot integrate and a rank-deficient fit are refused (statistics.BadInput).
     A method that builds no PCE of its own on this design is exported as its registry entry says
     (`exported_as`: monte_carlo, and integration on a sampled design, as least squares). The export
     and the calibration both fit here. `options`: statistics.Options (default 200 band draws: the PCE
     does not depend on them, and its bands and PDFs are not exported); `progress`: see analyse."""
-    from .designs import REGISTRY as DESIGNS
-    from .methods import METHODS, normalised
+    from ..designs import REGISTRY as DESIGNS
+    from ..methods import METHODS, normalised
     from .statistics import BadInput, Options, analyse, file_setup
-    from .store import ResultStore
+    from ..store import ResultStore
 
     with ResultStore.open(path) as store:
         setup = file_setup(store, path)
@@ -125,7 +125,7 @@ def fit_surrogate(path, method: dict | None = None, partial: bool = False, allow
 
 def _copula(dependence: dict | None):
     """The GaussianCopula of a `dependence` mapping (ValueError naming the key when it is not one)."""
-    from .parameters.dependence import KINDS, GaussianCopula
+    from ..parameters.dependence import KINDS, GaussianCopula
 
     if dependence is None:
         return None
@@ -143,8 +143,8 @@ def _copula(dependence: dict | None):
 def _parameters(store, path) -> list[dict]:
     """The parameters' laws from the stored campaign text (κ ↔ ξ) of the results file `path`, via the campaign
     parser; SurrogateError naming the file and why when they cannot be read."""
-    from .campaign import CampaignError
-    from .campaign.reading import parameter_rows, results_campaign
+    from ..campaign import CampaignError
+    from ..campaign.reading import parameter_rows, results_campaign
 
     try:
         found = parameter_rows(results_campaign(store.attrs, str(path)).parameters)
@@ -186,7 +186,7 @@ def surrogate_json(surrogate: Surrogate, results: str = "") -> dict:
 def export(results, out, method: dict | None = None, progress=None) -> Path:
     """Fit the PCE of `results` and write it to `out` as strict JSON; returns `out`. The folder of
     `out` must exist; nothing is left behind when the write fails (a full disk). `progress` (a
-    uqflight.progress.Progress) is told the stages."""
+    uqflight.running.progress.Progress) is told the stages."""
     data = surrogate_json(fit_surrogate(results, method, progress=progress), str(results))
     if progress is not None:
         progress.stage(f"writing {out}")
@@ -226,8 +226,8 @@ def load(path) -> Surrogate:
 def _checked(data: dict) -> Surrogate:
     """The Surrogate a parsed file describes, every type, shape and value checked before any array is
     built (ValueError naming the key)."""
-    from .parameters import Parameter
-    from .parameters.germs import GERMS
+    from ..parameters import Parameter
+    from ..parameters.germs import GERMS
 
     if data.get("version") != VERSION:
         raise ValueError(f"version: expected {VERSION}, got {_shown(data.get('version'))}")

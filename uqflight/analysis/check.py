@@ -16,11 +16,11 @@ from pathlib import Path
 
 import numpy as np
 
-from .bounded import Refused, read_bounded
-from .campaign.schema import shown
-from .console import listed
-from .console import shown as shown_name
-from .json_text import json_text
+from ..text.bounded import Refused, read_bounded
+from ..campaign.schema import shown
+from ..text.console import listed
+from ..text.console import shown as shown_name
+from ..text.json_text import json_text
 from .statistics import BadInput, Statistics, json_ready
 
 BASELINE_KIND = "uqflight-baseline"

@@ -14,10 +14,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from .campaign import Campaign
-from .designs.rare import RareSettings, germs_from_normal, rare_settings, run_algorithm
-from .designs.rare.record import estimate_record
-from .store import ResultStore, Status
+from ..campaign import Campaign
+from ..designs.rare import RareSettings, germs_from_normal, rare_settings, run_algorithm
+from ..designs.rare.record import estimate_record
+from ..store import ResultStore, Status
 
 
 class ReplayMismatch(ValueError):

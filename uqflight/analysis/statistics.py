@@ -33,32 +33,32 @@ from typing import Callable
 import numpy as np
 from threadpoolctl import threadpool_limits
 
-from .analysis.angles import angle_period, branch_shifts, unwrapped_runs
-from .analysis.density import pdf_over_time
-from .analysis.divergence import kl_divergence
-from .analysis.errors import error_summary, relative_errors
-from .analysis.exceedance import exceedance_from_pce, exceedance_from_runs, unit_slip
-from .analysis.failures import grid_failure_probability
-from .analysis.floors import central_moments, floors_from_moments, kld_estimator_bias, kld_floor
-from .analysis.moments import (modified_cov, sorted_by_time, standardised_moments, weighted_moments,
+from .angles import angle_period, branch_shifts, unwrapped_runs
+from .density import pdf_over_time
+from .divergence import kl_divergence
+from .errors import error_summary, relative_errors
+from .exceedance import exceedance_from_pce, exceedance_from_runs, unit_slip
+from .failures import grid_failure_probability
+from .floors import central_moments, floors_from_moments, kld_estimator_bias, kld_floor
+from .moments import (modified_cov, sorted_by_time, standardised_moments, weighted_moments,
                                weighted_quantiles)
-from .analysis.resolution import RESOLUTION_RTOL, resolved_variance
-from .analysis.sobol import NEGLIGIBLE, UNRESOLVED_WIDTH, complete_rows, pick_freeze_indices, unresolved
-from .campaign.attributes import RecordedSetup, recorded_setup, stored_settings
-from .campaign.schema import CampaignError
-from .console import shown
-from .designs import REGISTRY as DESIGNS
-from .designs.adaptive import index_set_summary
-from .labels import name_unit, quantity_unit
-from .methods import DEFAULT_ORDER, PCE, METHODS, Auto, Method, normalised
-from .methods.basis import orthonormal_basis
-from .methods.pce_moments import pce_standardised_moments, triple_products
-from .methods import validation
-from .methods.validity import method_problem
-from .parameters.distributions import SEED_REFUSAL
-from .parameters.germs import draw_germs
-from .store import CorruptFile, LockHeld, ResultStore, Status
-from .store.results import one_line
+from .resolution import RESOLUTION_RTOL, resolved_variance
+from .sobol import NEGLIGIBLE, UNRESOLVED_WIDTH, complete_rows, pick_freeze_indices, unresolved
+from ..campaign.attributes import RecordedSetup, recorded_setup, stored_settings
+from ..campaign.schema import CampaignError
+from ..text.console import shown
+from ..designs import REGISTRY as DESIGNS
+from ..designs.adaptive import index_set_summary
+from ..text.labels import name_unit, quantity_unit
+from ..methods import DEFAULT_ORDER, PCE, METHODS, Auto, Method, normalised
+from ..methods.basis import orthonormal_basis
+from ..methods.pce_moments import pce_standardised_moments, triple_products
+from ..methods import validation
+from ..methods.validity import method_problem
+from ..parameters.distributions import SEED_REFUSAL
+from ..parameters.germs import draw_germs
+from ..store import CorruptFile, LockHeld, ResultStore, Status
+from ..store.results import one_line
 
 PDF_POINTS = 120
 TIME_BLOCK = 100  # recorded times whose runs or surrogate draws are rebuilt at once
@@ -253,7 +253,7 @@ def analyse(path, reference: str | None = None, options: Options | None = None, 
     `method` ({"kind", "order", "split"}) overrides the campaign's: the runs of one grid serve every
     method, so methods and orders are compared on the same runs. `partial` analyses a file with pending
     runs where a subset of the runs is valid; `allow_aliasing` lets a projection exceed the grid's degree.
-    `progress` (a uqflight.progress.Progress) gets a stage per file and counts its outputs and quantities.
+    `progress` (a uqflight.running.progress.Progress) gets a stage per file and counts its outputs and quantities.
     `exceedance` ({quantity: [{above: X} | {below: X}]}) replaces the campaign's `analysis.exceedance` of the
     quantities it names (`report --exceedance`: thresholds changed without flying again); BadInput when it
     names a quantity the file does not have.
