@@ -167,6 +167,24 @@ def test_the_command_line_refuses_an_event_of_no_quantity_in_one_line(tmp_path):
     assert len(done.stderr.strip().splitlines()) == 1 and not (tmp_path / "r.h5").exists()
 
 
+def test_an_active_learning_budget_too_small_for_its_rounds_is_refused_by_run_naming_design_budget(tmp_path):
+    # first design 4k + 12 = 20 and one enrichment of 5 within 40 % of the budget, two importance-sampling
+    # rounds of 100 in the rest: 332 runs at least (smallest_budget), so 331 is refused before a run
+    (tmp_path / "r.yaml").write_text(linear_text("active_learning", settings=", budget: 331"))
+    done = cli_in_process("run", tmp_path / "r.yaml", "--out", tmp_path / "r.h5")
+    assert done.returncode == 2 and "design.budget: 331 runs are too few for active learning on 2 inputs" in done.stderr
+    assert "at least 332" in done.stderr and len(done.stderr.strip().splitlines()) == 1, done.stderr
+    assert not (tmp_path / "r.h5").exists()
+    parse_campaign(linear_text("active_learning", settings=", budget: 332"), str(tmp_path / "r.yaml"))
+
+
+def test_active_learning_on_seed_parameters_alone_is_refused_naming_the_kind(tmp_path):
+    text = SEEDED.format(seed=1, threshold=THRESHOLD).replace("kind: subset_simulation", "kind: active_learning")
+    text = text.replace(", samples_per_level: 200, p0: 0.1,", ",").replace("  x: {distribution: normal, lower: -3, upper: 3}\n", "")
+    with pytest.raises(CampaignError, match="design.kind: active_learning learns a surrogate of the inputs that are not"):
+        parse_campaign(text, str(tmp_path / "r.yaml"))
+
+
 def test_analysis_exceedance_is_refused_beside_a_rare_event_design(tmp_path):
     text = linear_text("subset_simulation") + "analysis: {exceedance: {peak: [{above: 2.0}]}}\n"
     with pytest.raises(CampaignError, match="analysis.exceedance: a subset_simulation design's runs are not draws"):

@@ -147,6 +147,9 @@ class RareDesign(DesignKind):
 
     def build(self, spec, germs, seed, redrawn=()):
         settings = rare_settings(spec)
+        problem = self.input_problem(settings, len(germs), len(redrawn))
+        if problem:
+            raise ValueError(": ".join(problem))
         xi = germs_from_normal(first_round(settings, germs, seed, redrawn), germs)
         info = {"event": settings.event.text(), "budget": settings.budget, **settings.settings,
                 "rounds": "adapted to the event from the results, up to the budget"}
@@ -156,6 +159,11 @@ class RareDesign(DesignKind):
         """ValueError naming design.KEY when one round of `settings` does not fit the `budget`."""
         if settings.get("samples", 0) > budget:
             raise ValueError(f"design.budget: {budget} runs cannot hold one round of samples = {settings['samples']}")
+
+    def input_problem(self, settings: RareSettings, inputs: int, redrawn: int) -> tuple[str, str] | None:
+        """(field, message) when the design cannot work on `inputs` parameters of which `redrawn` are seeds
+        (`build` raises it as the ValueError 'field: message')."""
+        return None
 
 
 class SubsetSimulation(RareDesign):
@@ -213,6 +221,20 @@ class ActiveLearning(RareDesign):
     def algorithm():
         from .active import active_learning
         return active_learning
+
+    def input_problem(self, settings, inputs, redrawn):
+        from .active import smallest_budget
+
+        learned = inputs - redrawn
+        if learned == 0:
+            return ("design.kind", "active_learning learns a surrogate of the inputs that are not seeds, and every "
+                                   "parameter here is a seed: use subset_simulation or importance_sampling")
+        fewest = smallest_budget(learned)
+        if settings.budget < fewest:
+            return ("design.budget", f"{settings.budget} runs are too few for active learning on {learned} "
+                                     f"input{'s' if learned > 1 else ''}: its first design, one enrichment and two "
+                                     f"importance-sampling rounds need at least {fewest}")
+        return None
 
 
 RARE = {design.kind: design() for design in (SubsetSimulation, ImportanceSampling, ActiveLearning)}

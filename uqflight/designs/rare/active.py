@@ -133,6 +133,17 @@ def surrogate_levels(surrogate: Surrogate, k: int, rng: np.random.Generator):
     return levels.u, levels.g, levels.stopped == "converged"
 
 
+def smallest_budget(k: int, *, first: int | None = None, batch: int = 5, learning: float = 0.4,
+                    batch_is: int = 100) -> int:
+    """The fewest runs `active_learning` accepts with `k` surrogate inputs: its first design and one
+    enrichment within the `learning` share, and two importance-sampling rounds in the rest."""
+    first = 4 * k + 12 if first is None else first
+    budget = 1
+    while first + batch > int(learning * budget) or budget - int(learning * budget) < 2 * batch_is:
+        budget += 1
+    return budget
+
+
 @single_threaded
 def active_learning(evaluate, dimension, *, seed: int, budget: int, redrawn: tuple[int, ...] = (),
                     first: int | None = None, batch: int = 5, min_rounds: int = 10, max_rounds: int = 40,
@@ -177,7 +188,7 @@ def active_learning(evaluate, dimension, *, seed: int, budget: int, redrawn: tup
         raise ValueError("every dimension is redrawn: there is nothing to learn (Monte Carlo is the design)")
     first = 4 * k + 12 if first is None else first
     learning_runs = int(learning * budget)
-    if first + batch > learning_runs or budget - learning_runs < 2 * batch_is:
+    if budget < smallest_budget(k, first=first, batch=batch, learning=learning, batch_is=batch_is):
         raise ValueError(f"a budget of {budget} holds too few runs: the first design ({first}), one enrichment "
                          f"({batch}) within {learning:.0%} of it, and two importance-sampling rounds ({batch_is})")
     rng = np.random.default_rng(seed)
