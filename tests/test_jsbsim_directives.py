@@ -227,6 +227,36 @@ def test_an_output_in_a_namespace_is_checked_as_jsbsim_reads_it(tmp_path, home):
     assert precious.read_text() == "keep"
 
 
+def test_a_default_namespaced_aircraft_is_patched_and_flown_with_the_names_jsbsim_reads(tmp_path, home):
+    """JSBSim ignores a default namespace: a c172p whose <fdm_config xmlns="urn:x"> holds an <output> (removed)
+    is patched (aero/uq/scale/CLwbh scales its lift) and flown; the file JSBSim reads names its elements as
+    the original did, without the ns0: prefix Python's writer would give them (which JSBSim cannot read)."""
+    def spaced(xml):
+        return appended(f'<output name="out.csv" type="CSV" rate="1">{PROBE}</output>')(
+            xml.replace("<fdm_config ", '<fdm_config xmlns="urn:x" ', 1))
+    copied_aircraft(tmp_path, "spaced", spaced)
+    simulator = make_simulator({"kind": "jsbsim", "aircraft": "planes/spaced", "duration_s": 1.0, "flight": C172,
+                                "outputs": ["alpha_deg"]}, ["CL"], ["aero/uq/scale/CLwbh"], tmp_path)
+    nominal, scaled = (simulator.evaluate(np.array([x]))["alpha_deg"] for x in (1.0, 1.2))
+    assert np.all(np.isfinite(nominal)) and scaled[0] < nominal[0] - 0.1  # more lift per alpha trims lower
+    flown = [p.read_text() for p in (home / "cache").rglob("spaced.xml")]
+    assert flown and all("ns0:" not in text and 'xmlns="urn:x"' in text and "aero/uq/scale/CLwbh" in text
+                         and "out.csv" not in text for text in flown)
+
+
+def test_a_default_namespaced_script_trims_as_jsbsim_reads_it(tmp_path):
+    """JSBSim's 737_cruise sets simulation/do_simple_trim in one event; with <runscript xmlns="urn:x"> JSBSim
+    reads the same script, and so does uqflight (one trim event, its <output> removed, no prefix added)."""
+    text = (jsbsim_scripts() / "737_cruise.xml").read_text().replace("<runscript ", '<runscript xmlns="urn:x" ', 1)
+    path = tmp_path / "spaced.xml"
+    path.write_text(text.replace("</runscript>", '<output name="o.csv" type="CSV" rate="1"/>\n</runscript>'))
+    script = ScriptFile.read(path)
+    assert script.trims == 1 and script.initialize == "cruise_init"
+    from uqflight.simulators.directives import without_io
+    written = without_io(path.read_bytes()).decode()
+    assert "ns0:" not in written and "<output" not in written and 'name="simulation/do_simple_trim"' in written
+
+
 def test_a_child_aircraft_is_refused(tmp_path, home):
     """JSBSim loads a <child name=NAME> aircraft from the root's aircraft/NAME/NAME.xml: files no check saw."""
     copied_aircraft(tmp_path, "mother", appended(

@@ -20,6 +20,7 @@ import xml.etree.ElementTree as ET
 from dataclasses import dataclass
 
 from .aircraft import aero_functions
+from .directives import jsbsim_tree
 
 QBAR, AREA, CHORD, SPAN = "aero/qbar-psf", "metrics/Sw-sqft", "metrics/cbarw-ft", "metrics/bw-ft"
 FORCE_AXES = ("DRAG", "SIDE", "LIFT", "X", "Y", "Z", "AXIAL", "NORMAL")
@@ -74,7 +75,7 @@ def axis_factor(axis: str, metrics: ET.Element | None) -> AeroFactor:
 
 def aero_factors(xml: bytes) -> dict[str, AeroFactor]:
     """Each named function of the aircraft's <aerodynamics> and its reference."""
-    metrics = ET.fromstring(xml).find("metrics")
+    metrics = jsbsim_tree(xml).find("metrics")
     return {f.name: axis_factor(f.axis, metrics) for f in aero_functions(xml)}
 
 

@@ -22,14 +22,13 @@ from __future__ import annotations
 import hashlib
 import os
 import shutil
-import xml.etree.ElementTree as ET
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import jsbsim
 
 from ..text.console import one_line
-from .directives import checked, local_name, parsed, without_io
+from .directives import checked, jsbsim_tree, local_name, parsed, without_io
 from .safe_paths import is_inside, outside_links, relative_name, single_name
 
 PACKAGE_ROOT = Path(__file__).resolve().parents[1]  # uqflight/: holds aircraft/bacm as package data
@@ -183,7 +182,7 @@ def _file_names(xml: bytes, file: Path) -> list[tuple[str, str]]:
 
 def _no_child(xml: bytes, file: Path) -> None:
     """Refuse a `<child>` aircraft in the main file: JSBSim would load it from the root, unchecked."""
-    for element in ET.fromstring(xml):
+    for element in jsbsim_tree(xml):
         if local_name(element.tag) == "child":
             raise AircraftUnsafe(f'{file}: <child name="{one_line(element.get("name", ""))}">: JSBSim would load that aircraft '
                                  "from the root's aircraft folder, files uqflight neither checks nor copies; "
@@ -308,7 +307,7 @@ class AeroFunction:
 
 def aero_functions(xml: bytes) -> list[AeroFunction]:
     """The named functions of the <aerodynamics> section, in file order, with their axis."""
-    tree = ET.fromstring(xml)
+    tree = jsbsim_tree(xml)
     aero = tree.find("aerodynamics")
     if aero is None:
         return []
@@ -347,7 +346,7 @@ def elevator_travel_deg(xml: bytes) -> tuple[float, float] | None:
     whose output is fcs/elevator-pos-rad (or -deg), its <range> times its <gain>. None if absent."""
     import math
 
-    tree = ET.fromstring(xml)
+    tree = jsbsim_tree(xml)
     for component in tree.iter():
         output = (component.findtext("output") or "").strip()
         if output not in ("fcs/elevator-pos-rad", "fcs/elevator-pos-deg"):

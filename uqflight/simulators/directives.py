@@ -15,7 +15,10 @@ namespace processing), and skips an entity defined in another file. In the files
   `simulation/do_linearization` (FGFDMExec::DoLinearization), and `initfile.T.xml` below its output
   path for `simulation/write-state-file` (FGPropagate::WriteStateFile).
 
-`checked` refuses a file Python's parser cannot read (JSBSim's may still read it, and what it
+`jsbsim_tree` reads a file as JSBSim does: element and attribute names as written, a default
+namespace ignored and a prefix kept (`<p:event>` is no event to JSBSim), so that what uqflight finds
+in a file (the aerodynamic functions, the trim events) is what JSBSim finds, and a file it writes back
+(`ElementTree.tostring`) names its elements as the original did. `checked` refuses a file Python's parser cannot read (JSBSim's may still read it, and what it
 holds would go unchecked), a `file=` or output file name leading out of its folder, and a mention
 of `simulation/do_linearization`; element names are compared without their namespace. A
 `<child>` is the caller's to refuse (only an aircraft's main file has one). `without_io` removes
@@ -27,6 +30,7 @@ which no state file can be created.
 from __future__ import annotations
 
 import xml.etree.ElementTree as ET
+from xml.parsers import expat
 
 from ..text.console import one_line
 from .safe_paths import relative_name
@@ -37,15 +41,30 @@ LINEARIZATION = "do_linearization"  # simulation/do_linearization: JSBSim writes
 
 
 def local_name(tag) -> str:
-    """An element's name as JSBSim reads it: without the namespace Python's parser puts in front."""
-    return tag.rsplit("}", 1)[-1] if isinstance(tag, str) else ""
+    """An element's name without a namespace or a prefix (the checks take `<p:output>` for an output too)."""
+    return tag.rsplit("}", 1)[-1].rsplit(":", 1)[-1] if isinstance(tag, str) else ""
+
+
+def jsbsim_tree(data: bytes) -> ET.Element:
+    """The document's root element with its names as JSBSim reads them (expat without namespace
+    processing: `xmlns` attributes are attributes, a prefix is part of the name)."""
+    builder = ET.TreeBuilder()
+    parser = expat.ParserCreate()
+    parser.buffer_text = True
+    parser.StartElementHandler = builder.start
+    parser.EndElementHandler = builder.end
+    parser.CharacterDataHandler = builder.data
+    parser.Parse(data, True)
+    return builder.close()
 
 
 def parsed(data: bytes, file, error: type[Exception]) -> ET.Element:
-    """The document's root element; `error` naming `file` when Python's parser cannot read it."""
+    """The document's root element as JSBSim reads it (`jsbsim_tree`); `error` naming `file` when
+    Python's parser cannot read it."""
     try:
-        return ET.fromstring(data)
-    except ET.ParseError as exc:
+        ET.fromstring(data)  # refuses what JSBSim would skip unread: an entity defined in another file
+        return jsbsim_tree(data)
+    except (ET.ParseError, expat.ExpatError) as exc:
         raise error(f"{file} is not well-formed XML ({exc}): uqflight checks every file JSBSim may read and "
                     "cannot check this one (an entity defined in another file, a prefix without its namespace); "
                     "fix it (or move it out of the folder, if JSBSim does not need it)") from None
@@ -78,9 +97,9 @@ def checked(root: ET.Element, file, error: type[Exception], inside: str) -> list
 
 
 def without_io(data: bytes) -> bytes | None:
-    """The document without its own `<input>` and `<output>` children (namespace or not), as Python
-    read it; None when it has none (the file then goes to JSBSim as it is)."""
-    root = ET.fromstring(data)
+    """The document without its own `<input>` and `<output>` children (namespace or prefix or not), its
+    other names as written; None when it has none (the file then goes to JSBSim as it is)."""
+    root = jsbsim_tree(data)
     directives = [child for child in root if local_name(child.tag) in IO_DIRECTIVES]
     if not directives:
         return None

@@ -14,8 +14,9 @@ JSBSim's engines need different care to give a steady, repeatable trimmed flight
 """
 from __future__ import annotations
 
-import xml.etree.ElementTree as ET
 from pathlib import Path
+
+from .directives import jsbsim_tree
 
 KINDS = ("piston", "turbine", "turboprop", "electric", "rocket")
 _KIND_CACHE: dict[str, list[tuple[str, str, str]]] = {}
@@ -42,17 +43,17 @@ def engine_kinds(fdm) -> list[tuple[str, str, str]]:
     key = str(main)
     if key not in _KIND_CACHE:
         found = []
-        for engine in ET.parse(main).getroot().iter("engine"):
+        for engine in jsbsim_tree(main.read_bytes()).iter("engine"):
             name = engine.get("file", "")
             kind = thruster_kind = "unknown"
             path = engine_file(fdm, name)
             if path is not None:
-                kind = ET.parse(path).getroot().tag.removesuffix("_engine")
+                kind = jsbsim_tree(path.read_bytes()).tag.removesuffix("_engine")
             thruster = engine.find("thruster")
             if thruster is not None and thruster.get("file"):
                 tpath = engine_file(fdm, thruster.get("file"))
                 if tpath is not None:
-                    thruster_kind = ET.parse(tpath).getroot().tag
+                    thruster_kind = jsbsim_tree(Path(tpath).read_bytes()).tag
             found.append((name, kind, thruster_kind))
         _KIND_CACHE[key] = found
     return _KIND_CACHE[key]

@@ -27,6 +27,7 @@ import difflib
 import xml.etree.ElementTree as ET
 
 from .aircraft import AircraftFiles, aero_functions
+from .directives import jsbsim_tree
 from .aero_factors import AeroFactor, aero_factors
 
 KINDS = ("scale", "offset_value", "offset")  # the order they nest in, innermost first
@@ -94,7 +95,7 @@ def _wrapper(kind: str, prop: str, ref: AeroFactor) -> ET.Element:
 
 def patch_xml(xml: bytes, patches: list[tuple[str, str]]) -> bytes:
     """The aircraft XML with every (function, kind) patch applied (see the module doc)."""
-    tree = ET.ElementTree(ET.fromstring(xml))
+    tree = ET.ElementTree(jsbsim_tree(xml))
     root = tree.getroot()
     aero = root.find("aerodynamics")
     names = [f.name for f in aero_functions(xml)]
@@ -166,7 +167,7 @@ def patch_request(prop: str, functions: list[str]) -> tuple[str, str] | None:
 
 def declared_properties(xml: bytes) -> set[str]:
     """Properties the aircraft declares itself (`<property>` elements anywhere)."""
-    return {(e.text or "").strip() for e in ET.fromstring(xml).iter("property") if e.get("value") is not None}
+    return {(e.text or "").strip() for e in jsbsim_tree(xml).iter("property") if e.get("value") is not None}
 
 
 class PreparedAircraft:
