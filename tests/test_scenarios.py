@@ -103,6 +103,21 @@ def test_a_script_writes_and_prints_nothing(tmp_path, monkeypatch, capfd):
     assert captured.out == "" and captured.err == ""
 
 
+def test_what_a_script_prints_in_the_workers_never_reaches_the_terminal(tmp_path):
+    """c3104's events <notify format="kml">, which JSBSim writes to its standard output whatever its
+    logger and debug level: 20 lines per run in every worker, flooding the runner's terminal."""
+    text = yaml.safe_dump({"name": "c310", "simulator": {
+        "kind": "jsbsim", "scenario": {"kind": "script", "script": "c3104", "end_s": 1}, "output_rate_hz": 10,
+        "outputs": ["h_ft"]}, "parameters": {"CL": {"function": "CLalpha", "perturbation": "scale",
+                                                     "distribution": "uniform", "interval_pct": 5}},
+        "design": {"kind": "monte_carlo", "samples": 2}, "execution": {"workers": 1}})
+    (tmp_path / "c310.yaml").write_text(text)
+    done = cli("run", tmp_path / "c310.yaml", "--out", tmp_path / "c310.h5")
+    assert done.returncode == 0, done.stderr
+    assert "Placemark" not in done.stdout + done.stderr and "Start engine" not in done.stdout + done.stderr
+    assert len(done.stdout.splitlines()) == 1, done.stdout  # run's summary line alone
+
+
 class Altitude:
     """An observer: the altitude and the time at every integration step."""
 

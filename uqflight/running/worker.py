@@ -8,7 +8,8 @@ runner over a socket (pickled messages, `multiprocessing.connection.Connection`)
 chunks, announces each sample before flying it ("start", row) so that the runner knows which
 sample a dead or hung worker was flying, and returns the chunk's results. It never outlives its
 runner: the kernel kills it when the runner dies (PR_SET_PDEATHSIG), and a watchdog thread exits
-when its parent process changes or the socket closes. It ignores SIGINT: the runner decides.
+when its parent process changes or the socket closes. It ignores SIGINT: the runner decides. Its
+standard output goes to /dev/null: what a flight prints never reaches the runner's terminal.
 """
 from __future__ import annotations
 
@@ -22,7 +23,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..text.console import one_line
+from ..text.console import discard_output, one_line
 from .forking import die_with_parent
 from ..quantities import quantity_key
 from ..quantities.recorder import QuantityRecorder
@@ -158,6 +159,9 @@ def main(argv=None) -> None:
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     signal.signal(signal.SIGTERM, signal.SIG_DFL)
     die_with_parent(parent, watch=True)
+    # results travel on the socket: what a flight prints (a script's <notify> events, which JSBSim writes
+    # whatever its debug level, a python model's print) would flood the runner's terminal, once per run
+    discard_output(sys.stdout)
     conn = Connection(fd)
     while True:
         try:

@@ -47,13 +47,13 @@ def echo(message: object = "", err: bool = False, nl: bool = True) -> None:
     try:
         typer.echo(clean(str(message)), err=err, nl=nl)
     except BrokenPipeError:
-        _discard(sys.stderr if err else sys.stdout)
+        discard_output(sys.stderr if err else sys.stdout)
         raise typer.Exit(EXIT_CLOSED_PIPE) from None
 
 
-def _discard(stream) -> None:
-    """Point the stream's file descriptor at /dev/null: what it still buffers is flushed there at exit,
-    not reported as another broken pipe."""
+def discard_output(stream) -> None:
+    """Point the stream's file descriptor at /dev/null: what it still buffers is flushed there at exit
+    (not reported as another broken pipe), and what a library writes to it from C goes nowhere."""
     try:
         fd = stream.fileno()
     except (AttributeError, OSError, ValueError):  # a stream without a descriptor (tests capture output)
