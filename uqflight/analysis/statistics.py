@@ -232,9 +232,8 @@ def read_statistics(path, method: dict | None = None, partial: bool = False,
         raise BadInput(f"{path}: no such results file")
     try:
         with ResultStore.open(path) as store:
-            attrs = store.attrs
-        return analyse(path, method=method, partial=partial, allow_aliasing=allow_aliasing, progress=progress,
-                       exceedance=exceedance), attrs
+            return analyse_store(store, path, method=method, partial=partial, allow_aliasing=allow_aliasing,
+                                 progress=progress, exceedance=exceedance), store.attrs
     except BadInput:
         raise
     except CorruptFile as exc:
@@ -248,7 +247,16 @@ def read_statistics(path, method: dict | None = None, partial: bool = False,
 def analyse(path, reference: str | None = None, options: Options | None = None, method: dict | None = None,
             partial: bool = False, allow_aliasing: bool = False, progress=None,
             exceedance: dict | None = None) -> Statistics:
-    """All statistics of the results file `path` (and errors against `reference`).
+    """All statistics of the results file `path` (and errors against `reference`): `analyse_store` of the
+    file opened once."""
+    with ResultStore.open(path) as store:
+        return analyse_store(store, path, reference, options, method, partial, allow_aliasing, progress, exceedance)
+
+
+def analyse_store(store: ResultStore, path, reference: str | None = None, options: Options | None = None,
+                  method: dict | None = None, partial: bool = False, allow_aliasing: bool = False, progress=None,
+                  exceedance: dict | None = None) -> Statistics:
+    """All statistics of the open results file `store` read from `path` (and errors against `reference`).
 
     `method` ({"kind", "order", "split"}) overrides the campaign's: the runs of one grid serve every
     method, so methods and orders are compared on the same runs. `partial` analyses a file with pending
@@ -260,7 +268,7 @@ def analyse(path, reference: str | None = None, options: Options | None = None, 
     """
     # one BLAS thread: the matrices are tall and thin (runs or draws × terms), where several threads are no
     # faster, and 10-20x slower on a loaded machine; the time blocks run in threads instead
-    with ResultStore.open(path) as store, threadpool_limits(limits=1):
+    with threadpool_limits(limits=1):
         setup = file_setup(store, path)
         germs, analysis = setup.germs, setup.analysis
         method = {"order": DEFAULT_ORDER, **normalised(setup.method), **normalised(method or {})}

@@ -97,7 +97,7 @@ def fit_surrogate(path, method: dict | None = None, partial: bool = False, allow
     does not depend on them, and its bands and PDFs are not exported); `progress`: see analyse."""
     from ..designs import REGISTRY as DESIGNS
     from ..methods import METHODS, normalised
-    from .statistics import BadInput, Options, analyse, file_setup
+    from .statistics import BadInput, Options, analyse_store, file_setup
     from ..store import ResultStore
 
     with ResultStore.open(path) as store:
@@ -108,12 +108,12 @@ def fit_surrogate(path, method: dict | None = None, partial: bool = False, allow
                            "draws of the input law: no expansion of the law is fitted to them; fly a sampled "
                            "design or a grid for a surrogate")
         parameters, time = _parameters(store, path), np.asarray(store.time, dtype=float)
-    override = dict(method or {})
-    kind = override.get("kind", stored.get("kind"))
-    if isinstance(kind, str) and kind in METHODS:  # else analyse refuses
-        override["kind"] = METHODS[kind].exported_kind(DESIGNS[design_kind].sampled)
-    stats = analyse(path, method=override, partial=partial, allow_aliasing=allow_aliasing,
-                    options=options or Options(band_samples=200, bootstrap=0), progress=progress)
+        override = dict(method or {})
+        kind = override.get("kind", stored.get("kind"))
+        if isinstance(kind, str) and kind in METHODS:  # else analyse_store refuses
+            override["kind"] = METHODS[kind].exported_kind(DESIGNS[design_kind].sampled)
+        stats = analyse_store(store, path, method=override, partial=partial, allow_aliasing=allow_aliasing,
+                              options=options or Options(band_samples=200, bootstrap=0), progress=progress)
     pces = {name: out.pce for name, out in stats.outputs.items()}
     units = {name: out.units for name, out in stats.outputs.items()}  # the simulator's, else from the name
     dependence = {k: v for k, v in stats.dependence.items() if k != "sobol_of"} if stats.dependence else None
