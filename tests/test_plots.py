@@ -13,6 +13,7 @@ from matplotlib.image import imread
 
 from conftest import cli_in_process
 from test_report import run
+from uqflight.analysis.statistics import read_statistics
 from uqflight.report import plots, write_report
 from uqflight.report.formats import exporting
 from uqflight.report.loading import load_entries
@@ -55,6 +56,11 @@ def svg_texts(path: Path) -> list[str]:
     source = path.read_text(encoding="utf-8")
     return [html.unescape(t) for t in re.findall(r"<text[^>]*>([^<]*)</text>", source)] + \
         re.findall(r"<!-- (.*?) -->", source)
+
+
+def drawn_runs(results: Path):
+    """The runs the report draws of `results` (Statistics.drawn)."""
+    return read_statistics(results, scatter_time=float("inf"))[0].drawn
 
 
 def draw_svg(function, *args, **kwargs) -> Path:
@@ -147,12 +153,12 @@ def test_coefficient_decay_times_start_at_the_pulse():
 
 
 def test_symmetric_grid_design_is_drawn_once_with_physical_values(files, tmp_path):
-    path = draw_svg(plots.plot_design_pairs, files["grid"], tmp_path / "design.png", "Design: sparse_grid")
+    path = draw_svg(plots.plot_design_pairs, drawn_runs(files["grid"]), tmp_path / "design.png", "Design: sparse_grid")
     texts = svg_texts(path)
     assert "all 3 pairs of the 3 inputs coincide: drawn once" in texts
     assert "physical value κ of each input at each ξ level" in texts
     assert any(t.startswith("negative weight: ") for t in texts) and "failed run: 0" in texts
-    path = draw_svg(plots.plot_design_pairs, files["mc"], tmp_path / "design_mc.png", "Design: monte_carlo, 120 points")
+    path = draw_svg(plots.plot_design_pairs, drawn_runs(files["mc"]), tmp_path / "design_mc.png", "Design: monte_carlo, 120 points")
     width = float(re.search(r'<svg[^>]* width="([\d.]+)pt"', path.read_text()).group(1))
     assert width >= 7 * 72  # wide enough for its title (a 2-input design was 2.9 in: "esign: monte_carlo…")
     assert any("physical values κ" in t for t in svg_texts(path))

@@ -11,9 +11,10 @@ from test_closed_forms_end_to_end import LINEAR  # y = x1 + 2 x2 + 3 x3, exact o
 from uqflight.report import write_report
 from uqflight.report.headline import band_text, mean_std_text
 from uqflight.report.sensitivity import index_text, negligible, partial_variances, top_contributors
-from uqflight.report.trajectories import plot_spaghetti, run_subset
+from uqflight.analysis.drawn import run_subset
+from uqflight.report.trajectories import plot_spaghetti
 from uqflight.simulators.base import Status
-from uqflight.analysis.statistics import analyse
+from uqflight.analysis.statistics import analyse, read_statistics
 
 PHUGOID = """
 name: phugoid-grid
@@ -133,9 +134,11 @@ def test_the_runs_drawn_are_the_same_on_every_report(phugoid_report, tmp_path):
     np.testing.assert_array_equal(subset, run_subset(status, 50, 20261124))
     assert not np.array_equal(subset, run_subset(status, 50, 1))
     assert run_subset(status[:20], 50, 0).size == 19  # all successful runs when fewer
-    outputs = analyse(results).outputs
-    first, drawn = plot_spaghetti(results, outputs, tmp_path / "a.png", "t", seed=17)
-    again, _ = plot_spaghetti(results, outputs, tmp_path / "b.png", "t", seed=17)
+    stats, _ = read_statistics(results, scatter_time=float("inf"))
+    outputs = stats.outputs
+    assert stats.seed == 17 and stats.drawn.spaghetti_rows.tolist() == list(range(25))  # every run when fewer
+    first, drawn = plot_spaghetti(stats.drawn, outputs, tmp_path / "a.png", "t")
+    again, _ = plot_spaghetti(read_statistics(results, scatter_time=0.0)[0].drawn, outputs, tmp_path / "b.png", "t")
     assert drawn == 25 and first.read_bytes() == again.read_bytes()
     assert {"spaghetti_phugoid.png", "scatter_phugoid.png", "sensitivity_phugoid.png"} <= {
         p.name for p in (report / "plots").iterdir()}

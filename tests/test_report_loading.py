@@ -1,8 +1,17 @@
 """The report's reading of a results file: the campaign text it stores (report.loading.campaign_settings), and
 the file opened once to analyse it."""
+import os
+from pathlib import Path
+
 import pytest
 
+from conftest import run_python_campaign
+from test_closed_forms_end_to_end import LINEAR
+from uqflight.analysis.statistics import read_statistics
+from uqflight.analysis.surrogate import fit_surrogate
+from uqflight.report import write_report
 from uqflight.report.loading import campaign_settings
+from uqflight.store import ResultStore
 
 
 def test_unreadable_campaign_text_gives_no_settings():
@@ -19,24 +28,36 @@ def test_settings_are_a_copy_of_the_text_read_once():
     assert campaign_settings(text) == {"seed": 3, "parameters": {"CL0": {"distribution": "normal"}}}
 
 
-def test_reading_statistics_and_fitting_a_surrogate_open_the_results_file_once(tmp_path, monkeypatch):
-    from conftest import run_python_campaign
-    from test_closed_forms_end_to_end import LINEAR
-    from uqflight.analysis.statistics import read_statistics
-    from uqflight.analysis.surrogate import fit_surrogate
-    from uqflight.store import ResultStore
-
-    results = run_python_campaign(tmp_path, LINEAR)
-    opened = []
+def _count_opens(monkeypatch, log: Path) -> None:
+    """Every ResultStore.open from now on, in this process and the processes it forks, writes a line
+    "PID PATH" to `log`."""
     open_file = ResultStore.open.__func__
 
     def counted(cls, path, *args, **kwargs):
-        opened.append(path)
+        with open(log, "a") as lines:
+            lines.write(f"{os.getpid()} {path}\n")
         return open_file(cls, path, *args, **kwargs)
 
     monkeypatch.setattr(ResultStore, "open", classmethod(counted))
+
+
+def test_reading_statistics_and_fitting_a_surrogate_open_the_results_file_once(tmp_path, monkeypatch):
+    results = run_python_campaign(tmp_path, LINEAR)
+    log = tmp_path / "opened.log"
+    _count_opens(monkeypatch, log)
     stats, attrs = read_statistics(results)
-    assert opened == [results] and stats.outputs["y"].mean[0] == pytest.approx(3.0, abs=1e-9)  # 3 E[x3]
-    opened.clear()
+    assert log.read_text().splitlines() == [f"{os.getpid()} {results}"]
+    assert stats.outputs["y"].mean[0] == pytest.approx(3.0, abs=1e-9)  # 3 E[x3]
+    log.unlink()
     fit_surrogate(results)
-    assert opened == [results]
+    assert log.read_text().splitlines() == [f"{os.getpid()} {results}"]
+
+
+def test_a_report_opens_its_results_file_once_and_its_drawing_processes_never(tmp_path, monkeypatch):
+    # the design figure, the spaghetti plot and the scatter each opened the file again in a drawing child
+    results = run_python_campaign(tmp_path, LINEAR)
+    log = tmp_path / "opened.log"
+    _count_opens(monkeypatch, log)
+    written = write_report([results], tmp_path / "report")
+    assert log.read_text().splitlines() == [f"{os.getpid()} {results}"]
+    assert {"design_c.png", "scatter_c.png"} <= {path.name for path in written}  # y has one time: no spaghetti

@@ -36,6 +36,7 @@ from threadpoolctl import threadpool_limits
 from .angles import angle_period, branch_shifts, unwrapped_runs
 from .density import pdf_over_time
 from .divergence import kl_divergence
+from .drawn import DrawnRuns, read_drawn
 from .errors import error_summary, relative_errors
 from .exceedance import exceedance_from_pce, exceedance_from_runs, unit_slip
 from .failures import grid_failure_probability
@@ -153,6 +154,7 @@ class Statistics:
     index_set: dict | None = None  # an adaptive grid's refinement (designs.adaptive.index_set_summary)
     rare_event: dict | None = None  # a rare-event design's estimate and rounds (rare_statistics)
     rare_runs: dict | None = None  # its runs for the report's figures (not in summary.json)
+    drawn: DrawnRuns | None = None  # the runs the report draws (read_statistics with a scatter time; not in summary.json)
     design_info: dict = field(default_factory=dict)  # the design's recorded facts (replicates, n_base, ...)
     seed: int = 0  # what seeded the analysis's draws (the campaign's seed unless Options said otherwise)
 
@@ -223,17 +225,21 @@ def file_setup(store: ResultStore, path) -> RecordedSetup:
 
 def read_statistics(path, method: dict | None = None, partial: bool = False,
                     allow_aliasing: bool = False, progress=None,
-                    exceedance: dict | None = None) -> tuple[Statistics, dict]:
-    """The statistics of a results file (`method` overriding the campaign's) and its root attributes;
-    BadInput, one line naming the file, when it cannot give right numbers. `progress`, `exceedance`: see
-    analyse."""
+                    exceedance: dict | None = None, scatter_time: float | None = None) -> tuple[Statistics, dict]:
+    """The statistics of a results file (`method` overriding the campaign's) and its root attributes, the
+    file opened once; BadInput, one line naming the file, when it cannot give right numbers. `progress`,
+    `exceedance`: see analyse. With `scatter_time`, the statistics carry the runs a report draws
+    (`Statistics.drawn`, analysis.drawn.read_drawn: its scatter at the recorded time nearest it)."""
     path = Path(path)
     if not path.is_file():
         raise BadInput(f"{path}: no such results file")
     try:
         with ResultStore.open(path) as store:
-            return analyse_store(store, path, method=method, partial=partial, allow_aliasing=allow_aliasing,
-                                 progress=progress, exceedance=exceedance), store.attrs
+            stats = analyse_store(store, path, method=method, partial=partial, allow_aliasing=allow_aliasing,
+                                  progress=progress, exceedance=exceedance)
+            if scatter_time is not None:
+                stats.drawn = read_drawn(store, stats, scatter_time)
+            return stats, store.attrs
     except BadInput:
         raise
     except CorruptFile as exc:

@@ -64,7 +64,7 @@ def write_report(paths: list[Path], out_dir: Path | None = None, reference: Path
     drawer = PreparedChild(_ready_to_draw, _draw) if FORKS else None  # gets ready while the files are analysed
     try:
         entries, ref = load_entries(paths, reference, method, progress=progress, partial=partial,
-                                    allow_aliasing=allow_aliasing, exceedance=exceedance)
+                                    allow_aliasing=allow_aliasing, exceedance=exceedance, scatter_time=times[-1])
         if baseline and entries[0].stats.rare_runs:
             raise BadInput(f"{entries[0].stats.path}: --write-baseline: a {entries[0].stats.design_kind} file has no "
                            "statistics of the input law to keep (its event's probability is in summary.json); "

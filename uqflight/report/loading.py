@@ -106,11 +106,12 @@ def flight_facts(simulator: dict) -> dict[str, str]:
 
 def load_entries(paths: list[Path], reference: Path | None, method: dict | list[dict] | None = None,
                  progress=None, partial: bool = False, allow_aliasing: bool = False,
-                 exceedance: dict | None = None) -> tuple[list[Entry], Entry | None]:
+                 exceedance: dict | None = None, scatter_time: float = float("inf")) -> tuple[list[Entry], Entry | None]:
     """Every file analysed once per method (`method`: one override, several, or None for the
     campaigns' own; the reference keeps its own), with errors against the reference unless it is
     the reference itself, and the reference. `progress` (a Progress) counts each file's outputs.
-    `exceedance`: thresholds replacing the campaigns' (statistics.analyse)."""
+    `exceedance`: thresholds replacing the campaigns' (statistics.analyse). Each file's first entry
+    carries the runs the report draws (Statistics.drawn), its scatter at `scatter_time`."""
     methods = method if isinstance(method, list) else [method]
     methods = methods or [None]
     stems: set[str] = set()
@@ -120,9 +121,10 @@ def load_entries(paths: list[Path], reference: Path | None, method: dict | list[
         ref = _entry(reference, *read_statistics(reference, progress=progress), set(), _file_stems([reference]))
     entries = []
     for path in paths:
-        for override in methods:
+        for k, override in enumerate(methods):
             stats, attrs = read_statistics(path, override, partial=partial, allow_aliasing=allow_aliasing,
-                                           progress=progress, exceedance=exceedance)
+                                           progress=progress, exceedance=exceedance,
+                                           scatter_time=scatter_time if k == 0 else None)
             if ref is not None and not _same_file(path, reference):
                 add_reference_errors(stats, ref.stats)
             entries.append(_entry(path, stats, attrs, stems, file_stems, with_method=len(methods) > 1))

@@ -24,6 +24,7 @@ from matplotlib.figure import Figure  # noqa: E402
 from matplotlib.lines import Line2D  # noqa: E402
 from matplotlib.ticker import FixedLocator, FuncFormatter, LogLocator, MaxNLocator, NullFormatter  # noqa: E402
 
+from ..analysis.drawn import nearest_time_index  # noqa: E402
 from ..analysis.sobol import unresolved  # noqa: E402
 from ..text.labels import label, short_label, shown_time  # noqa: E402,F401 (plots.label: the report's captions)
 from .formats import export_format, shown_path  # noqa: E402
@@ -379,7 +380,7 @@ def _cell_edges(time: np.ndarray, support: np.ndarray) -> tuple[np.ndarray, np.n
 
 def time_indices(time: np.ndarray, times: list[float]) -> list[int]:
     """Indices of the recorded times nearest to `times` (inf: the final time), ascending, without repeats."""
-    return sorted({int(np.argmin(np.abs(time - np.clip(t, time[0], time[-1])))) for t in times})
+    return sorted({nearest_time_index(time, t) for t in times})
 
 
 def plot_cov(outputs: dict, path: Path, title: str) -> Path:
@@ -738,16 +739,14 @@ def plot_coefficient_decay(outputs: dict, path: Path, title: str, start_s: float
 MAX_PAIRS = 8  # parameters drawn in the design scatter (the first ones)
 
 
-def plot_design_pairs(results, path: Path, title: str) -> Path | None:
+def plot_design_pairs(drawn, path: Path, title: str) -> Path | None:
     """The design points on every pair of inputs (lower triangle) in physical values κ (paper Fig. 9,
     which is in ξ); marker area by |weight| for a grid, negative weights orange, failed runs as red
     crosses, each in the legend with its count. A design whose pairs all coincide in ξ (a symmetric
-    grid) is drawn once in ξ, with each input's κ at the grid's ξ levels in a table. None for one input."""
-    from ..store import ResultStore
-
-    with ResultStore.open(results) as store:
-        xi, kappa, weights = store.xi, store.kappa, store.weights
-        status, names = store.status, store.parameter_names
+    grid) is drawn once in ξ, with each input's κ at the grid's ξ levels in a table. None for one input.
+    `drawn`: the file's runs (analysis.drawn.DrawnRuns, Statistics.drawn)."""
+    xi, kappa, weights = drawn.xi, drawn.kappa, drawn.weights
+    status, names = drawn.status, drawn.parameter_names
     d = min(xi.shape[1], MAX_PAIRS)
     if d < 2:
         return None

@@ -146,7 +146,7 @@ def run_section(entries: list[Entry], out_dir: Path) -> Section:
                         ["file", "parameter", "property", "distribution", "lower", "upper", "nominal", "interval"],
                         parameter_rows, "tables/parameters.csv"))
     for e in one_per_file(entries):
-        path = plots.plot_design_pairs(e.path or e.stats.path,
+        path = plots.plot_design_pairs(e.stats.drawn,
                                        out_dir / "plots" / bounded(f"design_{e.file_stem}.png"),
                                        f"Design: {e.stats.design_kind}, "
                                        f"{e.stats.runs} points ({e.file_stem})")

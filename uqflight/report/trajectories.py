@@ -1,7 +1,7 @@
 """The runs themselves: a spaghetti plot of a seeded subset of runs per output with the mean and the 99 %
 band, and each output (at one time) and each quantity against the inputs in physical values (κ),
-coloured by the most influential other input. Only the drawn runs are read (or rebuilt from the tSVD
-factors)."""
+coloured by the most influential other input. The runs come with the statistics
+(Statistics.drawn, analysis.drawn): only the drawn runs were read (or rebuilt from the tSVD factors)."""
 from __future__ import annotations
 
 from pathlib import Path
@@ -11,47 +11,22 @@ from matplotlib.collections import LineCollection
 from matplotlib.lines import Line2D
 from matplotlib.ticker import MaxNLocator
 
-from ..analysis.angles import angle_period, on_branch
-from ..simulators.base import Status
-from ..store import ResultStore
+from ..analysis.drawn import SCATTER_RUNS, SPAGHETTI_RUNS, DrawnRuns
 from . import plots
 
-SPAGHETTI_RUNS = 50  # runs drawn per output
-SCATTER_RUNS = 1000  # points drawn per scatter panel at most
 SCATTER_INPUTS = 2  # inputs shown per output: the most influential
 COLOR_MAP = "viridis"
 
 
-def run_subset(status: np.ndarray, count: int, seed: int) -> np.ndarray:
-    """`count` successful runs (all when fewer), drawn without replacement with `seed`, ascending: the same
-    runs for the same file and seed, whatever else the report draws."""
-    ok = np.flatnonzero(status == Status.OK)
-    if ok.size <= count:
-        return ok
-    return np.sort(np.random.default_rng(seed).choice(ok, size=count, replace=False))
-
-
-def drawn_runs(runs: np.ndarray, out) -> np.ndarray:
-    """The runs (N, T) as the statistics `out` see them: an angle's unwrapped onto the statistics' branch
-    (analysis.angles), the others as stored."""
-    period = angle_period(out.units)
-    if not out.unwrapped or period is None or not np.isfinite(out.mean[0]):
-        return runs
-    return on_branch(runs, float(out.mean[0]), period)
-
-
-def plot_spaghetti(results: Path, outputs: dict, path: Path, title: str, seed: int,
-                   count: int = SPAGHETTI_RUNS) -> tuple[Path, int]:
-    """One panel per output over time: the subset's runs thin, the mean and the 99 % band of `outputs`
-    (the file's statistics) on top. Returns the PNG and the number of runs drawn."""
+def plot_spaghetti(drawn: DrawnRuns, outputs: dict, path: Path, title: str) -> tuple[Path, int]:
+    """One panel per output over time: the drawn runs (`drawn.histories`) thin, the mean and the 99 % band
+    of `outputs` (the file's statistics) on top. Returns the PNG and the number of runs drawn."""
     names = [name for name, out in outputs.items() if out.time.size > 1]
-    with ResultStore.open(results) as store:
-        rows = run_subset(store.status, count, seed)
-        histories = {name: drawn_runs(store.output_matrix(name, rows), outputs[name]) for name in names}
+    rows = drawn.spaghetti_rows
     fig, axes = plots._panels(len(names), title, row_height=2.6)
     for ax, name in zip(axes, names):
         out = outputs[name]
-        runs = histories[name]
+        runs = drawn.histories[name]
         segments = np.stack([np.broadcast_to(out.time, runs.shape), runs], axis=-1)
         ax.add_collection(LineCollection(segments, colors=plots.COLORS[0], linewidths=0.5, alpha=0.45))
         ax.plot(out.time, out.mean, color="k", lw=1.4)
@@ -76,25 +51,22 @@ def _influence(sobol_total: dict, i: int, kappa: np.ndarray, y: np.ndarray, name
     return np.divide(covariance, spread, out=np.zeros_like(spread), where=spread > 0) ** 2
 
 
-def scatter_rows(results: Path, outputs: dict, quantities: dict, time: float, seed: int) -> dict:
-    """What `plot_scatter` draws, for a seeded subset of at most SCATTER_RUNS successful runs: their
-    inputs in physical values ("kappa", "names"), and per row ("outputs": each output over time at the
-    recorded time nearest `time`, labelled "NAME at T s [unit]", or its one value; "quantities": each
-    defined quantity, labelled "NAME [unit]")
-    (the runs' values, the total Sobol' indices {parameter: (T,)}, the time index)."""
-    with ResultStore.open(results) as store:
-        drawn = run_subset(store.status, SCATTER_RUNS, seed)
-        at_time = {}
-        for name, out in outputs.items():
-            i = plots.time_indices(out.time, [time])[0]
-            at = f" at {plots.shown_time(out.time, i):g} s" if out.time.size > 1 else ""
-            at_time[f"{plots.short_label(name)}{at}" + (f" [{out.units}]" if out.units else "")] = (
-                drawn_runs(store.output_matrix(name, drawn), out)[:, i], out.sobol_total, i)
-        of_quantities = {plots.label(name, q.units): (
-            drawn_runs(store.quantity(name)[drawn][:, None], q.output)[:, 0], q.output.sobol_total, 0)
-                         for name, q in quantities.items() if q.output is not None}
-        return {"kappa": store.kappa[drawn], "names": store.parameter_names, "outputs": at_time,
-                "quantities": of_quantities}
+def scatter_rows(drawn: DrawnRuns, outputs: dict, quantities: dict) -> dict:
+    """What `plot_scatter` draws of the drawn runs' scatter subset (`drawn.scatter_rows`): their inputs in
+    physical values ("kappa", "names"), and per row ("outputs": each output over time at the recorded time
+    nearest the scatter's, labelled "NAME at T s [unit]", or its one value; "quantities": each defined
+    quantity, labelled "NAME [unit]") (the runs' values, the total Sobol' indices {parameter: (T,)}, the
+    time index)."""
+    at_time = {}
+    for name, out in outputs.items():
+        i, values = drawn.at_time[name]
+        at = f" at {plots.shown_time(out.time, i):g} s" if out.time.size > 1 else ""
+        at_time[f"{plots.short_label(name)}{at}" + (f" [{out.units}]" if out.units else "")] = (
+            values, out.sobol_total, i)
+    of_quantities = {plots.label(name, q.units): (drawn.quantities[name], q.output.sobol_total, 0)
+                     for name, q in quantities.items() if q.output is not None}
+    return {"kappa": drawn.kappa[drawn.scatter_rows], "names": drawn.parameter_names, "outputs": at_time,
+            "quantities": of_quantities}
 
 
 def plot_scatter(kappa: np.ndarray, names: list[str], rows_of: dict, path: Path, title: str) -> Path | None:
@@ -142,23 +114,22 @@ def trajectories_section(entries: list, times: list[float], out_dir: Path):
     quantities against the inputs, seeded by the campaign's seed (the same runs on every report); None
     when there is nothing to draw (no output and no quantity)."""
     from ..designs import REGISTRY as DESIGNS
-    from .loading import bounded, campaign_settings, one_per_file
+    from .loading import bounded, one_per_file
     from .blocks import Figure, Section, _rel
 
     blocks = []
     for e in one_per_file(entries):
-        results, stem = Path(e.path or e.stats.path), e.file_stem
-        seed = int(campaign_settings(str(e.attrs.get("campaign", ""))).get("seed", 0) or 0)
+        drawn, stem, seed = e.stats.drawn, e.file_stem, e.stats.seed
         nodes = ("" if DESIGNS[e.stats.design_kind].sampled else
                  f" The points are the {e.stats.design_kind}'s nodes, not random draws: how they spread says "
                  "nothing of the inputs' distribution.")
         if any(out.time.size > 1 for out in e.outputs.values()):
-            path, drawn = plot_spaghetti(results, e.outputs, out_dir / "plots" / bounded(f"spaghetti_{stem}.png"),
-                                         f"Runs, mean and 99 % band: {e.label}", seed)
-            blocks.append(Figure(_rel(path, out_dir), f"{drawn} of the {e.stats.completed} successful runs of {stem} "
+            path, count = plot_spaghetti(drawn, e.outputs, out_dir / "plots" / bounded(f"spaghetti_{stem}.png"),
+                                         f"Runs, mean and 99 % band: {e.label}")
+            blocks.append(Figure(_rel(path, out_dir), f"{count} of the {e.stats.completed} successful runs of {stem} "
                                  f"(drawn with the campaign's seed {seed}, at most {SPAGHETTI_RUNS}), thin, with "
                                  f"the mean (solid) and the 99 % band (dashed) of {e.label}." + nodes))
-        rows = scatter_rows(results, e.outputs, e.stats.quantities, times[-1], seed)
+        rows = scatter_rows(drawn, e.outputs, e.stats.quantities)
         single = len(rows["names"]) < 2
         against = "its one input" if single else f"its {SCATTER_INPUTS} most influential inputs"
         how = "" if single else (", each panel coloured by " + (
