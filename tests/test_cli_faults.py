@@ -21,6 +21,7 @@ def write(tmp_path, function, **kwargs):
     return path
 
 
+@pytest.mark.slow
 def test_plan_flies_its_nominal_under_the_campaigns_time_limit(tmp_path, monkeypatch):
     # the model never returns at the nominal: plan ran for ever; now it gives up as run does, after
     # execution.timeout_s plus the worker's start (shortened here from 60 s to 2 s: the same code path)

@@ -220,6 +220,7 @@ def f(p):
 '''
 
 
+@pytest.mark.slow
 def test_simulate_split_over_processes_equals_one_process_and_survives_a_dying_or_hung_run(tmp_path):
     # calibrate's predictive runs: the same numbers in 1 or 3 supervised worker processes; a run that kills
     # its worker, or runs past execution.timeout_s, fails with its reason, the other runs stand

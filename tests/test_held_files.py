@@ -9,6 +9,7 @@ import sys
 
 import h5py
 import numpy as np
+import pytest
 
 from conftest import DECAY_TWO_INPUTS, cli
 
@@ -43,6 +44,7 @@ def _refused_as_held(done, pid: int) -> None:
     assert "damaged" not in done.stderr and "force" not in done.stderr and "rm " not in done.stderr
 
 
+@pytest.mark.slow
 def test_a_healthy_file_another_process_writes_is_refused_as_held_and_never_replaced(decay_results, tmp_path):
     """D17: the file held by a writer without uqflight's lock was called damaged, with "force to overwrite
     it" as the advice; --force then deleted every completed run."""
@@ -64,6 +66,7 @@ def test_resuming_a_file_another_process_reads_is_one_line_naming_it(decay_resul
         _refused_as_held(cli("run", tmp_path / "decay.yaml", "--out", out, "--workers", 1), pid)
 
 
+@pytest.mark.slow
 def test_reading_a_file_another_process_writes_names_that_process(decay_results, tmp_path):
     """D20's sibling for the readers: `report` and `check` of a file a writer without uqflight's lock holds
     said "cannot analyse the results file ([Errno 11] Unable to synchronously open file (unable to lock
@@ -85,6 +88,7 @@ def test_reading_a_file_another_process_writes_names_that_process(decay_results,
         assert shown.returncode == 0 and "locked by another process" in shown.stdout, shown.stderr
 
 
+@pytest.mark.slow
 def test_calibrating_a_file_another_process_writes_names_that_process(decay_results, tmp_path):
     """The same for `calibrate` (its --truth is read from the file first: a LockHeld traceback otherwise)."""
     out, _ = _copy(decay_results, tmp_path)

@@ -57,6 +57,7 @@ def _names(out) -> list[str]:
     return [p.name for p in out.rglob("*")]
 
 
+@pytest.mark.slow
 def test_report_of_long_names_has_bounded_distinct_files(folder):
     out = folder / "rep"
     done = cli_in_process("report", folder / "r.h5", "--out", out)
@@ -74,6 +75,7 @@ def test_report_of_long_names_has_bounded_distinct_files(folder):
         assert (out / short).is_file(), short
 
 
+@pytest.mark.slow
 def test_long_results_file_stems(folder):
     """A stem of 252 bytes, ASCII and UTF-8: tables, summaries/ and the default report folder stay within 255."""
     ascii_stem, utf8_stem = folder / ("S" * 252 + ".h5"), folder / ("α" * 126 + ".h5")

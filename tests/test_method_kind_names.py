@@ -23,10 +23,11 @@ def comparisons_with_method_kinds(source: str) -> list[tuple[int, str]]:
             continue
         operands = [node.left, *node.comparators]
         named = set().union(*(_names(operand) for operand in operands)) & set(METHOD_KINDS)
-        text = ast.get_source_segment(source, node) or ""
+        if not named:  # get_source_segment reads the source anew: only for the comparisons that name a kind
+            continue
         others = " ".join(ast.get_source_segment(source, o) or "" for o in operands if not _names(o))
-        if named and not ("monte_carlo" in named and len(named) == 1 and "design" in others):
-            found.append((node.lineno, text))
+        if not ("monte_carlo" in named and len(named) == 1 and "design" in others):
+            found.append((node.lineno, ast.get_source_segment(source, node) or ""))
     return found
 
 

@@ -68,6 +68,7 @@ def test_calibrate_logs_the_sampler_steps(results, tmp_path):
     assert lines[0].startswith("calibrate: fitting the surrogate")
 
 
+@pytest.mark.slow
 def test_calibrate_says_where_an_adaptive_chain_converged(results, tmp_path):
     rng = np.random.default_rng(1)
     time = np.linspace(0.0, 1.0, 11)

@@ -185,6 +185,7 @@ def test_active_learning_reaches_a_1e_minus_6_event_from_an_all_safe_first_desig
     assert estimate.lower < 1e-6 < estimate.upper
 
 
+@pytest.mark.slow
 def test_active_learning_never_answers_a_silent_zero():
     # an event that never happens: the estimate is 0, but with an upper bound above 0 and a note
     estimate = active_learning(lambda u: -1.0 - np.square(u).sum(axis=1), 2, seed=0, budget=200, batch=10,

@@ -56,6 +56,7 @@ def declaring(decay_results, tmp_path, n_times: int):
     return out
 
 
+@pytest.mark.slow
 def test_runs_times_products_are_bounded_before_any_reader_allocates(decay_results, tmp_path):
     """D08: 29 runs x 10^7 times (each within its own bound) made info, report, surrogate export and calibrate
     allocate gigabytes for a file of a few MiB."""
@@ -118,6 +119,7 @@ def unbounded_inputs(tmp_path) -> dict:
             fifo: "a FIFO (named pipe), not a regular file"}
 
 
+@pytest.mark.slow
 def test_a_baseline_is_bounded_before_it_is_read(decay_results, tmp_path):
     """D14: `check --baseline` read a baseline of any size whole (a 4 GiB file: MemoryError); /dev/zero and
     a FIFO never ended."""
@@ -126,6 +128,7 @@ def test_a_baseline_is_bounded_before_it_is_read(decay_results, tmp_path):
         one_line_refusal(done, f"error: {baseline}: {said}", "--write-baseline FILE")
 
 
+@pytest.mark.slow
 def test_flight_data_is_bounded_in_bytes_and_a_regular_file(decay_results, tmp_path):
     """D15: `calibrate --data` sized the data by its lines: a 4 GiB single line passed (MemoryError), and
     /dev/zero never ended."""

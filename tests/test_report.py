@@ -276,6 +276,7 @@ analysis: {{band_samples: 200, bootstrap: 0}}
 """
 
 
+@pytest.mark.slow
 def test_two_files_of_one_name_each_get_their_own_design_and_runs_figures(tmp_path):
     """a/r.h5 and b/r.h5: the per-file figures are r and r-2 as the tables are (b's overwrote a's, and the
     page showed b's twice), the second the same as a report of b alone draws."""

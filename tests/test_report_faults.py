@@ -68,6 +68,7 @@ def _snapshot(folder):
     return {path.relative_to(folder): path.read_bytes() for path in sorted(folder.rglob("*")) if path.is_file()}
 
 
+@pytest.mark.slow
 def test_a_disk_that_fills_while_the_plots_are_drawn_leaves_the_old_report(decay_results, tmp_path):
     """D10: a full disk in a drawing child gave its traceback and RuntimeError "a process drawing them failed"
     (exit 1). A real full disk (a 2 MiB tmpfs holding the old report, filled but for 200 to 400 KiB, where the

@@ -250,6 +250,7 @@ def test_the_cli_exits_2_when_the_disk_fills_past_the_check(tmp_path, small_disk
 
 
 
+@pytest.mark.slow
 def test_a_disk_that_fills_while_the_results_file_is_created_is_one_clean_line(tmp_path):
     """D21: HDF5 met the full disk while releasing the new file's groups, and h5py printed each failure as an
     "Exception ignored" traceback before the clean error. A real full disk: a 256 KiB tmpfs filled but for a

@@ -46,6 +46,7 @@ def test_updates_match_a_full_svd():
     assert np.abs(reconstruction(svd) - A).max() <= 1e-8 * s_full[0]
 
 
+@pytest.mark.slow
 def test_moments_from_the_factors_match_the_raw_data():
     A = low_rank_data()
     svd = incremental(A, tol=1e-12, n_batches=10)
