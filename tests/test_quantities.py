@@ -13,6 +13,7 @@ from uqflight.campaign import parse_campaign
 from uqflight.running.runner import run_campaign
 from uqflight.quantities import REGISTRY
 from uqflight.quantities.recorder import QuantityRecorder
+from uqflight.simulators.validation_view import validation_view
 from uqflight.analysis.statistics import analyse, summary_json
 from uqflight.store import ResultStore
 from uqflight.running.worker import WorkerSpec, run_chunk
@@ -159,6 +160,21 @@ def test_plan_refuses_a_bad_quantity_naming_the_field(tmp_path, quantity, field)
     path.write_text(BACM.format(quantity=quantity))
     result = cli_in_process("plan", path)
     assert result.returncode == 2 and f"{field}:" in result.stderr + result.stdout, result.stderr
+
+
+def test_every_take_is_a_registered_class_whose_example_a_level_flight_campaign_accepts(tmp_path):
+    # the bacm's level flight records h_ft and alpha_deg and trims level: every take's example holds
+    assert list(REGISTRY) == ["max", "min", "final", "drop", "change", "mean", "at", "at_first", "time_of_first",
+                              "phugoid_period_s", "phugoid_damping", "short_period_frequency_rad_s",
+                              "short_period_damping"]
+    for name, take in REGISTRY.items():
+        assert take.name == name and take.example["take"] == name and set(take.required) <= set(take.example)
+        assert take.__doc__ and not (take.mode and take.windowed)
+    quantities = ", ".join(f"q_{name}: {json.dumps(take.example)}" for name, take in REGISTRY.items())
+    campaign = parse_campaign(BACM.format(quantity="{of: h_ft, take: max}").replace(
+        "quantities: {q: {of: h_ft, take: max}}", f"quantities: {{{quantities}}}"), str(tmp_path / "q.yaml"),
+        validation_view)
+    assert set(campaign.quantities) == {f"q_{name}" for name in REGISTRY}
 
 
 def test_plan_refuses_modes_where_there_is_no_level_flight_trim(tmp_path):

@@ -79,7 +79,8 @@ def test_an_angle_that_does_not_wrap_is_left_to_the_bit():
 
 
 def test_units_come_from_jsbsim_property_names():
-    from uqflight.text.labels import name_unit, quantity_unit
+    from uqflight.quantities import quantity_unit
+    from uqflight.text.labels import name_unit
 
     assert [name_unit(n) for n in ("attitude/psi-deg", "velocities/vc-kts", "velocities/u-fps", "aero/qbar-psf",
                                     "position/h-sl-mt", "simulation/sim-time-sec", "inertia/weight-lbs",

@@ -47,10 +47,11 @@ from .resolution import RESOLUTION_RTOL, resolved_variance
 from .sobol import NEGLIGIBLE, UNRESOLVED_WIDTH, complete_rows, pick_freeze_indices, unresolved
 from ..campaign.attributes import RecordedSetup, recorded_setup, stored_settings
 from ..campaign.schema import CampaignError
+from ..quantities import quantity_unit
 from ..text.console import shown
 from ..designs import REGISTRY as DESIGNS
 from ..designs.adaptive import index_set_summary
-from ..text.labels import name_unit, quantity_unit
+from ..text.labels import name_unit
 from ..methods import DEFAULT_ORDER, PCE, METHODS, Auto, Method, normalised
 from ..methods.basis import orthonormal_basis
 from ..methods.pce_moments import pce_standardised_moments, triple_products
@@ -168,7 +169,7 @@ class QuantityStatistics:
     missing: int  # successful runs where the quantity is undefined
     output: OutputStatistics | None
     exceedance: list[dict] = field(default_factory=list)
-    units: str = ""  # its take's own, or its `of`'s (labels.quantity_unit)
+    units: str = ""  # its take's own, or its `of`'s (quantities.quantity_unit)
     flags: list[str] = field(default_factory=list)  # its statistics' (output.flags) and its thresholds' (unit slips)
 
     def _first(self, attribute: str):
@@ -915,7 +916,7 @@ class _QuantityView:
 
 
 def quantity_units(store: ResultStore, name: str) -> str:
-    """The unit of quantity `name`: the stored campaign text's take and `of` give it (labels.quantity_unit)."""
+    """The unit of quantity `name`: the stored campaign text's take and `of` give it (quantities.quantity_unit)."""
     text = store.attrs.get("campaign", "")
     specs = stored_settings(text).get("quantities") if isinstance(text, str) else None
     return quantity_unit(specs.get(name) if isinstance(specs, dict) else None, store.units) or name_unit(name)

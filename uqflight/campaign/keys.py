@@ -161,26 +161,6 @@ VALUES = {
         "gauss_legendre": "Gauss–Legendre (uniform inputs).",
         "clenshaw_curtis": "Clenshaw–Curtis, nested (uniform inputs).",
         "gauss_patterson": "Gauss–Patterson, nested (uniform inputs)."},
-    "quantities.NAME.take": {
-        "max": "The largest value over the steps in the window.",
-        "min": "The smallest value over the steps in the window.",
-        "final": "The last step's value.",
-        "drop": "How far `of` falls below its value at the window's first step (first − min, 0 if it never "
-                "falls): `{of: h_ft, take: drop}` is an altitude loss.",
-        "change": "The last step's value minus the window's first (last − first): `{of: attitude/psi-deg, take: "
-                  "change}` is the heading change of a turn, continuous across 360° (an angle `of` is unwrapped "
-                  "along the run).",
-        "mean": "Time average by the trapezoid rule over the window.",
-        "at": "Linear interpolation at `at_s`.",
-        "at_first": "The value of `of` at the first step meeting `when`, no interpolation: the touchdown sink "
-                    "rate `{of: velocities/h-dot-fps, take: at_first, when: {of: \"gear/unit[1]/WOW\", above: 0.5}}`.",
-        "time_of_first": "The time of the first step meeting `when`.",
-        "phugoid_period_s": "The phugoid's damped period 2π/Im λ [s] of JSBSim's linearised model at the "
-                            "level-flight trim.",
-        "phugoid_damping": "The phugoid's damping ratio −Re λ/|λ| at the level-flight trim.",
-        "short_period_frequency_rad_s": "The short period's natural frequency |λ| [rad/s] at the level-flight "
-                                        "trim.",
-        "short_period_damping": "The short period's damping ratio at the level-flight trim."},
 }
 
 
@@ -267,7 +247,7 @@ def accepted_keys() -> list[Key]:
 
 def kind_description(path: str, kind: str, entry) -> str | None:
     """A kind's meaning: VALUES, else the first paragraph of its registry entry's docstring (a design kind's,
-    a distribution's, a simulator's or scenario's kind class)."""
+    a distribution's, a simulator's or scenario's kind class, a take's class)."""
     if kind in VALUES.get(path, {}):
         return VALUES[path][kind]
     from ..designs import DesignKind

@@ -7,51 +7,29 @@ Kinds of `take` (keys in braces; every one but the modes takes `after_s`/`before
 - at_first {of, when: {of, above | below}}; time_of_first {when};
 - phugoid_period_s, phugoid_damping, short_period_frequency_rad_s, short_period_damping {}: the modes
   of JSBSim's linearised model at the level-flight trim point (modes.py).
+Each kind is a class in takes.py, registered by subclassing `Take`.
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
+from ..text.labels import name_unit
+from .takes import REGISTRY, WINDOW, Take
 
-from . import takes
-
-
-@dataclass(frozen=True)
-class TakeKind:
-    """A registered `take`: its reduction over the steps (None for a mode of the linearised model,
-    read once at the trim point), the keys it requires, and a small example (help text and tests)."""
-
-    reduction: type | None
-    required: tuple[str, ...]
-    example: dict
-
-    @property
-    def mode(self) -> bool:
-        return self.reduction is None
-
-
-WINDOW = ("after_s", "before_s")
-REGISTRY: dict[str, TakeKind] = {
-    "max": TakeKind(takes.Max, ("of",), {"of": "h_ft", "take": "max"}),
-    "min": TakeKind(takes.Min, ("of",), {"of": "h_ft", "take": "min"}),
-    "final": TakeKind(takes.Final, ("of",), {"of": "h_ft", "take": "final"}),
-    "drop": TakeKind(takes.Drop, ("of",), {"of": "h_ft", "take": "drop"}),
-    "change": TakeKind(takes.Change, ("of",), {"of": "h_ft", "take": "change"}),
-    "mean": TakeKind(takes.Mean, ("of",), {"of": "h_ft", "take": "mean", "after_s": 10.0}),
-    "at": TakeKind(takes.At, ("of", "at_s"), {"of": "h_ft", "take": "at", "at_s": 20.0}),
-    "at_first": TakeKind(takes.AtFirst, ("of", "when"),
-                         {"of": "h_ft", "take": "at_first", "when": {"of": "alpha_deg", "above": 3.0}}),
-    "time_of_first": TakeKind(takes.TimeOfFirst, ("when",),
-                              {"take": "time_of_first", "when": {"of": "alpha_deg", "below": 2.0}}),
-    "phugoid_period_s": TakeKind(None, (), {"take": "phugoid_period_s"}),
-    "phugoid_damping": TakeKind(None, (), {"take": "phugoid_damping"}),
-    "short_period_frequency_rad_s": TakeKind(None, (), {"take": "short_period_frequency_rad_s"}),
-    "short_period_damping": TakeKind(None, (), {"take": "short_period_damping"}),
-}
 TAKES = tuple(REGISTRY)
 
 
-def take_entry(take: str) -> TakeKind:
-    return REGISTRY[take]
+def quantity_unit(spec, output_units: dict[str, str]) -> str:
+    """The unit of a quantity whose campaign spec is `spec` ({take, of, ...}): its take's own (`Take.unit`:
+    time_of_first s, a damping -, a frequency rad/s), else its `of`'s (`output_units`, else from the name);
+    "" unknown."""
+    if not isinstance(spec, dict) or not isinstance(spec.get("take"), str):
+        return ""
+    take = REGISTRY.get(spec["take"])
+    if take is not None and take.unit is not None:
+        return take.unit
+    of = spec.get("of")
+    if not isinstance(of, str):
+        return ""
+    return output_units.get(of) or name_unit(of)
 
 
 def quantity_key(name: str) -> tuple[str, str]:
@@ -63,4 +41,4 @@ def is_quantity_key(key) -> bool:
     return isinstance(key, tuple) and len(key) == 2 and key[0] == "quantity"
 
 
-__all__ = ["REGISTRY", "TAKES", "TakeKind", "is_quantity_key", "quantity_key", "take_entry"]
+__all__ = ["REGISTRY", "TAKES", "WINDOW", "Take", "is_quantity_key", "quantity_key", "quantity_unit"]

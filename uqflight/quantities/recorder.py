@@ -14,7 +14,7 @@ from __future__ import annotations
 from collections.abc import Callable, Sequence
 
 from ..text.labels import ANGLE_PERIODS, name_unit
-from . import take_entry
+from . import REGISTRY
 from .modes import eigen_modes
 
 Resolve = Callable[[str], tuple[str, float]]  # a name in `of:` -> (the property recorded, its scale)
@@ -35,11 +35,11 @@ class QuantityRecorder:
             return sources.setdefault(prop, len(sources)), scale
 
         for name, spec in self.specs.items():
-            entry = take_entry(spec["take"])
-            if entry.mode:
+            take = REGISTRY[spec["take"]]
+            if take.mode:
                 self.modes.append(name)
                 continue
-            reduction = self.reductions[name] = entry.reduction(spec)
+            reduction = self.reductions[name] = take(spec)
             of, of_scale = index(spec["of"]) if "of" in spec else (None, 1.0)
             when, when_scale = index(spec["when"]["of"]) if "when" in spec else (None, 1.0)
             period = ANGLE_PERIODS.get(name_unit(spec["of"])) if "of" in spec else None

@@ -45,7 +45,7 @@ def check_quantities(check, value, simulator: dict, aircraft=None) -> dict[str, 
         spec = dict(check.mapping(spec, path, KEYS, required=("take",)))
         take = check.string(spec["take"], f"{path}.take", TAKES)
         entry = REGISTRY[take]
-        allowed = set(entry.required) | (set() if entry.mode or take == "at" else set(WINDOW))
+        allowed = set(entry.required) | (set(WINDOW) if entry.windowed else set())
         for key in spec:
             if key != "take" and key not in allowed:
                 check.fail(f"{path}.{key}", f"has no meaning for take: {take} (it takes "

@@ -1,27 +1,54 @@
-"""The reductions a quantity of interest takes over one flight, one class per `take`, fed once per
-integration step (or per time point of a Python model) with the step's time and value.
+"""The kinds of `take`: one class each, registered by subclassing `Take` with its name (`REGISTRY`).
 
-Every reduction sees the steps inside its window [after_s, before_s] (ends included, within
-WINDOW_SLACK_S); one that sees no step, or whose condition never holds, is undefined (NaN):
-* max, min: over the steps; final: the value at the last step; drop: how far the value falls below
-  its value at the window's first step, first − min (0 when it never falls; an altitude loss);
-  change: the value at the last step minus that at the first, last − first (a heading change);
-* mean: the time average by the trapezoid rule over the steps, ∫y dt / (t_last − t_first); a window
-  holding one step gives that step's value;
-* at: linear interpolation between the two steps around at_s (exact at a step's time);
-* at_first: the value of `of` at the first step where `when.of` is above (>) or below (<) the threshold;
-  time_of_first: that step's time. No interpolation between steps: exact at a model's time points.
+A take over the steps is a reduction fed once per integration step (or per time point of a Python model)
+with the step's time and value. Every reduction sees the steps inside its window [after_s, before_s]
+(ends included, within WINDOW_SLACK_S); one that sees no step, or whose condition never holds, is
+undefined (NaN). A mode of the linearised model (`Mode`) is read once at the level-flight trim point
+instead (modes.py). A new take is a class here and a line in docs/quantities.md.
 """
 from __future__ import annotations
 
 import math
+from typing import ClassVar
 
 NAN = float("nan")
 WINDOW_SLACK_S = 1e-9  # a step's time and a window's end written in decimal differ by rounding only
+WINDOW = ("after_s", "before_s")
+
+REGISTRY: dict[str, type[Take]] = {}  # every take by its name, in the order the classes are defined
 
 
-class Reduction:
-    """Window handling shared by every reduction: `update` sees only the steps inside it."""
+class Take:
+    """A `take`: what one quantity of interest takes of a flight.
+
+    A subclass registers itself under its name, `class Max(Take, name="max")`, and says which keys it
+    requires (`required`), whether it takes the window keys (`windowed`), its own unit where it is not
+    its `of`'s (`unit`) and a small `example` (tests); its docstring's first paragraph describes it in
+    the campaign-key reference.
+
+    Examples
+    --------
+    >>> REGISTRY["max"].required, REGISTRY["max"].windowed, REGISTRY["max"].mode
+    (('of',), True, False)
+    >>> reduction = REGISTRY["max"]({"of": "h_ft", "take": "max", "after_s": 1.0})
+    >>> for t, x in [(0.0, 9.0), (1.0, 2.0), (2.0, 5.0)]:
+    ...     reduction.step(t, x, NAN)
+    >>> reduction.result()
+    5.0
+    """
+
+    name: ClassVar[str]
+    required: ClassVar[tuple[str, ...]] = ("of",)
+    windowed: ClassVar[bool] = True  # takes after_s and before_s
+    mode: ClassVar[bool] = False  # a mode of the linearised model at the trim point, not a reduction
+    unit: ClassVar[str | None] = None  # its own unit; None: its `of`'s (quantity_unit)
+    example: ClassVar[dict]
+
+    def __init_subclass__(cls, name: str | None = None, **kwargs):
+        super().__init_subclass__(**kwargs)
+        if name is not None:
+            cls.name = name
+            REGISTRY[name] = cls
 
     def __init__(self, spec: dict):
         self.after = float(spec.get("after_s", -math.inf)) - WINDOW_SLACK_S
@@ -36,23 +63,48 @@ class Reduction:
         if self.after <= t <= self.before:
             self.update(t, x, y)
 
+    def update(self, t: float, x: float, y: float) -> None:
+        raise NotImplementedError
+
     def result(self) -> float:
         return self.value
 
 
-class Max(Reduction):
+class Max(Take, name="max"):
+    """The largest value over the steps in the window."""
+
+    example = {"of": "h_ft", "take": "max"}
+
     def update(self, t, x, y):
         if not x <= self.value:  # NaN at first
             self.value = x
 
 
-class Min(Reduction):
+class Min(Take, name="min"):
+    """The smallest value over the steps in the window."""
+
+    example = {"of": "h_ft", "take": "min"}
+
     def update(self, t, x, y):
         if not x >= self.value:
             self.value = x
 
 
-class Drop(Reduction):
+class Final(Take, name="final"):
+    """The last step's value."""
+
+    example = {"of": "h_ft", "take": "final"}
+
+    def update(self, t, x, y):
+        self.value = x
+
+
+class Drop(Take, name="drop"):
+    """How far `of` falls below its value at the window's first step (first − min, 0 if it never falls):
+    `{of: h_ft, take: drop}` is an altitude loss."""
+
+    example = {"of": "h_ft", "take": "drop"}
+
     def reset(self):
         self.value = self.first = NAN
 
@@ -63,7 +115,12 @@ class Drop(Reduction):
             self.value = self.first - x
 
 
-class Change(Reduction):
+class Change(Take, name="change"):
+    """The last step's value minus the window's first (last − first): `{of: attitude/psi-deg, take: change}`
+    is the heading change of a turn, continuous across 360° (an angle `of` is unwrapped along the run)."""
+
+    example = {"of": "h_ft", "take": "change"}
+
     def reset(self):
         self.value = self.first = NAN
 
@@ -73,12 +130,12 @@ class Change(Reduction):
         self.value = x - self.first
 
 
-class Final(Reduction):
-    def update(self, t, x, y):
-        self.value = x
+class Mean(Take, name="mean"):
+    """Time average by the trapezoid rule over the window, ∫y dt / (t_last − t_first) (a window holding one
+    step: that step's value)."""
 
+    example = {"of": "h_ft", "take": "mean", "after_s": 10.0}
 
-class Mean(Reduction):
     def reset(self):
         self.first = self.last = self.previous = NAN
         self.area = 0.0
@@ -97,7 +154,13 @@ class Mean(Reduction):
         return self.previous if span == 0 else self.area / span
 
 
-class At(Reduction):
+class At(Take, name="at"):
+    """Linear interpolation at `at_s` between the two steps around it (exact at a step's time)."""
+
+    required = ("of", "at_s")
+    windowed = False
+    example = {"of": "h_ft", "take": "at", "at_s": 20.0}
+
     def __init__(self, spec: dict):
         self.at = float(spec["at_s"])
         super().__init__(spec)
@@ -116,8 +179,12 @@ class At(Reduction):
         self.last, self.previous = t, x
 
 
-class AtFirst(Reduction):
-    """The value of `of` (or, for time_of_first, the time) at the first step meeting `when`."""
+class AtFirst(Take, name="at_first"):
+    """The value of `of` at the first step meeting `when`, no interpolation: the touchdown sink rate `{of:
+    velocities/h-dot-fps, take: at_first, when: {of: "gear/unit[1]/WOW", above: 0.5}}`."""
+
+    required = ("of", "when")
+    example = {"of": "h_ft", "take": "at_first", "when": {"of": "alpha_deg", "above": 3.0}}
 
     def __init__(self, spec: dict, time: bool = False):
         when = spec["when"]
@@ -133,6 +200,49 @@ class AtFirst(Reduction):
             self.value = t if self.time else x
 
 
-class TimeOfFirst(AtFirst):
+class TimeOfFirst(AtFirst, name="time_of_first"):
+    """The time of the first step meeting `when`."""
+
+    required = ("when",)
+    unit = "s"
+    example = {"take": "time_of_first", "when": {"of": "alpha_deg", "below": 2.0}}
+
     def __init__(self, spec: dict):
         super().__init__(spec, time=True)
+
+
+class Mode(Take):
+    """A mode of JSBSim's linearised model at the level-flight trim point (modes.py), read once per run
+    by the recorder: no reduction over the steps, no key but `take`."""
+
+    required = ()
+    windowed = False
+    mode = True
+
+
+class PhugoidPeriod(Mode, name="phugoid_period_s"):
+    """The phugoid's damped period 2π/Im λ [s] of JSBSim's linearised model at the level-flight trim."""
+
+    unit = "s"
+    example = {"take": "phugoid_period_s"}
+
+
+class PhugoidDamping(Mode, name="phugoid_damping"):
+    """The phugoid's damping ratio −Re λ/|λ| at the level-flight trim."""
+
+    unit = "-"
+    example = {"take": "phugoid_damping"}
+
+
+class ShortPeriodFrequency(Mode, name="short_period_frequency_rad_s"):
+    """The short period's natural frequency |λ| [rad/s] at the level-flight trim."""
+
+    unit = "rad/s"
+    example = {"take": "short_period_frequency_rad_s"}
+
+
+class ShortPeriodDamping(Mode, name="short_period_damping"):
+    """The short period's damping ratio at the level-flight trim."""
+
+    unit = "-"
+    example = {"take": "short_period_damping"}

@@ -21,10 +21,6 @@ PROPERTY_SUFFIXES = {"ft": "ft", "deg": "deg", "rad": "rad", "lbs": "lbs", "kts"
                      "fps2": "ft/s²", "lbf": "lbf", "lbsft": "lbf·ft", "kt": "kt", "degps": "deg/s"}
 # JSBSim's load factors carry no suffix: they are in g
 UNITLESS_PROPERTIES = {"accelerations/Nx": "g", "accelerations/Ny": "g", "accelerations/Nz": "g"}
-# A quantity's unit: its `of`'s for a take that keeps it (max, min, final, drop, mean, at, at_first, change);
-# these takes have their own
-TAKE_UNITS = {"time_of_first": "s", "phugoid_period_s": "s", "phugoid_damping": "-",
-              "short_period_frequency_rad_s": "rad/s", "short_period_damping": "-"}
 ANGLE_PERIODS = {"deg": 360.0, "rad": 2 * 3.141592653589793}  # an angle's period in its unit
 
 
@@ -60,19 +56,6 @@ def name_unit(name: str) -> str:
         if char in "-_" and tail[k + 1:] in PROPERTY_SUFFIXES:
             return PROPERTY_SUFFIXES[tail[k + 1:]]
     return ""
-
-
-def quantity_unit(spec, output_units: dict[str, str]) -> str:
-    """The unit of a quantity whose campaign spec is `spec` ({take, of, ...}): its take's own (time_of_first
-    s, a damping -, a frequency rad/s), else its `of`'s (`output_units`, else from the name); "" unknown."""
-    if not isinstance(spec, dict) or not isinstance(spec.get("take"), str):
-        return ""
-    if spec["take"] in TAKE_UNITS:
-        return TAKE_UNITS[spec["take"]]
-    of = spec.get("of")
-    if not isinstance(of, str):
-        return ""
-    return output_units.get(of) or name_unit(of)
 
 
 def parameter_label(name: str, prop: str) -> str:
