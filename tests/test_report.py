@@ -389,7 +389,7 @@ def test_a_section_that_fails_in_the_child_sharing_the_drawing_fails_the_report_
         pg, tmp_path, monkeypatch, capfd, error):
     """An OSError (a file it could not write: a full disk) comes back to the parent as that OSError, without
     a traceback (the command says "cannot write the report"); any other error is the child's traceback and
-    a RuntimeError."""
+    DrawingFailed naming the section and what it raised."""
     import time
 
     import uqflight.report as report
@@ -408,12 +408,37 @@ def test_a_section_that_fails_in_the_child_sharing_the_drawing_fails_the_report_
     monkeypatch.setattr(sections, "section_jobs", lambda *args: [(cost, stage, failing_in_the_child(build))
                                                                  for cost, stage, build in jobs_of(*args)])
     raised = (OSError, r"^no space left on device$") if error is OSError else \
-        (RuntimeError, r"cannot draw the report's plots: a process drawing them failed \(exit 1\)")
+        (report.DrawingFailed, r"^cannot draw the report's plots: drawing [a-z' ]+ raised ZeroDivisionError: "
+                               r"no space left on device$")
     with pytest.raises(raised[0], match=raised[1]):
         report.write_report([pg], tmp_path / "out")
     printed = capfd.readouterr().err
     assert ("Traceback" in printed and "no space left on device" in printed) == (error is not OSError)
+    # printed where it was raised, not again by the process relaying it
+    assert printed.count("\nZeroDivisionError: no space left on device") == (error is not OSError)
     assert list(tmp_path.iterdir()) == []  # no report, no staging folder
+
+
+def test_a_figure_that_raises_is_one_line_naming_its_section_with_exit_1(pg, tmp_path, monkeypatch):
+    import uqflight.report.sections as sections
+
+    jobs_of = sections.section_jobs
+
+    def failing(stage, build):
+        def job():
+            if stage == "drawing the PDFs":
+                raise ValueError("a bad figure")
+            return build()
+        return job
+
+    monkeypatch.setattr(sections, "section_jobs", lambda *args: [(cost, stage, failing(stage, build))
+                                                                 for cost, stage, build in jobs_of(*args)])
+    result = cli_in_process("report", pg, "--out", tmp_path / "out")
+    assert result.returncode == 1
+    assert result.stderr.strip().splitlines()[-1] == (
+        "error: cannot draw the report's plots: drawing the PDFs raised ValueError: a bad figure; no report "
+        f"written ({tmp_path / 'out'} unchanged)")
+    assert not (tmp_path / "out").exists()
 
 
 def test_without_a_drawer_the_report_draws_the_same_files_itself(pg, tmp_path, monkeypatch):

@@ -477,7 +477,7 @@ def report(
     plots/*.png, report.html (self-contained, plots embedded) and report.md (linking plots/).
     The report is written to a temporary folder and moved into place when complete.
     """
-    from ..report import DEFAULT_TIMES, default_out_dir, parse_methods, write_report
+    from ..report import DEFAULT_TIMES, DrawingFailed, default_out_dir, parse_methods, write_report
     from ..analysis.statistics import BadInput
 
     try:
@@ -521,6 +521,9 @@ def report(
     except OSError as exc:
         echo(f"error: cannot write the report: {exc}", err=True)
         raise typer.Exit(2)
+    except DrawingFailed as exc:  # uqflight's own failure, not the input's: its traceback is above
+        echo(f"error: {exc}; no report written ({out} unchanged)", err=True)
+        raise typer.Exit(1)
     except KeyboardInterrupt:
         echo(f"\ninterrupted: no report written ({out} unchanged)", err=True)
         raise typer.Exit(130)

@@ -32,9 +32,14 @@ from .loading import Entry, bounded, load_entries
 from .formats import FORMATS, export_format, exporting
 from .replace import OUT_NAME_BYTES, check_replaceable, make_staging, replace_dir
 
-__all__ = ["check_replaceable", "default_out_dir", "parse_methods", "write_report"]
+__all__ = ["DrawingFailed", "check_replaceable", "default_out_dir", "parse_methods", "write_report"]
 
 DEFAULT_TIMES = (10.0, 25.0, float("inf"))  # the tables' times: 10 s, 25 s and the final time
+
+
+class DrawingFailed(RuntimeError):
+    """A figure of the report could not be drawn: the message names its section and what it raised (the
+    traceback is printed where it was drawn). Nothing is written."""
 
 
 def default_out_dir(results: Path) -> Path:
@@ -99,16 +104,15 @@ def _write_into(out_dir: Path, entries: list[Entry], ref: Entry | None, times, p
         drawer.start((entries, ref, times, out_dir, export_format()))
     progress.stage("writing summaries and tables")
     written = _data_files(entries, out_dir)
-    if drawer is None:
-        from .sections import build_sections
+    try:
+        if drawer is None:
+            from .sections import build_sections
 
-        sections = build_sections(entries, ref, times, out_dir, on_message)
-    else:
-        try:
+            sections = build_sections(entries, ref, times, out_dir, on_message)
+        else:
             sections = drawer.wait(on_message)
-        except ChildFailed as exc:
-            raise RuntimeError(f"cannot draw the report's plots: a process drawing them {exc} (any error it "
-                               "printed is above)") from None
+    except ChildFailed as exc:  # a section that raised, named, or a drawing process that died
+        raise DrawingFailed(f"cannot draw the report's plots: {exc}") from exc
     on_message(("drawn", None))
     from .blocks import Table, files_section
     from .render import render_html, render_markdown

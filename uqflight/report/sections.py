@@ -12,7 +12,8 @@ from .blocks import Figure, Section, Table, _rel
 from ..text.labels import shown_time
 from .formats import shown_path
 from ..analysis.sobol import unresolved
-from ..running.forking import share_work
+from ..running.forking import ChildFailed, share_work
+from ..text.console import one_line
 from .sensitivity import N_TOO_SMALL, NEGLIGIBLE, index_text, plot_sensitivity
 from .loading import (Entry, _same_file, bounded, campaign_settings, campaign_simulator, estimator_label, flight_facts,
                       method_label, one_per_file)
@@ -32,9 +33,22 @@ def build_sections(entries: list[Entry], ref: Entry | None, times: list[float], 
         on_message(("jobs", [stage for _, stage, _ in jobs]))
     plots.warm_text_caches()  # before the fork: every process inherits the loaded fonts
     with plots.collecting_at_the_end():
-        sections = share_work([build for _, _, build in jobs], order,
+        sections = share_work([_named(stage, build) for _, stage, build in jobs], order,
                               starting=None if on_message is None else lambda k: on_message(("starting", k)))
     return [section for section in sections if section is not None]
+
+
+def _named(stage: str, build: Callable[[], Section | None]) -> Callable[[], Section | None]:
+    """`build`, whose error (a file error aside: the report's "cannot write") is a ChildFailed naming the
+    section by its `stage` and saying what it raised."""
+    def run():
+        try:
+            return build()
+        except OSError:
+            raise
+        except Exception as exc:
+            raise ChildFailed(f"{stage} raised {type(exc).__name__}: {one_line(str(exc))}") from exc
+    return run
 
 
 def section_jobs(entries: list[Entry], ref: Entry | None, times: list[float],

@@ -16,11 +16,14 @@ import time
 import traceback
 from typing import Callable
 
+from ..text.console import one_line
+
 FORKS = hasattr(os, "fork")  # where the system cannot fork, callers do the work themselves
 
 
 class ChildFailed(RuntimeError):
-    """A child that raised (its traceback printed to stderr) or died; the message says which."""
+    """A child that raised (its traceback printed to stderr) or died, or a job that raised where the
+    caller names it; the message says which, and what was raised."""
 
 
 class Child:
@@ -45,9 +48,18 @@ class Child:
                     payload = pickle.dumps((False, error))
                 with os.fdopen(write, "wb") as pipe:
                     pipe.write(payload)
-            except BaseException:
-                _tell_error(traceback.format_exc())
+            except BaseException as exc:
+                relayed = isinstance(exc, ChildFailed) and exc.__cause__ is None  # its own child printed it
+                if not relayed:
+                    _tell_error(traceback.format_exc())
                 code = 1
+                said = str(exc) if isinstance(exc, ChildFailed) else \
+                    f"failed (exit 1): {type(exc).__name__}: {one_line(str(exc))}"
+                try:  # what it raised, in one line, for the parent's message
+                    with os.fdopen(write, "wb") as pipe:
+                        pipe.write(pickle.dumps((False, ChildFailed(said))))
+                except BaseException:  # the pipe already written or closed: the exit status says it
+                    pass
             os._exit(code)
         gc.unfreeze()
         os.close(write)
@@ -67,11 +79,14 @@ class Child:
         status = os.waitstatus_to_exitcode(os.waitpid(self.pid, 0)[1])
         if status < 0:
             raise ChildFailed(f"died (signal {-status})")
-        if status != 0 or not payload:
-            raise ChildFailed(f"failed (exit {status})")
-        done, result = pickle.loads(payload)
+        try:  # a child that failed sent what it raised, unless writing its result is what failed
+            done, result = pickle.loads(payload)
+        except Exception:
+            raise ChildFailed(f"failed (exit {status})") from None
         if not done:
             raise result
+        if status != 0:
+            raise ChildFailed(f"failed (exit {status})")
         return result
 
 
