@@ -198,6 +198,30 @@ def test_an_output_rate_divides_a_rounded_dt_only_within_its_rounding():
     assert script.steps_per_output(10) == 12  # 12 dt = 0.099996 s, within 12 x 5e-7 of 0.1
     assert script.steps_per_output(120) == 1 and script.steps_per_output(7) is None
     assert script.steps_per_output(1000) is None  # less than one step
+    c310 = ScriptFile.read(jsbsim_scripts() / "c3104.xml")  # dt="0.02": JSBSim steps by 0.02 s, 50 Hz
+    assert c310.steps_per_output(20) is None and c310.steps_per_output(30) is None  # were 2 steps, 25 Hz, and 33 Hz
+    assert c310.steps_per_output(25) == 2 and c310.steps_per_output(10) == 5
+
+
+def test_without_an_output_rate_a_script_records_at_a_divisor_of_its_own_rate(tmp_path):
+    # ah1s_flight_test's dt = 0.0075 s (133.3 Hz), c3104's 0.02 s (50 Hz): 20 Hz divides neither, and a
+    # campaign that names no rate was refused for the default it never chose
+    helicopter, c310 = (ScriptFile.read(jsbsim_scripts() / f"{name}.xml") for name in ("ah1s_flight_test", "c3104"))
+    assert helicopter.default_output_rate_hz == pytest.approx(400 / 21) and helicopter.steps_per_output(400 / 21) == 7
+    assert c310.default_output_rate_hz == pytest.approx(50 / 3) and c310.steps_per_output(50 / 3) == 3
+    assert ScriptFile.read(CRUISE).default_output_rate_hz == 20.0  # 120 Hz: the default as it was
+    assert c310.output_rate_hz({"output_rate_hz": 10}) == 10.0
+    path = script_campaign(tmp_path, {"kind": "script", "script": "ah1s_flight_test", "end_s": 1}, name="ah1s",
+                           outputs=["h_ft"])
+    text = yaml.safe_load(path.read_text())
+    del text["simulator"]["output_rate_hz"]
+    text["parameters"] = {"wind": PARAMETERS["wind"]}
+    path.write_text(yaml.safe_dump(text))
+    done = cli("run", path, "--out", tmp_path / "ah1s.h5")
+    assert done.returncode == 0, done.stderr
+    with h5py.File(tmp_path / "ah1s.h5") as f:
+        time = f["time"][:]
+    np.testing.assert_allclose(np.diff(time), 7 * 0.0075, rtol=1e-9)
 
 
 def test_a_script_and_its_initialisation_travel_in_the_bundle_hashed(tmp_path, monkeypatch):

@@ -40,7 +40,8 @@ NAMED_OUTPUTS = {
 }
 # every scenario's recording rate
 OUTPUT_RATE = Field("Recording rate [Hz]; must divide the integration rate (120 Hz for level flight, the script's "
-                    "own). Default 20. `output_rate_hz: 10`", number=True, minimum=0.0, strict=True)
+                    "own). Default 20, or for a script whose rate 20 does not divide the fastest divisor of its rate "
+                    "below 20 (dt = 0.02 s: 16.67). `output_rate_hz: 10`", number=True, minimum=0.0, strict=True)
 UNITS = {"alpha_deg": "deg", "theta_deg": "deg", "h_ft": "ft", "q_degps": "deg/s", "vtas_kt": "kt"}
 
 ATMOSPHERE = "atmosphere/"  # settings applied after the trim (still air), at t = 0 of the recorded flight

@@ -40,6 +40,7 @@ from ..jsbsim import (ATMOSPHERE, DEFAULT_OUTPUTS, OUTPUT_RATE, FlightResult, Pr
                       ready_to_load)
 
 DEFAULT_OUTPUT_RATE_HZ = 20.0
+RATE_MISMATCH = 1e-4  # the most a recording interval may differ from k steps, relatively (dt = 0.0083333: 4e-6)
 MAX_SCRIPT_BYTES = 1 << 20
 MAX_STEPS = 10**7  # integration steps (80 MB of step times; 23 h at 120 Hz), as many as a results file holds times
 TIME = "simulation/sim-time-sec"
@@ -146,13 +147,29 @@ class ScriptFile:
             return 0.0
         return 0.5 * 10.0 ** exponent if isinstance(exponent, int) else 0.0
 
+    @property
+    def default_output_rate_hz(self) -> float:
+        """The recording rate when the campaign gives none: DEFAULT_OUTPUT_RATE_HZ where it divides the
+        script's rate, else the fastest divisor of that rate at most DEFAULT_OUTPUT_RATE_HZ (dt = 0.0075 s:
+        133.3 Hz / 7 = 19.05 Hz; dt = 0.02 s: 50 Hz / 3 = 16.67 Hz; a rate below it: the rate itself)."""
+        if self.steps_per_output(DEFAULT_OUTPUT_RATE_HZ) is not None:
+            return DEFAULT_OUTPUT_RATE_HZ
+        return self.rate_hz / math.ceil(self.rate_hz / DEFAULT_OUTPUT_RATE_HZ)
+
+    def output_rate_hz(self, config: dict) -> float:
+        """The recording rate of a campaign's `simulator:` mapping `config` flying this script: its
+        `output_rate_hz`, else `default_output_rate_hz`."""
+        return float(config["output_rate_hz"]) if "output_rate_hz" in config else self.default_output_rate_hz
+
     def steps_per_output(self, output_rate_hz: float) -> int | None:
         """Integration steps per recorded time; None when `output_rate_hz` does not divide the script's
-        rate within the rounding of its dt (k steps of dt must last 1 / output_rate_hz)."""
+        rate within the rounding of its dt (k steps of dt must last 1 / output_rate_hz), and at most
+        RATE_MISMATCH of it: a dt written with few digits is what JSBSim steps by ("0.02" is 50 Hz, which
+        20 Hz does not divide, however "0.02" was rounded), one with many may be a rounded 1/120."""
         k = round(1.0 / (self.dt_s * output_rate_hz))
         if k < 1:
             return None
-        tolerance = k * self.dt_rounding + 1e-9 * k * self.dt_s
+        tolerance = min(k * self.dt_rounding, RATE_MISMATCH * k * self.dt_s) + 1e-9 * k * self.dt_s
         return k if abs(k * self.dt_s - 1.0 / output_rate_hz) <= tolerance else None
 
     def initfile(self, aircraft_folder: Path) -> Path | None:
@@ -460,7 +477,7 @@ class Script(ScenarioKind):
         except ScriptError as exc:
             check.fail("simulator.scenario.end_s" if end is not None else "simulator.scenario.script", str(exc))
         check_fields(check, sim, "simulator", self.fields)
-        rate = float(sim.get("output_rate_hz", DEFAULT_OUTPUT_RATE_HZ))
+        rate = script.output_rate_hz(sim)
         if script.steps_per_output(rate) is None:
             divisors = ", ".join(f"{script.rate_hz / k:.4g}" for k in range(1, 7))
             check.fail("simulator.output_rate_hz", f"expected a divisor of the script's {script.rate_hz:.7g} Hz rate "
@@ -495,7 +512,7 @@ class Script(ScenarioKind):
         script = _script_file(config, None)
         end_s = config.get("scenario", {}).get("end_s")
         steps = script.steps(None if end_s is None else float(end_s))
-        return steps // script.steps_per_output(float(config.get("output_rate_hz", DEFAULT_OUTPUT_RATE_HZ))) + 1
+        return steps // script.steps_per_output(script.output_rate_hz(config)) + 1
 
     def setup(self, config: dict, root: Path | None = None, base: Path | None = None, properties=()) -> ScriptSetup:
         """A ScriptSetup from a campaign's `simulator:` mapping (keys already validated): the script's
@@ -514,7 +531,7 @@ class Script(ScenarioKind):
             aircraft=name, root=root, script=script,
             initfile=script.initfile(root / "aircraft" / name) if (root / "aircraft" / name).is_dir() else None,
             end_s=float(scenario["end_s"]) if "end_s" in scenario else None,
-            output_rate_hz=float(config.get("output_rate_hz", DEFAULT_OUTPUT_RATE_HZ)),
+            output_rate_hz=script.output_rate_hz(config),
             outputs=tuple(config.get("outputs", DEFAULT_OUTPUTS)),
         )
 
