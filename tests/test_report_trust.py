@@ -170,7 +170,9 @@ def test_a_flagged_quantity_is_marked_in_the_headline_and_an_unflagged_page_has_
     (entry,), _ = load_entries([files["mc"]], None)
     exceedance, key_numbers = headline_section(entry, [float("inf")]).blocks
     assert "flags" not in page_view(key_numbers)[0] and "flags" not in page_view(exceedance)[0]
-    entry.stats.quantities["final_y"].flags.append("band beyond the runs: use least_squares")  # as the analysis flags
+    quantity = entry.stats.quantities["final_y"]
+    quantity.flags.append("band beyond the runs: use least_squares")  # as the analysis flags an expansion's
+    quantity.exceedance[0]["flags"].append("band beyond the runs: use least_squares")  # and its draws' fraction
     exceedance, key_numbers = headline_section(entry, [float("inf")]).blocks
     header, [(_, rows)] = page_view(key_numbers)
     row = next(row for row in rows if row[0].endswith("final_y"))

@@ -108,6 +108,19 @@ def test_pick_freeze_with_n_32_says_its_indices_are_unresolved(flown):
     assert all(0 <= share <= 100 for share in shares)
 
 
+def test_an_exceedance_from_runs_is_not_flagged_for_the_indices_of_the_same_runs(flown):
+    # 32 base rows resolve no Sobol' index, which flags the quantity; the proportion of runs above 5 and its
+    # Wilson interval do not rest on them: its entry carries no such flag (the headline marked it with them)
+    stats = analyse(flown(campaign("ishigami-32-peak", "ishigami_failing", ISHIGAMI_BOX,
+                                   "{kind: pick_freeze, samples: 32}", "quantities:\n  peak: {of: y, take: max}\n",
+                                   ", exceedance: {peak: [{above: 5}]}"), "ishigami-32-peak"))
+    quantity = stats.quantities["peak"]
+    assert quantity.flags and "unresolved" in quantity.flags[0]
+    entry, = quantity.exceedance
+    assert entry["method"] == "wilson" and not any("Sobol'" in flag for flag in entry["flags"])
+    assert summary_json(stats)["quantities"]["peak"]["exceedance"][0]["flags"] == entry["flags"]
+
+
 def test_headline_shares_carry_their_intervals_and_never_exceed_100_percent():
     from uqflight.report.sensitivity import top_contributors
 
@@ -147,6 +160,7 @@ def test_a_smooth_model_is_not_flagged_and_a_unit_slip_is(flown):
     assert stats.quantities["y_time"].flags == []
     near, far = quantity.exceedance
     assert "unit slip" in far["note"] and "run more" not in far["note"] and "unit slip" not in near["note"]
+    assert near["flags"] == [] and far["flags"] == quantity.flags  # each threshold's own flag alone
     assert far["probability"] == 0.0
     summary = summary_json(stats)
     assert summary["outputs"]["y"]["flags"] == [] and summary["quantities"]["y_time"]["units"] == "s"

@@ -6,10 +6,10 @@
 * From a PCE: the fraction of the expansion's draws beyond the threshold, `method: "pce"`. Its bounds
   are null: a PCE's error is known in the mean square (leave-one-out, lower-order difference), not on
   the individual values a threshold sorts, so no interval would hold.
-Fewer than RARE_COUNT runs beyond the threshold (p < RARE_COUNT/n for a PCE) is flagged: the estimate
-then rests on the tail of a few runs, a rare-event extrapolation. A threshold beyond the runs' range by
-more than the range's own width (`unit_slip`) is flagged instead as a probable unit slip: more runs
-would not reach it.
+Fewer than RARE_COUNT runs beyond the threshold (p < RARE_COUNT/n for a PCE) is flagged (the entry's
+`flags`, and its note): the estimate then rests on the tail of a few runs, a rare-event extrapolation. A
+threshold beyond the runs' range by more than the range's own width (`unit_slip`) is flagged instead as a
+probable unit slip: more runs would not reach it.
 """
 from __future__ import annotations
 
@@ -45,7 +45,7 @@ def unit_slip(runs: np.ndarray, threshold: float, units: str = "") -> str | None
 
 def exceedance_from_runs(values: np.ndarray, defined: np.ndarray, thresholds: list[dict], draws: Independent = Independent(),
                          info: dict | None = None, units: str = "") -> list[dict]:
-    """[{above|below, probability, lower, upper, method, note}] over the runs where `defined` (bool (N,),
+    """[{above|below, probability, lower, upper, method, flags, note}] over the runs where `defined` (bool (N,),
     design order) holds; `draws`, `info`: how the design drew its points (analysis.proportions); `units`:
     the quantity's, for the unit-slip flag (`unit_slip`)."""
     found = []
@@ -53,21 +53,18 @@ def exceedance_from_runs(values: np.ndarray, defined: np.ndarray, thresholds: li
         (bound, threshold), = item.items()
         beyond = _beyond(values, bound, threshold) & defined
         p = draws.proportion(beyond, defined, info or {}, CONFIDENCE, event=f"{bound} {threshold:g}")
-        note = p["sentence"]
         slip = unit_slip(values[defined], threshold, units)
-        if slip:
-            note += f"; {slip}"
-        elif int(beyond.sum()) < RARE_COUNT:
-            note += (f"; fewer than {RARE_COUNT} runs exceed: a rare-event extrapolation from the runs, "
-                     "run more to resolve it")
+        flag = slip or (f"fewer than {RARE_COUNT} runs exceed: a rare-event extrapolation from the runs, run more "
+                        "to resolve it (or a rare-event design)" if int(beyond.sum()) < RARE_COUNT else None)
         found.append({bound: threshold, "probability": p["estimate"], "lower": p["lower"], "upper": p["upper"],
-                      "method": p["method"], "note": note})
+                      "method": p["method"], "flags": [flag] if flag else [],
+                      "note": p["sentence"] + (f"; {flag}" if flag else "")})
     return found
 
 
 def exceedance_from_pce(draws: np.ndarray, runs: int, thresholds: list[dict], run_values: np.ndarray | None = None,
                         units: str = "") -> list[dict]:
-    """[{above|below, probability, lower: None, upper: None, method: "pce", note}] from the PCE's draws;
+    """[{above|below, probability, lower: None, upper: None, method: "pce", flags, note}] from the PCE's draws;
     `runs`: the runs the expansion was made from (the rare-event flag compares p with 10/runs);
     `run_values`, `units`: those runs' values and unit, for the unit-slip flag (`unit_slip`)."""
     found = []
@@ -77,11 +74,8 @@ def exceedance_from_pce(draws: np.ndarray, runs: int, thresholds: list[dict], ru
         note = (f"fraction of {draws.size} draws of the PCE {bound} {threshold:g}; no interval: the expansion's "
                 "error is known in the mean square, not on the individual values a threshold sorts")
         slip = None if run_values is None else unit_slip(run_values, threshold, units)
-        if slip:
-            note += f"; {slip}"
-        elif p < RARE_COUNT / runs:
-            note += (f"; p < {RARE_COUNT}/{runs} (fewer than {RARE_COUNT} of the runs' worth): a rare-event "
-                     "extrapolation of the expansion's tail")
+        flag = slip or (f"p < {RARE_COUNT}/{runs} (fewer than {RARE_COUNT} of the runs' worth): a rare-event "
+                        "extrapolation of the expansion's tail" if p < RARE_COUNT / runs else None)
         found.append({bound: threshold, "probability": p, "lower": None, "upper": None, "method": "pce",
-                      "note": note})
+                      "flags": [flag] if flag else [], "note": note + (f"; {flag}" if flag else "")})
     return found

@@ -25,7 +25,7 @@ def exceedance_entry(record: dict, names: list[str]) -> dict:
             "beta": record["beta"],
             "design_point": dict(zip(names, map(float, point))) if found else None,
             "importance": dict(zip(names, map(float, record["importance"]))) if found else None,
-            "failed": record["failed"], "stopped": record["stopped"],
+            "failed": record["failed"], "stopped": record["stopped"], "flags": [],
             "note": f"{record['method']}: the 95 % interval of its estimator; stopped by {record['stopped']}"}
 
 

@@ -955,7 +955,7 @@ def quantity_statistics(store: ResultStore, stats: Statistics, name: str, germs:
                                "its statistics are conditional on the runs where it is defined")
     if why:
         stats.notes.append(why)
-        nulls = [{**item, "probability": None, "lower": None, "upper": None, "method": None, "note": why}
+        nulls = [{**item, "probability": None, "lower": None, "upper": None, "method": None, "flags": [], "note": why}
                  for item in thresholds]
         return QuantityStatistics(name, missing, None, nulls, units)
     view = _QuantityView(store, name, values, units)
@@ -968,13 +968,16 @@ def quantity_statistics(store: ResultStore, stats: Statistics, name: str, germs:
         if note:
             stats.notes.append(note)
     if out.pce is None and not sampled:  # auto's runs' own statistics on a grid: the weighted runs
-        exceedance = _grid_exceedance(values, defined, store.weights, thresholds)
+        exceedance = _grid_exceedance(values, defined, store.weights, thresholds, units)
     elif out.pce is None:
         exceedance = exceedance_from_runs(values, defined, thresholds, DESIGNS[stats.design_kind].draws,
                                           stats.design_info, units)
     else:
         exceedance = exceedance_from_pce(out.pce.sample(options.band_samples, options.seed)[:, 0],
                                          int(defined.sum()), thresholds, values[defined], units)
+    if out.pce is not None:  # a fraction of the expansion's draws: its flags bear on it (an index's do not)
+        for item in exceedance:
+            item["flags"] += out.flags
     slips = [slip for item in thresholds if (slip := unit_slip(values[defined], next(iter(item.values())), units))]
     flags = [*out.flags, *slips]
     stats.notes.extend(f"quantity {name}: {flag}" for flag in flags)
@@ -982,17 +985,20 @@ def quantity_statistics(store: ResultStore, stats: Statistics, name: str, germs:
 
 
 def _grid_exceedance(values: np.ndarray, defined: np.ndarray, weights: np.ndarray,
-                     thresholds: list[dict]) -> list[dict]:
+                     thresholds: list[dict], units: str = "") -> list[dict]:
     """Exceedance probabilities of a grid's weighted runs (weights >= 0): the quadrature of the indicator,
-    without an interval (analysis.failures: the nodes are not random draws)."""
+    without an interval (analysis.failures: the nodes are not random draws); a threshold's unit slip flagged."""
     found = []
     for item in thresholds:
         (bound, threshold), = item.items()
         beyond = values[defined] > threshold if bound == "above" else values[defined] < threshold
         p = grid_failure_probability(beyond, weights[defined])
+        slip = unit_slip(values[defined], threshold, units)
         found.append({bound: threshold, "probability": p["estimate"], "lower": None, "upper": None, "method": "grid",
+                      "flags": [slip] if slip else [],
                       "note": f"the grid's quadrature of the indicator {bound} {threshold:g}, without an interval "
-                              "(the nodes are not random draws); a sampled design gives one"})
+                              "(the nodes are not random draws); a sampled design gives one"
+                              + (f"; {slip}" if slip else "")})
     return found
 
 

@@ -84,9 +84,8 @@ def exceedance_table(entry: Entry) -> Table | None:
     with their 95 % intervals, "—" for none; None when none was asked for."""
     rows, page = [], []
     for name, quantity in entry.stats.quantities.items():
-        flags = quantity.flags
         for item in quantity.exceedance:
-            event = event_text(name, item)
+            event, flags = event_text(name, item), item["flags"]
             rows.append([entry.label, name, event, item["probability"], item["lower"], item["upper"],
                          item["method"], "; ".join(flags), item["note"]])
             page.append([flagged(event, flags), probability_text(item["probability"]),
