@@ -50,6 +50,7 @@ def _calibrated(flown, tmp_path, *args):
                           *args)
 
 
+@pytest.mark.slow
 def test_a_calibrated_campaign_keeps_function_and_perturbation_and_plans(flown, tmp_path):
     done = _calibrated(flown, tmp_path)
     assert done.returncode == 0, done.stderr

@@ -237,6 +237,7 @@ def test_info_prints_a_results_files_texts_on_their_own_lines(forged, tmp_path):
     assert "aircraft sha256: 'abc\\nerror: forged'" in shown.stdout
 
 
+@pytest.mark.slow
 def test_ctrl_c_while_plan_flies_its_nominal_is_one_line_and_exit_130_and_ends_its_worker(tmp_path):
     import time
     from pathlib import Path

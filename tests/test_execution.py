@@ -137,6 +137,7 @@ def test_resume_after_sigkill_equals_an_uninterrupted_run(tmp_path, storage):
     assert_same_results(killed, tmp_path / "whole.h5")
 
 
+@pytest.mark.slow
 def test_tsvd_storage_and_property_outputs(tmp_path):
     text = JSBSIM_CAMPAIGN.format(samples=10, duration=5).replace(
         "  output_rate_hz: 10\n", "  output_rate_hz: 10\n  outputs: [theta_deg, aero/qbar-psf]\n").replace(
@@ -179,6 +180,7 @@ def test_force_never_replaces_what_is_not_a_results_file(tmp_path, make_campaign
         run_campaign(make_campaign(samples=2), out=tmp_path / "other.h5", force=True)
 
 
+@pytest.mark.slow
 def test_resuming_with_changed_aircraft_files_is_refused_unless_forced(tmp_path):
     run_campaign(jsbsim_campaign(samples=2), out=tmp_path / "r.h5")
     with h5py.File(tmp_path / "r.h5", "a") as f:
@@ -273,6 +275,7 @@ def test_restart_starts_a_same_campaign_file_over_and_force_keeps_its_meaning(tm
         assert "marker" not in f.attrs  # a new file
 
 
+@pytest.mark.slow
 def test_an_idle_worker_gets_its_next_chunk_before_the_runner_writes(tmp_path):
     """The pool hands a finished chunk to its caller (who writes it to HDF5) only once the worker
     that flew it has its next chunk: workers never wait for the writer."""

@@ -6,6 +6,7 @@ import textwrap
 
 import h5py
 import numpy as np
+import pytest
 from conftest import ROOT, cli
 
 # an object whose finaliser runs only in the interpreter's teardown: it says whether the teardown ran
@@ -75,6 +76,7 @@ def test_a_message_code_is_printed_with_status_1(tmp_path):
     assert "cannot go on" in done.stderr
 
 
+@pytest.mark.slow
 def test_the_console_script_keeps_the_commands_exit_status_and_output(tmp_path):
     bad = cli("report", tmp_path / "none.h5")
     assert bad.returncode == 2 and "no such results file" in bad.stderr

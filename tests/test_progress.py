@@ -54,6 +54,7 @@ def test_report_and_export_log_their_stages_with_percentages(results, tmp_path):
     assert any("(100 %)" in line for line in logged(export.stderr, "surrogate export"))
 
 
+@pytest.mark.slow
 def test_calibrate_logs_the_sampler_steps(results, tmp_path):
     rng = np.random.default_rng(0)
     time = np.linspace(0.0, 1.0, 11)

@@ -230,6 +230,7 @@ def assert_same_estimate(a, b):
                                   [(r.runs, r.probability, r.cov) for r in b.rounds])
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("kind", SMALL)
 def test_same_seed_same_runs_and_estimate_bit_for_bit(kind):
     first, calls = small_run(kind)
@@ -241,6 +242,7 @@ def test_same_seed_same_runs_and_estimate_bit_for_bit(kind):
     assert first.probability > 0.0 and first.method == kind
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("kind", SMALL)
 def test_replayed_values_resume_to_the_same_bits(kind):
     # the runner's resume: the algorithm runs again from the start, and the batches already flown are
@@ -262,6 +264,7 @@ def test_replayed_values_resume_to_the_same_bits(kind):
     assert_same_estimate(whole, again)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("kind", SMALL)
 def test_another_seed_gives_another_estimate(kind):
     assert small_run(kind, seed=0)[0].probability != small_run(kind, seed=1)[0].probability

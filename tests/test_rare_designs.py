@@ -101,6 +101,7 @@ def check_entry(entry: dict, kind: str, names: list[str], runs_at_most: int) -> 
     assert point.sum() / math.sqrt(len(names)) > THRESHOLD
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("kind", ["subset_simulation", "importance_sampling", "active_learning"])
 def test_each_kind_estimates_its_event_end_to_end_through_run_and_report(tmp_path, kind):
     (tmp_path / "r.yaml").write_text(linear_text(kind))
@@ -199,6 +200,7 @@ def test_an_unfinished_rare_event_file_is_refused_by_the_report(quick, tmp_path)
     assert done.returncode == 2 and "has not finished" in done.stderr and "uqflight run" in done.stderr
 
 
+@pytest.mark.slow
 def test_one_worker_and_two_give_the_same_bits_and_another_seed_another_estimate(quick, tmp_path):
     folder, text, one = quick
     two = fly(tmp_path, text, "two", workers=2)

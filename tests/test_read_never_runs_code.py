@@ -133,6 +133,7 @@ def test_calibrate_imports_the_model_only_for_its_predictive_runs(world, tmp_pat
     (world["sentinels"] / "beside").unlink()
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("where", ["../proj/model.py", "{root}/proj/model.py"])
 def test_calibrate_refuses_a_model_that_a_results_file_places_outside_its_folder(world, tmp_path, where):
     """A results file whose stored campaign names its model by a path leading out of its folder (edited, or

@@ -222,6 +222,7 @@ def test_report_never_replaces_what_is_not_an_earlier_report(pg, tmp_path, occup
     assert sorted(str(p) for p in tmp_path.rglob("*")) == before
 
 
+@pytest.mark.slow
 def test_a_relative_out_counts_the_files_written_and_the_baseline_is_the_files_statistics(pg, tmp_path):
     result = cli_in_process("report", pg, "--out", "rel", "--write-baseline", "b.json", cwd=tmp_path)
     assert result.returncode == 0, result.stderr
@@ -246,6 +247,7 @@ def test_an_empty_folder_or_an_earlier_report_may_be_replaced(tmp_path):
         check_replaceable(folder)
 
 
+@pytest.mark.slow
 def test_report_writes_next_to_the_results_file_by_default(decay_results, tmp_path):
     shutil.copy(decay_results.with_suffix(".yaml"), tmp_path)  # the campaign and its file, copied: the report
     results = Path(shutil.copy(decay_results, tmp_path / "decay.h5"))  # is written beside them
@@ -355,6 +357,7 @@ def test_data_files_that_cannot_be_written_fail_the_report_and_leave_nothing(pg,
     _assert_reaped(drawers, report)
 
 
+@pytest.mark.slow
 def test_a_page_module_that_cannot_be_imported_is_the_error_told_and_the_drawer_is_reaped(
         pg, tmp_path, monkeypatch, capfd):
     import sys
@@ -370,6 +373,7 @@ def test_a_page_module_that_cannot_be_imported_is_the_error_told_and_the_drawer_
     _assert_reaped(drawers, report)
 
 
+@pytest.mark.slow
 @pytest.mark.skipif(not hasattr(os, "fork"), reason="the system cannot fork")
 def test_the_reports_own_process_never_imports_matplotlib(pg, tmp_path):
     """The drawer (a child that got ready during the analysis) draws everything: the report's process
@@ -441,6 +445,7 @@ def test_a_figure_that_raises_is_one_line_naming_its_section_with_exit_1(pg, tmp
     assert not (tmp_path / "out").exists()
 
 
+@pytest.mark.slow
 def test_without_a_drawer_the_report_draws_the_same_files_itself(pg, tmp_path, monkeypatch):
     """Where the system cannot fork there is no drawer (report.FORKS): this process draws the sections,
     the same bytes as the drawer's."""

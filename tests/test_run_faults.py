@@ -72,6 +72,7 @@ def test_a_worker_death_on_dask_is_a_failed_run(tmp_path):
     assert_same_results(tmp_path / "d.h5", tmp_path / "l.h5")
 
 
+@pytest.mark.slow
 def test_a_hung_sample_is_stopped_by_its_timeout(tmp_path):
     summary = run_campaign(hostile_campaign("hanging", extra=", timeout_s: 1"), out=tmp_path / "h.h5", workers=2)
     with ResultStore.open(tmp_path / "h.h5") as store:

@@ -20,6 +20,7 @@ def outputs():
             for k, (name, offset) in enumerate((("alpha_deg", 0.0), ("h_ft", 15000.0)))}
 
 
+@pytest.mark.slow
 def test_the_same_png_bytes_in_a_child(tmp_path):
     plots.plot_cov(outputs(), tmp_path / "here.png", "CoV")
     plots.warm_text_caches()

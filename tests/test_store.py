@@ -152,6 +152,7 @@ def test_runs_arriving_out_of_order_land_in_design_order(tmp_path):
             write_runs(store, [[3]])
 
 
+@pytest.mark.slow
 def test_tsvd_factors_do_not_depend_on_the_arrival_order(tmp_path, reference):
     for seed in (2, 3):
         path = tmp_path / f"shuffled{seed}.h5"
