@@ -173,12 +173,14 @@ def test_a_flagged_quantity_is_marked_in_the_headline_and_an_unflagged_page_has_
     quantity = entry.stats.quantities["final_y"]
     quantity.flags.append("band beyond the runs: use least_squares")  # as the analysis flags an expansion's
     quantity.exceedance[0]["flags"].append("band beyond the runs: use least_squares")  # and its draws' fraction
+    quantity.exceedance[0]["note"] += "; band beyond the runs: use least_squares"  # with the flag in its note
     exceedance, key_numbers = headline_section(entry, [float("inf")]).blocks
     header, [(_, rows)] = page_view(key_numbers)
     row = next(row for row in rows if row[0].endswith("final_y"))
     assert row[0] == "⚠ final_y" and row[header.index("flags")] == "band beyond the runs: use least_squares"
     header, [(_, rows)] = page_view(exceedance)
     assert rows[0][0] == "⚠ P(final_y > 5)" and rows[0][header.index("flags")].startswith("band beyond")
+    assert "band beyond" not in rows[0][header.index("note")]  # said once on the page, in its column
 
 
 def test_the_python_api_takes_thresholds_too(campaigns):

@@ -88,9 +88,11 @@ def exceedance_table(entry: Entry) -> Table | None:
             event, flags = event_text(name, item), item["flags"]
             rows.append([entry.label, name, event, item["probability"], item["lower"], item["upper"],
                          item["method"], "; ".join(flags), item["note"]])
+            note = item["note"]
+            for flag in flags:  # on the page, a flag is said once, in its column (the CSV keeps the whole note)
+                note = note.replace(f"; {flag}", "")
             page.append([flagged(event, flags), probability_text(item["probability"]),
-                         interval_text(item["lower"], item["upper"]), item["method"] or "", "; ".join(flags),
-                         item["note"]])
+                         interval_text(item["lower"], item["upper"]), item["method"] or "", "; ".join(flags), note])
     if not rows:
         return None
     return Table(f"Exceedance probabilities of {entry.label}",
