@@ -10,10 +10,9 @@ from typing import List, Optional
 import typer
 
 from ..cli.arguments import check_campaign_file, check_output, check_results_file
-from ..text.console import echo, one_line, shown
+from ..text.console import echo, one_line, refuse, shown
 from ..running.progress import Progress
 
-EXIT_BAD_INPUT = 2
 EXIT_NOT_CONVERGED = 3
 EXIT_INTERRUPTED = 130
 
@@ -72,20 +71,17 @@ def calibrate_command(
     check_output(out, "--out", folder=True, create=True)
     overwritten = foreign_outputs(out)
     if overwritten:
-        echo(f"error: --out {out}: holds {', '.join(overwritten)}, which a calibration would replace and which "
+        refuse(f"--out {out}: holds {', '.join(overwritten)}, which a calibration would replace and which "
              "an earlier calibration did not write (no posterior.h5 of one there); choose another --out, or move "
-             "them away", err=True)
-        raise typer.Exit(EXIT_BAD_INPUT)
+             "them away")
     method, order = _method(method, order)
     if predictive_draws < 1:
-        echo(f"error: --predictive-draws: expected an integer >= 1, got {predictive_draws}", err=True)
-        raise typer.Exit(EXIT_BAD_INPUT)
+        refuse(f"--predictive-draws: expected an integer >= 1, got {predictive_draws}")
     try:  # before the sampler's and the surrogate's modules are even imported: a refusal is immediate
         sigmas = parse_noise(list(noise))
         check_size(data, list(output) or None, walkers, steps, predictive_draws, campaign_memory_limit(results))
     except DataError as exc:
-        echo(f"error: {exc}", err=True)
-        raise typer.Exit(EXIT_BAD_INPUT)
+        refuse(f"{exc}")
     known = _truth(truth, results)
     from ..running.runner import WorkerError
     from .run import NotConverged, SurrogateError, calibrate
@@ -101,11 +97,9 @@ def calibrate_command(
         echo(f"\ninterrupted: no calibration written to {out}", err=True)
         raise typer.Exit(EXIT_INTERRUPTED)
     except (DataError, SurrogateError, ValueError) as exc:
-        echo(f"error: {exc}", err=True)
-        raise typer.Exit(EXIT_BAD_INPUT)
+        refuse(f"{exc}")
     except WorkerError as exc:  # no simulator for the predictive runs (the model cannot be built or hangs)
-        echo(f"error: {results}: the posterior predictive runs cannot be flown: {exc}", err=True)
-        raise typer.Exit(EXIT_BAD_INPUT)
+        refuse(f"{results}: the posterior predictive runs cannot be flown: {exc}")
     except NotConverged as exc:
         echo("not converged: no posterior is reported.", err=True)
         for problem in exc.diagnostics["problems"]:
@@ -159,14 +153,12 @@ def _truth(items: list[str], results: Path) -> dict[str, float] | None:
         with ResultStore.open(results) as store:
             names = list(store.parameter_names)
     except (OSError, ValueError) as exc:  # damaged, or held by another process (the message names it)
-        echo(f"error: {exc}" if str(exc).startswith(str(results)) else f"error: {results}: {exc}", err=True)
-        raise typer.Exit(EXIT_BAD_INPUT)
+        refuse(str(exc) if str(exc).startswith(str(results)) else f"{results}: {exc}")
     try:
         return check_names(parse_pairs(items, "--truth", "NAME=VALUE with a finite VALUE"), "--truth", names,
                            f"the parameters of {results}")
     except DataError as exc:
-        echo(f"error: {exc}", err=True)
-        raise typer.Exit(EXIT_BAD_INPUT)
+        refuse(f"{exc}")
 
 
 def _method(text: str | None, order: int | None) -> tuple[str | None, int | None]:
@@ -178,11 +170,9 @@ def _method(text: str | None, order: int | None) -> tuple[str | None, int | None
             return None, None if order is None else checked_order(order)
         parsed = parse_methods([text], order)[0]
     except ValueError as exc:
-        echo(f"error: {'--method' if text else '--order'}: {exc}", err=True)
-        raise typer.Exit(EXIT_BAD_INPUT)
+        refuse(f"{'--method' if text else '--order'}: {exc}")
     if order is not None and parsed.get("order", order) != order:
-        echo(f"error: --method {text} and --order {order} give two orders: give one", err=True)
-        raise typer.Exit(EXIT_BAD_INPUT)
+        refuse(f"--method {text} and --order {order} give two orders: give one")
     return parsed["kind"], parsed.get("order", order)
 
 

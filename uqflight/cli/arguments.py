@@ -7,9 +7,7 @@ import os
 import stat
 from pathlib import Path
 
-import typer
-
-from ..text.console import echo
+from ..text.console import refuse
 
 CAMPAIGN_KEYS = ("simulator:", "parameters:", "design:")  # lines a campaign file starts
 
@@ -20,8 +18,7 @@ def check_output(path: Path, option: str, folder: bool = False, create: bool = F
     `inputs`: the command's input files, which its output must not replace."""
     problem = output_problem(Path(path), folder, create, inputs)
     if problem:
-        echo(f"error: {option} {path}: {problem}; choose another path", err=True)
-        raise typer.Exit(2)
+        refuse(f"{option} {path}: {problem}; choose another path")
 
 
 def output_problem(path: Path, folder: bool = False, create: bool = False, inputs=()) -> str | None:
@@ -55,8 +52,7 @@ def check_results_file(path: Path) -> None:
     """Exit 2 unless `path` is an HDF5 file, naming what it is instead."""
     problem = results_problem(Path(path))
     if problem:
-        echo(f"error: {problem}", err=True)
-        raise typer.Exit(2)
+        refuse(f"{problem}")
 
 
 def results_problem(path: Path) -> str | None:
@@ -78,9 +74,7 @@ def check_campaign_file(path: Path) -> None:
     import h5py
 
     if Path(path).is_file() and h5py.is_hdf5(path):
-        echo(f"error: {path} is a results file (HDF5), not a campaign file: `uqflight info {path}` describes it",
-             err=True)
-        raise typer.Exit(2)
+        refuse(f"{path} is a results file (HDF5), not a campaign file: `uqflight info {path}` describes it")
 
 
 def is_campaign_text(path: Path) -> bool:

@@ -32,7 +32,7 @@ import typer
 
 from .arguments import check_campaign_file, check_output, check_results_file
 from ..calibration.command import register as register_calibrate
-from ..text.console import echo, listed, one_line, shown
+from ..text.console import EXIT_BAD_INPUT, echo, listed, one_line, refuse, shown
 from ..running import stopping
 from .fast_exit import exit_fast
 from ..running.progress import Progress
@@ -143,8 +143,7 @@ def simulate(
     try:
         check_noise(recorded, sigmas, seed)
     except ValueError as exc:
-        echo(f"error: {exc}", err=True)
-        raise typer.Exit(2)
+        refuse(f"{exc}")
     files = [] if no_files else [(out, "--out"), (plot, "--plot")]
     for path, option in files:
         check_output(path, option, create=path in (DEFAULT_CSV, DEFAULT_PLOT))
@@ -167,8 +166,7 @@ def simulate(
         echo(f"flight failed: {exc}", err=True)
         raise typer.Exit(1)
     except (ValueError, KeyError, FileNotFoundError, RuntimeError) as exc:  # bad input; an aircraft JSBSim refuses
-        echo(f"error: {exc.args[0]}", err=True)
-        raise typer.Exit(2)
+        refuse(f"{exc.args[0]}")
     echo(result.trim.describe())
     if flight.surface_warning:
         echo(f"warning: {flight.surface_warning}", err=True)
@@ -241,8 +239,7 @@ def _load(path: Path):
     try:
         return load_campaign(path, view=validation_view)
     except CampaignError as exc:
-        echo(f"error: {exc}", err=True)
-        raise typer.Exit(2)
+        refuse(f"{exc}")
 
 
 @app.command()
@@ -279,8 +276,7 @@ def plan(campaign_file: Path = typer.Argument(..., metavar="CAMPAIGN", help="Cam
     try:
         timed = timed_nominal(campaign)
     except WorkerError as exc:  # its message says it all (a hang, a crash, a build or nominal failure), as `run`'s
-        echo(f"error: {campaign_file}: {exc}", err=True)
-        raise typer.Exit(2)
+        refuse(f"{campaign_file}: {exc}")
     for warning in timed.warnings:  # e.g. the excitation left the elevator unmoved
         echo(f"warning: the nominal flight: {one_line(warning)}", err=True)
     seconds = timed.seconds
@@ -318,11 +314,9 @@ def run(
     check_output(out or Path(campaign.storage["path"]), "--out" if out else "storage.path", create=True,
                  inputs=[campaign_file])
     if executor not in (None, "local", "dask"):
-        echo(f"error: --executor: expected local or dask, got {executor!r}", err=True)
-        raise typer.Exit(2)
+        refuse(f"--executor: expected local or dask, got {executor!r}")
     if workers is not None and workers < 1:
-        echo(f"error: --workers: expected an integer >= 1, got {workers}", err=True)
-        raise typer.Exit(2)
+        refuse(f"--workers: expected an integer >= 1, got {workers}")
     resume = f"uqflight run {campaign_file}" + (f" --out {out}" if out else "")
     previous = stopping.install()  # SIGINT and SIGTERM stop cleanly, even if a handler's exception is lost
     try:
@@ -332,14 +326,12 @@ def run(
         echo(f"\nerror: {exc.strerror}", err=True)
         _exit_now(2)
     except CorruptFile as exc:  # the fix named with this run's own command
-        echo(f"error: {str(exc).removesuffix(': ' + REFLY)}; `{resume} --restart` starts it over", err=True)
-        raise typer.Exit(2)
+        refuse(f"{str(exc).removesuffix(': ' + REFLY)}; `{resume} --restart` starts it over")
     except IncompleteFile as exc:
         echo(f"error: {exc}", err=True)
         _exit_now(1)
     except (FileExistsError, ValueError, WorkerError) as exc:
-        echo(f"error: {campaign_file}: {exc}", err=True)
-        raise typer.Exit(2)
+        refuse(f"{campaign_file}: {exc}")
     except KeyboardInterrupt as exc:
         code = 143 if isinstance(exc, stopping.Terminated) else 130
         echo(f"\n{'terminated' if code == 143 else 'interrupted'}: the finished runs are stored; "
@@ -379,21 +371,17 @@ def info(results: Path = typer.Argument(..., metavar="RESULTS", help="Results fi
             writer = {"locked": True}
             store = ResultStore.open(results, while_written=True)
     except CorruptFile as exc:
-        echo(f"error: {exc}", err=True)
-        raise typer.Exit(2)
+        refuse(f"{exc}")
     except (OSError, ValueError) as exc:
         retry = "; it is being written: try again in a moment" if writer else ""
-        echo(f"error: {results}: {read_error(exc)}{retry}", err=True)
-        raise typer.Exit(2)
+        refuse(f"{results}: {read_error(exc)}{retry}")
     with store:
         try:
             _describe_results(results, store, Status)
         except CorruptFile as exc:  # a part read on the way (an adaptive grid's state)
-            echo(f"error: {exc}", err=True)
-            raise typer.Exit(2)
+            refuse(f"{exc}")
         except OSError as exc:
-            echo(f"error: {results}: {read_error(exc)}", err=True)
-            raise typer.Exit(2)
+            refuse(f"{results}: {read_error(exc)}")
 
 
 def _describe_results(results, store, Status) -> None:
@@ -430,7 +418,7 @@ def _describe_results(results, store, Status) -> None:
     if "aircraft_hash" in attrs:
         echo(f"aircraft sha256: {one_line(str(attrs['aircraft_hash']))}")
     if problems:
-        raise typer.Exit(2)
+        raise typer.Exit(EXIT_BAD_INPUT)
 
 
 @app.command()
@@ -516,11 +504,9 @@ def report(
                                    method=overrides or None, progress=progress, partial=partial,
                                    allow_aliasing=allow_aliasing, fmt=figure_format, exceedance=thresholds or None)
     except BadInput as exc:
-        echo(f"error: {exc}", err=True)
-        raise typer.Exit(2)
+        refuse(f"{exc}")
     except OSError as exc:
-        echo(f"error: cannot write the report: {exc}", err=True)
-        raise typer.Exit(2)
+        refuse(f"cannot write the report: {exc}")
     except DrawingFailed as exc:  # uqflight's own failure, not the input's: its traceback is above
         echo(f"error: {exc}; no report written ({out} unchanged)", err=True)
         raise typer.Exit(1)
@@ -546,9 +532,8 @@ def _check_quantities(thresholds: dict, results: list[Path]) -> None:
             continue
         unknown = [name for name in thresholds if name not in names]
         if unknown:
-            echo(f"error: --exceedance: {path} has no quantity {unknown[0]!r}; its quantities: "
-                 f"{', '.join(names) or 'none (the campaign has no quantities: mapping)'}", err=True)
-            raise typer.Exit(2)
+            refuse(f"--exceedance: {path} has no quantity {unknown[0]!r}; its quantities: "
+                 f"{', '.join(names) or 'none (the campaign has no quantities: mapping)'}")
 
 
 def _check_times(text: str, selected: list[float], results: list[Path]) -> None:
@@ -567,10 +552,9 @@ def _check_times(text: str, selected: list[float], results: list[Path]) -> None:
         half = (time[-1] - time[0]) / max(len(time) - 1, 1) / 2
         outside = [t for t in selected if np.isfinite(t) and not time[0] - half <= t <= time[-1] + half]
         if outside:
-            echo(f"error: --times {text}: {', '.join(f'{t:g}' for t in outside)} s outside the flight of {path}, "
+            refuse(f"--times {text}: {', '.join(f'{t:g}' for t in outside)} s outside the flight of {path}, "
                  f"which records {shown_time(time, 0):g} to {shown_time(time, -1):g} s; choose times in that range "
-                 "or 'end'", err=True)
-            raise typer.Exit(2)
+                 "or 'end'")
 
 
 @app.command()
@@ -601,8 +585,7 @@ def design(
             with open(csv_path, "w", newline="") as fh:
                 csv.writer(fh).writerows(rows)
         except OSError as exc:
-            echo(f"error: cannot write {csv_path}: {exc.strerror}", err=True)
-            raise typer.Exit(2)
+            refuse(f"cannot write {csv_path}: {exc.strerror}")
     echo(f"wrote {'the design' if to_stdout else csv_path}: {len(points.xi)} points of a {points.kind} design in "
          f"{len(names)} parameters ({listed(names)})", err=to_stdout)
 
@@ -632,11 +615,9 @@ def surrogate_export(
         with Progress(0, label="surrogate export") as progress:
             export(results, out, override, progress)
     except (SurrogateError, BadInput) as exc:
-        echo(f"error: {exc}", err=True)
-        raise typer.Exit(2)
+        refuse(f"{exc}")
     except (OSError, KeyError, ValueError) as exc:
-        echo(f"error: {results}: cannot export the surrogate ({' '.join(str(exc).split())})", err=True)
-        raise typer.Exit(2)
+        refuse(f"{results}: cannot export the surrogate ({' '.join(str(exc).split())})")
     echo(f"wrote {out}")
 
 
@@ -666,21 +647,18 @@ def check(
     from ..analysis.statistics import BadInput, read_statistics
 
     if rtol < 0 or atol < 0:
-        echo("error: --rtol and --atol must be >= 0", err=True)
-        raise typer.Exit(2)
+        refuse("--rtol and --atol must be >= 0")
     check_results_file(results)
     try:
         expected = load_baseline(baseline)
         stats, attrs = read_statistics(results, partial=partial)
         comparison = compare(stats, expected, rtol, atol)
     except BadInput as exc:
-        echo(f"error: {exc}", err=True)
-        raise typer.Exit(2)
+        refuse(f"{exc}")
     if expected.get("campaign_hash") and expected["campaign_hash"] != attrs.get("campaign_hash"):
-        echo(f"error: {results} comes from another campaign (sha256 {one_line(str(attrs.get('campaign_hash'))[:12])}) "
+        refuse(f"{results} comes from another campaign (sha256 {one_line(str(attrs.get('campaign_hash'))[:12])}) "
              f"than the baseline {baseline} ({str(expected['campaign_hash'])[:12]}): compare a results file "
-             "with the baseline of its own campaign", err=True)
-        raise typer.Exit(2)
+             "with the baseline of its own campaign")
     if comparison.drifts:
         echo(f"drift: {len(comparison.drifts)} of {comparison.compared} values outside "
              f"rtol={rtol:g}, atol={atol:g}")
@@ -712,8 +690,7 @@ def aircraft_command(
     try:
         located = _prepared(aircraft, [], [])
     except (ValueError, FileNotFoundError) as exc:
-        echo(f"error: {exc}", err=True)
-        raise typer.Exit(2)
+        refuse(f"{exc}")
     files = AircraftFiles.read(located.location)
     echo(f"aircraft: {located.name} ({located.location.origin}: {located.location.folder})")
     echo(f"files: {len(files.files)} XML, sha256 {files.hash()}")
@@ -732,8 +709,7 @@ def aircraft_command(
     try:
         flight = JSBSimFlight(setup)
     except (RuntimeError, FileNotFoundError) as exc:
-        echo(f"error: {exc}", err=True)
-        raise typer.Exit(2)
+        refuse(f"{exc}")
     echo("engines:")
     for i, (name, kind, thruster) in enumerate(engine_kinds(flight.fdm)):
         echo(f"  {i}: {shown(name):<24} {shown(kind):<10} thruster: {shown(thruster)}")

@@ -7,9 +7,11 @@ from __future__ import annotations
 import os
 import re
 import sys
+from typing import NoReturn
 
 CONTROL = re.compile("[\x00-\x08\x0b-\x1f\x7f-\x9f]")  # C0 but tab and newline, DEL, C1
 EXIT_CLOSED_PIPE = 141  # 128 + SIGPIPE
+EXIT_BAD_INPUT = 2  # a refusal: the input is wrong, nothing was done
 
 
 def clean(text: str) -> str:
@@ -49,6 +51,15 @@ def echo(message: object = "", err: bool = False, nl: bool = True) -> None:
     except BrokenPipeError:
         discard_output(sys.stderr if err else sys.stdout)
         raise typer.Exit(EXIT_CLOSED_PIPE) from None
+
+
+def refuse(message: str) -> NoReturn:
+    """A command's refusal of its input: "error: MESSAGE" on one line of standard error, and exit
+    EXIT_BAD_INPUT (2). Every command refuses through it."""
+    import typer
+
+    echo(f"error: {message}", err=True)
+    raise typer.Exit(EXIT_BAD_INPUT)
 
 
 def discard_output(stream) -> None:
