@@ -11,8 +11,8 @@
     /rare_event/design_point (d,)          ... in physical values κ (NaN everywhere when no run failed)
     /rare_event/importance (d,)            each input's share α_k² of it (summing to 1)
 
-Written once, when the algorithm returns (as /rare_event_next, then moved in place: a kill leaves no
-half-written estimate). A file without it holds rounds of a design that has not finished.
+Written once, when the algorithm returns (store.staged: as /rare_event_next, then moved in place: a kill
+leaves no half-written estimate). A file without it holds rounds of a design that has not finished.
 """
 from __future__ import annotations
 
@@ -21,7 +21,9 @@ import json
 import h5py
 import numpy as np
 
-GROUP, STAGED = "rare_event", "rare_event_next"
+from .staged import current_group, replace_group
+
+GROUP = "rare_event"
 NUMBERS = ("threshold", "probability", "lower", "upper", "cov", "beta")
 COUNTS = ("budget", "runs", "failed")
 TEXTS = ("method", "of", "side", "stopped")
@@ -32,28 +34,22 @@ MAX_NOTES_BYTES = 1 << 16
 
 def write_rare_event(f: h5py.File, record: dict) -> None:
     """Record the estimate (see the module docstring), replacing any."""
-    if STAGED in f:
-        del f[STAGED]
-    staged = f.create_group(STAGED)
-    for key in (*ROUND_ARRAYS, "batch_end", *POINT_ARRAYS):
-        staged.create_dataset(key, data=np.asarray(record[key]))
-    staged.attrs.update({key: record[key] for key in (*NUMBERS, *COUNTS, *TEXTS)})
-    staged.attrs["notes"] = json.dumps(record["notes"])
-    staged.attrs["description"] = ("rare-event design: the probability of the event (of above or below threshold), "
-                                   "its 95 % interval, c.o.v., the rounds and the most probable failure point")
-    staged.attrs["complete"] = True
-    f.flush()
-    if GROUP in f:
-        del f[GROUP]
-    f.move(STAGED, GROUP)
-    del f[GROUP].attrs["complete"]
+    def fill(staged: h5py.Group) -> None:
+        for key in (*ROUND_ARRAYS, "batch_end", *POINT_ARRAYS):
+            staged.create_dataset(key, data=np.asarray(record[key]))
+        staged.attrs.update({key: record[key] for key in (*NUMBERS, *COUNTS, *TEXTS)})
+        staged.attrs["notes"] = json.dumps(record["notes"])
+        staged.attrs["description"] = ("rare-event design: the probability of the event (of above or below "
+                                       "threshold), its 95 % interval, c.o.v., the rounds and the most probable "
+                                       "failure point")
+
+    replace_group(f, GROUP, fill)
 
 
 def read_rare_event(f: h5py.File, n: int, d: int) -> dict | None:
     """The recorded estimate, or None when the file holds none; ValueError naming what is wrong when the group
     is not such a record (`n` runs and `d` parameters bound its arrays)."""
-    staged = f.get(STAGED)
-    group = staged if isinstance(staged, h5py.Group) and staged.attrs.get("complete", False) else f.get(GROUP)
+    group = current_group(f, GROUP)
     if group is None:
         return None
     if not isinstance(group, h5py.Group):

@@ -7,9 +7,8 @@
     attributes: rounds, stopped ("" while refining; "budget", "tolerance", "levels" or "failed"),
                 eta (Σ of the active indicators when last computed)
 
-The group is replaced whole: written as /design_next, marked complete, then moved in place; a reader
-prefers a complete /design_next (a writer killed before the move), so a kill leaves the old or the new
-state, never a mix.
+The group is replaced whole (store.staged: written as /design_next, marked complete, then moved in place;
+a reader prefers a complete /design_next), so a kill leaves the old or the new state, never a mix.
 """
 from __future__ import annotations
 
@@ -17,14 +16,14 @@ import h5py
 import numpy as np
 
 from ..designs.adaptive import IndexSet
+from .staged import current_group, replace_group
 
-GROUP, STAGED = "design", "design_next"
+GROUP = "design"
 
 
 def read_index_set(f: h5py.File) -> IndexSet | None:
     """The state recorded in `f`, or None when the file holds none."""
-    staged = f.get(STAGED)
-    group = staged if staged is not None and staged.attrs.get("complete", False) else f.get(GROUP)
+    group = current_group(f, GROUP)
     if group is None:
         return None
     indices = [tuple(int(level) for level in row) for row in group["index_set"][()]]
@@ -35,20 +34,14 @@ def read_index_set(f: h5py.File) -> IndexSet | None:
 
 def write_index_set(f: h5py.File, state: IndexSet) -> None:
     """Replace the recorded state by `state` (see the module docstring)."""
-    if STAGED in f:
-        del f[STAGED]
-    staged = f.create_group(STAGED)
-    d = len(state.indices[0])
-    staged.create_dataset("index_set", data=np.array(state.indices, dtype=np.int64).reshape(-1, d))
-    staged.create_dataset("old", data=np.array(state.old, dtype=np.int8))
-    staged.create_dataset("round", data=np.array(state.added, dtype=np.int64))
-    staged.create_dataset("indicator", data=np.array(state.indicator, dtype=float))
-    staged.attrs.update({"rounds": state.rounds, "stopped": state.stopped, "eta": state.eta,
-                         "description": "adaptive sparse grid: multi-indices (1-D levels from 0), refined (old) "
-                                        "or active, the round that added each and its error indicator"})
-    staged.attrs["complete"] = True
-    f.flush()
-    if GROUP in f:
-        del f[GROUP]
-    f.move(STAGED, GROUP)
-    del f[GROUP].attrs["complete"]
+    def fill(staged: h5py.Group) -> None:
+        d = len(state.indices[0])
+        staged.create_dataset("index_set", data=np.array(state.indices, dtype=np.int64).reshape(-1, d))
+        staged.create_dataset("old", data=np.array(state.old, dtype=np.int8))
+        staged.create_dataset("round", data=np.array(state.added, dtype=np.int64))
+        staged.create_dataset("indicator", data=np.array(state.indicator, dtype=float))
+        staged.attrs.update({"rounds": state.rounds, "stopped": state.stopped, "eta": state.eta,
+                             "description": "adaptive sparse grid: multi-indices (1-D levels from 0), refined (old) "
+                                            "or active, the round that added each and its error indicator"})
+
+    replace_group(f, GROUP, fill)
