@@ -9,7 +9,7 @@ import numpy as np
 from uqflight.designs.adaptive import IndexSet
 from uqflight.store.rare import read_rare_event, write_rare_event
 from uqflight.store.rounds import read_index_set, write_index_set
-from uqflight.store.staged import staged_names
+from uqflight.store.staged import staged_keys
 
 
 def _damage_a_staged_group(path, name: str) -> None:
@@ -41,7 +41,7 @@ def test_an_index_set_is_replaced_past_a_staged_group_a_kill_left_unreadable(tmp
         write_index_set(f, _state(3))
     with h5py.File(path, "r") as f:
         assert read_index_set(f) == _state(3)
-        assert staged_names(f, "design") == ["design_next"]  # the damaged link alone is left
+        assert staged_keys(f, "design_next") == ["design_next"]  # the damaged link alone is left
 
 
 def test_a_rare_event_record_is_written_past_a_damaged_staged_group(tmp_path):
@@ -60,3 +60,24 @@ def test_a_rare_event_record_is_written_past_a_damaged_staged_group(tmp_path):
     with h5py.File(path, "r") as f:
         found = read_rare_event(f, 4, 2)
     assert found["probability"] == 0.25 and found["stopped"] == "converged"
+
+
+def test_tsvd_factors_are_committed_past_a_damaged_staged_group(tmp_path):
+    from uqflight.store.compressed import apply_staged, commit
+    from uqflight.store.tsvd import IncrementalSVD
+
+    path = tmp_path / "r.h5"
+    U, s, V = np.eye(3, 2), np.array([2.0, 1.0]), np.eye(2)
+    with h5py.File(path, "w") as f:
+        f.create_group("tsvd").attrs["batch"] = 4
+        commit(f["tsvd"].create_group("y"), IncrementalSVD.from_factors(U, s, V, 0.0), np.arange(2),
+               np.zeros((0, 3)), np.zeros(0, dtype=np.int64))
+    _damage_a_staged_group(path, "tsvd/y/next")
+    with h5py.File(path, "r+") as f:
+        group = f["tsvd/y"]
+        apply_staged(group)  # reopening mends: the damaged link is no complete step, left as it is
+        commit(group, IncrementalSVD.from_factors(U, 3 * s, V, 0.0), np.arange(2), np.zeros((0, 3)),
+               np.zeros(0, dtype=np.int64))
+    with h5py.File(path, "r") as f:
+        np.testing.assert_array_equal(f["tsvd/y/s"][()], 3 * s)
+        assert staged_keys(f["tsvd/y"], "next") == ["next"]

@@ -5,9 +5,9 @@ the truncation tolerance tol and the fold size batch).
 The buffer takes the runs as they come; the runs are folded into the factors in design order, `batch`
 columns at a time, only over the contiguous completed prefix (and the last partial batch once no run is
 pending), with one BLAS thread, so the factors depend neither on the workers nor on interruptions.
-An output's factors and buffer are replaced together: written into `/tsvd/<name>/next`, marked
-complete, flushed, then moved in place; `apply_staged` finishes or discards such a half-done step when
-the file is reopened, so a killed writer leaves either the old or the new state.
+An output's factors and buffer are replaced together: written into `/tsvd/<name>/next` (store.staged),
+marked complete, flushed, then moved in place; `apply_staged` finishes or discards such a half-done step
+when the file is reopened, so a killed writer leaves either the old or the new state.
 """
 from __future__ import annotations
 
@@ -20,7 +20,10 @@ from threadpoolctl import threadpool_limits
 from ..simulators.base import Status
 from .tsvd import IncrementalSVD, iter_column_blocks
 from .chunks import chunk_rows
+from .staged import COMPLETE, complete_staged, drop_staged, new_staged
 from .storage import OutputStorage, key_of, name_of
+
+STAGED = "next"  # an output's staged factors and buffer (store.staged)
 
 
 def ingest(svd: IncrementalSVD, rows: np.ndarray, batch: int) -> None:
@@ -65,12 +68,11 @@ def write_state(group: h5py.Group, svd: IncrementalSVD, columns, rows, index) ->
 
 
 def commit(group: h5py.Group, svd: IncrementalSVD, columns, rows, index) -> None:
-    """Replace an output's factors and buffer together: staged in `next`, marked complete, moved in."""
-    if "next" in group:
-        del group["next"]
-    staged = group.create_group("next")
+    """Replace an output's factors and buffer together: staged in `next` (store.staged), marked complete,
+    moved in."""
+    staged = new_staged(group, STAGED)
     write_state(staged, svd, columns, rows, index)
-    staged.attrs["complete"] = True
+    staged.attrs[COMPLETE] = True
     group.file.flush()
     apply_staged(group)
     group.file.flush()
@@ -78,15 +80,13 @@ def commit(group: h5py.Group, svd: IncrementalSVD, columns, rows, index) -> None
 
 def apply_staged(group: h5py.Group) -> None:
     """Move a complete staged state in place (also after a kill half-way through); drop an incomplete one."""
-    staged = group.get("next")
-    if staged is None:
-        return
-    if staged.attrs.get("complete", False):
+    staged = complete_staged(group, STAGED)
+    if staged is not None:
         for key in list(staged):
             if key in group:
                 del group[key]
-            group.move(f"next/{key}", key)
-    del group["next"]
+            group.move(f"{staged.name}/{key}", key)
+    drop_staged(group, STAGED)
 
 
 class TsvdStorage(OutputStorage):

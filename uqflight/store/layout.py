@@ -11,6 +11,7 @@ import h5py
 import numpy as np
 
 from ..designs.adaptive import STOP_REASONS
+from .staged import staged_keys
 
 KINDS = {"float": "f", "integer": "iu"}
 # Beyond any campaign (limits.max_runs defaults to 10^6), and beyond what a reader can hold in memory:
@@ -173,7 +174,7 @@ def _tsvd_problems(f: h5py.File, group: h5py.Group, n: int, n_times, problems: l
             problems.append(f"/tsvd/{key} is not a group of factors")
             continue
         path = f"tsvd/{key}"
-        if "next" in group[key] and not {"U", "s", "V"} <= set(group[key]):
+        if staged_keys(group[key], "next") and not {"U", "s", "V"} <= set(group[key]):
             problems.append(f"/{path} is half replaced (its writer was killed): resume the run to finish the step")
             continue
         U = _dataset(f, f"{path}/U", "float", (n_times, None), problems)

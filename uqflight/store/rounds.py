@@ -8,7 +8,7 @@
                 eta (Σ of the active indicators when last computed)
 
 The group is replaced whole (store.staged: written as /design_next, marked complete, then moved in place;
-a reader prefers a complete /design_next), so a kill leaves the old or the new state, never a mix.
+a reader prefers a complete staged group), so a kill leaves the old or the new state, never a mix.
 """
 from __future__ import annotations
 
