@@ -1,5 +1,5 @@
-"""The report's reading of a results file: the campaign text it stores (report.loading.campaign_settings), and
-the file opened once to analyse it."""
+"""Reading a results file: the campaign text it stores (report.loading.campaign_settings), the file opened
+once per command, and the campaign checked once per command."""
 import os
 from pathlib import Path
 
@@ -61,3 +61,30 @@ def test_a_report_opens_its_results_file_once_and_its_drawing_processes_never(tm
     written = write_report([results], tmp_path / "report")
     assert log.read_text().splitlines() == [f"{os.getpid()} {results}"]
     assert {"design_c.png", "scatter_c.png"} <= {path.name for path in written}  # y has one time: no spaghetti
+
+
+def test_each_command_checks_the_campaign_once(tmp_path, monkeypatch):
+    # the campaign text through the schema (build_campaign: run, and the parameters a reader shows) and the
+    # stored attributes (recorded_setup: what the analysis reads) once per command, not once per reader
+    from collections import Counter
+
+    import uqflight.analysis.statistics as statistics
+    import uqflight.campaign as campaign
+    import uqflight.campaign.reading as reading
+    from uqflight.campaign import load_campaign
+    from uqflight.running.runner import run_campaign
+
+    calls = Counter()
+    for module, name in ((statistics, "recorded_setup"), (reading, "build_campaign"), (campaign, "build_campaign")):
+        def counted(*args, _name=name, _original=getattr(module, name), **kwargs):
+            calls[_name] += 1
+            return _original(*args, **kwargs)
+        monkeypatch.setattr(module, name, counted)
+    (tmp_path / "c.yaml").write_text(LINEAR)
+    run_campaign(load_campaign(tmp_path / "c.yaml"), out=tmp_path / "c.h5", workers=1)
+    assert calls == {"build_campaign": 1}
+    for command in (lambda: write_report([tmp_path / "c.h5"], tmp_path / "report"),
+                    lambda: fit_surrogate(tmp_path / "c.h5")):
+        calls.clear()
+        command()
+        assert calls == {"recorded_setup": 1, "build_campaign": 1}

@@ -262,8 +262,9 @@ def analyse(path, reference: str | None = None, options: Options | None = None, 
 
 def analyse_store(store: ResultStore, path, reference: str | None = None, options: Options | None = None,
                   method: dict | None = None, partial: bool = False, allow_aliasing: bool = False, progress=None,
-                  exceedance: dict | None = None) -> Statistics:
+                  exceedance: dict | None = None, setup: RecordedSetup | None = None) -> Statistics:
     """All statistics of the open results file `store` read from `path` (and errors against `reference`).
+    `setup`: the file's checked setup (`file_setup`) when the caller has it already, so that it is checked once.
 
     `method` ({"kind", "order", "split"}) overrides the campaign's: the runs of one grid serve every
     method, so methods and orders are compared on the same runs. `partial` analyses a file with pending
@@ -276,7 +277,7 @@ def analyse_store(store: ResultStore, path, reference: str | None = None, option
     # one BLAS thread: the matrices are tall and thin (runs or draws × terms), where several threads are no
     # faster, and 10-20x slower on a loaded machine; the time blocks run in threads instead
     with threadpool_limits(limits=1):
-        setup = file_setup(store, path)
+        setup = file_setup(store, path) if setup is None else setup
         germs, analysis = setup.germs, setup.analysis
         method = {"order": DEFAULT_ORDER, **normalised(setup.method), **normalised(method or {})}
         allow_aliasing = allow_aliasing or bool(method.get("allow_aliasing"))

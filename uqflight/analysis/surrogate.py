@@ -113,7 +113,8 @@ def fit_surrogate(path, method: dict | None = None, partial: bool = False, allow
         if isinstance(kind, str) and kind in METHODS:  # else analyse_store refuses
             override["kind"] = METHODS[kind].exported_kind(DESIGNS[design_kind].sampled)
         stats = analyse_store(store, path, method=override, partial=partial, allow_aliasing=allow_aliasing,
-                              options=options or Options(band_samples=200, bootstrap=0), progress=progress)
+                              options=options or Options(band_samples=200, bootstrap=0), progress=progress,
+                              setup=setup)
     pces = {name: out.pce for name, out in stats.outputs.items()}
     units = {name: out.units for name, out in stats.outputs.items()}  # the simulator's, else from the name
     dependence = {k: v for k, v in stats.dependence.items() if k != "sobol_of"} if stats.dependence else None
