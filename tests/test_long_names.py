@@ -6,7 +6,7 @@ import shutil
 import pytest
 from conftest import cli_in_process
 
-from uqflight.text.console import shown
+from uqflight.text.console import quoted_name
 from uqflight.report.loading import bounded
 
 LONG = "L" * 300
@@ -110,5 +110,5 @@ def test_info_lists_names_one_entry_each(folder):
     assert done.returncode == 0, done.stderr
     [outputs] = [line for line in done.stdout.splitlines() if line.startswith("outputs:")]
     assert "alpha_deg, 'y\\noutputs: forged' (5 times" in outputs
-    assert [shown(n) for n in ("a_b", "a, b", " a", "it's", "\x1b[2J", "")] == \
+    assert [quoted_name(n) for n in ("a_b", "a, b", " a", "it's", "\x1b[2J", "")] == \
            ["a_b", "'a, b'", "' a'", '"it\'s"', "'\\x1b[2J'", "''"]

@@ -17,9 +17,8 @@ from pathlib import Path
 import numpy as np
 
 from ..text.bounded import Refused, read_bounded
-from ..campaign.schema import shown
 from ..text.console import listed
-from ..text.console import shown as shown_name
+from ..text.console import quoted_name, quoted_value
 from ..text.json_text import json_text
 from .statistics import BadInput, Statistics, json_ready
 
@@ -115,23 +114,23 @@ def load_baseline(path: Path) -> dict:
     rewrite = "write one with `uqflight report RESULTS.h5 --out DIR --write-baseline FILE`"
     if data.get("version") != BASELINE_VERSION:
         raise BadInput(f"{path}: version: expected {BASELINE_VERSION} (the baselines this uqflight writes), got "
-                       f"{shown(data.get('version'))}; {rewrite}")
+                       f"{quoted_value(data.get('version'))}; {rewrite}")
     if not isinstance(data.get("campaign_hash"), str) or not re.fullmatch(r"[0-9a-f]{64}", data["campaign_hash"]):
         raise BadInput(f"{path}: campaign_hash: expected the sha256 of the campaign the baseline was written from "
-                       f"(64 hex digits), got {shown(data.get('campaign_hash'))}: without it, a file of "
+                       f"(64 hex digits), got {quoted_value(data.get('campaign_hash'))}: without it, a file of "
                        f"another campaign could pass; {rewrite}")
     outputs = data.get("outputs")
     if not isinstance(outputs, dict) or not outputs:
         raise BadInput(f"{path}: outputs: expected a non-empty mapping of output names to statistics")
     for name, entry in outputs.items():
-        _check_entry(f"{path}: outputs.{shown_name(name)}", entry)
+        _check_entry(f"{path}: outputs.{quoted_name(name)}", entry)
     quantities = data.get("quantities")
     if not isinstance(quantities, dict):
         raise BadInput(f"{path}: quantities: expected a mapping of quantity names to statistics ({{}} without "
-                       f"quantities), got {shown(quantities)}; {rewrite}")
+                       f"quantities), got {quoted_value(quantities)}; {rewrite}")
     for name, entry in quantities.items():
         if entry is not None:  # undefined in every run
-            _check_entry(f"{path}: quantities.{shown_name(name)}", entry)
+            _check_entry(f"{path}: quantities.{quoted_name(name)}", entry)
     return data
 
 
@@ -192,7 +191,7 @@ def _compare_section(what: str, fresh: dict, expected: dict, rtol: float, atol: 
         plural = {"output": "outputs", "quantity": "quantities"}[what]
         raise BadInput(f"the baseline is for {plural} {listed(expected) or '-'}; the results have "
                        f"{listed(fresh) or '-'}")
-    label = shown_name if what == "output" else (lambda name: f"quantity {shown_name(name)}")
+    label = quoted_name if what == "output" else (lambda name: f"quantity {quoted_name(name)}")
     compared, drifts = 0, []
     for name, entry in expected.items():
         if entry is None or fresh[name] is None:
@@ -202,12 +201,12 @@ def _compare_section(what: str, fresh: dict, expected: dict, rtol: float, atol: 
             compared += 1
             continue
         time = np.asarray(fresh[name]["time"])
-        _check_time_grid(f"{what} {shown_name(name)}", time, np.asarray(entry["time"], dtype=float))
+        _check_time_grid(f"{what} {quoted_name(name)}", time, np.asarray(entry["time"], dtype=float))
         values, reference = _series(fresh[name]), _series(entry)
         if set(values) != set(reference):
             only_baseline = listed(sorted(set(reference) - set(values))) or "-"
             only_results = listed(sorted(set(values) - set(reference))) or "-"
-            raise BadInput(f"{what} {shown_name(name)}: the baseline has statistics {only_baseline} that the results "
+            raise BadInput(f"{what} {quoted_name(name)}: the baseline has statistics {only_baseline} that the results "
                            f"lack, the results {only_results} that the baseline lacks (another method or parameters?)")
         for statistic, baseline_values in reference.items():
             value = np.asarray(values[statistic], dtype=float)

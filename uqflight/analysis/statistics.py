@@ -48,7 +48,7 @@ from .sobol import NEGLIGIBLE, UNRESOLVED_WIDTH, complete_rows, pick_freeze_indi
 from ..campaign.attributes import RecordedSetup, recorded_setup, stored_settings
 from ..campaign.schema import CampaignError
 from ..quantities import quantity_unit
-from ..text.console import shown
+from ..text.console import quoted_name
 from ..designs import REGISTRY as DESIGNS
 from ..designs.adaptive import index_set_summary
 from ..text.labels import name_unit
@@ -60,7 +60,7 @@ from ..methods.validity import method_problem
 from ..parameters.distributions import SEED_REFUSAL
 from ..parameters.germs import draw_germs
 from ..store import CorruptFile, LockHeld, ResultStore, Status
-from ..store.results import one_line
+from ..store.results import error_line
 
 PDF_POINTS = 120
 TIME_BLOCK = 100  # recorded times whose runs or surrogate draws are rebuilt at once
@@ -248,7 +248,7 @@ def read_statistics(path, method: dict | None = None, partial: bool = False,
     except LockHeld as exc:  # names the file and the process holding it
         raise BadInput(str(exc)) from exc
     except (OSError, ValueError, KeyError) as exc:
-        raise BadInput(f"{path}: cannot analyse the results file ({one_line(exc)})") from exc
+        raise BadInput(f"{path}: cannot analyse the results file ({error_line(exc)})") from exc
 
 
 def analyse(path, reference: str | None = None, options: Options | None = None, method: dict | None = None,
@@ -452,7 +452,7 @@ def output_basis(store: ResultStore, name: str, ok: np.ndarray,
         histories = store.output_matrix(name, runs)
         bad = runs[~np.isfinite(histories).all(axis=1)]
         if bad.size:
-            raise CorruptFile(f"output {shown(name)}: {bad.size} runs with status ok hold values that are not finite "
+            raise CorruptFile(f"output {quoted_name(name)}: {bad.size} runs with status ok hold values that are not finite "
                               f"(e.g. run {bad[0]}): the file is damaged (`uqflight info` lists its problems)")
         problem = too_large("output", name, float(np.abs(histories).max(initial=0.0)))
         if problem:
@@ -460,7 +460,7 @@ def output_basis(store: ResultStore, name: str, ok: np.ndarray,
         return _unwrapped(histories, period, name, unwrapped, histories), None
     U, s, V, columns = factors
     if not (np.isfinite(U).all() and np.isfinite(s).all() and np.isfinite(V).all()):
-        raise CorruptFile(f"output {shown(name)}: its tSVD factors hold values that are not finite: the file is damaged")
+        raise CorruptFile(f"output {quoted_name(name)}: its tSVD factors hold values that are not finite: the file is damaged")
     row_of = np.full(ok.size, -1)
     row_of[columns] = np.arange(columns.size)
     basis, scale = V[row_of[np.flatnonzero(ok)]], s[:, None] * U.T

@@ -24,7 +24,7 @@ import numpy as np
 
 from ..text.bounded import read_bounded
 from ..text.console import listed
-from ..text.console import shown as shown_name
+from ..text.console import quoted_name, quoted_value
 
 FORMAT = "uqflight-pce"
 VERSION = 1
@@ -134,7 +134,7 @@ def _copula(dependence: dict | None):
         raise ValueError(f"dependence.kind: expected one of {', '.join(KINDS)}")
     names, rows = dependence.get("parameters"), dependence.get("correlation")
     if not isinstance(names, list) or not all(isinstance(n, str) for n in names):
-        raise ValueError(f"dependence.parameters: expected a list of parameter names, got {_shown(names)}")
+        raise ValueError(f"dependence.parameters: expected a list of parameter names, got {quoted_value(names)}")
     try:
         return GaussianCopula(tuple(names), _array(rows, "dependence.correlation", (len(names), len(names))))
     except ValueError as exc:
@@ -231,10 +231,10 @@ def _checked(data: dict) -> Surrogate:
     from ..parameters.germs import GERMS
 
     if data.get("version") != VERSION:
-        raise ValueError(f"version: expected {VERSION}, got {_shown(data.get('version'))}")
+        raise ValueError(f"version: expected {VERSION}, got {quoted_value(data.get('version'))}")
     germs = data["germs"]
     if not isinstance(germs, list) or not germs or not all(isinstance(g, str) for g in germs):
-        raise ValueError(f"germs: expected a list of names ({', '.join(GERMS)}), got {_shown(germs)}")
+        raise ValueError(f"germs: expected a list of names ({', '.join(GERMS)}), got {quoted_value(germs)}")
     unknown = [g for g in germs if g not in GERMS]
     if unknown:
         raise ValueError(f"germs: unknown {unknown} (known: {', '.join(GERMS)})")
@@ -247,21 +247,21 @@ def _checked(data: dict) -> Surrogate:
     for j, p in enumerate(parameters):  # their laws map κ to ξ: built once here so that a bad one is refused now
         for key in ("name", "distribution", "property"):
             if not isinstance(p.get(key, ""), str):
-                raise ValueError(f"parameters[{j}].{key}: expected a string, got {_shown(p[key])}")
+                raise ValueError(f"parameters[{j}].{key}: expected a string, got {quoted_value(p[key])}")
         for key in ("lower", "upper", "nominal"):
             _number(p[key], f"parameters[{j}].{key}")
         law = Parameter(p["name"], p.get("property", p["name"]), p["distribution"], p["nominal"], p["lower"],
                         p["upper"])
         germ = "normal" if copula is not None and law.name in copula.names else law.germ
         if germ != germs[j]:
-            raise ValueError(f"parameters[{j}] ({shown_name(p['name'])}): a {p['distribution']} law is driven by a {germ} "
+            raise ValueError(f"parameters[{j}] ({quoted_name(p['name'])}): a {p['distribution']} law is driven by a {germ} "
                              f"germ{' (dependence:)' if germ != law.germ else ''}, but germs[{j}] is {germs[j]}")
     unknown = set(copula.names) - {p["name"] for p in parameters} if copula is not None else set()
     if unknown:
         raise ValueError(f"dependence.parameters: {sorted(unknown)} are not among the parameters")
     order = data["order"]
     if isinstance(order, bool) or not isinstance(order, int) or not 0 <= order <= MAX_DEGREE:
-        raise ValueError(f"order: expected an integer in [0, {MAX_DEGREE}], got {_shown(order)}")
+        raise ValueError(f"order: expected an integer in [0, {MAX_DEGREE}], got {quoted_value(order)}")
     shared = _multi_indices(data["multi_indices"], "multi_indices", d, order) if "multi_indices" in data else None
     time = _array(data["time"], "time", (None,))
     if not time.size or np.any(np.diff(time) <= 0):
@@ -272,16 +272,16 @@ def _checked(data: dict) -> Surrogate:
     coefficients, indices = {}, {}
     for name, output in outputs.items():
         if shared is None or "multi_indices" in output:
-            indices[name] = _multi_indices(output["multi_indices"], f"outputs.{shown_name(name)}.multi_indices", d, order)
+            indices[name] = _multi_indices(output["multi_indices"], f"outputs.{quoted_name(name)}.multi_indices", d, order)
         else:
             indices[name] = shared
-        coefficients[name] = _array(output["coefficients"], f"outputs.{shown_name(name)}.coefficients",
+        coefficients[name] = _array(output["coefficients"], f"outputs.{quoted_name(name)}.coefficients",
                                     (len(indices[name]), time.size))
         if not isinstance(output.get("units", ""), str):
-            raise ValueError(f"outputs.{shown_name(name)}.units: expected a string, got {_shown(output['units'])}")
+            raise ValueError(f"outputs.{quoted_name(name)}.units: expected a string, got {quoted_value(output['units'])}")
     for key, kind in (("method", str), ("split", bool), ("campaign", str)):
         if key in data and not isinstance(data[key], kind):
-            raise ValueError(f"{key}: expected a {kind.__name__}, got {_shown(data[key])}")
+            raise ValueError(f"{key}: expected a {kind.__name__}, got {quoted_value(data[key])}")
     return Surrogate(parameters, germs, indices, time, coefficients,
                      {name: o.get("units", "") for name, o in outputs.items()},
                      {"kind": data["method"], "order": order, "split": data.get("split", False)},
@@ -309,7 +309,7 @@ _LARGEST = 1.7976931348623157e308
 def _number(value, key: str) -> float:
     """A finite JSON number (never a string, a boolean, a null or an integer beyond float range)."""
     if isinstance(value, bool) or not isinstance(value, (int, float)) or not -_LARGEST <= value <= _LARGEST:
-        raise ValueError(f"{key}: expected a finite number, got {_shown(value)}")
+        raise ValueError(f"{key}: expected a finite number, got {quoted_value(value)}")
     return float(value)
 
 
@@ -330,11 +330,6 @@ def _array(value, key: str, shape: tuple, integers: bool = False) -> np.ndarray:
         else:
             good = type(cell) in (int, float) and -_LARGEST <= cell <= _LARGEST
         if not good:
-            found = "nulls" if cell is None else _shown(cell)
+            found = "nulls" if cell is None else quoted_value(cell)
             raise ValueError(f"{key}: expected {expected} {what}, got shape {cells.shape} with {found}")
     return cells.astype(np.int64 if integers else float)
-
-
-def _shown(value) -> str:
-    text = repr(value) if not isinstance(value, int) or abs(value) < 10**50 else "an integer of 50+ digits"
-    return text if len(text) <= 60 else text[:57] + "..."

@@ -10,7 +10,7 @@ from typing import List, Optional
 import typer
 
 from ..cli.arguments import check_campaign_file, check_output, check_results_file
-from ..text.console import echo, one_line, refuse, shown
+from ..text.console import echo, one_line, refuse, quoted_name
 from ..running.progress import Progress
 
 EXIT_NOT_CONVERGED = 3
@@ -122,14 +122,14 @@ def calibrate_command(
          f"{'narrowing':>9}  95 % interval")
     for name, p in summary["parameters"].items():
         narrowing = p["narrowing"]
-        echo(f"{shown(name):<10} {p['prior']['mean']:12.6g} {p['prior']['std']:11.4g} {p['posterior']['mean']:12.6g} "
+        echo(f"{quoted_name(name):<10} {p['prior']['mean']:12.6g} {p['prior']['std']:11.4g} {p['posterior']['mean']:12.6g} "
              f"{p['posterior']['std']:11.4g} {narrowing if narrowing is not None else float('nan'):9.2f}  "
              f"[{p['posterior']['ci95'][0]:.6g}, {p['posterior']['ci95'][1]:.6g}]")
     for name, n in summary["noise"].items():
         if n["inferred"]:
-            echo(f"noise {shown(name)}: sigma {n['inferred']['mean']:.4g} (inferred)")
+            echo(f"noise {quoted_name(name)}: sigma {n['inferred']['mean']:.4g} (inferred)")
     pred = summary["predictive"]
-    cover = ", ".join(f"{shown(k)} {v:.0%}" if v is not None else f"{shown(k)} -" for k, v in pred["coverage95"].items())
+    cover = ", ".join(f"{quoted_name(k)} {v:.0%}" if v is not None else f"{quoted_name(k)} -" for k, v in pred["coverage95"].items())
     echo(f"posterior predictive ({pred['draws']} simulator runs, {pred['failed']} failed): data inside the "
          f"95 % band: {cover}")
     written = list(result.written)

@@ -23,7 +23,7 @@ from typing import Callable
 import numpy as np
 
 from ..text.bounded import Refused, read_bounded
-from ..text.console import listed, shown
+from ..text.console import listed, quoted_name
 from ..parameters.germs import GERMS, germ_columns
 
 
@@ -72,7 +72,7 @@ def read_flight_csv(path, outputs: list[str] | None, available: list[str]) -> Fl
                             f"output of the campaign ({listed(available)})")
     for name in outputs:
         if name not in available:
-            raise DataError(f"--output {shown(name)}: not an output of the campaign ({listed(available)})")
+            raise DataError(f"--output {quoted_name(name)}: not an output of the campaign ({listed(available)})")
         if name not in header:
             raise DataError(f"{path}: no column {name!r} (header: {listed(header)})")
     table = np.full((len(rows) - 1, len(header)), np.nan)
@@ -85,7 +85,7 @@ def read_flight_csv(path, outputs: list[str] | None, available: list[str]) -> Fl
                 try:
                     table[i - 2, j] = float(cell)
                 except ValueError:
-                    raise DataError(f"{path}: line {i}, column {shown(header[j])}: expected a number, "
+                    raise DataError(f"{path}: line {i}, column {quoted_name(header[j])}: expected a number, "
                                     f"got {cell!r}") from None
     time = table[:, header.index("time_s")]
     if not np.all(np.isfinite(time)) or np.any(np.diff(time) <= 0):
@@ -109,7 +109,7 @@ def check_noise(noise: dict, outputs: list[str]) -> dict[str, float]:
     DataError naming the output otherwise."""
     for name, sigma in noise.items():
         if isinstance(sigma, bool) or not isinstance(sigma, (int, float)) or not math.isfinite(sigma) or sigma <= 0:
-            raise DataError(f"--noise {shown(name)}: expected SIGMA > 0 (a finite number), got {sigma!r}")
+            raise DataError(f"--noise {quoted_name(name)}: expected SIGMA > 0 (a finite number), got {sigma!r}")
     return check_names({str(name): float(sigma) for name, sigma in noise.items()}, "--noise", outputs,
                        "the calibrated outputs")
 
@@ -128,7 +128,7 @@ def parse_pairs(pairs: list[str], option: str, form: str, positive: bool = False
         if not sep or not name or not math.isfinite(value) or (positive and not value > 0):
             raise DataError(f"{option}: expected {form}, got {pair!r}")
         if name in values:
-            raise DataError(f"{option} {shown(name)}: given twice ({values[name]:g} and {value:g}); give it once")
+            raise DataError(f"{option} {quoted_name(name)}: given twice ({values[name]:g} and {value:g}); give it once")
         values[name] = value
     return values
 
@@ -137,7 +137,7 @@ def check_names(values: dict[str, float], option: str, names: list[str], among: 
     """`values` when every name is one of `names` (`among` says what they are); DataError otherwise."""
     for name in values:
         if name not in names:
-            raise DataError(f"{option} {shown(name)}: not one of {among} ({listed(names)})")
+            raise DataError(f"{option} {quoted_name(name)}: not one of {among} ({listed(names)})")
     return values
 
 

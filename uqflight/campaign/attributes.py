@@ -16,7 +16,8 @@ from ..designs.base import is_integer
 from ..parameters.germs import GERMS
 from ..store.resume import campaign_mapping
 from . import schema
-from .schema import CampaignError, Checker, shown
+from ..text.console import quoted_value
+from .schema import CampaignError, Checker
 
 # provenance shown by the report and compared by check (campaign_hash, aircraft_hash, scenario): text when present
 TEXT = ("campaign_name", "campaign_hash", "campaign_path", "created", "aircraft_hash", "scenario")
@@ -54,13 +55,13 @@ def recorded_setup(attrs: dict, source: str, parameters: list[str], quantities: 
     check = AttributeChecker(source)
     for name in TEXT:
         if name in attrs and not isinstance(attrs[name], str):
-            check.fail(name, f"expected text, got {shown(attrs[name])}")
+            check.fail(name, f"expected text, got {quoted_value(attrs[name])}")
     versions = _json(check, attrs, "versions")
     if not isinstance(versions, dict):
-        check.fail("versions", f"expected a mapping of package versions, got {shown(versions)}")
+        check.fail("versions", f"expected a mapping of package versions, got {quoted_value(versions)}")
     kind = attrs.get("design_kind")
     if not isinstance(kind, str) or kind not in DESIGN_KINDS:
-        check.fail("design_kind", f"expected one of {', '.join(DESIGN_KINDS)}, got {shown(kind)}")
+        check.fail("design_kind", f"expected one of {', '.join(DESIGN_KINDS)}, got {quoted_value(kind)}")
     info = _design_info(check, _json(check, attrs, "design_info"), kind, runs, len(parameters))
     method = schema.method(check, _json(check, attrs, "method"))
     analysis = schema.analysis(check, _json(check, attrs, "analysis"), quantities)
@@ -104,16 +105,16 @@ def _design_info(check: Checker, info, kind: str, runs: int, d: int) -> dict:
     """The design's recorded facts, those the statistics read checked against the file's `runs` and `d`
     parameters: replicates (blocks of runs), n_base (a pick-freeze design's base rows), scramble."""
     if not isinstance(info, dict):
-        check.fail("design_info", f"expected a mapping of the design's facts, got {shown(info)}")
+        check.fail("design_info", f"expected a mapping of the design's facts, got {quoted_value(info)}")
     replicates = info.get("replicates", 1)
     if not is_integer(replicates) or not 1 <= replicates <= max(runs, 1) or runs % replicates:
         check.fail("design_info.replicates", f"expected an integer >= 1 dividing the {runs} runs, "
-                                             f"got {shown(replicates)}")
+                                             f"got {quoted_value(replicates)}")
     problem = DESIGNS[kind].info_problem(info, runs, d)
     if problem:
-        check.fail(f"design_info.{problem[0]}", f"{problem[1]}, got {shown(info.get(problem[0]))}")
+        check.fail(f"design_info.{problem[0]}", f"{problem[1]}, got {quoted_value(info.get(problem[0]))}")
     if not isinstance(info.get("scramble", True), bool):
-        check.fail("design_info.scramble", f"expected true or false, got {shown(info['scramble'])}")
+        check.fail("design_info.scramble", f"expected true or false, got {quoted_value(info['scramble'])}")
     return info
 
 
@@ -125,7 +126,7 @@ def _json(check: Checker, attrs: dict, name: str, default: str | None = None):
         check.fail(name, "is missing: the file is damaged or was not written by uqflight: fly its campaign again "
                          "(`uqflight run CAMPAIGN --out FILE --restart`)")
     if not isinstance(text, str):
-        check.fail(name, f"expected JSON text, got {shown(text)}")
+        check.fail(name, f"expected JSON text, got {quoted_value(text)}")
     try:
         return json.loads(text)
     except (ValueError, RecursionError) as exc:
@@ -135,5 +136,5 @@ def _json(check: Checker, attrs: dict, name: str, default: str | None = None):
 def _listed(value) -> str:
     """A value as a message quotes it, a list by its first items."""
     if not isinstance(value, list):
-        return shown(value)
-    return "[" + ", ".join(shown(item) for item in value[:4]) + (", ...]" if len(value) > 4 else "]")
+        return quoted_value(value)
+    return "[" + ", ".join(quoted_value(item) for item in value[:4]) + (", ...]" if len(value) > 4 else "]")

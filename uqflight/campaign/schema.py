@@ -22,6 +22,7 @@ from ..parameters.distributions import SEED_REFUSAL
 from ..simulators.patch import patch_kind
 from ..simulators.kinds import REGISTRY as SIMULATORS
 from ..simulators.kinds import SIMULATOR_KINDS, simulator_entry
+from ..text.console import quoted_value
 
 EXECUTORS = ("local", "dask")
 TOP_KEYS = ("name", "description", "seed", "simulator", "parameters", "design", "method",
@@ -58,22 +59,10 @@ class CampaignError(ValueError):
         super().__init__(where + message)
 
 
-def shown(value) -> str:
-    """A value as an error message quotes it: short, and readable for people who wrote YAML."""
-    if value is None:
-        return "nothing"
-    if isinstance(value, dict):
-        return "a mapping"
-    if isinstance(value, list):
-        return "a list"
-    text = repr(value)
-    return text if len(text) <= 60 else text[:57] + "..."
-
-
 class Checker:
     """Typed access to a YAML mapping that raises CampaignError with the field's path."""
 
-    shown = staticmethod(shown)
+    quoted = staticmethod(quoted_value)
 
     def __init__(self, source: str):
         self.source = source
@@ -83,7 +72,7 @@ class Checker:
 
     def mapping(self, value, path: str, allowed: tuple[str, ...], required=()) -> dict:
         if not isinstance(value, dict):
-            self.fail(path, f"expected a mapping with the keys {', '.join(allowed)}, got {shown(value)}")
+            self.fail(path, f"expected a mapping with the keys {', '.join(allowed)}, got {quoted_value(value)}")
         for key in value:
             if key not in allowed:
                 close = difflib.get_close_matches(str(key), allowed, n=1)
@@ -98,25 +87,25 @@ class Checker:
 
     def number(self, value, path: str, minimum: float | None = None, strict=False) -> float:
         if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
-            self.fail(path, f"expected a finite number, got {shown(value)}")
+            self.fail(path, f"expected a finite number, got {quoted_value(value)}")
         if minimum is not None and (value <= minimum if strict else value < minimum):
             self.fail(path, f"expected a number {'>' if strict else '>='} {minimum:g}, got {value!r}")
         return float(value)
 
     def integer(self, value, path: str, minimum: int) -> int:
         if isinstance(value, bool) or not isinstance(value, int) or value < minimum:
-            self.fail(path, f"expected an integer >= {minimum}, got {shown(value)}")
+            self.fail(path, f"expected an integer >= {minimum}, got {quoted_value(value)}")
         return value
 
     def string(self, value, path: str, choices: tuple[str, ...] | None = None) -> str:
         expected = f"one of {', '.join(choices)}" if choices else "a non-empty string"
         if not isinstance(value, str) or not value or (choices and value not in choices):
-            self.fail(path, f"expected {expected}, got {shown(value)}")
+            self.fail(path, f"expected {expected}, got {quoted_value(value)}")
         return value
 
     def boolean(self, value, path: str) -> bool:
         if not isinstance(value, bool):
-            self.fail(path, f"expected true or false, got {shown(value)}")
+            self.fail(path, f"expected true or false, got {quoted_value(value)}")
         return value
 
 
@@ -239,7 +228,7 @@ def simulator(check: Checker, value) -> dict:
     """The `simulator:` mapping checked as written by its kind's entry (simulators/kinds): nothing is
     imported or located (`resolve_simulator`)."""
     if not isinstance(value, dict):
-        check.fail("simulator", f"expected a mapping with a kind key, got {shown(value)}")
+        check.fail("simulator", f"expected a mapping with a kind key, got {quoted_value(value)}")
     if "kind" not in value:
         check.fail("simulator.kind", f"is required; expected one of {', '.join(SIMULATOR_KINDS)}")
     kind = check.string(value["kind"], "simulator.kind", SIMULATOR_KINDS)
@@ -268,7 +257,7 @@ def resolve_simulator(check: Checker, sim: dict, source: str) -> None:
 
 def parameters(check: Checker, value, kind: str, aircraft) -> list[Parameter]:
     if not isinstance(value, dict) or not value:
-        check.fail("parameters", f"expected a mapping of parameter names to their definitions, got {shown(value)}")
+        check.fail("parameters", f"expected a mapping of parameter names to their definitions, got {quoted_value(value)}")
     parameters = []
     owners: dict[str, str] = {}  # property -> the parameter that sets it
     for name, spec in value.items():
@@ -380,13 +369,13 @@ def dependence(check: Checker, value, known: list[str], seeds: list[str], fixed=
     check.string(value["kind"], "dependence.kind", DEPENDENCE_KINDS)
     names = value.get("parameters", [name for name in known if name not in seeds])
     if not isinstance(names, list) or len(names) < 2:
-        check.fail("dependence.parameters", f"expected a list of at least two parameter names, got {shown(names)}")
+        check.fail("dependence.parameters", f"expected a list of at least two parameter names, got {quoted_value(names)}")
     for i, name in enumerate(names):
         path = f"dependence.parameters[{i}]"
         if not isinstance(name, str) or name not in known:
             what = (" is a fixed property (simulator.properties), not an uncertain parameter"
                     if isinstance(name, str) and name in fixed else "")
-            check.fail(path, f"expected one of the campaign's parameters ({', '.join(known)}), got {shown(name)}{what}")
+            check.fail(path, f"expected one of the campaign's parameters ({', '.join(known)}), got {quoted_value(name)}{what}")
         if name in seeds:
             check.fail(path, f"{name} is a seed: a random stream's seed cannot be correlated")
         if name in names[:i]:
@@ -395,11 +384,11 @@ def dependence(check: Checker, value, known: list[str], seeds: list[str], fixed=
     rows = value["correlation"]
     size = f"a {n} x {n} list of rows (one per parameter: {', '.join(names)})"
     if not isinstance(rows, list) or len(rows) != n:
-        check.fail("dependence.correlation", f"expected {size}, got {shown(rows)}"
+        check.fail("dependence.correlation", f"expected {size}, got {quoted_value(rows)}"
                                              + (f" of {len(rows)} rows" if isinstance(rows, list) else ""))
     for i, row in enumerate(rows):
         if not isinstance(row, list) or len(row) != n:
-            check.fail(f"dependence.correlation[{i}]", f"expected a row of {n} numbers ({size}), got {shown(row)}"
+            check.fail(f"dependence.correlation[{i}]", f"expected a row of {n} numbers ({size}), got {quoted_value(row)}"
                                                        + (f" of {len(row)}" if isinstance(row, list) else ""))
         for j, entry in enumerate(row):
             check.number(entry, f"dependence.correlation[{i}][{j}]")
@@ -543,7 +532,7 @@ def analysis(check: Checker, value, quantities: dict | None = None) -> dict:
     if "quantiles" in analysis:  # kept only when given (default: statistics.DEFAULT_QUANTILES)
         value = analysis["quantiles"]
         if not isinstance(value, list) or not value or len(value) > 20:
-            check.fail("analysis.quantiles", f"expected a list of 1 to 20 probabilities, got {shown(value)}")
+            check.fail("analysis.quantiles", f"expected a list of 1 to 20 probabilities, got {quoted_value(value)}")
         for i, probability in enumerate(value):
             check.number(probability, f"analysis.quantiles[{i}]")
             if not 0.0 < probability < 1.0:
@@ -556,7 +545,7 @@ def campaign_name(check: Checker, value) -> str:
     name = check.string(value, "name")
     if not NAME_PATTERN.fullmatch(name):
         check.fail("name", f"expected 1-100 characters among A-Z a-z 0-9 _ . - (not starting with . or -), "
-                           f"got {shown(name)}")
+                           f"got {quoted_value(name)}")
     return name
 
 

@@ -32,7 +32,7 @@ import typer
 
 from .arguments import check_campaign_file, check_output, check_results_file
 from ..calibration.command import register as register_calibrate
-from ..text.console import EXIT_BAD_INPUT, echo, listed, one_line, refuse, shown
+from ..text.console import EXIT_BAD_INPUT, echo, listed, one_line, refuse, quoted_name
 from ..running import stopping
 from .fast_exit import exit_fast
 from ..running.progress import Progress
@@ -252,10 +252,10 @@ def plan(campaign_file: Path = typer.Argument(..., metavar="CAMPAIGN", help="Cam
 
     campaign = _load(campaign_file)
     design = campaign.design()
-    echo(f"campaign: {shown(str(campaign.name))} ({campaign_file})")
+    echo(f"campaign: {quoted_name(str(campaign.name))} ({campaign_file})")
     echo("parameters:")
     for p in campaign.parameters:
-        echo(f"  {shown(p.name):<10} {shown(p.property):<18} {p.distribution:<16} nominal {p.nominal:<10.6g} "
+        echo(f"  {quoted_name(p.name):<10} {quoted_name(p.property):<18} {p.distribution:<16} nominal {p.nominal:<10.6g} "
              f"interval [{p.lower:.6g}, {p.upper:.6g}]")
     if campaign.dependence is not None:
         echo(f"dependence: {campaign.dependence.kind} over {listed(campaign.dependence.names)} (standard-normal germs, "
@@ -388,18 +388,18 @@ def _describe_results(results, store, Status) -> None:
     status = store.status
     attrs = store.attrs
     echo(f"file: {results}")
-    echo(f"campaign: {shown(str(attrs.get('campaign_name', '?')))} (sha256 {one_line(str(store.campaign_hash[:12]))})")
-    echo(f"design: {shown(str(attrs.get('design_kind', '?')))} {one_line(str(attrs.get('design_info', '')))}")
+    echo(f"campaign: {quoted_name(str(attrs.get('campaign_name', '?')))} (sha256 {one_line(str(store.campaign_hash[:12]))})")
+    echo(f"design: {quoted_name(str(attrs.get('design_kind', '?')))} {one_line(str(attrs.get('design_info', '')))}")
     state = store.index_set()  # an adaptive grid's refinement (/design)
     if state is not None:
         echo(f"index set: {len(state.indices)} multi-indices, {state.rounds} rounds, "
              f"{'stopped by ' + state.stopped if state.stopped else 'refining (resume to go on)'}")
     record = store.rare_event()  # a rare-event design's estimate (/rare_event), once its rounds finished
     if record is not None:
-        echo(f"rare event: P({shown(record['of'])} {'>' if record['side'] == 'above' else '<'} {record['threshold']:g})"
+        echo(f"rare event: P({quoted_name(record['of'])} {'>' if record['side'] == 'above' else '<'} {record['threshold']:g})"
              f" = {record['probability']:.4g} (95 %: {record['lower']:.4g} to {record['upper']:.4g}), cov "
              f"{record['cov']:.3g}".replace("cov nan", "cov undefined")
-             + f", {record['runs']} runs, stopped by {shown(record['stopped'])}")
+             + f", {record['runs']} runs, stopped by {quoted_name(record['stopped'])}")
     echo(f"parameters: {listed(store.parameter_names)}")
     echo(f"outputs: {listed(store.output_names)} ({store.time.size} times, "
          f"{store.time[0]:g} to {store.time[-1]:g} s)")
@@ -701,7 +701,7 @@ def aircraft_command(
     for f in functions:
         ref = refs[f.name]
         factor = f"ΔC x {ref.symbol}" if not ref.refusal else "offset_value only"
-        echo(f"  {shown(f.axis) if f.axis else '-':<6} {shown(f.name):<40} {ref.unit or 'own':<6} {factor:<17} "
+        echo(f"  {quoted_name(f.axis) if f.axis else '-':<6} {quoted_name(f.name):<40} {ref.unit or 'own':<6} {factor:<17} "
              f"{one_line(f.description[:60])}")
     condition = default_condition(located.name)
     condition.update({k: v for k, v in (("altitude_ft", altitude_ft), ("airspeed_ktas", airspeed_ktas)) if v is not None})
@@ -712,7 +712,7 @@ def aircraft_command(
         refuse(f"{exc}")
     echo("engines:")
     for i, (name, kind, thruster) in enumerate(engine_kinds(flight.fdm)):
-        echo(f"  {i}: {shown(name):<24} {shown(kind):<10} thruster: {shown(thruster)}")
+        echo(f"  {i}: {quoted_name(name):<24} {quoted_name(kind):<10} thruster: {quoted_name(thruster)}")
     echo(f"elevator travel: {flight.elevator_travel_deg[0]:.1f} deg down, {flight.elevator_travel_deg[1]:.1f} deg up"
          + ("" if not flight.has_property("fcs/elevator-excitation-deg") else " (fcs/elevator-excitation-deg used)"))
     if trim:

@@ -12,7 +12,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import ClassVar
 
-from ..text.console import one_line, shown
+from ..text.console import one_line, quoted_name
 
 
 class Status(enum.IntEnum):
@@ -52,7 +52,7 @@ class NominalFailed(RuntimeError):
 
 def nominal_failed(names, kappa, exc: Exception) -> NominalFailed:
     """The NominalFailed that says sample `kappa` of the parameters `names` failed with `exc`."""
-    values = ", ".join(f"{shown(name)} = {float(value):.10g}" for name, value in zip(names, kappa))
+    values = ", ".join(f"{quoted_name(name)} = {float(value):.10g}" for name, value in zip(names, kappa))
     return NominalFailed(
         f"the nominal sample failed ({values}: the centre of every parameter's law, ξ = 0), which uqflight "
         f"runs first to learn the outputs, the time grid and the cost of a run: {type(exc).__name__}: "

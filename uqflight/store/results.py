@@ -89,14 +89,14 @@ class CorruptFile(ValueError):
 READ_ERRORS = (OSError, RuntimeError)  # what h5py raises for data or links it cannot read
 
 
-def one_line(exc: BaseException) -> str:
+def error_line(exc: BaseException) -> str:
     """An error's message on one line (h5py's span several)."""
     return " ".join(str(exc).split())
 
 
 def read_error(exc: BaseException) -> str:
     """One line on an HDF5 read error; a failed checksum is called what it is."""
-    text = one_line(exc)
+    text = error_line(exc)
     if "filter" in text.lower() or "checksum" in text.lower():
         return f"data corrupted: a checksum (fletcher32) does not match ({text})"
     if past_recorded_end(text):
@@ -108,7 +108,7 @@ def _unreadable(path, exc: BaseException, extended: bool) -> CorruptFile:
     """The CorruptFile for a file that fails a read on opening; `extended`: its recorded end was moved to
     the file's already (file_end), so a read past it is past the bytes on disk."""
     if extended and past_recorded_end(str(exc)):
-        return CorruptFile(f"{path}: {one_line(exc)}: data past the end of the file on disk (the file was cut short, "
+        return CorruptFile(f"{path}: {error_line(exc)}: data past the end of the file on disk (the file was cut short, "
                            "e.g. copied or written out incompletely): it cannot be mended; fly the campaign "
                            "again (`uqflight run CAMPAIGN --out FILE --restart`)")
     return CorruptFile(f"{path}: {read_error(exc)}")
@@ -446,7 +446,7 @@ class ResultStore:
             state = read_index_set(self._file)
         except (KeyError, ValueError, TypeError, IndexError) as exc:
             raise CorruptFile(f"{self._file.filename}: /design: the adaptive grid's recorded state cannot be read "
-                              f"({one_line(exc)}): the file is damaged or was not written by uqflight") from None
+                              f"({error_line(exc)}): the file is damaged or was not written by uqflight") from None
         if state is not None and (not state.indices or len({len(state.indices), len(state.old), len(state.added),
                                                              len(state.indicator)}) != 1):
             raise CorruptFile(f"{self._file.filename}: /design: the adaptive grid's index_set, old, round and "
@@ -466,7 +466,7 @@ class ResultStore:
                                    int(self._file["samples/xi"].shape[1]))
         except (KeyError, ValueError, TypeError, IndexError, OSError, RuntimeError) as exc:
             raise CorruptFile(f"{self._file.filename}: /rare_event: the rare-event estimate cannot be read "
-                              f"({one_line(exc)}): the file is damaged or was not written by uqflight") from None
+                              f"({error_line(exc)}): the file is damaged or was not written by uqflight") from None
 
     def write_rare_event(self, record: dict) -> None:
         """Record a rare-event design's estimate in /rare_event (`store.rare`)."""

@@ -8,10 +8,10 @@ from pathlib import Path
 import h5py
 import yaml
 
-from ..text.console import shown
+from ..text.console import quoted_name
 from .file_end import extend_file, past_recorded_end
 from .lock import LockHeld, held_message, is_lock_error, open_elsewhere
-from .results import READ_ERRORS, ResultStore, one_line, text_hash
+from .results import READ_ERRORS, ResultStore, error_line, text_hash
 
 
 # top-level campaign keys that change how the stored runs are read, never what they flew: a file whose campaign
@@ -59,7 +59,7 @@ def open_for_campaign(path, *, campaign_text: str, force: bool = False, restart:
             if is_lock_error(exc):  # opened by another process since the check above
                 raise LockHeld(held_message(path)) from None
             if not force:
-                reason = one_line(exc)[:200]
+                reason = error_line(exc)[:200]
                 if past_recorded_end(reason):  # and _stored_campaign could not move that end
                     reason += "; its data run past the end its superblock records, and that end could not be mended"
                 raise FileExistsError(f"{path} is a damaged HDF5 file ({reason}); choose another results "
@@ -88,11 +88,11 @@ def open_for_campaign(path, *, campaign_text: str, force: bool = False, restart:
             if stored == text_hash(campaign_text):
                 key = next(key for key in FLOWN if stored_flown.get(key) != flown[key])
                 what = {"aircraft_hash": "aircraft files (sha256", "scenario": "script files ("}[key]
-                raise FileExistsError(f"{path} was made with other {what} {shown(str(stored_flown.get(key))[:80])}); "
+                raise FileExistsError(f"{path} was made with other {what} {quoted_name(str(stored_flown.get(key))[:80])}); "
                                       "resuming would mix two models: choose another results file, or force "
                                       "to start over")
-            where = (f": its campaign differs first at {shown(differs)}" if differs else
-                     f" (campaign_hash {shown(str(stored))})")
+            where = (f": its campaign differs first at {quoted_name(differs)}" if differs else
+                     f" (campaign_hash {quoted_name(str(stored))})")
             if differs and differs.startswith("quantities"):
                 where += (" (a quantity is computed in the worker at every integration step, finer than the "
                           "stored histories: a changed one is flown again)")

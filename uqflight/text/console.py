@@ -19,7 +19,7 @@ def clean(text: str) -> str:
     return CONTROL.sub("", text)
 
 
-def shown(name: str) -> str:
+def quoted_name(name: str) -> str:
     """A name from a file as one unambiguous entry of a listing: as it is when plain, else as repr shows it
     (quoted, control characters escaped such as \\n): a name holding a newline, a comma or a quote, or
     starting or ending with a space."""
@@ -28,8 +28,23 @@ def shown(name: str) -> str:
 
 
 def listed(names) -> str:
-    """Names from a file as one comma-separated listing, each as `shown` gives it."""
-    return ", ".join(shown(str(name)) for name in names)
+    """Names from a file as one comma-separated listing, each as `quoted_name` gives it."""
+    return ", ".join(quoted_name(str(name)) for name in names)
+
+
+def quoted_value(value) -> str:
+    """A value (read from a campaign or a file) as an error message quotes it: short, and readable for
+    people who wrote YAML ("nothing", "a mapping", "a list", else its repr cut at 60 characters)."""
+    if value is None:
+        return "nothing"
+    if isinstance(value, dict):
+        return "a mapping"
+    if isinstance(value, list):
+        return "a list"
+    if isinstance(value, int) and not isinstance(value, bool) and abs(value) >= 10**50:
+        return "an integer of 50+ digits"
+    text = repr(value)
+    return text if len(text) <= 60 else text[:57] + "..."
 
 
 LINE_BREAK = re.compile("[\n\u2028\u2029]")  # what `clean` keeps that starts a new line

@@ -97,7 +97,7 @@ class JSBSim(SimulatorKind):
         if "scenario" in value:
             written = value["scenario"]
             if not isinstance(written, dict):
-                check.fail("simulator.scenario", f"expected a mapping with a kind key, got {check.shown(written)}")
+                check.fail("simulator.scenario", f"expected a mapping with a kind key, got {check.quoted(written)}")
             if "kind" not in written:
                 check.fail("simulator.scenario.kind", f"is required; expected one of {', '.join(SCENARIO_KINDS)}")
             scenario = SCENARIOS[check.string(written["kind"], "simulator.scenario.kind", SCENARIO_KINDS)]
@@ -172,7 +172,7 @@ def check_fixed_properties(check, value) -> dict:
     """`simulator.properties`: {PROPERTY: VALUE} set for every run (a turbulence model, a steady wind)."""
     if not isinstance(value, dict) or not value:
         check.fail("simulator.properties", "expected a mapping of JSBSim properties to numbers, got "
-                                           f"{check.shown(value)}")
+                                           f"{check.quoted(value)}")
     for name, number in value.items():
         check.string(name, "simulator.properties")
         check.number(number, f"simulator.properties.{name}")

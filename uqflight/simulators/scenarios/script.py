@@ -371,12 +371,12 @@ class ScriptFlight(PropertyAccess):
         active += [name for name in WINDS if abs(value(name)) > CALM_FPS]
         applied = held and self._air_applied
 
-        def shown(name: str) -> str:
+        def setting_text(name: str) -> str:
             text = f"{name} = {value(name):.4g}"
             return text + f" ({TURBULENCE_TYPES.get(kind, '?')})" if name == "atmosphere/turb-type" else text
 
-        theirs = [shown(name) for name in active if not (applied and name in held)]
-        ours = [shown(name) for name in active if applied and name in held]
+        theirs = [setting_text(name) for name in active if not (applied and name in held)]
+        ours = [setting_text(name) for name in active if applied and name in held]
         parts = []
         if theirs:
             parts.append("active at the trim from the script's own events: " + ", ".join(theirs)
