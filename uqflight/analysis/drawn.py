@@ -83,12 +83,15 @@ def read_drawn(store, stats, scatter_time: float) -> DrawnRuns:
     status = store.status
     spaghetti_rows = run_subset(status, SPAGHETTI_RUNS, stats.seed)
     scatter_rows = run_subset(status, SCATTER_RUNS, stats.seed)
-    histories = {name: as_analysed(store.output_matrix(name, spaghetti_rows), out)
-                 for name, out in stats.outputs.items() if out.time.size > 1}
-    at_time = {}
+    rows = np.union1d(spaghetti_rows, scatter_rows)  # each output read once for both subsets
+    spaghetti_at, scatter_at = np.searchsorted(rows, spaghetti_rows), np.searchsorted(rows, scatter_rows)
+    histories, at_time = {}, {}
     for name, out in stats.outputs.items():
+        runs = as_analysed(store.output_matrix(name, rows), out)
+        if out.time.size > 1:
+            histories[name] = runs[spaghetti_at]
         i = nearest_time_index(out.time, scatter_time)
-        at_time[name] = (i, as_analysed(store.output_matrix(name, scatter_rows), out)[:, i])
+        at_time[name] = (i, runs[scatter_at, i])
     quantities = {name: as_analysed(store.quantity(name)[scatter_rows][:, None], q.output)[:, 0]
                   for name, q in stats.quantities.items() if q.output is not None}
     return DrawnRuns(list(store.parameter_names), store.xi, store.kappa, store.weights, status, spaghetti_rows,
