@@ -43,6 +43,14 @@ def unit_slip(runs: np.ndarray, threshold: float, units: str = "") -> str | None
             "more runs would resolve")
 
 
+def exceedance_entry(bound: str, threshold: float, probability, lower, upper, method, sentence: str,
+                     flag: str | None) -> dict:
+    """One exceedance entry: its probability, 95 % interval and method, and the flag that bears on it (None:
+    none) as its `flags` and after the sentence of its note."""
+    return {bound: threshold, "probability": probability, "lower": lower, "upper": upper, "method": method,
+            "flags": [flag] if flag else [], "note": sentence + (f"; {flag}" if flag else "")}
+
+
 def exceedance_from_runs(values: np.ndarray, defined: np.ndarray, thresholds: list[dict], draws: Independent = Independent(),
                          info: dict | None = None, units: str = "") -> list[dict]:
     """[{above|below, probability, lower, upper, method, flags, note}] over the runs where `defined` (bool (N,),
@@ -56,9 +64,8 @@ def exceedance_from_runs(values: np.ndarray, defined: np.ndarray, thresholds: li
         slip = unit_slip(values[defined], threshold, units)
         flag = slip or (f"fewer than {RARE_COUNT} runs exceed: a rare-event extrapolation from the runs, run more "
                         "to resolve it (or a rare-event design)" if int(beyond.sum()) < RARE_COUNT else None)
-        found.append({bound: threshold, "probability": p["estimate"], "lower": p["lower"], "upper": p["upper"],
-                      "method": p["method"], "flags": [flag] if flag else [],
-                      "note": p["sentence"] + (f"; {flag}" if flag else "")})
+        found.append(exceedance_entry(bound, threshold, p["estimate"], p["lower"], p["upper"], p["method"],
+                                      p["sentence"], flag))
     return found
 
 
@@ -76,6 +83,5 @@ def exceedance_from_pce(draws: np.ndarray, runs: int, thresholds: list[dict], ru
         slip = None if run_values is None else unit_slip(run_values, threshold, units)
         flag = slip or (f"p < {RARE_COUNT}/{runs} (fewer than {RARE_COUNT} of the runs' worth): a rare-event "
                         "extrapolation of the expansion's tail" if p < RARE_COUNT / runs else None)
-        found.append({bound: threshold, "probability": p, "lower": None, "upper": None, "method": "pce",
-                      "flags": [flag] if flag else [], "note": note + (f"; {flag}" if flag else "")})
+        found.append(exceedance_entry(bound, threshold, p, None, None, "pce", note, flag))
     return found

@@ -38,7 +38,7 @@ from .density import pdf_over_time
 from .divergence import kl_divergence
 from .drawn import DrawnRuns, read_drawn
 from .errors import error_summary, relative_errors
-from .exceedance import exceedance_from_pce, exceedance_from_runs, unit_slip
+from .exceedance import exceedance_entry, exceedance_from_pce, exceedance_from_runs, unit_slip
 from .failures import grid_failure_probability
 from .floors import central_moments, floors_from_moments, kld_estimator_bias, kld_floor
 from .moments import (modified_cov, sorted_by_time, standardised_moments, weighted_moments,
@@ -994,12 +994,10 @@ def _grid_exceedance(values: np.ndarray, defined: np.ndarray, weights: np.ndarra
         (bound, threshold), = item.items()
         beyond = values[defined] > threshold if bound == "above" else values[defined] < threshold
         p = grid_failure_probability(beyond, weights[defined])
-        slip = unit_slip(values[defined], threshold, units)
-        found.append({bound: threshold, "probability": p["estimate"], "lower": None, "upper": None, "method": "grid",
-                      "flags": [slip] if slip else [],
-                      "note": f"the grid's quadrature of the indicator {bound} {threshold:g}, without an interval "
-                              "(the nodes are not random draws); a sampled design gives one"
-                              + (f"; {slip}" if slip else "")})
+        found.append(exceedance_entry(bound, threshold, p["estimate"], None, None, "grid",
+                                      f"the grid's quadrature of the indicator {bound} {threshold:g}, without an "
+                                      "interval (the nodes are not random draws); a sampled design gives one",
+                                      unit_slip(values[defined], threshold, units)))
     return found
 
 

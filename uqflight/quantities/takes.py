@@ -219,30 +219,30 @@ class Mode(Take):
     windowed = False
     mode = True
 
+    def __init_subclass__(cls, name: str | None = None, **kwargs):
+        super().__init_subclass__(name=name, **kwargs)
+        cls.example = {"take": name}  # a mode takes no key but its name
+
 
 class PhugoidPeriod(Mode, name="phugoid_period_s"):
     """The phugoid's damped period 2π/Im λ [s] of JSBSim's linearised model at the level-flight trim."""
 
     unit = "s"
-    example = {"take": "phugoid_period_s"}
 
 
 class PhugoidDamping(Mode, name="phugoid_damping"):
     """The phugoid's damping ratio −Re λ/|λ| at the level-flight trim."""
 
     unit = "-"
-    example = {"take": "phugoid_damping"}
 
 
 class ShortPeriodFrequency(Mode, name="short_period_frequency_rad_s"):
     """The short period's natural frequency |λ| [rad/s] at the level-flight trim."""
 
     unit = "rad/s"
-    example = {"take": "short_period_frequency_rad_s"}
 
 
 class ShortPeriodDamping(Mode, name="short_period_damping"):
     """The short period's damping ratio at the level-flight trim."""
 
     unit = "-"
-    example = {"take": "short_period_damping"}
