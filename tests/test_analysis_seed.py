@@ -3,7 +3,7 @@ draws and its exceedance draws differ between seeds 1 and 2 while the projection
 nothing, is the same; the same seed gives the same bits."""
 import numpy as np
 
-from uqflight.campaign.attributes import recorded_setup
+from uqflight.campaign.record import read_record
 from uqflight.analysis.statistics import analyse
 from uqflight.store import ResultStore
 
@@ -28,7 +28,7 @@ def test_the_campaign_seed_reaches_the_band_and_exceedance_draws(tmp_path):
     files = {name: run_python_campaign(tmp_path, TEXT.format(seed=seed), name)
              for name, seed in (("one", 1), ("two", 2), ("again", 1))}
     with ResultStore.open(files["two"]) as store:
-        assert recorded_setup(store.attrs, "f", store.parameter_names, store.quantity_names, store.status.size).seed == 2
+        assert read_record(store.attrs, "f").campaign.seed == 2
     one, two, again = (analyse(files[name]) for name in ("one", "two", "again"))
     assert (one.seed, two.seed) == (1, 2)
     x1, x2, x1_again = (stats.outputs["x"] for stats in (one, two, again))

@@ -220,16 +220,19 @@ def test_an_aircrafts_function_names_are_quoted_by_the_aircraft_command(tmp_path
 
 
 def test_info_prints_a_results_files_texts_on_their_own_lines(forged, tmp_path):
-    # the attributes info shows as they are (the design's facts, the versions, the aircraft's hash), edited
-    # to hold newlines followed by lines of uqflight's
+    # the texts info shows as they are (the design's facts and the versions in the record, the aircraft's
+    # hash), edited to hold newlines followed by lines of uqflight's
+    import json
     import shutil
 
     import h5py
 
     shutil.copy(forged / "c.h5", tmp_path / "c.h5")
     with h5py.File(tmp_path / "c.h5", "a") as f:
-        f.attrs["design_info"] = f.attrs["design_info"].replace(", ", ",\nerror: forged\n")
-        f.attrs["versions"] = f.attrs["versions"].replace(", ", ",\nerror: forged\n", 1)
+        record = json.loads(f.attrs["record"])
+        record["design"]["info"]["points\nerror: forged"] = "5\nerror: forged"
+        record["versions"]["numpy\nerror: forged"] = "2\nerror: forged"
+        f.attrs["record"] = json.dumps(record)
         f.attrs["aircraft_hash"] = "abc\nerror: forged"
     shown = cli_in_process("info", tmp_path / "c.h5")
     assert shown.returncode == 0, shown.stderr

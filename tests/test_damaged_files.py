@@ -147,14 +147,14 @@ def test_an_ok_run_without_finite_values_is_refused_by_the_analysis(sound, tmp_p
 
 
 def test_a_garbled_campaign_text_does_not_stop_the_report(sound, tmp_path):
-    """The campaign text is shown ("?" for its distributions), not computed with (the method and germs
-    are attributes of their own)."""
+    """The campaign text is shown, never read as a campaign: the campaign is the file's record
+    (campaign.record)."""
     path = tmp_path / "garbled.h5"
     shutil.copy(sound["raw"], path)
     with h5py.File(path, "r+") as f:
         f.attrs["campaign"] = "{{{: ["
     (entry,), _ = load_entries([path], None)
-    assert entry.inputs == "?" and entry.stats.runs == N
+    assert entry.inputs == "uniform" and entry.stats.runs == N
 
 
 def test_run_refuses_to_resume_a_damaged_file_and_restart_starts_it_over(sound, tmp_path):

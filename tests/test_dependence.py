@@ -47,12 +47,11 @@ def run_linear(tmp_path, name, design, method, band=20000):
 
 def result_parameters(path):
     """The parameters (laws) a results file records."""
-    from uqflight.campaign.reading import stored_parameters
-    from uqflight.parameters import Parameter
+    from uqflight.campaign.record import read_record
     from uqflight.store import ResultStore
 
     with ResultStore.open(path) as store:
-        return [Parameter(**row) for row in stored_parameters(store.attrs)]
+        return read_record(store.attrs, str(path)).campaign.parameters
 
 
 def test_nataf_transform_inverts_and_leaves_the_unlisted_and_the_first_listed_alone():
@@ -114,7 +113,7 @@ def test_correlated_normals_on_a_gauss_hermite_grid_are_exact(tmp_path):
     assert "Cholesky order x1, x2" in summary["dependence"]["sobol_of"]
     assert any("Gaussian copula" in note for note in summary["notes"])
     # the exported surrogate evaluates at physical values through the inverse Nataf transform
-    from uqflight.campaign.reading import results_campaign
+    from uqflight.campaign.record import read_record
     from uqflight.store import ResultStore
     from uqflight.analysis.surrogate import SurrogateError, export, load
 
@@ -128,7 +127,7 @@ def test_correlated_normals_on_a_gauss_hermite_grid_are_exact(tmp_path):
         load(tmp_path / "bad.json")
     # reading the results rebuilds the transform from the stored campaign text, running no campaign code
     with ResultStore.open(path) as store:
-        again = results_campaign(store.attrs, str(path))
+        again = read_record(store.attrs, str(path)).campaign
         np.testing.assert_array_equal(again.to_physical(store.xi), store.kappa)
 
 

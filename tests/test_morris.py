@@ -144,15 +144,19 @@ def test_a_bad_morris_design_is_refused_naming_its_field(design, field):
         build_design(design, ["uniform", "normal"], 0)
 
 
-@pytest.mark.parametrize("info, field", [('{"trajectories": 12, "levels": 3}', "design_info.levels"),
-                                         ('{"trajectories": 11, "levels": 4}', "design_info.trajectories")])
+@pytest.mark.parametrize("info, field", [({"trajectories": 12, "levels": 3}, "design.info.levels"),
+                                         ({"trajectories": 11, "levels": 4}, "design.info.trajectories")])
 def test_a_design_info_that_does_not_fit_the_runs_is_refused_in_one_line(tmp_path, info, field):
+    import json
+
     import h5py
     from conftest import cli_in_process
 
     path = run_python_campaign(tmp_path, campaign("linear", UNIFORM))
     with h5py.File(path, "a") as f:
-        f.attrs["design_info"] = info
+        record = json.loads(f.attrs["record"])
+        record["design"]["info"] = info
+        f.attrs["record"] = json.dumps(record)
     done = cli_in_process("report", path, "--out", tmp_path / "report")
     assert done.returncode == 2 and "Traceback" not in done.stdout + done.stderr
     line, = done.stderr.strip().splitlines()

@@ -173,26 +173,27 @@ design: {kind: monte_carlo, samples: 2}
 """
 
 
-def without_parameters_attribute(path, copy):
-    """A copy of a results file without its `parameters` attribute."""
+def without_record(path, copy):
+    """A copy of a results file without its `record` attribute (a file of an older layout)."""
     import shutil
 
     import h5py
 
     shutil.copy(path, copy)
     with h5py.File(copy, "a") as f:
-        del f.attrs["parameters"]
+        del f.attrs["record"]
     return copy
 
 
-MISSING = ("parameters: the results file records no parameters attribute (the parameters' laws with the nominal values "
-           "its run read): fly the campaign again (`uqflight run CAMPAIGN --out FILE --restart` starts this file over)")
+MISSING = ("the results file has no record attribute (the campaign it was made with): a file of an older layout, or "
+           "not written by uqflight: fly the campaign again (`uqflight run CAMPAIGN --out FILE --restart` starts "
+           "this file over)")
 
 
 def test_a_jsbsim_run_stores_the_nominal_values_it_read_from_the_aircraft(tmp_path):
-    """Readers take them from the file; a file without the attribute is refused naming it and the fix."""
+    """Readers take them from the file's record; a file without it is refused naming it and the fix."""
     from uqflight.campaign import parse_campaign
-    from uqflight.campaign.reading import parameter_rows, results_campaign, stored_parameters
+    from uqflight.campaign.record import parameter_rows, read_record
     from uqflight.campaign.schema import CampaignError
     from uqflight.running.runner import run_campaign
     from uqflight.simulators.validation_view import validation_view
@@ -203,23 +204,22 @@ def test_a_jsbsim_run_stores_the_nominal_values_it_read_from_the_aircraft(tmp_pa
     expected = parameter_rows(campaign.parameters)
     assert expected[0]["nominal"] == validation_view(campaign.simulator).value("aero/uq/CL0")  # not in the campaign
     with ResultStore.open(tmp_path / "j.h5") as store:
-        assert stored_parameters(store.attrs) == expected
-    with ResultStore.open(without_parameters_attribute(tmp_path / "j.h5", tmp_path / "old.h5")) as store:
-        assert stored_parameters(store.attrs) is None
+        assert read_record(store.attrs, "j.h5").parameter_rows == expected
+    with ResultStore.open(without_record(tmp_path / "j.h5", tmp_path / "old.h5")) as store:
         with pytest.raises(CampaignError) as refused:
-            results_campaign(store.attrs, "old.h5")
+            read_record(store.attrs, "old.h5")
     assert str(refused.value) == f"old.h5: {MISSING}"
 
 
-def test_a_file_without_its_parameters_attribute_is_refused_without_running_its_model(world, monkeypatch):
-    from uqflight.campaign.reading import results_campaign
+def test_a_file_without_its_record_is_refused_without_running_its_model(world, monkeypatch):
+    from uqflight.campaign.record import read_record
     from uqflight.campaign.schema import CampaignError
     from uqflight.store import ResultStore
 
-    old = without_parameters_attribute(world["results"] / "file.h5", world["results"] / "older.h5")
+    old = without_record(world["results"] / "file.h5", world["results"] / "older.h5")
     monkeypatch.chdir(world["cwd"])
     with ResultStore.open(old) as store:
-        with pytest.raises(CampaignError, match="no parameters attribute"):
-            results_campaign(store.attrs, str(old))
+        with pytest.raises(CampaignError, match="no record attribute"):
+            read_record(store.attrs, str(old))
     old.unlink()
     assert ran_code(world) == {}

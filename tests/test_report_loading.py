@@ -1,5 +1,5 @@
-"""Reading a results file: the campaign text it stores (report.loading.campaign_settings), the file opened
-once per command, and the campaign checked once per command."""
+"""Reading a results file: the file opened once per command, and the campaign it records checked once per
+command."""
 import os
 from pathlib import Path
 
@@ -10,22 +10,7 @@ from test_closed_forms_end_to_end import LINEAR
 from uqflight.analysis.statistics import read_statistics
 from uqflight.analysis.surrogate import fit_surrogate
 from uqflight.report import write_report
-from uqflight.report.loading import campaign_settings
 from uqflight.store import ResultStore
-
-
-def test_unreadable_campaign_text_gives_no_settings():
-    # a stored campaign is the file's to hold: a YAML error, a date that is no date, nesting too deep
-    # for Python and a mapping that is not one all read as {} instead of failing the report
-    for text in ("a: [1, 2", "a: 2001-13-45", "[" * 3000 + "]" * 3000, "- 1\n- 2", "a: !!python/object:os.system x"):
-        assert campaign_settings(text) == {}
-
-
-def test_settings_are_a_copy_of_the_text_read_once():
-    text = "seed: 3\nparameters:\n  CL0: {distribution: normal}\n"
-    first = campaign_settings(text)
-    first["parameters"]["CL0"]["distribution"] = "changed"
-    assert campaign_settings(text) == {"seed": 3, "parameters": {"CL0": {"distribution": "normal"}}}
 
 
 def _count_opens(monkeypatch, log: Path) -> None:
@@ -64,18 +49,18 @@ def test_a_report_opens_its_results_file_once_and_its_drawing_processes_never(tm
 
 
 def test_each_command_checks_the_campaign_once(tmp_path, monkeypatch):
-    # the campaign text through the schema (build_campaign: run, and the parameters a reader shows) and the
-    # stored attributes (recorded_setup: what the analysis reads) once per command, not once per reader
+    # the campaign through its checks (build_campaign): run checks the file's text, a reader the record a run
+    # stored (read_record: what the analysis, the report and the export read), once per command, not per reader
     from collections import Counter
 
     import uqflight.analysis.statistics as statistics
     import uqflight.campaign as campaign
-    import uqflight.campaign.reading as reading
+    import uqflight.campaign.record as record
     from uqflight.campaign import load_campaign
     from uqflight.running.runner import run_campaign
 
     calls = Counter()
-    for module, name in ((statistics, "recorded_setup"), (reading, "build_campaign"), (campaign, "build_campaign")):
+    for module, name in ((statistics, "read_record"), (record, "build_campaign"), (campaign, "build_campaign")):
         def counted(*args, _name=name, _original=getattr(module, name), **kwargs):
             calls[_name] += 1
             return _original(*args, **kwargs)
@@ -87,4 +72,4 @@ def test_each_command_checks_the_campaign_once(tmp_path, monkeypatch):
                     lambda: fit_surrogate(tmp_path / "c.h5")):
         calls.clear()
         command()
-        assert calls == {"recorded_setup": 1, "build_campaign": 1}
+        assert calls == {"read_record": 1, "build_campaign": 1}

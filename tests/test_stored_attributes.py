@@ -1,7 +1,9 @@
-"""A results file's campaign facts are root attributes of JSON text (method, germs, analysis, seeds,
-dependence, design_info, versions) or text (design_kind, campaign_name, campaign_hash, ...): every reading
-command refuses a malformed one with exit 2 and one line naming the file, the attribute and the field, never
-a traceback. A real file of `uqflight run`, then edited with h5py."""
+"""A results file records its campaign once, in the root attribute `record` (versioned JSON: the campaign as
+written, the parameters' laws and the method as its run resolved them, the design's kind and facts, the
+versions), beside text attributes of provenance (campaign_hash, created, ...): every reading command refuses a
+malformed one with exit 2 and one line naming the file, the attribute and the field, never a traceback. A
+real file of `uqflight run`, then edited with h5py."""
+import json
 import shutil
 
 import h5py
@@ -10,57 +12,72 @@ import pytest
 from conftest import DATA, DECAY_TWO_INPUTS, cli_in_process
 
 BASELINE = DATA.parent / "baselines" / "ci-small.json"  # any sound baseline: the results file is refused first
-PG = '{"kind": "pseudo_galerkin", "order": %s}'
-COPULA = '{"kind": "gaussian_copula", "parameters": ["a", "b"], "correlation": %s}'
-MALFORMED = {  # name: (attribute, value, what the message says after "FILE: attribute ATTRIBUTE: ")
-    "method a string": ("method", '"pseudo_galerkin"', "expected a mapping with the keys kind"),
-    "method an integer": ("method", np.int64(5), "expected JSON text, got np.int64(5)"),
-    "method nested 100,000 deep": ("method", "[" * 100_000 + "]" * 100_000, "is not JSON (maximum recursion depth"),
-    "method order NaN": ("method", PG % "NaN", "order: expected an integer >= 0, got nan"),
-    "method order 1e308": ("method", PG % "1e308", "order: expected an integer >= 0, got 1e+308"),
-    "method order -3": ("method", PG % "-3", "order: expected an integer >= 0, got -3"),
-    "method order true": ("method", PG % "true", "order: expected an integer >= 0, got True"),
-    "band_samples 1e12": ("analysis", '{"band_samples": 1e12, "bootstrap": -1}',
-                          "band_samples: expected an integer >= 100, got 1000000000000.0"),
-    "band_samples a word": ("analysis", '{"band_samples": "many"}',
-                            "band_samples: expected an integer >= 100, got 'many'"),
-    "band_samples NaN": ("analysis", '{"band_samples": NaN}', "band_samples: expected an integer >= 100, got nan"),
-    "band_samples 10^12": ("analysis", '{"band_samples": 1000000000000, "bootstrap": 0}',
-                           "band_samples: expected at most 1000000 draws"),
-    "bootstrap -1": ("analysis", '{"bootstrap": -1}', "bootstrap: expected an integer >= 0, got -1"),
-    "bootstrap 10^9": ("analysis", '{"bootstrap": 1000000000}', "bootstrap: expected at most 10000 resamplings"),
-    "seeds a number": ("seeds", "5", "expected a list of distinct parameter names (a, b), got 5"),
-    "seeds an unknown name": ("seeds", '["c"]', "expected a list of distinct parameter names (a, b), got ['c']"),
-    "dependence without kind": ("dependence", '{"parameters": 5}', "kind: is required"),
-    "dependence a list": ("dependence", "[1]", "expected a mapping with the keys kind, parameters, correlation"),
-    "dependence a correlation of 2": ("dependence", COPULA % "[[1, 2], [2, 1]]",
-                                      "correlation[0][1]: expected a correlation in [-1, 1], got 2.0"),
-    "germs too few": ("germs", '["normal"]', "expected a list of 2 germs (normal / uniform), one per parameter"),
-    "germs unknown": ("germs", '["normal", "cauchy"]', "got ['normal', 'cauchy']"),
-    "design_info 5": ("design_info", "5", "expected a mapping of the design's facts, got 5"),
-    "design_info not JSON": ("design_info", "{level", "is not JSON (Expecting property name"),
-    "design_info an array": ("design_info", np.array([1, 2]), "expected JSON text, got array([1, 2])"),
-    "replicates 10^12": ("design_info", '{"replicates": 1000000000000}',
-                         "replicates: expected an integer >= 1 dividing the 29 runs, got 1000000000000"),
-    "replicates a word": ("design_info", '{"replicates": "x"}', "replicates: expected an integer >= 1 dividing"),
-    "scramble a number": ("design_info", '{"scramble": 2}', "scramble: expected true or false, got 2"),
-    "design_kind an array": ("design_kind", np.array([1, 2]), "expected one of monte_carlo, sobol, halton"),
-    "design_kind unknown": ("design_kind", "spiral", "expected one of monte_carlo, sobol, halton"),
-    "design_kind missing": ("design_kind", None, "expected one of monte_carlo, sobol, halton"),
-    "versions 5": ("versions", "5", "expected a mapping of package versions, got 5"),
-    "versions missing": ("versions", None, "is missing: the file is damaged or was not written by uqflight: fly its "
-                                           "campaign again (`uqflight run CAMPAIGN --out FILE --restart`)"),
-    "analysis missing": ("analysis", None, "is missing: the file is damaged or was not written by uqflight"),
-    "campaign_name an array": ("campaign_name", np.array([1, 2]), "expected text, got array([1, 2])"),
-    "campaign_name an integer": ("campaign_name", np.int64(5), "expected text, got np.int64(5)"),
-    "campaign_hash an array": ("campaign_hash", np.array([1, 2]), "expected text, got array([1, 2])"),
-    "created an array": ("created", np.array([1.0]), "expected text, got array([1.])"),
-    "campaign seed a word": ("campaign", DECAY_TWO_INPUTS.replace("seed: 3", "seed: abc"),
-                             "seed: expected an integer >= 0, got 'abc'"),  # it draws the report's runs
-    "campaign seed a list": ("campaign", DECAY_TWO_INPUTS.replace("seed: 3", "seed: [1]"),
-                             "seed: expected an integer >= 0, got a list"),
-    "campaign seed a word, a key twice": ("campaign", DECAY_TWO_INPUTS.replace("seed: 3", "seed: abc") + "name: x\n",
-                                          "seed: expected an integer >= 0, got 'abc'"),  # read as the report reads
+DEPENDENT = {"kind": "gaussian_copula", "parameters": ["a", "b"], "correlation": [[1, 2], [2, 1]]}
+
+
+def at(path: str, value):
+    """An edit of the record (a dict read from its JSON) that sets the field at the dotted `path`."""
+    def edit(record):
+        *parents, last = [int(key) if key.isdigit() else key for key in path.split(".")]
+        inside = record
+        for key in parents:
+            inside = inside[key]
+        inside[last] = value
+    return edit
+
+
+MALFORMED = {  # name: (attribute, its value or an edit of the record, what the message says after "FILE: attribute ")
+    "record a string": ("record", '"x"', "record: expected a mapping with the keys version, campaign, parameters"),
+    "record an integer": ("record", np.int64(5), "record: expected JSON text, got np.int64(5)"),
+    "record nested 100,000 deep": ("record", "[" * 100_000 + "]" * 100_000, "record: is not JSON (maximum recursion"),
+    "record without its method": ("record", lambda r: r.pop("method"), "record: method: is required"),
+    "record of version 2": ("record", at("version", 2), "record: version: this uqflight reads version 1, the file "
+                                                        "holds version 2: fly the campaign again (`uqflight run"),
+    "method a string": ("record", at("method", "pseudo_galerkin"), "record: method: expected a mapping with the keys kind"),
+    "method order NaN": ("record", at("method.order", float("nan")), "record: method.order: expected an integer >= 0, "
+                                                                     "got nan"),
+    "method order 1e308": ("record", at("method.order", 1e308), "method.order: expected an integer >= 0, got 1e+308"),
+    "method order -3": ("record", at("method.order", -3), "record: method.order: expected an integer >= 0, got -3"),
+    "method order true": ("record", at("method.order", True), "method.order: expected an integer >= 0, got True"),
+    "band_samples 1e12": ("record", at("campaign.analysis.band_samples", 1e12),
+                          "record: campaign.analysis.band_samples: expected an integer >= 100, got 1000000000000.0"),
+    "band_samples a word": ("record", at("campaign.analysis.band_samples", "many"),
+                            "campaign.analysis.band_samples: expected an integer >= 100, got 'many'"),
+    "band_samples 10^12": ("record", at("campaign.analysis", {"band_samples": 10**12, "bootstrap": 0}),
+                           "campaign.analysis.band_samples: expected at most 1000000 draws"),
+    "bootstrap -1": ("record", at("campaign.analysis.bootstrap", -1),
+                     "campaign.analysis.bootstrap: expected an integer >= 0, got -1"),
+    "bootstrap 10^9": ("record", at("campaign.analysis.bootstrap", 10**9),
+                       "campaign.analysis.bootstrap: expected at most 10000 resamplings"),
+    "dependence without kind": ("record", at("campaign.dependence", {"parameters": ["a", "b"]}),
+                                "campaign.dependence.kind: is required"),
+    "dependence a correlation of 2": ("record", at("campaign.dependence", DEPENDENT),
+                                      "campaign.dependence.correlation[0][1]: expected a correlation in [-1, 1], got 2"),
+    "a parameter's law unknown": ("record", at("parameters", [{"name": "a"}]),
+                                  "record: parameters: expected one entry (name, property, distribution, nominal, "
+                                  "lower, upper) per parameter of the campaign (a, b)"),
+    "a parameter's bound NaN": ("record", at("parameters.0.lower", float("nan")),
+                                "record: parameters.a: holds a value that is not a finite number"),
+    "the campaign's parameters not the runs'": ("record", lambda r: r["campaign"]["parameters"].pop("b"),
+                                                "record: parameters: expected one entry"),
+    "design kind unknown": ("record", at("design.kind", "spiral"), "record: design.kind: expected one of monte_carlo"),
+    "design info 5": ("record", at("design.info", 5), "record: design.info: expected a mapping of the design's facts, "
+                                                       "got 5"),
+    "replicates 10^12": ("record", at("design.info", {"replicates": 10**12}),
+                         "record: design.info.replicates: expected an integer >= 1 dividing the 29 runs, "
+                         "got 1000000000000"),
+    "replicates a word": ("record", at("design.info", {"replicates": "x"}), "design.info.replicates: expected an "
+                                                                           "integer >= 1 dividing"),
+    "scramble a number": ("record", at("design.info", {"scramble": 2}), "design.info.scramble: expected true or "
+                                                                        "false, got 2"),
+    "versions 5": ("record", at("versions", 5), "record: versions: expected a mapping of package versions, got 5"),
+    "campaign seed a word": ("record", at("campaign.seed", "abc"), "record: campaign.seed: expected an integer >= 0, "
+                                                                   "got 'abc'"),
+    "campaign name a list": ("record", at("campaign.name", [1]), "record: campaign.name: expected a non-empty string, "
+                                                                 "got a list"),
+    "campaign a list": ("record", at("campaign", [1]), "record: campaign: expected a mapping with the keys name"),
+    "campaign_hash an array": ("campaign_hash", np.array([1, 2]), "campaign_hash: expected text, got array([1, 2])"),
+    "created an array": ("created", np.array([1.0]), "created: expected text, got array([1.])"),
 }
 
 
@@ -75,12 +92,17 @@ def sound(tmp_path_factory):
 
 
 def malformed(sound, folder, attribute, value):
-    """A copy of the sound file in `folder` with `attribute` set to `value` (None: deleted)."""
+    """A copy of the sound file in `folder` with `attribute` set to `value` (None: deleted; a function: the
+    record edited by it)."""
     path = folder / "r.h5"
     shutil.copy(sound, path)
     with h5py.File(path, "a") as f:
         if value is None:
             del f.attrs[attribute]
+        elif callable(value):
+            record = json.loads(f.attrs[attribute])
+            value(record)
+            f.attrs[attribute] = json.dumps(record)
         else:
             f.attrs[attribute] = value
     return path
@@ -103,7 +125,7 @@ def test_every_reader_refuses_a_malformed_attribute_naming_file_attribute_and_fi
     assert not (tmp_path / "report").exists() and not (tmp_path / "s.json").exists()
 
 
-@pytest.mark.parametrize("name", ["method a string", "germs too few"])
+@pytest.mark.parametrize("name", ["method a string", "design kind unknown"])
 def test_calibrate_refuses_a_malformed_attribute(sound, tmp_path, name):
     attribute, value, message = MALFORMED[name]
     path = malformed(sound, tmp_path, attribute, value)
@@ -120,10 +142,10 @@ def test_a_pick_freeze_file_needs_its_base_rows(tmp_path, n_base):
     (tmp_path / "c.yaml").write_text(campaign.replace("pseudo_galerkin, order: 2", "monte_carlo"))
     path = tmp_path / "r.h5"
     assert cli_in_process("run", tmp_path / "c.yaml", "--out", path).returncode == 0
-    with h5py.File(path, "a") as f:
-        f.attrs["design_info"] = '{"n_base": %s}' % n_base
-    refused(cli_in_process("report", path, "--out", tmp_path / "report"), path, "design_info",
-            "n_base: expected the base rows n of the 64 runs, n (2 parameters + 2)")
+    (tmp_path / "edited").mkdir()
+    path = malformed(path, tmp_path / "edited", "record", at("design.info", {"n_base": json.loads(n_base)}))
+    refused(cli_in_process("report", path, "--out", tmp_path / "report"), path, "record",
+            "design.info.n_base: expected the base rows n of the 64 runs, n (2 parameters + 2)")
 
 
 @pytest.mark.parametrize("text", [
@@ -138,53 +160,15 @@ def test_a_stored_campaign_text_that_is_no_campaign_is_shown_not_trusted(sound, 
     assert (tmp_path / "report" / "report.html").is_file()
 
 
-def test_the_export_names_the_file_and_the_field_of_a_stored_campaign_it_cannot_read(sound, tmp_path):
-    path = malformed(sound, tmp_path, "campaign", DECAY_TWO_INPUTS.replace("name: decay-people", "name: [1]"))
-    done = cli_in_process("surrogate", "export", path, "--out", tmp_path / "s.json")
-    assert done.returncode == 2 and not (tmp_path / "s.json").exists()
-    assert done.stderr == (f"error: {path}: cannot read the parameters' distributions from the campaign stored in "
-                           "the file: name: expected a non-empty string, got a list\n")
-
-
-SCRIPT_CAMPAIGN = """name: old-script
-seed: 3
-simulator:
-  kind: jsbsim
-  scenario: {kind: script, script: 737_cruise_steady_turn}
-  outputs: [h_ft]
-parameters:
-  a: {property: fcs/elevator-cmd-norm, distribution: normal, interval_pct: 10}
-  b: {property: fcs/aileron-cmd-norm, distribution: uniform, interval_pct: 10}
-design: {kind: sparse_grid, level: 3}
-method: {kind: pseudo_galerkin, order: 2}
-analysis: {band_samples: 500, bootstrap: 0}
-"""
-
-
-def test_a_stored_script_campaign_without_its_parameters_names_field_and_fix(decay_results, tmp_path):
-    """D11: a file without the parameters attribute whose stored campaign is a script's, which names no
-    simulator.aircraft. The campaign reader refuses it naming the attribute and `run --restart`: surrogate export,
-    which needs the parameters, in one line (exit 2); the report, whose numbers do not depend on them (it shows
-    the stored text, test above), flags it in its notes."""
-    import hashlib
-
-    from conftest import read_summary
-
-    out = tmp_path / "old.h5"
-    shutil.copy(decay_results, out)
-    with h5py.File(out, "a") as f:
-        f.attrs["campaign"] = SCRIPT_CAMPAIGN
-        f.attrs["campaign_hash"] = hashlib.sha256(SCRIPT_CAMPAIGN.encode()).hexdigest()
-        del f.attrs["parameters"]
-    said = ("parameters: the results file records no parameters attribute (the parameters' laws with the nominal "
-            "values its run read): fly the campaign again (`uqflight run CAMPAIGN --out FILE --restart` starts this "
-            "file over)")
-    done = cli_in_process("surrogate", "export", out, "--out", tmp_path / "s.json")
-    assert done.returncode == 2 and not (tmp_path / "s.json").exists(), done.stderr
-    errors = [line for line in done.stderr.splitlines() if line.startswith("error:")]
-    assert len(errors) == 1 and "Traceback" not in done.stderr and errors[0].startswith(f"error: {out}: "), done.stderr
-    assert errors[0].endswith(said), errors[0]
-    done = cli_in_process("report", out, "--out", tmp_path / "rep")
-    assert done.returncode == 0, done.stderr
-    notes = read_summary(tmp_path / "rep" / "summary.json")["notes"]
-    assert any(note.endswith(said) and f"stored in {out} cannot be read" in note for note in notes), notes
+def test_a_file_without_its_record_is_refused_by_every_reader_naming_the_fix(sound, tmp_path):
+    """D11: a file of an older layout (no record attribute) is refused in one line (exit 2) that names the
+    attribute and `run --restart`, by every command that reads results."""
+    path = malformed(sound, tmp_path, "record", None)
+    said = (f"error: {path}: the results file has no record attribute (the campaign it was made with): a file of "
+            "an older layout, or not written by uqflight: fly the campaign again (`uqflight run CAMPAIGN --out FILE "
+            "--restart` starts this file over)")
+    for command in (["report", path, "--out", tmp_path / "report"], ["check", path, "--baseline", BASELINE],
+                    ["surrogate", "export", path, "--out", tmp_path / "s.json"], ["info", path]):
+        done = cli_in_process(*command)
+        assert done.returncode == 2 and done.stderr.strip() == said, (command, done.stderr)
+    assert not (tmp_path / "report").exists() and not (tmp_path / "s.json").exists()

@@ -58,7 +58,7 @@ def rare_statistics(store: ResultStore, stats) -> None:
         values = store.quantity(name)
         missing = int(np.count_nonzero(ok & ~np.isfinite(values)))
         exceedance = [exceedance_entry(record, names)] if name == record["of"] else []
-        stats.quantities[name] = QuantityStatistics(name, missing, None, exceedance, quantity_units(store, name))
+        stats.quantities[name] = QuantityStatistics(name, missing, None, exceedance, quantity_units(store, stats, name))
         if name == record["of"]:
             margin = Event(name, record["side"], record["threshold"]).margin(values)
             margin[~ok] = np.nan

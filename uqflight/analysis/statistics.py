@@ -45,7 +45,7 @@ from .moments import (modified_cov, sorted_by_time, standardised_moments, weight
                                weighted_quantiles)
 from .resolution import RESOLUTION_RTOL, resolved_variance
 from .sobol import NEGLIGIBLE, UNRESOLVED_WIDTH, complete_rows, pick_freeze_indices, unresolved
-from ..campaign.attributes import RecordedSetup, recorded_setup, stored_settings
+from ..campaign.record import CampaignRecord, check_design_info, read_record
 from ..campaign.schema import CampaignError
 from ..quantities import quantity_unit
 from ..text.console import quoted_name
@@ -158,6 +158,7 @@ class Statistics:
     drawn: DrawnRuns | None = None  # the runs the report draws (read_statistics with a scatter time; not in summary.json)
     design_info: dict = field(default_factory=dict)  # the design's recorded facts (replicates, n_base, ...)
     seed: int = 0  # what seeded the analysis's draws (the campaign's seed unless Options said otherwise)
+    record: CampaignRecord | None = None  # the campaign the file records (campaign.record), for the report
 
 
 @dataclass
@@ -215,13 +216,21 @@ class QuantityStatistics:
         return {} if self.output is None else self._first("sobol_total")
 
 
-def file_setup(store: ResultStore, path) -> RecordedSetup:
-    """The method, germs, analysis options, seeds and copula the results file `path` was made with, checked
-    as its campaign was: BadInput naming the file, the attribute and the field."""
+def file_record(store: ResultStore, path) -> CampaignRecord:
+    """The campaign the results file `path` records (campaign.record), checked once with the campaign's own
+    checks and against the file's runs, parameters and quantities: BadInput naming the file, the attribute
+    and the field."""
     try:
-        return recorded_setup(store.attrs, str(path), store.parameter_names, store.quantity_names, store.status.size)
+        record = read_record(store.attrs, str(path))
+        check_design_info(record, str(path), int(store.status.size))
     except CampaignError as exc:
         raise BadInput(str(exc)) from exc
+    names, quantities = [p.name for p in record.campaign.parameters], list(record.campaign.quantities)
+    if names != list(store.parameter_names) or sorted(quantities) != sorted(store.quantity_names):
+        raise BadInput(f"{path}: attribute record: the campaign's parameters ({', '.join(names)}) and quantities "
+                       f"({', '.join(quantities) or 'none'}) are not the runs' ({', '.join(store.parameter_names)}; "
+                       f"{', '.join(store.quantity_names) or 'none'}): the file is damaged")
+    return record
 
 
 def read_statistics(path, method: dict | None = None, partial: bool = False,
@@ -262,9 +271,9 @@ def analyse(path, reference: str | None = None, options: Options | None = None, 
 
 def analyse_store(store: ResultStore, path, reference: str | None = None, options: Options | None = None,
                   method: dict | None = None, partial: bool = False, allow_aliasing: bool = False, progress=None,
-                  exceedance: dict | None = None, setup: RecordedSetup | None = None) -> Statistics:
+                  exceedance: dict | None = None, record: CampaignRecord | None = None) -> Statistics:
     """All statistics of the open results file `store` read from `path` (and errors against `reference`).
-    `setup`: the file's checked setup (`file_setup`) when the caller has it already, so that it is checked once.
+    `record`: the file's checked campaign (`file_record`) when the caller has it already, so that it is checked once.
 
     `method` ({"kind", "order", "split"}) overrides the campaign's: the runs of one grid serve every
     method, so methods and orders are compared on the same runs. `partial` analyses a file with pending
@@ -277,23 +286,25 @@ def analyse_store(store: ResultStore, path, reference: str | None = None, option
     # one BLAS thread: the matrices are tall and thin (runs or draws × terms), where several threads are no
     # faster, and 10-20x slower on a loaded machine; the time blocks run in threads instead
     with threadpool_limits(limits=1):
-        setup = file_setup(store, path) if setup is None else setup
-        germs, analysis = setup.germs, setup.analysis
-        method = {"order": DEFAULT_ORDER, **normalised(setup.method), **normalised(method or {})}
+        record = file_record(store, path) if record is None else record
+        campaign = record.campaign
+        germs, analysis = campaign.germs, campaign.analysis
+        method = {"order": DEFAULT_ORDER, **normalised(campaign.method), **normalised(method or {})}
         allow_aliasing = allow_aliasing or bool(method.get("allow_aliasing"))
         options = options or Options(**{k: (tuple(v) if k == "quantiles" else v) for k, v in analysis.items()
                                         if k in ("band_samples", "bootstrap", "quantiles")})
         if options.seed is None:
-            options = replace(options, seed=setup.seed)
-        status, design_kind = store.status, setup.design_kind
+            options = replace(options, seed=campaign.seed)
+        status, design_kind = store.status, record.design_kind
         if method["kind"] not in METHODS:
             raise BadInput(f"{path}: unknown method {method['kind']!r}: expected one of {', '.join(METHODS)}")
         sampled = DESIGNS[design_kind].sampled
         ok = status == Status.OK
         pending = int(np.sum(status == Status.PENDING))
-        stats = Statistics(str(path), store.attrs.get("campaign_name", ""), method, design_kind,
+        stats = Statistics(str(path), campaign.name, method, design_kind,
                            store.parameter_names, int(status.size), int(ok.sum()), int(np.sum(status > 0)),
-                           pending, {}, partial=pending > 0, design_info=setup.design_info, seed=options.seed)
+                           pending, {}, partial=pending > 0, design_info=record.design_info, seed=options.seed,
+                           record=record)
         if DESIGNS[design_kind].rare:  # its runs are not draws of the input law: its event's probability only
             from .rare_statistics import rare_statistics
 
@@ -307,9 +318,9 @@ def analyse_store(store: ResultStore, path, reference: str | None = None, option
         stats.index_set = None if state is None else index_set_summary(state, store.parameter_names)
         problem = method_problem(method["kind"], method["order"], store.xi[ok], store.weights[ok], germs, sampled,
                                  missing=int(status.size - ok.sum()), allow_aliasing=allow_aliasing)
-        if setup.seeds and not (sampled and METHODS[method["kind"]].runs_on_sampled):
-            problem = f"parameter {setup.seeds[0]} is a seed: {SEED_REFUSAL}"
-        stats.seeds, stats.dependence = setup.seeds, setup.dependence
+        if record.seeds and not (sampled and METHODS[method["kind"]].runs_on_sampled):
+            problem = f"parameter {record.seeds[0]} is a seed: {SEED_REFUSAL}"
+        stats.seeds, stats.dependence = record.seeds, record.dependence
         if stats.dependence:
             stats.notes.append(f"dependent inputs: {', '.join(stats.dependence['parameters'])} are correlated by a "
                                "Gaussian copula (Nataf); the mean, variance, bands and densities are those of the "
@@ -325,7 +336,7 @@ def analyse_store(store: ResultStore, path, reference: str | None = None, option
                                     "failed and pending runs" if stats.pending else "failed runs")
             if note:
                 stats.notes.append(note)
-        replicates = setup.design_info.get("replicates", 1)
+        replicates = record.design_info.get("replicates", 1)
         stats.replicates = replicates if stats.from_runs and ok.all() else 1
         if progress is not None:
             progress.stage(f"analysing {Path(path).name} ({method['kind']} order {method['order']})",
@@ -916,11 +927,9 @@ class _QuantityView:
         return None
 
 
-def quantity_units(store: ResultStore, name: str) -> str:
-    """The unit of quantity `name`: the stored campaign text's take and `of` give it (quantities.quantity_unit)."""
-    text = store.attrs.get("campaign", "")
-    specs = stored_settings(text).get("quantities") if isinstance(text, str) else None
-    return quantity_unit(specs.get(name) if isinstance(specs, dict) else None, store.units) or name_unit(name)
+def quantity_units(store: ResultStore, stats: Statistics, name: str) -> str:
+    """The unit of quantity `name`: its take and `of` in the recorded campaign give it (quantities.quantity_unit)."""
+    return quantity_unit(stats.record.campaign.quantities.get(name), store.units) or name_unit(name)
 
 
 def quantity_statistics(store: ResultStore, stats: Statistics, name: str, germs: list[str], ok: np.ndarray,
@@ -929,7 +938,7 @@ def quantity_statistics(store: ResultStore, stats: Statistics, name: str, germs:
     a sampled design's statistics are conditional on the others (noted); a grid's are None (noted:
     a projection needs every run). Exceedance probabilities from the runs or from the PCE."""
     values = store.quantity(name)
-    units = quantity_units(store, name)
+    units = quantity_units(store, stats, name)
     defined = ok & np.isfinite(values)
     period = angle_period(units)
     shifts = None if period is None else branch_shifts(np.where(defined, values, np.nan), period)

@@ -97,24 +97,24 @@ def fit_surrogate(path, method: dict | None = None, partial: bool = False, allow
     does not depend on them, and its bands and PDFs are not exported); `progress`: see analyse."""
     from ..designs import REGISTRY as DESIGNS
     from ..methods import METHODS, normalised
-    from .statistics import BadInput, Options, analyse_store, file_setup
+    from .statistics import BadInput, Options, analyse_store, file_record
     from ..store import ResultStore
 
     with ResultStore.open(path) as store:
-        setup = file_setup(store, path)
-        stored, design_kind = normalised(setup.method), setup.design_kind
+        record = file_record(store, path)
+        stored, design_kind = normalised(record.campaign.method), record.design_kind
         if DESIGNS[design_kind].rare:
             raise BadInput(f"{path}: a {design_kind} design's runs were chosen to reach its event, they are not "
                            "draws of the input law: no expansion of the law is fitted to them; fly a sampled "
                            "design or a grid for a surrogate")
-        parameters, time = _parameters(store, path), np.asarray(store.time, dtype=float)
+        parameters, time = record.parameter_rows, np.asarray(store.time, dtype=float)
         override = dict(method or {})
         kind = override.get("kind", stored.get("kind"))
         if isinstance(kind, str) and kind in METHODS:  # else analyse_store refuses
             override["kind"] = METHODS[kind].exported_kind(DESIGNS[design_kind].sampled)
         stats = analyse_store(store, path, method=override, partial=partial, allow_aliasing=allow_aliasing,
                               options=options or Options(band_samples=200, bootstrap=0), progress=progress,
-                              setup=setup)
+                              record=record)
     pces = {name: out.pce for name, out in stats.outputs.items()}
     units = {name: out.units for name, out in stats.outputs.items()}  # the simulator's, else from the name
     dependence = {k: v for k, v in stats.dependence.items() if k != "sobol_of"} if stats.dependence else None
@@ -139,24 +139,6 @@ def _copula(dependence: dict | None):
         return GaussianCopula(tuple(names), _array(rows, "dependence.correlation", (len(names), len(names))))
     except ValueError as exc:
         raise ValueError(str(exc) if str(exc).startswith("dependence") else f"dependence.{exc}") from None
-
-
-def _parameters(store, path) -> list[dict]:
-    """The parameters' laws from the stored campaign text (κ ↔ ξ) of the results file `path`, via the campaign
-    parser; SurrogateError naming the file and why when they cannot be read."""
-    from ..campaign import CampaignError
-    from ..campaign.reading import parameter_rows, results_campaign
-
-    try:
-        found = parameter_rows(results_campaign(store.attrs, str(path)).parameters)
-    except (CampaignError, OSError) as exc:
-        reason = str(exc).removeprefix(f"{path}: ")
-        raise SurrogateError(f"{path}: cannot read the parameters' distributions from the campaign stored in the "
-                             f"file: {reason}") from exc
-    if [p["name"] for p in found] != store.parameter_names:
-        raise SurrogateError(f"{path}: the parameters of the stored campaign ({listed(p['name'] for p in found)}) "
-                             f"are not the file's ({listed(store.parameter_names)})")
-    return found
 
 
 def surrogate_json(surrogate: Surrogate, results: str = "") -> dict:

@@ -31,13 +31,13 @@ def row_bytes(predictive_draws: int, walkers: int, noise_draws: int = PREDICTIVE
 def campaign_memory_limit(results) -> float:
     """The results file's campaign `limits.max_memory_gb`, read without running any of its code; the
     default when the file cannot be read (then its own checks speak)."""
-    from ..campaign.reading import results_campaign
+    from ..campaign.record import read_record
     from ..store import ResultStore
 
     try:
         with ResultStore.open(results) as store:
             attrs = dict(store.attrs)
-        return float(results_campaign(attrs, str(results)).limits["max_memory_gb"])
+        return float(read_record(attrs, str(results)).campaign.limits["max_memory_gb"])
     except (OSError, ValueError, KeyError):
         return DEFAULT_LIMITS["max_memory_gb"]
 

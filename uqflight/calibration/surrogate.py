@@ -17,7 +17,8 @@ import numpy as np
 from ..campaign import Campaign, CampaignError, load_campaign
 from ..text.bounded import Refused, read_bounded
 from ..campaign.schema import MAX_FILE_BYTES
-from ..campaign.reading import campaign_folder, check_campaign_text, portable_mapping, results_campaign
+from ..campaign.reading import campaign_folder, check_campaign_text, portable_mapping
+from ..campaign.record import CampaignRecord
 from ..text.console import listed
 from ..designs import REGISTRY as DESIGNS
 from ..running.runner import simulate
@@ -29,7 +30,7 @@ from ..parameters import to_physical as _to_physical
 from ..parameters import to_standard as _to_standard
 from ..parameters.summaries import parameter_specs, prior_summaries
 from ..simulators.validation_view import validation_view
-from ..analysis.statistics import BadInput, Options, file_setup, output_basis
+from ..analysis.statistics import BadInput, Options, file_record, output_basis
 from ..store import ResultStore, Status
 from ..analysis.surrogate import SurrogateError, fit_surrogate
 from .likelihood import error_factors_of
@@ -102,10 +103,10 @@ def load_campaign_file(path) -> Campaign:
     return load_campaign(path, view=validation_view)
 
 
-def _campaign_of(store: ResultStore, results: Path, campaign_path: Path | None) -> Campaign:
-    """The campaign stored in the results file, read without running any of its code (a python model
-    is imported only by the predictive runs, from beside the results file), or from beside the campaign
-    file given, which must be the same text."""
+def _record_of(store: ResultStore, results: Path, campaign_path: Path | None) -> CampaignRecord:
+    """The campaign the results file records (campaign.record), read without running any of its code (a
+    python model is imported only by the predictive runs, from beside the results file), or from beside the
+    campaign file given, which must be the same text."""
     source = str(results)
     if campaign_path is not None:
         try:
@@ -116,9 +117,10 @@ def _campaign_of(store: ResultStore, results: Path, campaign_path: Path | None) 
             raise SurrogateError(f"{campaign_path} is not the campaign {results} was run from (the texts differ)")
         source = str(campaign_path)
     try:
-        campaign = results_campaign(store.attrs, source)
-    except CampaignError as exc:
-        raise SurrogateError(f"cannot rebuild the campaign stored in {results}: {exc}") from exc
+        record = file_record(store, source)
+    except BadInput as exc:
+        raise SurrogateError(str(exc)) from exc
+    campaign = record.campaign
     module, _, _ = campaign.simulator.get("function", "").partition(":")
     if module.endswith(".py"):  # looked for, not imported
         folder = campaign_folder(campaign)
@@ -130,7 +132,7 @@ def _campaign_of(store: ResultStore, results: Path, campaign_path: Path | None) 
             raise SurrogateError(f"the python model {module} that the posterior-predictive runs call is not beside "
                                  f"{source}; pass the campaign file with --campaign (its model file is looked up "
                                  "beside it)")
-    return campaign
+    return record
 
 
 def calibration_surrogate(results, method: str | None = None, order: int | None = None,
@@ -146,13 +148,10 @@ def calibration_surrogate(results, method: str | None = None, order: int | None 
     except (OSError, ValueError) as exc:  # CorruptFile's message names the file already
         raise SurrogateError(str(exc) if str(exc).startswith(f"{results}:") else f"{results}: {exc}") from exc
     with store:
-        campaign = _campaign_of(store, results, Path(campaign_path) if campaign_path else None)
-        try:
-            setup = file_setup(store, results)
-        except BadInput as exc:
-            raise SurrogateError(str(exc)) from exc
-        stored, germs = normalised(setup.method), setup.germs
-        sampled = DESIGNS[setup.design_kind].sampled
+        record = _record_of(store, results, Path(campaign_path) if campaign_path else None)
+        campaign = record.campaign
+        stored, germs = normalised(campaign.method), campaign.germs
+        sampled = DESIGNS[record.design_kind].sampled
         kind = method or stored["kind"]
         order = stored.get("order", DEFAULT_ORDER) if order is None else order
         if kind not in METHOD_KINDS:

@@ -6,6 +6,7 @@ names the file, the field and what was expected, e.g.
 """
 from __future__ import annotations
 
+import copy
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Callable
@@ -45,6 +46,7 @@ class Campaign:
     runs: int | None = None  # the design's size, known once validated
     quantities: dict = field(default_factory=dict)  # name -> checked spec (uqflight.quantities)
     dependence: GaussianCopula | None = None  # `dependence:` (parameters.dependence), None: independent
+    mapping: dict = field(default_factory=dict, repr=False)  # the file's mapping as written (YAML), never changed
 
     @property
     def germs(self) -> list[str]:
@@ -91,7 +93,8 @@ def parse_campaign(text: str, source: str = "<campaign>", view: ValidationView |
     """Validate campaign text; see `load_campaign`. A python simulator's module is imported (its code
     runs): this is for campaigns about to be planned or run; results are read with
     `campaign.reading.results_campaign`, which never resolves the simulator."""
-    check, data, simulator = read_settings(text, source)
+    written = campaign_yaml(text, source)
+    check, data, simulator = check_settings(Checker(source), written)
     schema.resolve_simulator(check, simulator, source)
     aircraft = None
     if view and simulator_entry(simulator).aircraft:
@@ -106,7 +109,7 @@ def parse_campaign(text: str, source: str = "<campaign>", view: ValidationView |
     parameters = schema.parameters(check, data["parameters"], simulator["kind"], aircraft)
     schema.check_fixed_properties(check, simulator, parameters, aircraft)
     quantities = check_quantities(check, data.get("quantities"), simulator, aircraft)
-    campaign = build_campaign(check, data, simulator, parameters, text, quantities)
+    campaign = build_campaign(check, data, simulator, parameters, text, quantities, written)
     schema.check_dependence_design(check, data["design"], campaign.dependence, parameters)
     if isinstance(data["design"], dict):  # sizes from the campaign alone, before building anything
         schema.check_size(check, data, simulator, parameters, campaign.method, campaign.execution,
@@ -138,27 +141,33 @@ def parse_campaign(text: str, source: str = "<campaign>", view: ValidationView |
     return campaign
 
 
-def read_settings(text: str, source: str) -> tuple[Checker, dict, dict]:
-    """(checker, the YAML mapping, the checked `simulator:`) of campaign text: the name, seed and
-    simulator checked as written; nothing imported, located or built."""
-    check = Checker(source)
+def campaign_yaml(text: str, source: str):
+    """The value campaign text holds (YAML, as written): CampaignError naming `source` when the text is too
+    long or not YAML."""
     if len(text) > schema.MAX_FILE_BYTES:
-        check.fail("", f"the text is longer than {schema.MAX_FILE_BYTES // 1024} KiB; a campaign is a few "
-                       "lines of YAML")
+        raise CampaignError(source, "", f"the text is longer than {schema.MAX_FILE_BYTES // 1024} KiB; a campaign "
+                                        "is a few lines of YAML")
     try:
-        data = yaml.load(text, Loader=CampaignLoader)
+        return yaml.load(text, Loader=CampaignLoader)
     except yaml.YAMLError as exc:
         raise CampaignError(source, "", yaml_error(exc)) from exc
-    data = check.mapping(data, "", TOP_KEYS, required=("name", "simulator", "parameters", "design"))
+
+
+def check_settings(check: Checker, written) -> tuple[Checker, dict, dict]:
+    """(checker, the mapping, the checked `simulator:`) of a campaign's value as written (`written`, left
+    unchanged: the mapping returned is a copy that the later checks fill): the name, seed and simulator
+    checked as written; nothing imported, located or built."""
+    data = check.mapping(copy.deepcopy(written), "", TOP_KEYS, required=("name", "simulator", "parameters", "design"))
     schema.campaign_name(check, data["name"])
     check.integer(data.get("seed", 0), "seed", 0)
     return check, data, schema.simulator(check, data["simulator"])
 
 
 def build_campaign(check: Checker, data: dict, simulator: dict, parameters: list[Parameter], text: str,
-                   quantities: dict | None = None) -> Campaign:
+                   quantities: dict | None = None, mapping: dict | None = None) -> Campaign:
     """The Campaign of a checked mapping (`read_settings`) and its parameters, its other sections checked
-    (the design is not built: `runs` stays None)."""
+    (the design is not built: `runs` stays None); `mapping`: the mapping as written (`data` before it was
+    checked)."""
     name = data["name"]
     design_kind = data["design"].get("kind") if isinstance(data["design"], dict) else None
     entry = DESIGNS.get(design_kind) if isinstance(design_kind, str) else None
@@ -177,4 +186,5 @@ def build_campaign(check: Checker, data: dict, simulator: dict, parameters: list
     dependence = schema.dependence(check, data.get("dependence"), [p.name for p in parameters], seeds,
                                    simulator.get("properties", {}))
     return Campaign(check.source, text, name, data.get("seed", 0), simulator, parameters, data["design"], method,
-                    execution, storage, analysis, limits, quantities=quantities, dependence=dependence)
+                    execution, storage, analysis, limits, quantities=quantities, dependence=dependence,
+                    mapping=mapping if mapping is not None else {})

@@ -23,6 +23,7 @@ if _STARTING:
 
 import csv  # noqa: E402 (the imports below are what Ctrl-C may interrupt)
 import io
+import json
 from collections import Counter
 from pathlib import Path
 from typing import List, Optional
@@ -385,11 +386,18 @@ def info(results: Path = typer.Argument(..., metavar="RESULTS", help="Results fi
 
 
 def _describe_results(results, store, Status) -> None:
+    from ..campaign import CampaignError
+    from ..campaign.record import read_record
+
     status = store.status
     attrs = store.attrs
+    try:
+        recorded = read_record(attrs, str(results))
+    except CampaignError as exc:
+        refuse(f"{exc}")
     echo(f"file: {results}")
-    echo(f"campaign: {quoted_name(str(attrs.get('campaign_name', '?')))} (sha256 {one_line(str(store.campaign_hash[:12]))})")
-    echo(f"design: {quoted_name(str(attrs.get('design_kind', '?')))} {one_line(str(attrs.get('design_info', '')))}")
+    echo(f"campaign: {quoted_name(recorded.campaign.name)} (sha256 {one_line(str(store.campaign_hash[:12]))})")
+    echo(f"design: {recorded.design_kind} {one_line(json.dumps(recorded.design_info))}")
     state = store.index_set()  # an adaptive grid's refinement (/design)
     if state is not None:
         echo(f"index set: {len(state.indices)} multi-indices, {state.rounds} rounds, "
@@ -414,7 +422,7 @@ def _describe_results(results, store, Status) -> None:
     for problem in problems:
         echo(f"  problem: {one_line(str(problem))}")
     echo(f"storage: {store.storage_description}")
-    echo(f"versions: {one_line(str(attrs.get('versions', '?')))}")  # text of the file's: one line whatever it holds
+    echo(f"versions: {', '.join(f'{one_line(k)} {one_line(v)}' for k, v in recorded.versions.items())}")
     if "aircraft_hash" in attrs:
         echo(f"aircraft sha256: {one_line(str(attrs['aircraft_hash']))}")
     if problems:

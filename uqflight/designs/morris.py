@@ -201,12 +201,10 @@ def morris_screening(xi: np.ndarray, Y: np.ndarray, ok: np.ndarray, info: dict, 
     tuple
         (`morris_measures`' dict, the note or None).
     """
-    levels, trajectories = info.get("levels"), info.get("trajectories")
-    if not (is_integer(levels) and levels >= 2 and levels % 2 == 0):
-        raise ValueError(f"design_info.levels: expected an even integer >= 2, got {levels!r}")
-    if not (is_integer(trajectories) and trajectories * (xi.shape[1] + 1) == len(xi)):
-        raise ValueError(f"design_info.trajectories: expected the {len(xi)} runs' trajectories of "
-                         f"{xi.shape[1]} + 1 points, got {trajectories!r}")
+    problem = info_problem(info, len(xi), xi.shape[1])
+    if problem:
+        raise ValueError(f"design.info.{problem[0]}: {problem[1]}, got {info.get(problem[0])!r}")
+    levels = info["levels"]
     effects, dropped = elementary_effects(xi, Y, ok, levels)
     note = None
     if dropped:
@@ -215,6 +213,17 @@ def morris_screening(xi: np.ndarray, Y: np.ndarray, ok: np.ndarray, info: dict, 
                 f"(a trajectory with a failed or undefined run has no elementary effect of the inputs after it): "
                 f"{dropped} dropped" + ("; σ is undefined with fewer than 2" if kept < 2 else ""))
     return morris_measures(effects, n_boot, seed), note
+
+
+def info_problem(info: dict, runs: int, d: int) -> tuple[str, str] | None:
+    """(the key, what it expects) when a Morris design's recorded `info` does not fit its `runs` of `d`
+    parameters; None when it fits."""
+    levels, trajectories = info.get("levels"), info.get("trajectories")
+    if not (is_integer(levels) and levels >= 2 and levels % 2 == 0):
+        return "levels", "expected an even integer >= 2"
+    if not (is_integer(trajectories) and trajectories * (d + 1) == runs):
+        return "trajectories", f"expected the {runs} runs' trajectories of {d} + 1 points"
+    return None
 
 
 class Morris(DesignKind):
@@ -227,6 +236,7 @@ class Morris(DesignKind):
     draws = Points()
     not_draws = NOT_DRAWS
     screening = staticmethod(morris_screening)
+    info_problem = staticmethod(info_problem)
 
     def size(self, spec, germs):
         """R (d + 1)."""

@@ -1,16 +1,12 @@
 """Analysed results files → report entries: statistics, labels, the campaign's parameters and the file's facts."""
 from __future__ import annotations
 
-import copy
 import hashlib
 import os
 import re
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from ..campaign import CampaignError
-from ..campaign.attributes import stored_settings
-from ..campaign.reading import parameter_rows, results_campaign
 from ..designs import REGISTRY as DESIGNS
 from ..methods import METHODS
 from ..analysis.statistics import BadInput, Statistics, add_reference_errors, read_statistics
@@ -24,12 +20,30 @@ class Entry:
     stem: str
     label: str
     campaign_hash: str
-    inputs: str
     attrs: dict = field(default_factory=dict)  # the results file's root attributes
     path: str = ""  # the results file (several entries share one with several --method)
     output_files: dict = field(default_factory=dict)  # output name → its part of file names, unique in the entry
     file_stem: str = ""  # the results file's part of the names of its own figures (design, runs), unique in the report
-    parameters: list | None = None  # the stored campaign's parameters (STORED_KEYS); None: unreadable (a note)
+
+    @property
+    def settings(self) -> dict:
+        """The recorded campaign's mapping as written (campaign.record: checked when the file was read)."""
+        return self.stats.record.campaign.mapping
+
+    @property
+    def simulator(self) -> dict:
+        """The recorded campaign's `simulator:` mapping as written."""
+        return self.settings["simulator"]
+
+    @property
+    def parameters(self) -> list[dict]:
+        """The recorded campaign's parameters (campaign.record.STORED_KEYS), with the nominal values its run read."""
+        return self.stats.record.parameter_rows
+
+    @property
+    def inputs(self) -> str:
+        """The campaign's input distribution(s), e.g. "normal" or "normal, uniform"."""
+        return ", ".join(dict.fromkeys(p.distribution for p in self.stats.record.campaign.parameters))
 
     @property
     def outputs(self) -> dict:
@@ -68,40 +82,12 @@ def estimator_label(stats) -> str:
     return stats.design_kind if getattr(stats, "rare_runs", None) else method_label(stats.method)
 
 
-def input_distributions(campaign_text: str) -> str:
-    """The campaign's input distribution(s), e.g. "normal" or "normal, uniform"."""
-    parameters = campaign_settings(campaign_text).get("parameters")
-    if not isinstance(parameters, dict) or not parameters:
-        return "?"
-    return ", ".join(dict.fromkeys(str(spec.get("distribution", "?")) if isinstance(spec, dict) else "?"
-                                   for spec in parameters.values()))
-
-
-def campaign_settings(campaign_text: str) -> dict:
-    """The campaign's mapping as written (YAML), {} when unreadable: a copy, the text read once."""
-    return copy.deepcopy(stored_settings(campaign_text))
-
-
-def campaign_simulator(campaign_text: str) -> dict:
-    """The campaign's `simulator:` mapping as written, {} when the text has none (an edited file's text is
-    shown, never trusted to be a campaign)."""
-    simulator = campaign_settings(campaign_text).get("simulator")
-    return simulator if isinstance(simulator, dict) else {}
-
-
 def flight_facts(simulator: dict) -> dict[str, str]:
     """What a campaign's simulator flies ({"flight": ..., "excitation": ...}), defaults resolved by its
-    kind (and scenario kind); {} for a python model, and for a stored text that is not a campaign (the
-    report shows the text, and its notes say why its parameters cannot be read)."""
+    kind (and scenario kind); {} for a python model."""
     from ..simulators.kinds import REGISTRY
 
-    entry = REGISTRY.get(simulator.get("kind")) if isinstance(simulator, dict) else None
-    if entry is None:
-        return {}
-    try:
-        return entry.facts(simulator)
-    except (TypeError, ValueError, KeyError, AttributeError):
-        return {}
+    return REGISTRY[simulator["kind"]].facts(simulator)
 
 
 def load_entries(paths: list[Path], reference: Path | None, method: dict | list[dict] | None = None,
@@ -162,23 +148,8 @@ def _entry(path: Path, stats: Statistics, attrs: dict, stems: set[str], file_ste
     label = f"{stats.campaign_name or stem}: {estimator_label(stats)}, {runs}"
     taken: set[str] = set()
     output_files = {name: _unique(file_name(name), taken) for name in stats.outputs}
-    return Entry(stats, stem, label, str(attrs.get("campaign_hash", "")),
-                 input_distributions(str(attrs.get("campaign", ""))), dict(attrs), str(path), output_files,
-                 file_stems[Path(path).resolve()], stored_parameters(path, attrs, stats))
-
-
-def stored_parameters(path, attrs: dict, stats: Statistics) -> list[dict] | None:
-    """The parameters of the campaign stored in the results file `path` (its root attributes `attrs`), read
-    as every reader reads it (`campaign.reading.results_campaign`); None when they cannot be, flagged in
-    the file's notes with the reason (the field and the fix): the report shows the stored text, and its
-    numbers do not depend on it."""
-    try:
-        return parameter_rows(results_campaign(attrs, str(path)).parameters)
-    except (CampaignError, OSError) as exc:
-        reason = " ".join(str(exc).removeprefix(f"{path}: ").split())
-        stats.notes.append(f"the parameters of the campaign stored in {path} cannot be read, and the parameters "
-                           f"table lacks them: {reason}")
-        return None
+    return Entry(stats, stem, label, str(attrs.get("campaign_hash", "")), dict(attrs), str(path), output_files,
+                 file_stems[Path(path).resolve()])
 
 
 def file_name(name: str) -> str:

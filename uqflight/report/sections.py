@@ -1,7 +1,6 @@
 """What the report page says: its sections, each with text, figures (drawn into plots/) and tables."""
 from __future__ import annotations
 
-import json
 from pathlib import Path
 from typing import Callable
 
@@ -15,7 +14,7 @@ from ..analysis.sobol import unresolved
 from ..running.forking import ChildFailed, share_work
 from ..text.console import one_line
 from .sensitivity import N_TOO_SMALL, NEGLIGIBLE, index_text, plot_sensitivity
-from .loading import (Entry, _same_file, bounded, campaign_settings, campaign_simulator, estimator_label, flight_facts,
+from .loading import (Entry, _same_file, bounded, estimator_label, flight_facts,
                       method_label, one_per_file)
 
 BELOW_FLOOR = "below reference resolution"
@@ -126,11 +125,10 @@ def run_section(entries: list[Entry], out_dir: Path) -> Section:
     blocks = []
     facts, parameter_rows = [], []
     for e in one_per_file(entries):
-        text = str(e.attrs.get("campaign", ""))
-        settings, simulator = campaign_settings(text), campaign_simulator(text)
+        settings, simulator = e.settings, e.simulator
         methods = ", ".join(dict.fromkeys(estimator_label(x.stats) for x in entries
                                           if (x.path or x.stats.path) == (e.path or e.stats.path)))
-        versions = ", ".join(f"{k} {v}" for k, v in json.loads(e.attrs.get("versions", "{}")).items())
+        versions = ", ".join(f"{k} {v}" for k, v in e.stats.record.versions.items())
         failed = getattr(e.stats, "failed", 0)
         counts = f"{e.stats.runs} runs, {failed} failed"
         if getattr(e.stats, "pending", 0):
@@ -142,13 +140,11 @@ def run_section(entries: list[Entry], out_dir: Path) -> Section:
                                                                               "duration_s", "output_rate_hz")
                                               if k in simulator)),
                       ("design", f"{e.stats.design_kind} {info}".strip()),
-                      ("method", methods), ("seed", settings.get("seed", 0)), ("runs", counts),
+                      ("method", methods), ("seed", e.stats.record.campaign.seed), ("runs", counts),
                       ("created", e.attrs.get("created", "?")), ("aircraft sha256", e.attrs.get("aircraft_hash", "-")),
                       ("campaign sha256", e.campaign_hash), ("versions", versions)])
-        if e.parameters is None:  # the reason is in the notes (report.loading.stored_parameters)
-            parameter_rows.append([e.stem, "(the stored campaign cannot be read: see the notes)", "", "", "", "", ""])
-        for p in e.parameters or []:
-            spec = ((settings.get("parameters") or {}).get(p["name"]) or {})
+        for p in e.parameters:
+            spec = settings["parameters"][p["name"]]
             interval = (f"±{spec['interval_pct']:g} % of nominal" if "interval_pct" in spec else "lower, upper")
             parameter_rows.append([e.stem, p["name"], p["property"], p["distribution"], p["lower"], p["upper"],
                                    p["nominal"], interval])
@@ -461,10 +457,7 @@ def decay_section(entries: list[Entry], out_dir: Path) -> Section:
     """The PCE coefficients' root-sum-square per total degree over time (convergence of the expansion)."""
     blocks = []
     for e in entries:
-        excitation = campaign_simulator(str(e.attrs.get("campaign", ""))).get("excitation")
-        start = excitation.get("start_s") if isinstance(excitation, dict) else None
-        if isinstance(start, bool) or not isinstance(start, (int, float)) or not np.isfinite(start):
-            start = None  # the stored text is shown, not trusted: a number or nothing
+        start = e.simulator.get("excitation", {}).get("start_s")
         path = plots.plot_coefficient_decay(e.outputs, out_dir / "plots" / bounded(f"coefficient_decay_{e.stem}.png"),
                                             f"PCE coefficients by total degree: {e.label}", start_s=start)
         blocks.append(Figure(_rel(path, out_dir), f"Root-sum-square of the PCE coefficients of each total degree "

@@ -25,7 +25,6 @@ Nothing lost, nothing hung:
 from __future__ import annotations
 
 import errno
-import json
 import os
 import shutil
 import signal
@@ -44,12 +43,11 @@ import numpy as np
 from threadpoolctl import threadpool_limits
 
 from ..campaign import Campaign
-from ..campaign.reading import parameters_attribute
+from ..campaign.record import ATTRIBUTE, record_text
 from ..campaign.schema import WORKER_BYTES
 from ..text.console import one_line
 from ..designs import REGISTRY as DESIGNS
 from ..designs import Design
-from ..parameters import seed_names
 from .stopping import check as check_stop
 from .progress import Progress
 from .rare_rounds import run_rare
@@ -132,16 +130,8 @@ def prepare_store(campaign: Campaign, design: Design, out: Path, force: bool, no
             nominal = pool.nominal_flight(nominal_kappa(campaign))
         finally:
             pool.close()
-    attrs = {"versions": json.dumps(versions()), "campaign_name": campaign.name,
-             "campaign_path": str(Path(campaign.source).resolve()), "parameters": parameters_attribute(campaign),
-             "method": json.dumps(campaign.method), "germs": json.dumps(campaign.germs),
-             "analysis": json.dumps(campaign.analysis),
-             "design_kind": design.kind, "design_info": json.dumps(design.info, default=str)}
-    seeds = seed_names(campaign.parameters)
-    if seeds:  # written only when there are any: files of other campaigns keep their attributes
-        attrs["seeds"] = json.dumps(seeds)
-    if campaign.dependence is not None:  # likewise
-        attrs["dependence"] = json.dumps(campaign.dependence.summary())
+    attrs = {ATTRIBUTE: record_text(campaign, design.kind, design.info, versions()),
+             "campaign_path": str(Path(campaign.source).resolve())}
     from ..simulators import simulator_provenance
 
     attrs.update(simulator_provenance(campaign.simulator, Path(campaign.source).resolve().parent,

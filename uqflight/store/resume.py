@@ -76,9 +76,9 @@ def open_for_campaign(path, *, campaign_text: str, force: bool = False, restart:
             differs = first_difference(stored_text, campaign_text)
             if differs is not None and _only_read_keys_differ(stored_text, campaign_text):
                 store = ResultStore.open(path, "a")  # the runs stand: the new reading of them is stored
-                given = create_args.get("attrs") or {}
+                given = create_args.get("attrs") or {}  # the new campaign's record (campaign.record)
                 store._file.attrs.update({"campaign": campaign_text, "campaign_hash": text_hash(campaign_text),
-                                          **{key: given[key] for key in READ_ONLY_KEYS if key in given}})
+                                          **{key: given[key] for key in ("record",) if key in given}})
                 return store
         if stored == text_hash(campaign_text) and stored_flown == flown and not restart:
             return ResultStore.open(path, "a")  # LockHeld when another process opened it since the check
