@@ -104,3 +104,13 @@ storage: {path: c.h5}
     ran = cli_in_process("run", tmp_path / "c.yaml", cwd=tmp_path)  # run says it too, in its summary
     assert ran.returncode == 0, ran.stderr
     assert "warning: the nominal flight: the pulse of 1 deg never moved the elevator" in ran.stdout
+
+
+def test_aircraft_list_names_the_projects_and_jsbsims_aircraft():
+    # `uqflight aircraft --list` (and `uqflight aircraft` alone) raised a NameError before it printed a line
+    for args in (("aircraft", "--list"), ("aircraft",)):
+        listed = cli_in_process(*args)
+        assert listed.returncode == 0, listed.stderr
+        lines = dict(line.split(": ", 1) for line in listed.stdout.splitlines())
+        assert any("bacm" in names.split() for names in lines.values()), listed.stdout
+        assert any({"c172x", "737"} <= set(names.split()) for names in lines.values()), listed.stdout

@@ -693,7 +693,7 @@ def aircraft_command(
 
     if list_ or aircraft is None:
         for origin, names in known_aircraft().items():
-            echo(f"{origin}: {' '.join(map(shown, names))}")  # folder names: quoted when odd
+            echo(f"{origin}: {' '.join(map(quoted_name, names))}")  # folder names: quoted when odd
         return
     try:
         located = _prepared(aircraft, [], [])
