@@ -96,6 +96,22 @@ def test_a_worker_imports_only_what_flying_needs():
                for m in loaded), loaded
 
 
+# what the report may import beside its own modules: the analysis's result types and functions, text and labels,
+# and the process plumbing its drawing children and progress use; no design, method, simulator, campaign or
+# store module (what it needs of those comes with the analysis result: Statistics and its CampaignRecord)
+REPORT_MAY_IMPORT = ("uqflight.analysis", "uqflight.text", "uqflight.running.forking", "uqflight.running.progress")
+
+
+def test_the_report_imports_only_the_analysis_text_and_process_plumbing():
+    report = [path for path in MODULES if module_name(path).startswith("uqflight.report")]
+    assert len(report) > 10
+    found = {module_name(path): sorted(target for target in imports(path) if not target.startswith("uqflight.report")
+                                       and not any(target == allowed or target.startswith(allowed + ".")
+                                                   for allowed in REPORT_MAY_IMPORT))
+             for path in report}
+    assert {name: targets for name, targets in found.items() if targets} == {}
+
+
 def import_cycles(lazy: bool) -> list[set[str]]:
     """The strongly connected sets of two or more uqflight modules in the import graph (Tarjan)."""
     graph = {module_name(path): imports(path, lazy) & NAMES - {module_name(path)} for path in MODULES}

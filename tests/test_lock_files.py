@@ -12,7 +12,8 @@ from conftest import cli, cli_in_process, hostile_campaign
 
 from uqflight.running.runner import run_campaign
 from uqflight.store import LockHeld, ResultsLock, ResultStore
-from uqflight.store.lock import start_time, read_holder
+from uqflight.running.forking import start_time
+from uqflight.store.lock import read_holder
 
 CAMPAIGN = """
 name: locks

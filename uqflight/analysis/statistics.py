@@ -160,6 +160,32 @@ class Statistics:
     seed: int = 0  # what seeded the analysis's draws (the campaign's seed unless Options said otherwise)
     record: CampaignRecord | None = None  # the campaign the file records (campaign.record), for the report
 
+    @property
+    def method_label(self) -> str:
+        """The method as in the paper's legends, e.g. "PG order 2", "MC"."""
+        return Method.label_of(self.method)
+
+    @property
+    def estimator_label(self) -> str:
+        """What gives the numbers: the method's label, or a rare-event design's kind (its runs are not the
+        method's draws: it estimates its event's probability only)."""
+        return self.design_kind if self.rare_runs else self.method_label
+
+    @property
+    def expands(self) -> bool:
+        """Whether the statistics are of an expansion (a PCE), not of the runs themselves."""
+        return METHODS[self.method["kind"]].expands
+
+    @property
+    def sampled(self) -> bool:
+        """Whether the design's runs are draws of the input law (not a grid's nodes)."""
+        return DESIGNS[self.design_kind].sampled
+
+    @property
+    def sobol_from_runs(self) -> bool:
+        """Whether the design carries Sobol' indices of its own runs (pick-freeze), with their intervals."""
+        return DESIGNS[self.design_kind].sobol_from_runs
+
 
 @dataclass
 class QuantityStatistics:

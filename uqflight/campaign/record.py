@@ -21,6 +21,7 @@ from ..designs import DESIGN_KINDS
 from ..designs import REGISTRY as DESIGNS
 from ..designs.base import is_integer
 from ..parameters import Parameter, seed_names
+from ..simulators.kinds import simulator_entry
 from ..text.console import quoted_value
 from . import Campaign, build_campaign, check_settings, schema
 from .schema import CampaignError, Checker
@@ -52,6 +53,12 @@ class CampaignRecord:
     def dependence(self) -> dict | None:
         """The inputs' copula as summary.json states it (GaussianCopula.summary); None: independent."""
         return None if self.campaign.dependence is None else self.campaign.dependence.summary()
+
+    @property
+    def flight(self) -> dict[str, str]:
+        """What the simulator flies ({"flight": ..., "excitation": ...}), defaults resolved by its kind (and
+        scenario kind); {} for a python model."""
+        return simulator_entry(self.campaign.mapping["simulator"]).facts(self.campaign.mapping["simulator"])
 
     @property
     def parameter_rows(self) -> list[dict]:

@@ -473,7 +473,8 @@ def report(
     plots/*.png, report.html (self-contained, plots embedded) and report.md (linking plots/).
     The report is written to a temporary folder and moved into place when complete.
     """
-    from ..report import DEFAULT_TIMES, DrawingFailed, default_out_dir, parse_methods, write_report
+    from ..methods.parsing import parse_methods
+    from ..report import DEFAULT_TIMES, DrawingFailed, default_out_dir, write_report
     from ..analysis.statistics import BadInput
 
     try:

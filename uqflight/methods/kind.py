@@ -137,6 +137,14 @@ class Method:
         """The method whose statistics are the runs' own: monte_carlo on a sampled design, else integration."""
         return METHODS["monte_carlo" if sampled else "integration"]
 
+    @staticmethod
+    def label_of(method: dict) -> str:
+        """A method (`{kind, order, split}`) as in the paper's legends, e.g. "PG order 2", "MC"."""
+        entry = METHODS[method["kind"]]
+        if not entry.expands:
+            return entry.label
+        return f"{entry.label} order {method['order']}" + (" split" if method.get("split") else "")
+
     @property
     def settings(self) -> tuple[str, ...]:
         """Its keys its `expansion` takes by name (beyond the order and the split form)."""

@@ -26,13 +26,12 @@ from ..analysis.check import write_baseline
 from ..running.forking import FORKS, ChildFailed, PreparedChild
 from ..running.progress import Progress
 from ..analysis.statistics import BadInput
-from ..methods.parsing import parse_methods
 from .files import _write_text, write_csv, write_statistics_tables, write_summaries
 from .loading import Entry, bounded, load_entries
 from .formats import FORMATS, export_format, exporting
 from .replace import OUT_NAME_BYTES, check_replaceable, make_staging, replace_dir
 
-__all__ = ["DrawingFailed", "check_replaceable", "default_out_dir", "parse_methods", "write_report"]
+__all__ = ["DrawingFailed", "check_replaceable", "default_out_dir", "write_report"]
 
 DEFAULT_TIMES = (10.0, 25.0, float("inf"))  # the tables' times: 10 s, 25 s and the final time
 

@@ -7,8 +7,6 @@ import re
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from ..designs import REGISTRY as DESIGNS
-from ..methods import METHODS
 from ..analysis.statistics import BadInput, Statistics, add_reference_errors, read_statistics
 
 
@@ -51,11 +49,11 @@ class Entry:
 
     @property
     def monte_carlo(self) -> bool:
-        return not METHODS[self.stats.method["kind"]].expands
+        return not self.stats.expands
 
     @property
     def pick_freeze(self) -> bool:
-        return DESIGNS[self.stats.design_kind].sobol_from_runs
+        return self.stats.sobol_from_runs
 
     @property
     def has_sobol(self) -> bool:
@@ -64,30 +62,6 @@ class Entry:
     @property
     def has_errors(self) -> bool:
         return any(out.errors for out in self.outputs.values())
-
-
-
-def method_label(method: dict) -> str:
-    """A method as in the paper's legends, e.g. "PG order 2", "MC"."""
-    entry = METHODS[method["kind"]]
-    name = entry.label
-    if not entry.expands:
-        return name
-    return f"{name} order {method['order']}" + (" split" if method.get("split") else "")
-
-
-def estimator_label(stats) -> str:
-    """What gives a file's numbers: its method's label, or a rare-event design's kind (its runs are not the
-    method's draws: it estimates its event's probability only)."""
-    return stats.design_kind if getattr(stats, "rare_runs", None) else method_label(stats.method)
-
-
-def flight_facts(simulator: dict) -> dict[str, str]:
-    """What a campaign's simulator flies ({"flight": ..., "excitation": ...}), defaults resolved by its
-    kind (and scenario kind); {} for a python model."""
-    from ..simulators.kinds import REGISTRY
-
-    return REGISTRY[simulator["kind"]].facts(simulator)
 
 
 def load_entries(paths: list[Path], reference: Path | None, method: dict | list[dict] | None = None,
@@ -145,7 +119,7 @@ def _entry(path: Path, stats: Statistics, attrs: dict, stems: set[str], file_ste
     name = Path(path).stem + (f"_{stats.method['kind']}{stats.method.get('order', '')}" if with_method else "")
     stem = _unique(file_name(name), stems)
     runs = f"partial: {stats.completed} of {stats.runs} runs" if stats.partial else f"{stats.runs} runs"
-    label = f"{stats.campaign_name or stem}: {estimator_label(stats)}, {runs}"
+    label = f"{stats.campaign_name or stem}: {stats.estimator_label}, {runs}"
     taken: set[str] = set()
     output_files = {name: _unique(file_name(name), taken) for name in stats.outputs}
     return Entry(stats, stem, label, str(attrs.get("campaign_hash", "")), dict(attrs), str(path), output_files,

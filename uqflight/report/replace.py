@@ -32,7 +32,7 @@ import stat
 from contextlib import contextmanager
 from pathlib import Path
 
-from ..store.lock import alive, start_time
+from ..running.forking import alive, start_time
 
 REPORT_FILES = {"report.html": None, "report.md": None, "summary.json": None,  # what a report writes, and
                 "plots": ".png", "tables": ".csv", "summaries": ".json"}      # its folders' file types

@@ -14,8 +14,7 @@ from ..analysis.sobol import unresolved
 from ..running.forking import ChildFailed, share_work
 from ..text.console import one_line
 from .sensitivity import N_TOO_SMALL, NEGLIGIBLE, index_text, plot_sensitivity
-from .loading import (Entry, _same_file, bounded, estimator_label, flight_facts,
-                      method_label, one_per_file)
+from .loading import Entry, _same_file, bounded, one_per_file
 
 BELOW_FLOOR = "below reference resolution"
 UNRESOLVED = "unresolved"
@@ -126,14 +125,14 @@ def run_section(entries: list[Entry], out_dir: Path) -> Section:
     facts, parameter_rows = [], []
     for e in one_per_file(entries):
         settings, simulator = e.settings, e.simulator
-        methods = ", ".join(dict.fromkeys(estimator_label(x.stats) for x in entries
+        methods = ", ".join(dict.fromkeys(x.stats.estimator_label for x in entries
                                           if (x.path or x.stats.path) == (e.path or e.stats.path)))
         versions = ", ".join(f"{k} {v}" for k, v in e.stats.record.versions.items())
         failed = getattr(e.stats, "failed", 0)
         counts = f"{e.stats.runs} runs, {failed} failed"
         if getattr(e.stats, "pending", 0):
             counts += f", {e.stats.pending} not run"
-        flown = flight_facts(simulator)
+        flown = e.stats.record.flight
         info = ", ".join(f"{k} {v}" for k, v in e.stats.design_info.items())
         facts.append([e.stem, ("flight", flown.get("flight", "-")), ("excitation", flown.get("excitation", "-")),
                       ("simulator", ", ".join(f"{k} {simulator[k]}" for k in ("kind", "aircraft", "function",
@@ -204,7 +203,7 @@ def _finite(value) -> float | None:
 
 
 def inputs_section(entries: list[Entry], ref: Entry | None) -> Section:
-    rows = [[e.label, e.stats.path, e.stats.design_kind, method_label(e.stats.method), e.inputs, e.stats.runs,
+    rows = [[e.label, e.stats.path, e.stats.design_kind, e.stats.method_label, e.inputs, e.stats.runs,
              e.stats.failed, e.campaign_hash[:12]] for e in entries]
     text = (f"Errors and KLD are against the reference {ref.label} ({ref.stats.path})." if ref
             else "No reference file: no errors or KLD (give a Monte Carlo file with --reference).")
@@ -335,7 +334,7 @@ def accuracy_section(entries: list[Entry], out_dir: Path) -> Section:
                                                   "(paper Figs. 10-19); the reference's own floor dashed when "
                                                   "known: errors below it are not resolved by the reference."))
     if len(compared) >= 2:
-        points = [(f"{method_label(e.stats.method)} ({e.stats.design_kind})", e.stats.runs,
+        points = [(f"{e.stats.method_label} ({e.stats.design_kind})", e.stats.runs,
                    {name: (out.errors["eps_m_summary"]["max"], out.errors["eps_v_summary"]["max"],
                            _floor_max(out, "eps_m"), _floor_max(out, "eps_v"))
                     for name, out in e.outputs.items() if out.errors}) for e in compared]
@@ -343,7 +342,7 @@ def accuracy_section(entries: list[Entry], out_dir: Path) -> Section:
                                       "Largest error over time against the number of runs")
         blocks.append(Figure(_rel(path, out_dir), "max over time of ε_m and ε_v against the number of runs, one line "
                              "per method and design, log-log; the reference's floor dashed when known."))
-        points = [(f"{method_label(e.stats.method)} ({e.stats.design_kind})", e.stats.runs,
+        points = [(f"{e.stats.method_label} ({e.stats.design_kind})", e.stats.runs,
                    {name: (out.errors["kld_final"], out.errors.get("kld_floor")) for name, out in e.outputs.items()
                     if out.errors}) for e in compared]
         path = plots.plot_kld_vs_runs(points, out_dir / "plots" / "kld_vs_runs.png",

@@ -113,14 +113,13 @@ def trajectories_section(entries: list, times: list[float], out_dir: Path):
     """Per results file: the spaghetti plot and the scatter of the outputs at the last of `times` and of the
     quantities against the inputs, seeded by the campaign's seed (the same runs on every report); None
     when there is nothing to draw (no output and no quantity)."""
-    from ..designs import REGISTRY as DESIGNS
     from .loading import bounded, one_per_file
     from .blocks import Figure, Section, _rel
 
     blocks = []
     for e in one_per_file(entries):
         drawn, stem, seed = e.stats.drawn, e.file_stem, e.stats.seed
-        nodes = ("" if DESIGNS[e.stats.design_kind].sampled else
+        nodes = ("" if e.stats.sampled else
                  f" The points are the {e.stats.design_kind}'s nodes, not random draws: how they spread says "
                  "nothing of the inputs' distribution.")
         if any(out.time.size > 1 for out in e.outputs.values()):

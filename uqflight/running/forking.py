@@ -14,11 +14,35 @@ import sys
 import threading
 import time
 import traceback
+from pathlib import Path
 from typing import Callable
 
 from ..text.console import one_line
 
 FORKS = hasattr(os, "fork")  # where the system cannot fork, callers do the work themselves
+
+
+def start_time(pid: int) -> str | None:
+    """The process's start time in clock ticks since boot (/proc/PID/stat field 22), or None."""
+    try:
+        stat_line = Path(f"/proc/{pid}/stat").read_text()
+    except OSError:
+        return None
+    return stat_line.rsplit(")", 1)[1].split()[19]
+
+
+def alive(pid: int, started: str | None) -> bool:
+    """False only when no process `pid` runs, or the one that does started at another time."""
+    if pid <= 0:
+        return False
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:
+        return True
+    now = start_time(pid)
+    return started is None or now is None or now == started
 
 
 class ChildFailed(RuntimeError):

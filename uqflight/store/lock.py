@@ -21,6 +21,8 @@ import stat
 import time
 from pathlib import Path
 
+from ..running.forking import alive, start_time
+
 
 class LockHeld(FileExistsError):
     """Another run holds the results file, or something that is not a lock of ours sits at FILE.lock."""
@@ -33,29 +35,6 @@ LOCK_BYTES = 4096  # a lock we write is ~150 bytes: more is not ours
 def lock_path(path) -> Path:
     path = Path(path)
     return path.with_name(path.name + ".lock")
-
-
-def start_time(pid: int) -> str | None:
-    """The process's start time in clock ticks since boot (/proc/PID/stat field 22), or None."""
-    try:
-        stat_line = Path(f"/proc/{pid}/stat").read_text()
-    except OSError:
-        return None
-    return stat_line.rsplit(")", 1)[1].split()[19]
-
-
-def alive(pid: int, started: str | None) -> bool:
-    """False only when no process `pid` runs, or the one that does started at another time."""
-    if pid <= 0:
-        return False
-    try:
-        os.kill(pid, 0)
-    except ProcessLookupError:
-        return False
-    except PermissionError:
-        return True
-    now = start_time(pid)
-    return started is None or now is None or now == started
 
 
 def _is_ours(holder) -> bool:
