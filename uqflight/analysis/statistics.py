@@ -33,6 +33,7 @@ from typing import Callable
 import numpy as np
 from threadpoolctl import threadpool_limits
 
+from . import BAND_SAMPLES, BOOTSTRAP, QUANTILES
 from .angles import angle_period, branch_shifts, unwrapped_runs
 from .density import pdf_over_time
 from .divergence import kl_divergence
@@ -67,7 +68,6 @@ TIME_BLOCK = 100  # recorded times whose runs or surrogate draws are rebuilt at 
 ANALYSIS_THREADS = min(2, os.cpu_count() or 1)  # time blocks analysed at once (each with one BLAS thread)
 MAX_MAGNITUDE = 1e75  # an output's or quantity's values beyond: their fourth powers (kurtosis) leave float64
 BAND_LEVEL = 0.99
-DEFAULT_QUANTILES = (0.005, 0.995)
 # The relative spread a JSBSim output can resolve: the same sample flown on a reused model and on a
 # freshly loaded one differs by up to 3.7e-9 of the output (JSBSim's trim; 1e-12 with the Newton
 # trim), so a spread below 1e-9 of the output's own size is the simulator's noise, not the inputs'.
@@ -85,10 +85,10 @@ class Options:
     every draw of the analysis (band and PDF draws, bootstrap, exceedance draws, the KLD floor's splits);
     None: the results file's campaign seed."""
 
-    band_samples: int = 20000
-    bootstrap: int = 200
+    band_samples: int = BAND_SAMPLES
+    bootstrap: int = BOOTSTRAP
     seed: int | None = None
-    quantiles: tuple[float, ...] = DEFAULT_QUANTILES
+    quantiles: tuple[float, ...] = QUANTILES
 
 
 @dataclass

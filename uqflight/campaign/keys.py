@@ -12,6 +12,7 @@ import inspect
 import re
 from dataclasses import dataclass
 
+from ..analysis import BAND_SAMPLES, BOOTSTRAP, QUANTILES
 from ..methods import METHODS, Method
 
 # The meaning of each key, its default and an example, by its path (NAME: a name the user chooses).
@@ -29,7 +30,7 @@ KEYS = {
               "`{kind: integration}` for grids. `method: {kind: pseudo_galerkin, order: 2}`",
     "execution": "How the runs are executed: `execution: {workers: 2, executor: local, chunk: 16}`",
     "storage": "Where and how the results are stored: `storage: {path: results/x.h5, raw: true}`",
-    "analysis": "Options of the statistics: `analysis: {band_samples: 20000, bootstrap: 200}`",
+    "analysis": f"Options of the statistics: `analysis: {{band_samples: {BAND_SAMPLES}, bootstrap: {BOOTSTRAP}}}`",
     "limits": "Size limits checked before anything is built (exit 2 beyond them): "
               "`limits: {max_runs: 1000000}`",
     "quantities": "Quantities of interest, one number per run, stored in `/quantities/NAME`: "
@@ -107,16 +108,16 @@ KEYS = {
     "storage.tsvd.batch": "Runs per SVD update, >= 1. Default 1000.",
     # analysis
     "analysis.band_samples": "Draws of the PCE for the bands and PDFs, from 100 to 10^6 (a million draws of an "
-                             "output take about 1.6 GB to sort). Default 20000: on the paper's "
+                             f"output take about 1.6 GB to sort). Default {BAND_SAMPLES}: on the paper's "
                              "expansion the band's sampling error is about 3.5 % of the output's std, "
                              "and grows as 1/sqrt(draws) (`benchmarks/band_samples.py`).",
-    "analysis.bootstrap": "Resamplings for the pick-freeze Sobol' intervals, 0 (none) to 10^4. Default 200. "
+    "analysis.bootstrap": f"Resamplings for the pick-freeze Sobol' intervals, 0 (none) to 10^4. Default {BOOTSTRAP}. "
                           "Each costs time and memory in every output's every time: on 1024 base rows, 3 "
                           "inputs and 5 outputs of 1001 times, 10^4 add 45 s of CPU and 1 GB to the report. "
                           "A 95 % interval's ends are steady from about 2000 on; at 10^4 the error of "
                           "each 2.5 % tail is 0.16 % (its 6 %): more buys nothing.",
     "analysis.quantiles": "1-20 probabilities in (0, 1) reported over time in summary.json. Default "
-                          "[0.005, 0.995]. `quantiles: [0.05, 0.5, 0.95]`",
+                          f"{list(QUANTILES)}. `quantiles: [0.05, 0.5, 0.95]`",
     "analysis.exceedance": "`{QUANTITY: [{above: X}, {below: Y}]}`: P(QUANTITY > X) and P(QUANTITY < Y). "
                            "`exceedance: {peak_load_factor: [{above: 3}]}`",
     "analysis.exceedance.QUANTITY[i].above": "The threshold of P(QUANTITY > X).",

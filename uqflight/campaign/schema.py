@@ -10,6 +10,7 @@ from collections.abc import Hashable
 import numpy as np
 import yaml
 
+from ..analysis import BAND_SAMPLES, BOOTSTRAP
 from ..designs import REGISTRY as DESIGNS
 from ..designs import Design, design_size
 from ..methods import DEFAULT_ORDER, METHOD_KINDS, METHODS, Method
@@ -519,17 +520,17 @@ def analysis(check: Checker, value, quantities: dict | None = None) -> dict:
         from ..quantities.spec import check_exceedance
 
         analysis["exceedance"] = check_exceedance(check, analysis["exceedance"], quantities or {})
-    analysis["band_samples"] = check.integer(analysis.get("band_samples", 20000), "analysis.band_samples", 100)
+    analysis["band_samples"] = check.integer(analysis.get("band_samples", BAND_SAMPLES), "analysis.band_samples", 100)
     if analysis["band_samples"] > MAX_BAND_SAMPLES:
         check.fail("analysis.band_samples", f"expected at most {MAX_BAND_SAMPLES} draws (a million draws of an "
                                             "output, sorted 100 times at once, take about 1.6 GB in two threads), "
                                             f"got {analysis['band_samples']}")
-    analysis["bootstrap"] = check.integer(analysis.get("bootstrap", 200), "analysis.bootstrap", 0)
+    analysis["bootstrap"] = check.integer(analysis.get("bootstrap", BOOTSTRAP), "analysis.bootstrap", 0)
     if analysis["bootstrap"] > MAX_BOOTSTRAP:
         check.fail("analysis.bootstrap", f"expected at most {MAX_BOOTSTRAP} resamplings (10^4 of a pick-freeze "
                                          "design of 1024 base rows take about a minute and 1 GB), "
                                          f"got {analysis['bootstrap']}")
-    if "quantiles" in analysis:  # kept only when given (default: statistics.DEFAULT_QUANTILES)
+    if "quantiles" in analysis:  # kept only when given (default: analysis.QUANTILES)
         value = analysis["quantiles"]
         if not isinstance(value, list) or not value or len(value) > 20:
             check.fail("analysis.quantiles", f"expected a list of 1 to 20 probabilities, got {quoted_value(value)}")
