@@ -118,7 +118,7 @@ def bare_processes(campaign_spec, processes: int) -> float:
     spec, kappa = worker_spec(campaign_spec), to_physical(campaign_spec.parameters, campaign_spec.design().xi)
     nominal = nominal_flight(spec, nominal_kappa(campaign_spec))
     time_grid, outputs = nominal.time, nominal.outputs
-    chunks = pending_chunks(np.arange(len(kappa)), campaign_spec.execution["chunk"], len(kappa))
+    chunks = pending_chunks(np.arange(len(kappa)), campaign_spec.execution.chunk, len(kappa))
     with tempfile.TemporaryDirectory() as tmp:
         shares = []
         for i in range(processes):

@@ -140,7 +140,7 @@ def test_initial_conditions_are_uncertain_parameters_with_the_flight_condition_a
     assert speed.nominal == pytest.approx(190.0)  # the campaign's airspeed, not the aircraft's 0
     assert (altitude.lower, altitude.upper) == pytest.approx((11400.0, 12600.0))  # 5 % of 12000 ft
     assert lift.distribution == "lognormal"
-    assert campaign.storage["tsvd"]["tol"] == 1e-6
+    assert campaign.storage.tsvd.tol == 1e-6
 
 
 def test_calibrated_airspeed_takes_its_nominal_from_the_flight_condition():
@@ -184,7 +184,7 @@ design: {kind: monte_carlo, samples: 4}
 
 def test_exponents_without_a_dot_are_numbers():
     text = (DATA / "good_python_ishigami.yaml").read_text() + "storage: {raw: false, tsvd: {tol: 1e-8}}\n"
-    assert parse_campaign(text, "x.yaml").storage["tsvd"]["tol"] == 1e-8
+    assert parse_campaign(text, "x.yaml").storage.tsvd.tol == 1e-8
 
 
 HOSTILE_YAML = {  # name: (the value of `seed:`, what the one line says)
@@ -224,3 +224,16 @@ def test_a_list_where_a_name_is_expected_is_refused_naming_the_field(name):
     with pytest.raises(CampaignError) as caught:
         parse_campaign(text, "lists.yaml")
     assert caught.value.field == field and message in str(caught.value)
+
+
+def test_the_sections_are_typed_frozen_and_their_examples_run():
+    import dataclasses
+    import doctest
+
+    import uqflight.campaign.sections as sections
+
+    assert doctest.testmod(sections).failed == 0
+    campaign = parse_campaign((DATA / "good_python_ishigami.yaml").read_text(), "x.yaml")
+    assert isinstance(campaign.execution, sections.Execution) and campaign.limits == sections.Limits()
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        campaign.execution.workers = 4

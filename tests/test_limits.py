@@ -62,11 +62,12 @@ def test_a_huge_level_is_refused_up_front():
 
 def test_a_raised_limit_lets_a_large_design_through():
     text = limited(design="{kind: monte_carlo, samples: 2000000}") + "limits: {max_runs: 3000000}\n"
-    from uqflight.campaign.schema import CampaignLoader, Checker, limits
+    from uqflight.campaign.schema import CampaignLoader, Checker
+    from uqflight.campaign.sections import Limits
     import yaml
     data = yaml.load(text, Loader=CampaignLoader)
-    found = limits(Checker("x"), data["limits"])
-    assert found["max_runs"] == 3000000
+    found = Limits.checked(Checker("x"), data["limits"])
+    assert found.max_runs == 3000000 and found.max_memory_gb == Limits.max_memory_gb
 
 
 def test_a_long_flight_is_refused_by_its_memory_or_disk():

@@ -317,8 +317,8 @@ def analyse_store(store: ResultStore, path, reference: str | None = None, option
         germs, analysis = campaign.germs, campaign.analysis
         method = {"order": DEFAULT_ORDER, **normalised(campaign.method), **normalised(method or {})}
         allow_aliasing = allow_aliasing or bool(method.get("allow_aliasing"))
-        options = options or Options(**{k: (tuple(v) if k == "quantiles" else v) for k, v in analysis.items()
-                                        if k in ("band_samples", "bootstrap", "quantiles")})
+        options = options or Options(analysis.band_samples, analysis.bootstrap,
+                                     quantiles=analysis.quantiles or QUANTILES)
         if options.seed is None:
             options = replace(options, seed=campaign.seed)
         status, design_kind = store.status, record.design_kind
@@ -401,7 +401,7 @@ def analyse_store(store: ResultStore, path, reference: str | None = None, option
         if unknown:
             raise BadInput(f"{path}: --exceedance {unknown[0]}: no such quantity in the file; its quantities: "
                            + (", ".join(store.quantity_names) or "none"))
-        thresholds = {**analysis.get("exceedance", {}), **(exceedance or {})}
+        thresholds = {**analysis.exceedance, **(exceedance or {})}
         for name in store.quantity_names:
             stats.quantities[name] = quantity_statistics(store, stats, name, germs, ok, options,
                                                          thresholds.get(name, []))

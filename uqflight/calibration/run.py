@@ -360,7 +360,7 @@ def _predictive(chain, posterior, surrogate, flight, rng, count):
     pick = rng.choice(len(draws), size=min(count, len(draws)), replace=False)
     xi = draws[pick, :len(surrogate.names)]
     kappa = to_physical(surrogate.parameters, xi, surrogate.campaign.dependence)
-    processes = min(surrogate.campaign.execution["workers"], os.cpu_count() or 1)  # the campaign's, on this machine
+    processes = min(surrogate.campaign.execution.workers, os.cpu_count() or 1)  # the campaign's, on this machine
     # matplotlib (a second to import) is loaded while the flights run: the plots come next
     sim_time, runs, failures = simulate(surrogate.campaign, kappa, list(flight.values), processes, meanwhile=pyplot)
     ok = np.all([np.all(np.isfinite(runs[o]), axis=1) for o in runs], axis=0)

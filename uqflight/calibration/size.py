@@ -14,7 +14,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from ..text.bounded import Refused, open_bounded
-from ..campaign.schema import DEFAULT_LIMITS
+from ..campaign.sections import Limits
 from .likelihood import DATA_FORM, MAX_DATA_BYTES, DataError
 
 DEFAULT_WALKERS = 32  # the fewest `calibrate` uses when --walkers is not given
@@ -37,9 +37,9 @@ def campaign_memory_limit(results) -> float:
     try:
         with ResultStore.open(results) as store:
             attrs = dict(store.attrs)
-        return float(read_record(attrs, str(results)).campaign.limits["max_memory_gb"])
+        return float(read_record(attrs, str(results)).campaign.limits.max_memory_gb)
     except (OSError, ValueError, KeyError):
-        return DEFAULT_LIMITS["max_memory_gb"]
+        return Limits.max_memory_gb
 
 
 def check_size(data, outputs: list[str] | None, walkers: int | None, steps: int | None, predictive_draws: int,

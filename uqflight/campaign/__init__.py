@@ -24,6 +24,7 @@ from ..simulators.jsbsim import NAMED_OUTPUTS
 from ..simulators.kinds import simulator_entry
 from . import schema
 from .schema import TOP_KEYS, CampaignError, CampaignLoader, Checker, yaml_error
+from .sections import Analysis, Execution, Limits, Storage
 
 ValidationView = Callable[[dict], object]  # simulator config -> its aircraft's properties (see validation_view)
 
@@ -39,10 +40,10 @@ class Campaign:
     parameters: list[Parameter]
     design_spec: dict
     method: dict
-    execution: dict
-    storage: dict
-    analysis: dict = field(default_factory=dict)
-    limits: dict = field(default_factory=lambda: dict(schema.DEFAULT_LIMITS))
+    execution: Execution
+    storage: Storage
+    analysis: Analysis = field(default_factory=Analysis)
+    limits: Limits = field(default_factory=Limits)
     runs: int | None = None  # the design's size, known once validated
     quantities: dict = field(default_factory=dict)  # name -> checked spec (uqflight.quantities)
     dependence: GaussianCopula | None = None  # `dependence:` (parameters.dependence), None: independent
@@ -177,12 +178,12 @@ def build_campaign(check: Checker, data: dict, simulator: dict, parameters: list
     seeds = seed_names(parameters)
     if seeds and simulator_entry(simulator).integer_seeds:
         simulator["seed_parameters"] = seeds
-    execution = schema.execution(check, data.get("execution", {}))
-    storage = schema.storage(check, data.get("storage", {}), name)
+    execution = Execution.checked(check, data.get("execution", {}))
+    storage = Storage.checked(check, data.get("storage", {}), name)
     if quantities is None:  # read from a results file: checked as written, no aircraft to name properties
         quantities = check_quantities(check, data.get("quantities"), simulator)
-    analysis = schema.analysis(check, data.get("analysis", {}), quantities)
-    limits = schema.limits(check, data.get("limits", {}))
+    analysis = Analysis.checked(check, data.get("analysis", {}), quantities)
+    limits = Limits.checked(check, data.get("limits", {}))
     dependence = schema.dependence(check, data.get("dependence"), [p.name for p in parameters], seeds,
                                    simulator.get("properties", {}))
     return Campaign(check.source, text, name, data.get("seed", 0), simulator, parameters, data["design"], method,

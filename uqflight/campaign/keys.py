@@ -14,6 +14,7 @@ from dataclasses import dataclass
 
 from ..analysis import BAND_SAMPLES, BOOTSTRAP, QUANTILES
 from ..methods import METHODS, Method
+from .sections import Analysis, Execution, Limits, Storage, Tsvd, keys_of
 
 # The meaning of each key, its default and an example, by its path (NAME: a name the user chooses).
 KEYS = {
@@ -231,14 +232,14 @@ def accepted_keys() -> list[Key]:
     found += [Key(p, "method", kinds if p == "method.kind" else None)
               for p in _paths("method", ("kind", *dict.fromkeys(k for entry in (Method, *METHODS.values())
                                                                    for k in entry.keys)))]
-    found += [Key(p, "execution") for p in _paths("execution", schema.EXECUTION_KEYS)]
-    found += [Key(p, "storage") for p in _paths("storage", schema.STORAGE_KEYS) + _paths("storage.tsvd",
-                                                                                           schema.TSVD_KEYS)]
-    found += [Key(p, "analysis") for p in _paths("analysis", schema.ANALYSIS_KEYS)]
+    found += [Key(p, "execution") for p in _paths("execution", keys_of(Execution))]
+    found += [Key(p, "storage") for p in _paths("storage", keys_of(Storage)) + _paths("storage.tsvd",
+                                                                                         keys_of(Tsvd))]
+    found += [Key(p, "analysis") for p in _paths("analysis", keys_of(Analysis))]
     from ..quantities.spec import BOUNDS
 
     found += [Key(p, "analysis") for p in _paths("analysis.exceedance.QUANTITY[i]", BOUNDS)]
-    found += [Key(p, "limits") for p in _paths("limits", schema.LIMIT_KEYS)]
+    found += [Key(p, "limits") for p in _paths("limits", keys_of(Limits))]
     found += [Key(p, "dependence", {"gaussian_copula": None} if p == "dependence.kind" else None)
               for p in _paths("dependence", schema.DEPENDENCE_KEYS)]
     found += [Key(p, "quantities", dict(TAKES) if p.endswith(".take") else None)

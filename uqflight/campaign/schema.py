@@ -10,12 +10,11 @@ from collections.abc import Hashable
 import numpy as np
 import yaml
 
-from ..analysis import BAND_SAMPLES, BOOTSTRAP
 from ..designs import REGISTRY as DESIGNS
 from ..designs import Design, design_size
 from ..methods import DEFAULT_ORDER, METHOD_KINDS, METHODS, Method
 from ..methods.exactness import exact_total_degree, max_projection_order
-from ..methods.validity import MAX_TERMS, method_problem
+from ..methods.validity import method_problem
 from ..parameters import DISTRIBUTIONS, Parameter, make_parameter, seed_names
 from ..parameters.dependence import KINDS as DEPENDENCE_KINDS
 from ..parameters.dependence import GaussianCopula, correlation_problem
@@ -24,25 +23,16 @@ from ..simulators.patch import patch_kind
 from ..simulators.kinds import REGISTRY as SIMULATORS
 from ..simulators.kinds import SIMULATOR_KINDS, simulator_entry
 from ..text.console import quoted_value
+from .sections import Execution, Limits, Storage
 
-EXECUTORS = ("local", "dask")
 TOP_KEYS = ("name", "description", "seed", "simulator", "parameters", "design", "method",
             "execution", "storage", "analysis", "limits", "quantities", "dependence")
 PARAMETER_KEYS = ("property", "function", "perturbation", "distribution", "nominal", "interval_pct", "lower", "upper")
 LAW_KEYS = ("distribution", "nominal", "interval_pct", "lower", "upper")  # a parameter's law; the rest say what it sets
 PERTURBATIONS = ("scale", "offset", "offset_value")
-EXECUTION_KEYS = ("workers", "executor", "scheduler", "chunk", "timeout_s")
-STORAGE_KEYS = ("path", "raw", "tsvd")
-TSVD_KEYS = ("tol", "batch")
 DEPENDENCE_KEYS = ("kind", "parameters", "correlation")
-ANALYSIS_KEYS = ("band_samples", "bootstrap", "quantiles", "exceedance")
-# A million draws of one output are sorted 100 times at once (statistics.TIME_BLOCK): about 1.6 GB in two threads.
-MAX_BAND_SAMPLES = 10**6
-MAX_BOOTSTRAP = 10**4
 # Refused before anything is built (see `check_size`); a campaign raises them under `limits:`.
 WORKER_BYTES = 60e6  # memory of one local worker process: Python, numpy, JSBSim, the aircraft (52 MB measured)
-DEFAULT_LIMITS = {"max_runs": 1_000_000, "max_memory_gb": 8.0, "max_disk_gb": 100.0, "max_pce_terms": MAX_TERMS}
-LIMIT_KEYS = tuple(DEFAULT_LIMITS)
 MAX_FILE_BYTES = 1 << 20  # a campaign file is at most 1 MiB
 NAME_PATTERN = re.compile(r"[A-Za-z0-9_][A-Za-z0-9_.-]{0,99}")
 
@@ -484,63 +474,6 @@ def method(check: Checker, value) -> dict:
     return method
 
 
-def execution(check: Checker, value) -> dict:
-    execution = dict(check.mapping(value, "execution", EXECUTION_KEYS))
-    execution["workers"] = check.integer(execution.get("workers", 1), "execution.workers", 1)
-    execution["executor"] = check.string(execution.get("executor", "local"), "execution.executor", EXECUTORS)
-    execution["chunk"] = check.integer(execution.get("chunk", 16), "execution.chunk", 1)
-    if execution.get("scheduler") is not None:
-        check.string(execution["scheduler"], "execution.scheduler")
-    if execution.get("timeout_s") is not None:  # default: derived from a measured nominal flight
-        execution["timeout_s"] = check.number(execution["timeout_s"], "execution.timeout_s", 0.0, strict=True)
-    return execution
-
-
-def storage(check: Checker, value, name: str) -> dict:
-    storage = dict(check.mapping(value, "storage", STORAGE_KEYS))
-    storage["path"] = check.string(storage.get("path", f"results/{name}.h5"), "storage.path")
-    storage["raw"] = check.boolean(storage.get("raw", True), "storage.raw")
-    tsvd = storage.get("tsvd")
-    if tsvd is not None:
-        tsvd = dict(check.mapping(tsvd, "storage.tsvd", TSVD_KEYS))
-        tsvd["tol"] = check.number(tsvd.get("tol", 1e-8), "storage.tsvd.tol", 0.0, strict=True)
-        if tsvd["tol"] >= 1:
-            check.fail("storage.tsvd.tol", f"expected a relative tolerance in (0, 1), got {tsvd['tol']!r}")
-        tsvd["batch"] = check.integer(tsvd.get("batch", 1000), "storage.tsvd.batch", 1)
-        storage["tsvd"] = tsvd
-    if not storage["raw"] and tsvd is None:
-        check.fail("storage.raw", "false needs storage.tsvd: otherwise nothing of the outputs would be kept")
-    return storage
-
-
-def analysis(check: Checker, value, quantities: dict | None = None) -> dict:
-    """`quantities`: the campaign's checked quantities, which `exceedance:` must name."""
-    analysis = dict(check.mapping(value, "analysis", ANALYSIS_KEYS))
-    if "exceedance" in analysis:
-        from ..quantities.spec import check_exceedance
-
-        analysis["exceedance"] = check_exceedance(check, analysis["exceedance"], quantities or {})
-    analysis["band_samples"] = check.integer(analysis.get("band_samples", BAND_SAMPLES), "analysis.band_samples", 100)
-    if analysis["band_samples"] > MAX_BAND_SAMPLES:
-        check.fail("analysis.band_samples", f"expected at most {MAX_BAND_SAMPLES} draws (a million draws of an "
-                                            "output, sorted 100 times at once, take about 1.6 GB in two threads), "
-                                            f"got {analysis['band_samples']}")
-    analysis["bootstrap"] = check.integer(analysis.get("bootstrap", BOOTSTRAP), "analysis.bootstrap", 0)
-    if analysis["bootstrap"] > MAX_BOOTSTRAP:
-        check.fail("analysis.bootstrap", f"expected at most {MAX_BOOTSTRAP} resamplings (10^4 of a pick-freeze "
-                                         "design of 1024 base rows take about a minute and 1 GB), "
-                                         f"got {analysis['bootstrap']}")
-    if "quantiles" in analysis:  # kept only when given (default: analysis.QUANTILES)
-        value = analysis["quantiles"]
-        if not isinstance(value, list) or not value or len(value) > 20:
-            check.fail("analysis.quantiles", f"expected a list of 1 to 20 probabilities, got {quoted_value(value)}")
-        for i, probability in enumerate(value):
-            check.number(probability, f"analysis.quantiles[{i}]")
-            if not 0.0 < probability < 1.0:
-                check.fail(f"analysis.quantiles[{i}]", f"expected a probability in (0, 1), got {probability!r}")
-    return analysis
-
-
 def campaign_name(check: Checker, value) -> str:
     """A name that is safe in a path (the default results file is results/NAME.h5)."""
     name = check.string(value, "name")
@@ -550,21 +483,8 @@ def campaign_name(check: Checker, value) -> str:
     return name
 
 
-def limits(check: Checker, value) -> dict:
-    """The campaign's size limits (`limits:`), defaults in DEFAULT_LIMITS."""
-    given = dict(check.mapping(value, "limits", LIMIT_KEYS))
-    found = dict(DEFAULT_LIMITS)
-    for key, default in DEFAULT_LIMITS.items():
-        if key in given:
-            if isinstance(default, int):
-                found[key] = check.integer(given[key], f"limits.{key}", 1)
-            else:
-                found[key] = check.number(given[key], f"limits.{key}", 0.0, strict=True)
-    return found
-
-
-def check_size(check: Checker, data: dict, simulator: dict, parameters: list, method: dict, execution: dict,
-               storage: dict, limits: dict, germs: list[str] | None = None) -> dict:
+def check_size(check: Checker, data: dict, simulator: dict, parameters: list, method: dict, execution: Execution,
+               storage: Storage, limits: Limits, germs: list[str] | None = None) -> dict:
     """The design's size, its memory and disk estimate and the PCE size, from the campaign alone
     (nothing built): refused beyond `limits` (CampaignError naming the figure and the limit).
     Returns the figures {"runs", "memory_gb", "disk_gb", "pce_terms"}."""
@@ -575,40 +495,39 @@ def check_size(check: Checker, data: dict, simulator: dict, parameters: list, me
         field_path, _, message = str(exc).partition(": ")
         check.fail(field_path, message)
     figures = {"runs": points}
-    if points is not None and points > limits["max_runs"]:
-        check.fail("design", f"{points:.4g} runs (points built), more than limits.max_runs = {limits['max_runs']}; "
+    if points is not None and points > limits.max_runs:
+        check.fail("design", f"{points:.4g} runs (points built), more than limits.max_runs = {limits.max_runs}; "
                              "choose a smaller design or raise limits.max_runs")
     order = method.get(METHODS.get(method.get("kind"), Method).order_key, DEFAULT_ORDER)  # DEFAULT_ORDER at most
     terms = math.comb(d + order, order) if order <= 10**6 else math.inf
     figures["pce_terms"] = terms
-    if terms > limits["max_pce_terms"]:
+    if terms > limits.max_pce_terms:
         check.fail("method.order", f"a PCE of order {order} in {d} dimensions has {float(terms):.4g} "
-                                   f"terms, more than limits.max_pce_terms = {limits['max_pce_terms']}")
+                                   f"terms, more than limits.max_pce_terms = {limits.max_pce_terms}")
     times, n_outputs = simulator_entry(simulator).recorded(simulator)  # 1 where known once a sample has run
     n = points or 0
     rank = min(times, n, 1000)
     memory = 8.0 * (n * (3 * d + 6)                                    # the design, status, merging
-                    + execution["workers"] * execution["chunk"] * times * n_outputs * 3  # chunks in flight
-                    + n_outputs * times * execution["chunk"] * 4)      # results being written
-    on_this_machine = execution.get("executor", "local") == "local" or not execution.get("scheduler")
-    processes = execution["workers"] if on_this_machine else 0  # dask without a scheduler: a LocalCluster
+                    + execution.workers * execution.chunk * times * n_outputs * 3  # chunks in flight
+                    + n_outputs * times * execution.chunk * 4)      # results being written
+    processes = execution.workers if execution.on_this_machine else 0  # dask without a scheduler: a LocalCluster
     memory += processes * WORKER_BYTES
-    tsvd = storage.get("tsvd")
+    tsvd = storage.tsvd
     if tsvd:
-        memory += 8.0 * 4 * times * (tsvd["batch"] + rank) + 8.0 * n * rank
-    disk = 8.0 * n * times * n_outputs if storage["raw"] else 0.0
+        memory += 8.0 * 4 * times * (tsvd.batch + rank) + 8.0 * n * rank
+    disk = 8.0 * n * times * n_outputs if storage.raw else 0.0
     if tsvd:
         disk += 8.0 * n_outputs * (times + n) * rank * 2
     figures["memory_gb"], figures["disk_gb"] = memory / 1e9, disk / 1e9
-    if memory / 1e9 > limits["max_memory_gb"]:
+    if memory / 1e9 > limits.max_memory_gb:
         check.fail("design", f"the campaign needs about {memory / 1e9:.3g} GB of memory ({n:.4g} runs of "
                              f"{times:.4g} times x {n_outputs} outputs, {processes} worker processes of "
                              f"{WORKER_BYTES / 1e6:.0f} MB), more than limits.max_memory_gb = "
-                             f"{limits['max_memory_gb']:g}")
-    if disk / 1e9 > limits["max_disk_gb"]:
+                             f"{limits.max_memory_gb:g}")
+    if disk / 1e9 > limits.max_disk_gb:
         check.fail("storage", f"the results file would take about {disk / 1e9:.3g} GB ({n:.4g} runs of "
                               f"{times:.4g} times x {n_outputs} outputs), more than limits.max_disk_gb = "
-                              f"{limits['max_disk_gb']:g}")
+                              f"{limits.max_disk_gb:g}")
     from ..store.layout import MAX_OUTPUT_VALUES  # what every reader of the results file holds
 
     if n * times > MAX_OUTPUT_VALUES:

@@ -272,7 +272,7 @@ def plan(campaign_file: Path = typer.Argument(..., metavar="CAMPAIGN", help="Cam
                                   if entry.builds_pce(DESIGNS[design.kind].sampled) else ""))
     runs = campaign.runs or len(design.xi)  # an adaptive grid's budget: its rounds are made from the results
     echo(f"runs: {runs}" + (" at most (design.budget)" if DESIGNS[design.kind].adaptive else ""))
-    echo(f"results: {Path(campaign.storage['path']).resolve()} (storage.path, from the working directory; "
+    echo(f"results: {Path(campaign.storage.path).resolve()} (storage.path, from the working directory; "
          "--out to choose)")
     try:
         timed = timed_nominal(campaign)
@@ -281,7 +281,7 @@ def plan(campaign_file: Path = typer.Argument(..., metavar="CAMPAIGN", help="Cam
     for warning in timed.warnings:  # e.g. the excitation left the elevator unmoved
         echo(f"warning: the nominal flight: {one_line(warning)}", err=True)
     seconds = timed.seconds
-    workers = min(campaign.execution["workers"], CORES)
+    workers = min(campaign.execution.workers, CORES)
     echo(f"estimated time: {runs * seconds / workers:.0f} s with {workers} worker(s) "
          f"({seconds * 1e3:.0f} ms per run, one nominal run timed now on this machine)")
 
@@ -312,7 +312,7 @@ def run(
     from ..store.results import REFLY
 
     campaign = _load(campaign_file)
-    check_output(out or Path(campaign.storage["path"]), "--out" if out else "storage.path", create=True,
+    check_output(out or Path(campaign.storage.path), "--out" if out else "storage.path", create=True,
                  inputs=[campaign_file])
     if executor not in (None, "local", "dask"):
         refuse(f"--executor: expected local or dask, got {executor!r}")

@@ -33,7 +33,7 @@ import subprocess
 import sys
 import time
 from collections import Counter, deque
-from dataclasses import dataclass, field, replace
+from dataclasses import asdict, dataclass, field, replace
 from importlib import metadata
 from multiprocessing.connection import Connection
 from multiprocessing.connection import wait as wait_connections
@@ -140,8 +140,8 @@ def prepare_store(campaign: Campaign, design: Design, out: Path, force: bool, no
     return open_for_campaign(
         out, campaign_text=campaign.text, force=force, restart=restart, xi=design.xi, kappa=kappa, weights=design.weights,
         parameter_names=[p.name for p in campaign.parameters], outputs=nominal.outputs, time=nominal.time,
-        raw=campaign.storage["raw"], tsvd=campaign.storage.get("tsvd"), attrs=attrs, units=nominal.units,
-        batch_rows=campaign.execution["chunk"], resolution=nominal.resolution,
+        raw=campaign.storage.raw, tsvd=campaign.storage.tsvd and asdict(campaign.storage.tsvd), attrs=attrs, units=nominal.units,
+        batch_rows=campaign.execution.chunk, resolution=nominal.resolution,
         quantities=list(campaign.quantities), capacity=campaign.runs if DESIGNS[design.kind].adaptive else None)
 
 
@@ -157,7 +157,7 @@ def simulate(campaign: Campaign, kappa: np.ndarray, outputs: list[str], processe
     Raises WorkerError when no simulator can be built (the message says why)."""
     kappa = np.asarray(kappa, dtype=float)
     spec = replace(worker_spec(campaign), quantities=None)  # the outputs only
-    timeout = campaign.execution.get("timeout_s")
+    timeout = campaign.execution.timeout_s
     pool = WorkerPool(spec, max(1, min(processes, len(kappa))), timeout or NOMINAL_TIMEOUT_S)
     try:
         pool.start_warmup(nominal_kappa(campaign), measure_resolution=False)  # the time grid, a run's cost
@@ -205,7 +205,7 @@ def timed_nominal(campaign: Campaign) -> NominalFlight:
     worker's start), a first flight warming what every later one reuses (the Newton trim's nominal),
     the second timed. Raises WorkerError when the worker dies, runs past the limit or cannot build the
     simulator (the message says which), as `run` does."""
-    pool = WorkerPool(worker_spec(campaign), 1, campaign.execution.get("timeout_s") or NOMINAL_TIMEOUT_S)
+    pool = WorkerPool(worker_spec(campaign), 1, campaign.execution.timeout_s or NOMINAL_TIMEOUT_S)
     kappa = nominal_kappa(campaign)
     try:
         pool.nominal_flight(kappa, measure_resolution=False)
@@ -218,10 +218,10 @@ def local_workers(campaign: Campaign, workers: int, chunk: int) -> int:
     """The worker processes to start for `workers`: at most one per chunk of the design (more would
     only idle); ValueError when their memory exceeds the campaign's limits.max_memory_gb."""
     need = workers * WORKER_BYTES / 1e9
-    if need > campaign.limits["max_memory_gb"]:
+    if need > campaign.limits.max_memory_gb:
         raise ValueError(f"{workers} workers would need about {need:.3g} GB of memory "
                          f"({WORKER_BYTES / 1e6:.0f} MB each), more than limits.max_memory_gb = "
-                         f"{campaign.limits['max_memory_gb']:g}; this machine has {os.cpu_count()} cores")
+                         f"{campaign.limits.max_memory_gb:g}; this machine has {os.cpu_count()} cores")
     if campaign.runs:
         workers = min(workers, len(chunk_starts(campaign.runs, chunk)) - 1)
     return max(1, workers)
@@ -282,13 +282,13 @@ def run_campaign(campaign: Campaign, out: Path | None = None, workers: int | Non
     Raises LockHeld (another run writes the file), FileExistsError (a file that is not this
     campaign's), DiskFull (stopped cleanly, resumable), WorkerError (no simulator could be built)."""
     execution = campaign.execution
-    executor = executor or execution["executor"]
-    scheduler = scheduler or execution.get("scheduler")
-    chunk = execution["chunk"]
-    workers = workers or execution["workers"]
+    executor = executor or execution.executor
+    scheduler = scheduler or execution.scheduler
+    chunk = execution.chunk
+    workers = workers or execution.workers
     if executor == "local" or not scheduler:  # processes on this machine (dask's own LocalCluster too)
         workers = local_workers(campaign, workers, chunk)
-    out = Path(out or campaign.storage["path"])
+    out = Path(out or campaign.storage.path)
     started = time.perf_counter()
     spec = worker_spec(campaign)
     lock = ResultsLock(out)
@@ -306,14 +306,14 @@ def run_campaign(campaign: Campaign, out: Path | None = None, workers: int | Non
     pool = None
     try:
         pool = WorkerPool(spec, workers if executor == "local" else 1,
-                          execution.get("timeout_s") or NOMINAL_TIMEOUT_S)
+                          execution.timeout_s or NOMINAL_TIMEOUT_S)
         pool.start_warmup(nominal_kappa(campaign))
         design = campaign.design()  # built while the workers start
         nominal = pool.warmup_result()
         seconds = nominal.seconds
         # every run is stored against the nominal's times: a model giving other times fails the run
         pool.spec = spec = replace(spec, time=tuple(map(float, nominal.time)))
-        timeout = execution.get("timeout_s") or default_timeout(seconds)
+        timeout = execution.timeout_s or default_timeout(seconds)
         pool.timeout = timeout
         # One BLAS thread here, for the folds on opening too: the workers keep every core busy, a
         # multi-threaded BLAS competing with them is 10-100x slower, and the tSVD factors must not
@@ -343,7 +343,7 @@ def run_campaign(campaign: Campaign, out: Path | None = None, workers: int | Non
                     raise
         pool.close()
         verify_written(out, summary)
-        if complete and campaign.storage.get("tsvd"):
+        if complete and campaign.storage.tsvd:
             if free_bytes(out) > 2 * out.stat().st_size + SPACE_MARGIN_BYTES:
                 compact(out)
     finally:

@@ -249,7 +249,7 @@ def check_rare_campaign(check, campaign) -> None:
     if settings.event.of not in names:
         check.fail("design.event.of", f"expected one of the campaign's quantities ({', '.join(names) or 'none: add '}"
                                        f"{'' if names else 'one under quantities:'}), got {settings.event.of!r}")
-    if campaign.analysis.get("exceedance"):
+    if campaign.analysis.exceedance:
         check.fail("analysis.exceedance", f"a {settings.kind} design's runs are not draws of the input law: it "
                                           "estimates the probability of its design.event only; give the threshold "
                                           "there, one campaign per event")
