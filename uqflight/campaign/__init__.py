@@ -7,7 +7,7 @@ names the file, the field and what was expected, e.g.
 from __future__ import annotations
 
 import copy
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Callable
 
@@ -28,9 +28,9 @@ from .sections import Analysis, Execution, Limits, Storage
 
 ValidationView = Callable[[dict], object]  # simulator config -> its aircraft's properties (see validation_view)
 
-@dataclass
+@dataclass(frozen=True)
 class Campaign:
-    """A validated campaign. `text` is the file's exact text (its hash identifies results)."""
+    """A validated campaign, frozen. `text` is the file's exact text (its hash identifies results)."""
 
     source: str
     text: str
@@ -92,8 +92,8 @@ def load_campaign(path: str | Path, view: ValidationView | None = None) -> Campa
 
 def parse_campaign(text: str, source: str = "<campaign>", view: ValidationView | None = None) -> Campaign:
     """Validate campaign text; see `load_campaign`. A python simulator's module is imported (its code
-    runs): this is for campaigns about to be planned or run; results are read with
-    `campaign.reading.results_campaign`, which never resolves the simulator."""
+    runs): this is for campaigns about to be planned or run; a results file's campaign is read by
+    `campaign.record.read_record`, which never resolves the simulator."""
     written = campaign_yaml(text, source)
     check, data, simulator = check_settings(Checker(source), written)
     schema.resolve_simulator(check, simulator, source)
@@ -127,19 +127,16 @@ def parse_campaign(text: str, source: str = "<campaign>", view: ValidationView |
         from ..designs.rare import check_rare_campaign
 
         check_rare_campaign(check, campaign)
-        campaign.runs = int(design_size(campaign.design_spec, campaign.germs))
-        return campaign
+        return replace(campaign, runs=int(design_size(campaign.design_spec, campaign.germs)))
     if DESIGNS[design.kind].adaptive:  # its grid is made from the results: its points are checked on analysis
         entry = METHODS[campaign.method["kind"]]
-        campaign.method.setdefault(entry.order_key, entry.keys[entry.order_key].default)
         if entry.sampled_only:
             check.fail("method.kind", f"{campaign.method['kind']} needs a sampled design; an adaptive grid needs "
                                       "its weights: use integration, pseudo_galerkin or interpolation")
-        campaign.runs = int(design_size(campaign.design_spec, campaign.germs))
-        return campaign
-    schema.check_method_fits_design(check, campaign.method, design, campaign.germs)
-    campaign.runs = len(design.weights)
-    return campaign
+        method = {entry.order_key: entry.keys[entry.order_key].default, **campaign.method}
+        return replace(campaign, method=method, runs=int(design_size(campaign.design_spec, campaign.germs)))
+    method = schema.method_for_design(check, campaign.method, design, campaign.germs)
+    return replace(campaign, method=method, runs=len(design.weights))
 
 
 def campaign_yaml(text: str, source: str):

@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import json
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 from ..designs import DESIGN_KINDS
 from ..designs import REGISTRY as DESIGNS
@@ -122,9 +122,9 @@ def read_record(attrs, source: str) -> CampaignRecord:
     except RecursionError:
         check.fail("campaign", "is nested deeper than a campaign")
     parameters = _parameters(check, data, record["parameters"])
-    campaign = build_campaign(inside, data, simulator, parameters, str(attrs.get("campaign", "")),
-                              mapping=record["campaign"])
-    campaign.method = schema.method(RecordChecker(source), record["method"])
+    campaign = replace(build_campaign(inside, data, simulator, parameters, str(attrs.get("campaign", "")),
+                                      mapping=record["campaign"]),
+                       method=schema.method(RecordChecker(source), record["method"]))
     design = check.mapping(record["design"], "design", ("kind", "info"), required=("kind", "info"))
     kind = design["kind"]
     if not isinstance(kind, str) or kind not in DESIGN_KINDS:

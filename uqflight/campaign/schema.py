@@ -198,12 +198,14 @@ def yaml_error(exc: yaml.YAMLError) -> str:
     return message
 
 
-def check_method_fits_design(check: Checker, method: dict, design: Design, germs: list[str]) -> None:
-    """Refuse, before anything runs, a method the design's points cannot carry (methods.validity).
-    Without `order`, the order is 2, or the largest a grid's projection allows when that is lower."""
+def method_for_design(check: Checker, method: dict, design: Design, germs: list[str]) -> dict:
+    """The checked `method` with the order the design's points carry, refused before anything runs when they
+    cannot carry it (methods.validity). Without `order`, the order is 2, or the largest a grid's projection
+    allows when that is lower."""
     sampled = DESIGNS[design.kind].sampled
     entry = METHODS[method["kind"]]
     key = entry.order_key
+    method = dict(method)
     if key not in method:
         method[key] = DEFAULT_ORDER
         if entry.projects and not sampled:
@@ -213,6 +215,7 @@ def check_method_fits_design(check: Checker, method: dict, design: Design, germs
                              allow_aliasing=method.get("allow_aliasing", False))
     if problem:
         check.fail(f"method.{key}" if entry.expands else "method.kind", problem)
+    return method
 
 
 def simulator(check: Checker, value) -> dict:
