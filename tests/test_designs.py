@@ -316,3 +316,16 @@ def test_the_design_kind_docstring_example_runs():
 
     result = doctest.testmod(base)
     assert result.attempted >= 3 and result.failed == 0
+
+
+def test_a_design_refuses_a_value_with_its_fields_path_not_a_parsed_string():
+    # the field travels in the error (text.FieldError), never recovered by splitting its message
+    from uqflight.designs import build_design
+    from uqflight.text import FieldError
+
+    for spec, field in (({"kind": "sparse_grid", "level": -1}, "design.level"),
+                        ({"kind": "monte_carlo", "samples": 4, "colour": 1}, "design.colour"),
+                        ({"kind": "spiral"}, "design.kind")):
+        with pytest.raises(FieldError) as refused:
+            build_design(spec, ["normal", "normal"], 0)
+        assert refused.value.field == field and str(refused.value) == f"{field}: {refused.value.message}"

@@ -23,6 +23,7 @@ from ..quantities.spec import check_quantities
 from ..simulators.jsbsim import NAMED_OUTPUTS
 from ..simulators.kinds import simulator_entry
 from . import schema
+from ..text import FieldError
 from .schema import TOP_KEYS, CampaignError, CampaignLoader, Checker, yaml_error
 from .sections import Analysis, Execution, Limits, Storage
 
@@ -117,12 +118,10 @@ def parse_campaign(text: str, source: str = "<campaign>", view: ValidationView |
                           campaign.storage, campaign.limits, campaign.germs)
     try:
         design = campaign.design()
+    except FieldError as exc:
+        raise CampaignError(source, exc.field, exc.message) from exc
     except ValueError as exc:
-        message = str(exc)
-        field_path, sep, rest = message.partition(": ")
-        if sep and (field_path.startswith("design") or field_path == "seed"):
-            raise CampaignError(source, field_path, rest) from exc
-        raise CampaignError(source, "design", message) from exc
+        raise CampaignError(source, "design", str(exc)) from exc
     if DESIGNS[design.kind].rare:  # its rounds are made from the results; it estimates its event only
         from ..designs.rare import check_rare_campaign
 

@@ -22,6 +22,7 @@ from ..parameters.distributions import SEED_REFUSAL
 from ..simulators.patch import patch_kind
 from ..simulators.kinds import REGISTRY as SIMULATORS
 from ..simulators.kinds import SIMULATOR_KINDS, simulator_entry
+from ..text import FieldError
 from ..text.console import quoted_value
 from .sections import Execution, Limits, Storage
 
@@ -37,17 +38,18 @@ MAX_FILE_BYTES = 1 << 20  # a campaign file is at most 1 MiB
 NAME_PATTERN = re.compile(r"[A-Za-z0-9_][A-Za-z0-9_.-]{0,99}")
 
 
-class CampaignError(ValueError):
-    """A campaign file that cannot be run: names the file, the field and what was expected."""
+class CampaignError(FieldError):
+    """A campaign file that cannot be run: names the file (`source`), the field and what was expected."""
 
     def __init__(self, source: str, field_path: str, message: str):
-        self.source, self.field = source, field_path
         if len(field_path) > 200:
             field_path = field_path[:197] + "..."
         if len(message) > 2000:  # never quote a huge value back
             message = message[:1997] + "..."
+        super().__init__(field_path, message)
+        self.source = source
         where = f"{source}: {field_path}: " if field_path else f"{source}: "
-        super().__init__(where + message)
+        self.args = (where + message,)
 
 
 class Checker:
@@ -494,9 +496,8 @@ def check_size(check: Checker, data: dict, simulator: dict, parameters: list, me
     d = len(parameters)
     try:  # the design kind's own size (designs.DesignKind.size); an unknown kind is refused when built
         points = design_size(data["design"], germs or [p.germ for p in parameters])
-    except ValueError as exc:
-        field_path, _, message = str(exc).partition(": ")
-        check.fail(field_path, message)
+    except FieldError as exc:
+        check.fail(exc.field, exc.message)
     figures = {"runs": points}
     if points is not None and points > limits.max_runs:
         check.fail("design", f"{points:.4g} runs (points built), more than limits.max_runs = {limits.max_runs}; "

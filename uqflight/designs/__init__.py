@@ -15,6 +15,7 @@ from ..parameters.germs import check_germs
 # each module registers its kinds, in this order: that of the help and the key reference
 from . import montecarlo, smolyak, tensor, pickfreeze, morris, adaptive, rare  # noqa: F401,I001
 from .base import REGISTRY, DesignKind, is_integer
+from ..text import FieldError
 
 DESIGN_KINDS = tuple(REGISTRY)
 
@@ -42,12 +43,12 @@ def build_design(spec: dict, germs: list[str], seed: int, redrawn: tuple[int, ..
     """The design a campaign's `design:` mapping asks for, over the given germs; `redrawn`: the columns that
     are random-stream seeds (a rare-event design treats them apart, see designs.rare)."""
     if not isinstance(spec, dict):
-        raise ValueError(f"design: expected a mapping with a kind key, got {spec!r}")
+        raise FieldError("design", f"expected a mapping with a kind key, got {spec!r}")
     kind = spec.get("kind")
     if not isinstance(kind, str) or kind not in REGISTRY:
-        raise ValueError(f"design.kind: expected one of {', '.join(DESIGN_KINDS)}, got {kind!r}")
+        raise FieldError("design.kind", f"expected one of {', '.join(DESIGN_KINDS)}, got {kind!r}")
     if not is_integer(seed) or seed < 0:
-        raise ValueError(f"seed: expected an integer >= 0, got {seed!r}")
+        raise FieldError("seed", f"expected an integer >= 0, got {seed!r}")
     xi, weights, info = REGISTRY[kind].build(spec, check_germs(germs), int(seed), tuple(redrawn))
     return Design(kind, xi, weights, info)
 

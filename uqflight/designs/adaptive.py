@@ -27,6 +27,7 @@ from ..analysis.errors import relative_errors
 from . import rules as rule_catalog
 from .base import DesignKind, Key, count, number
 from .smolyak import _indexed_nodes
+from ..text import FieldError
 
 ADAPTIVE_RULES = ("genz_keister", "gauss_patterson", "clenshaw_curtis")
 MAX_LEVELS = 10  # 1-D levels of a rule without a tabulated end (Clenshaw–Curtis: up to 513 points)
@@ -232,7 +233,7 @@ def adaptive_rules(spec: dict, germs: list[str]) -> list[str]:
     rules = rule_catalog.rules_by_dimension(spec.get("rule"), germs, nested=None if spec.get("rule") else True)
     plain = [rule for rule in rules if rule not in ADAPTIVE_RULES]
     if plain:
-        raise ValueError(f"design.rule: an adaptive grid needs nested rules ({', '.join(ADAPTIVE_RULES)}), "
+        raise FieldError("design.rule", f"an adaptive grid needs nested rules ({', '.join(ADAPTIVE_RULES)}), "
                          f"got {plain[0]}")
     return rules
 

@@ -9,6 +9,7 @@ from typing import Callable, ClassVar
 import numpy as np
 
 from ..analysis.proportions import Independent
+from ..text import FieldError
 
 REQUIRED = object()  # a key's default: none, the key must be given
 
@@ -125,15 +126,15 @@ class DesignKind:
         """
         for key in spec:
             if key != "kind" and key not in self.keys:
-                raise ValueError(f"design.{key}: unknown key for kind {self.kind}; accepted keys: "
+                raise FieldError(f"design.{key}", f"unknown key for kind {self.kind}; accepted keys: "
                                  f"{', '.join(('kind', *self.keys))}")
         found = {}
         for key, declared in self.keys.items():
             if key not in spec and declared.default is REQUIRED:
-                raise ValueError(f"design.{key}: missing; kind {self.kind} expects {declared.expects}")
+                raise FieldError(f"design.{key}", f"missing; kind {self.kind} expects {declared.expects}")
             value = spec.get(key, declared.default)
             if key in spec and declared.test is not None and not declared.test(value):
-                raise ValueError(f"design.{key}: expected {declared.expects}, got {value!r}")
+                raise FieldError(f"design.{key}", f"expected {declared.expects}, got {value!r}")
             found[key] = value
         return found
 

@@ -10,6 +10,7 @@ import numpy as np
 from ..analysis.proportions import Net, Stratified
 from ..parameters.germs import draw_germs, germ_quantiles
 from .base import DesignKind, count, equal_weights, flag
+from ..text import FieldError
 
 
 def sobol_points(n: int, d: int, scramble: bool, seed: int) -> np.ndarray:
@@ -58,7 +59,7 @@ class Sobol(DesignKind):
             xi = germ_quantiles(sobol_points(n, len(germs), scramble, seed), germs)
             return xi, equal_weights(n), {"samples": n, "scramble": scramble, "seed": seed}
         if not scramble:
-            raise ValueError("design.replicates: replicates need scramble: true (unscrambled copies are identical)")
+            raise FieldError("design.replicates", "replicates need scramble: true (unscrambled copies are identical)")
         children = np.random.SeedSequence(seed).spawn(replicates)
         u = np.vstack([sobol_points(n, len(germs), True, np.random.default_rng(child)) for child in children])
         return (germ_quantiles(u, germs), equal_weights(n * replicates),

@@ -20,6 +20,7 @@ import numpy as np
 from ..analysis.proportions import Points
 from ..parameters.germs import GERMS
 from .base import DesignKind, count, equal_weights, is_integer
+from ..text import FieldError
 
 NOT_DRAWS = ("morris design: its runs are points of trajectories on a grid, not draws of the inputs' law: the "
              "mean, variance, band, quantiles, densities and failure share are the runs' own, not the law's; its "
@@ -203,7 +204,7 @@ def morris_screening(xi: np.ndarray, Y: np.ndarray, ok: np.ndarray, info: dict, 
     """
     problem = info_problem(info, len(xi), xi.shape[1])
     if problem:
-        raise ValueError(f"design.info.{problem[0]}: {problem[1]}, got {info.get(problem[0])!r}")
+        raise FieldError(f"design.info.{problem[0]}", f"{problem[1]}, got {info.get(problem[0])!r}")
     levels = info["levels"]
     effects, dropped = elementary_effects(xi, Y, ok, levels)
     note = None
@@ -246,7 +247,7 @@ class Morris(DesignKind):
     def points(self, settings, germs, seed):
         r, levels = settings["trajectories"], settings["levels"]
         if levels % 2:
-            raise ValueError(f"design.levels: expected an even number of levels (the jump Δ = p/(2(p−1)) is then "
+            raise FieldError("design.levels", f"expected an even number of levels (the jump Δ = p/(2(p−1)) is then "
                              f"p/2 grid steps), got {levels}")
         u = morris_unit_points(r, len(germs), levels, seed)
         info = {"trajectories": r, "levels": levels, "jump": morris_jump(levels), "samples": len(u), "seed": seed}

@@ -18,6 +18,7 @@ from numpy.polynomial.hermite_e import hermegauss
 from numpy.polynomial.legendre import leggauss
 
 from ..parameters.germs import GERMS
+from ..text import FieldError
 
 GROWTHS = ("linear", "exponential")
 GENZ_KEISTER_SIZES = (1, 3, 9, 19, 43)  # all chaospy tabulates for variant 24; 43 has ~9-digit weights
@@ -156,22 +157,22 @@ def rules_by_dimension(named, germs: list[str], nested: bool | None) -> list[str
     elif isinstance(named, dict):
         unknown = [key for key in named if key not in defaults]
         if unknown:
-            raise ValueError(f"design.rule: a mapping's keys are germs ({', '.join(defaults)}), got {unknown[0]!r}")
+            raise FieldError("design.rule", f"a mapping's keys are germs ({', '.join(defaults)}), got {unknown[0]!r}")
         by_germ = named
     else:
-        raise ValueError(f"design.rule: expected a rule name or a mapping germ -> rule name, got {named!r}")
+        raise FieldError("design.rule", f"expected a rule name or a mapping germ -> rule name, got {named!r}")
     rules = []
     for dimension, germ in enumerate(germs, start=1):
         if germ not in by_germ:
-            raise ValueError(f"design.rule: no rule given for the {germ} germ of dimension {dimension}")
+            raise FieldError("design.rule", f"no rule given for the {germ} germ of dimension {dimension}")
         name = by_germ[germ]
         if not isinstance(name, str) or name not in RULE_TABLE:
-            raise ValueError(f"design.rule: expected one of {', '.join(RULES)}, got {name!r}")
+            raise FieldError("design.rule", f"expected one of {', '.join(RULES)}, got {name!r}")
         if RULE_TABLE[name].germ != germ:
-            raise ValueError(f"design.rule: rule {name} is for {RULE_TABLE[name].germ} germs, "
+            raise FieldError("design.rule", f"rule {name} is for {RULE_TABLE[name].germ} germs, "
                              f"but dimension {dimension} has a {germ} germ")
         if nested is False and RULE_TABLE[name].nested:
-            raise ValueError(f"design.nested: rule {name} is nested; a non-nested grid needs "
+            raise FieldError("design.nested", f"rule {name} is nested; a non-nested grid needs "
                              f"{' or '.join(nested_versions)}")
         rules.append(nested_versions.get(name, name) if nested else name)
     return rules

@@ -18,6 +18,7 @@ import numpy as np
 
 from . import rules as rule_catalog
 from .base import DesignKind, Key, choice, count, flag, is_integer
+from ..text import FieldError
 
 MERGE_TOLERANCE = 1e-12  # relative: 1-D nodes closer than this are one point
 MAX_LEVEL = 1000  # levels beyond this are refused before any size is estimated
@@ -121,7 +122,7 @@ class SparseGrid(DesignKind):
         if not is_integer(level) or level < 0:
             return None
         if level > MAX_LEVEL:
-            raise ValueError(f"design.level: expected at most {MAX_LEVEL}, got {level}")
+            raise FieldError("design.level", f"expected at most {MAX_LEVEL}, got {level}")
         try:
             rules = rule_catalog.rules_by_dimension(spec.get("rule"), germs, spec.get("nested"))
             sizes = self._sizes(rules, spec.get("growth") or "linear", level)
@@ -140,7 +141,7 @@ class SparseGrid(DesignKind):
         for rule in dict.fromkeys(rules):
             top = rule_catalog.max_level(rule, growth)
             if top is not None and level + 1 > top:
-                raise ValueError(f"design.level: rule {rule} with {growth} growth reaches level {top - 1} at most, "
+                raise FieldError("design.level", f"rule {rule} with {growth} growth reaches level {top - 1} at most, "
                                  f"got {level}")
             sizes[rule] = rule_catalog.level_sizes(rule, growth, level + 1)
         return sizes

@@ -25,6 +25,7 @@ import numpy as np
 
 from ...parameters.germs import GERMS
 from ..base import REQUIRED, DesignKind, Key, count, number
+from ...text import FieldError
 
 SIDES = ("above", "below")
 EVENT_KEYS = ("of", *SIDES)
@@ -58,21 +59,21 @@ class RareSettings:
 
 def _event(value) -> Event:
     if not isinstance(value, dict):
-        raise ValueError(f"design.event: expected a mapping {{of: QUANTITY, above: X}} or {{of: QUANTITY, below: X}}, "
+        raise FieldError("design.event", f"expected a mapping {{of: QUANTITY, above: X}} or {{of: QUANTITY, below: X}}, "
                          f"got {value!r}")
     for key in value:
         if key not in EVENT_KEYS:
-            raise ValueError(f"design.event.{key}: unknown key; expected one of of, above, below")
+            raise FieldError(f"design.event.{key}", "unknown key; expected one of of, above, below")
     of = value.get("of")
     if not isinstance(of, str) or not of:
-        raise ValueError(f"design.event.of: expected the name of one of the campaign's quantities, got {of!r}")
+        raise FieldError("design.event.of", f"expected the name of one of the campaign's quantities, got {of!r}")
     sides = [side for side in SIDES if side in value]
     if len(sides) != 1:
-        raise ValueError("design.event: expected exactly one of above or below (the threshold), got "
+        raise FieldError("design.event", "expected exactly one of above or below (the threshold), got "
                          f"{' and '.join(sides) or 'neither'}")
     threshold = value[sides[0]]
     if isinstance(threshold, bool) or not isinstance(threshold, (int, float)) or not math.isfinite(threshold):
-        raise ValueError(f"design.event.{sides[0]}: expected a finite number, got {threshold!r}")
+        raise FieldError(f"design.event.{sides[0]}", f"expected a finite number, got {threshold!r}")
     return Event(of, sides[0], float(threshold))
 
 
@@ -158,7 +159,7 @@ class RareDesign(DesignKind):
     def check_round(self, settings: dict, budget: int) -> None:
         """ValueError naming design.KEY when one round of `settings` does not fit the `budget`."""
         if settings.get("samples", 0) > budget:
-            raise ValueError(f"design.budget: {budget} runs cannot hold one round of samples = {settings['samples']}")
+            raise FieldError("design.budget", f"{budget} runs cannot hold one round of samples = {settings['samples']}")
 
     def input_problem(self, settings: RareSettings, inputs: int, redrawn: int) -> tuple[str, str] | None:
         """(field, message) when the design cannot work on `inputs` parameters of which `redrawn` are seeds
@@ -186,10 +187,10 @@ class SubsetSimulation(RareDesign):
     def check_round(self, settings, budget):
         samples = settings.get("samples_per_level", 1000)
         if math.floor(samples * settings.get("p0", 0.1)) < 1:
-            raise ValueError(f"design.samples_per_level: times p0 must give at least one chain (samples_per_level "
+            raise FieldError("design.samples_per_level", f"times p0 must give at least one chain (samples_per_level "
                              f"{samples}, p0 {settings.get('p0', 0.1):g})")
         if samples > budget:
-            raise ValueError(f"design.budget: {budget} runs cannot hold one level of samples_per_level "
+            raise FieldError("design.budget", f"{budget} runs cannot hold one level of samples_per_level "
                              f"= {samples}")
 
 
