@@ -79,7 +79,7 @@ def test_calibrate_refuses_a_bad_method_before_any_work(results, tmp_path, args,
 
 def flight_facts(simulator: dict) -> dict:
     """What the report's campaign table says a simulator flies (campaign.record.CampaignRecord.flight)."""
-    return simulator_entry(simulator).facts(simulator)
+    return simulator_entry(simulator).flight_summary(simulator)
 
 
 def test_the_campaign_table_shows_the_flight_and_excitation_flown():

@@ -7,7 +7,7 @@ import pytest
 from conftest import cli_in_process
 
 from uqflight.text.console import quoted_name
-from uqflight.report.loading import bounded
+from uqflight.report.loading import file_name_within
 
 LONG = "L" * 300
 SHARED = "L" * 250 + "M" * 50  # the first 250 characters of LONG
@@ -65,10 +65,10 @@ def test_report_of_long_names_has_bounded_distinct_files(folder):
     assert max(len(n.encode()) for n in _names(out)) <= 255
     tables = out / "tables"
     assert len(list(tables.glob("statistics_r_*.csv"))) == 6  # one per output: none written over another
-    long, shared = tables / bounded(f"statistics_r_{LONG}.csv"), tables / bounded(f"statistics_r_{SHARED}.csv")
+    long, shared = tables / file_name_within(f"statistics_r_{LONG}.csv"), tables / file_name_within(f"statistics_r_{SHARED}.csv")
     assert long != shared and long.name.startswith("statistics_r_" + "L" * 200) and len(long.name) == 255
     assert _means(shared) == pytest.approx([2 * m for m in _means(long)]) and _means(long)[-1] > 0
-    assert (out / "plots" / bounded(f"pdf_r_{LONG}.png")).is_file()
+    assert (out / "plots" / file_name_within(f"pdf_r_{LONG}.png")).is_file()
     alpha, beta = tables / f"statistics_r_{'_' * 150}.csv", tables / f"statistics_r_{'_' * 150}-2.csv"
     assert _means(beta)[-1] == pytest.approx(_means(alpha)[-1] + 1)  # "α"*150 and "β"*150 each its own
     for short in ("tables/statistics_r_alpha_deg.csv", "plots/pdf_r_alpha_deg.png", "plots/mean_band_r.png"):
@@ -100,9 +100,9 @@ def test_too_long_report_folder_refused_before_any_work(folder):
 
 
 def test_bounded_cuts_utf8_between_characters():
-    name = bounded("α" * 200 + ".png")
+    name = file_name_within("α" * 200 + ".png")
     assert len(name.encode()) <= 255 and name.endswith(".png") and name.startswith("α" * 100)
-    assert bounded("x" * 251 + ".png") == "x" * 251 + ".png"
+    assert file_name_within("x" * 251 + ".png") == "x" * 251 + ".png"
 
 
 def test_info_lists_names_one_entry_each(folder):

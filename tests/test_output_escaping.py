@@ -7,7 +7,7 @@ import pytest
 from conftest import cli_in_process
 
 from uqflight.text.console import clean, one_line
-from uqflight.report.files import inert
+from uqflight.report.files import csv_safe
 from uqflight.report.render import md
 
 TITLE_AND_RETURN = "\x1b]0;pwned\x07"  # sets the terminal's title
@@ -38,9 +38,9 @@ def test_clean_strips_every_control_character_but_tab_and_newline():
 
 def test_markdown_and_formula_escapes():
     assert md("a|b *c* _d_ `e` [f](g) <h> #i\nj") == r"a\|b \*c\* \_d\_ \`e\` \[f\](g) \<h\> \#i j"
-    assert [inert(v) for v in ("=1+1", "+cmd", "-2+3", "@SUM(A1)", "\tx", "\rx", "-0.5", "+1e-3", "x=1")] == \
+    assert [csv_safe(v) for v in ("=1+1", "+cmd", "-2+3", "@SUM(A1)", "\tx", "\rx", "-0.5", "+1e-3", "x=1")] == \
            ["'=1+1", "'+cmd", "'-2+3", "'@SUM(A1)", "'\tx", "'\rx", "-0.5", "+1e-3", "x=1"]
-    assert inert(-1.5) == -1.5 and inert(-3) == -3
+    assert csv_safe(-1.5) == -1.5 and csv_safe(-3) == -3
 
 
 @pytest.fixture(scope="module")

@@ -58,7 +58,7 @@ class CampaignRecord:
     def flight(self) -> dict[str, str]:
         """What the simulator flies ({"flight": ..., "excitation": ...}), defaults resolved by its kind (and
         scenario kind); {} for a python model."""
-        return simulator_entry(self.campaign.mapping["simulator"]).facts(self.campaign.mapping["simulator"])
+        return simulator_entry(self.campaign.mapping["simulator"]).flight_summary(self.campaign.mapping["simulator"])
 
     @property
     def parameter_rows(self) -> list[dict]:

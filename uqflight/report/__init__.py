@@ -27,7 +27,7 @@ from ..running.forking import FORKS, ChildFailed, PreparedChild
 from ..running.progress import Progress
 from ..analysis.statistics import BadInput
 from .files import _write_text, write_csv, write_statistics_tables, write_summaries
-from .loading import Entry, bounded, load_entries
+from .loading import AnalysedFile, file_name_within, load_entries
 from .formats import FORMATS, export_format, exporting
 from .replace import OUT_NAME_BYTES, check_replaceable, make_staging, replace_dir
 
@@ -42,9 +42,9 @@ class DrawingFailed(RuntimeError):
 
 
 def default_out_dir(results: Path) -> Path:
-    """The report folder next to the (first) results file: RESULTS-report/ (a long RESULTS cut, see bounded)."""
+    """The report folder next to the (first) results file: RESULTS-report/ (a long RESULTS cut, see file_name_within)."""
     results = Path(results)
-    return results.with_name(bounded(results.stem, OUT_NAME_BYTES - len("-report")) + "-report")
+    return results.with_name(file_name_within(results.stem, OUT_NAME_BYTES - len("-report")) + "-report")
 
 
 def write_report(paths: list[Path], out_dir: Path | None = None, reference: Path | None = None,
@@ -92,7 +92,7 @@ def write_report(paths: list[Path], out_dir: Path | None = None, reference: Path
     return written
 
 
-def _write_into(out_dir: Path, entries: list[Entry], ref: Entry | None, times, progress: Progress,
+def _write_into(out_dir: Path, entries: list[AnalysedFile], ref: AnalysedFile | None, times, progress: Progress,
                 drawer: PreparedChild | None) -> None:
     """The report's files in `out_dir`: the data files written here while `drawer` (a PreparedChild of _draw;
     None: this process) draws the sections, then the page."""
@@ -164,6 +164,6 @@ def _drawing_progress(progress: Progress):
     return on_message
 
 
-def _data_files(entries: list[Entry], out_dir: Path) -> list[Path]:
+def _data_files(entries: list[AnalysedFile], out_dir: Path) -> list[Path]:
     """summary.json (and summaries/) and the statistics tables over time, written into `out_dir`."""
     return write_summaries(entries, out_dir) + write_statistics_tables(entries, out_dir)

@@ -9,20 +9,20 @@ import numpy as np
 
 from ..text.json_text import json_text
 from ..analysis.statistics import summary_json
-from .loading import Entry, bounded
+from .loading import AnalysedFile, file_name_within
 
 
-def write_summaries(entries: list[Entry], out_dir: Path) -> list[Path]:
+def write_summaries(entries: list[AnalysedFile], out_dir: Path) -> list[Path]:
     """summary.json for the first file; summaries/<stem>.json for each when there are several."""
     written = [_write_json(out_dir / "summary.json", summary_json(entries[0].stats))]
     if len(entries) > 1:
         (out_dir / "summaries").mkdir(exist_ok=True)
-        written += [_write_json(out_dir / "summaries" / bounded(f"{e.stem}.json"), summary_json(e.stats))
+        written += [_write_json(out_dir / "summaries" / file_name_within(f"{e.stem}.json"), summary_json(e.stats))
                     for e in entries]
     return written
 
 
-def write_statistics_tables(entries: list[Entry], out_dir: Path) -> list[Path]:
+def write_statistics_tables(entries: list[AnalysedFile], out_dir: Path) -> list[Path]:
     """tables/statistics_<stem>_<output>.csv: every statistic of one output over time."""
     written = []
     for entry in entries:
@@ -35,7 +35,7 @@ def write_statistics_tables(entries: list[Entry], out_dir: Path) -> list[Path]:
             if out.errors:
                 header += ["eps_m [-]", "eps_v [-]"]
                 columns += [out.errors["eps_m"], out.errors["eps_v"]]
-            path = out_dir / "tables" / bounded(f"statistics_{entry.stem}_{entry.output_files[name]}.csv")
+            path = out_dir / "tables" / file_name_within(f"statistics_{entry.stem}_{entry.output_files[name]}.csv")
             written.append(write_csv(path, header, np.column_stack(columns).tolist()))
     return written
 
@@ -43,8 +43,8 @@ def write_statistics_tables(entries: list[Entry], out_dir: Path) -> list[Path]:
 def write_csv(path: Path, header: list[str], rows: list[list]) -> Path:
     with open(path, "w", newline="", encoding="utf-8") as fh:
         writer = csv.writer(fh)
-        writer.writerow([inert(h) for h in header])
-        writer.writerows([[float(v) if isinstance(v, np.floating) else inert(v) for v in row] for row in rows])
+        writer.writerow([csv_safe(h) for h in header])
+        writer.writerows([[float(v) if isinstance(v, np.floating) else csv_safe(v) for v in row] for row in rows])
     return path
 
 
@@ -52,7 +52,7 @@ FORMULA_START = ("=", "+", "-", "@", "\t", "\r")
 NUMBER = re.compile(r"[-+]?(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?")
 
 
-def inert(value):
+def csv_safe(value):
     """A text cell a spreadsheet would evaluate as a formula (starting with = + - @, a tab or a carriage
     return) behind a single quote, which spreadsheets show as text; numbers, and text that is a
     plain number such as "-0.5", stay as they are."""

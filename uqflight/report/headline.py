@@ -10,7 +10,7 @@ import numpy as np
 
 from ..text.labels import shown_time
 from . import plots
-from .loading import Entry
+from .loading import AnalysedFile
 from .morris import ranked_text
 from .sensitivity import top_contributors
 from .blocks import Section, Table
@@ -79,7 +79,7 @@ def interval_text(lower, upper) -> str:
     return f"{lower:.3g} to {upper:.3g}"
 
 
-def exceedance_table(entry: Entry) -> Table | None:
+def exceedance_table(entry: AnalysedFile) -> Table | None:
     """The exceedance probabilities of `entry`'s quantities (analysis.exceedance, or report --exceedance)
     with their 95 % intervals, "—" for none; None when none was asked for."""
     rows, page = [], []
@@ -109,7 +109,7 @@ def _without_empty_flags(header: list[str], page: list[list]) -> tuple[list[str]
     return header[:k] + header[k + 1:], [row[:k] + row[k + 1:] for row in page]
 
 
-def headline_section(entry: Entry, times: list[float]) -> Section:
+def headline_section(entry: AnalysedFile, times: list[float]) -> Section:
     """The headline of `entry`: its exceedance probabilities (tables/headline_exceedance.csv) first, then its
     key numbers (tables/headline.csv at full precision, the page rounded to the std)."""
     rows, page = [], []

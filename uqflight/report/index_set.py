@@ -9,7 +9,7 @@ from pathlib import Path
 import numpy as np
 
 from . import plots
-from .loading import Entry, bounded
+from .loading import AnalysedFile, file_name_within
 from .blocks import Figure, Section, Table, _rel
 
 
@@ -40,7 +40,7 @@ def plot_index_set(index_set: dict, parameters: list[str], path: Path, title: st
     return plots._save(fig, path)
 
 
-def index_set_section(entries: list[Entry], out_dir: Path) -> Section:
+def index_set_section(entries: list[AnalysedFile], out_dir: Path) -> Section:
     """For the entries whose file holds an adaptive grid's index set (Statistics.index_set)."""
     blocks, rows, facts = [], [], []
     for entry in entries:
@@ -59,7 +59,7 @@ def index_set_section(entries: list[Entry], out_dir: Path) -> Section:
             rows.append([entry.label, parameters[k], int(refined[k]), int(levels[:, k].max()),
                          int(np.count_nonzero(levels[:, k])),
                          int(np.count_nonzero((levels[:, k] > 0) & (np.count_nonzero(levels, axis=1) > 1)))])
-        path = plot_index_set(index_set, parameters, out_dir / "plots" / bounded(f"index_set_{entry.stem}.png"),
+        path = plot_index_set(index_set, parameters, out_dir / "plots" / file_name_within(f"index_set_{entry.stem}.png"),
                               f"Adaptive grid: {entry.label}")
         blocks.append(Figure(_rel(path, out_dir), f"The index set of {entry.label}: each row a multi-index (its "
                                                   "1-D level per input, 0 = the centre point only), in the order "

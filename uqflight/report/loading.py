@@ -11,7 +11,7 @@ from ..analysis.statistics import BadInput, Statistics, add_reference_errors, re
 
 
 @dataclass
-class Entry:
+class AnalysedFile:
     """One analysed results file and how the report names it."""
 
     stats: Statistics
@@ -66,7 +66,7 @@ class Entry:
 
 def load_entries(paths: list[Path], reference: Path | None, method: dict | list[dict] | None = None,
                  progress=None, partial: bool = False, allow_aliasing: bool = False,
-                 exceedance: dict | None = None, scatter_time: float = float("inf")) -> tuple[list[Entry], Entry | None]:
+                 exceedance: dict | None = None, scatter_time: float = float("inf")) -> tuple[list[AnalysedFile], AnalysedFile | None]:
     """Every file analysed once per method (`method`: one override, several, or None for the
     campaigns' own; the reference keeps its own), with errors against the reference unless it is
     the reference itself, and the reference. `progress` (a Progress) counts each file's outputs.
@@ -92,7 +92,7 @@ def load_entries(paths: list[Path], reference: Path | None, method: dict | list[
     return entries, ref
 
 
-def _rare_alone(entries: list[Entry], ref: Entry | None) -> None:
+def _rare_alone(entries: list[AnalysedFile], ref: AnalysedFile | None) -> None:
     """A rare-event design's file is reported alone (BadInput otherwise): its runs are not draws of the input
     law, so it has no statistics over time to overlay on another file's or to compare with a reference."""
     rare = [e for e in entries + ([ref] if ref else []) if e.stats.rare_runs]
@@ -115,14 +115,14 @@ def _file_stems(paths: list[Path]) -> dict[Path, str]:
 
 
 def _entry(path: Path, stats: Statistics, attrs: dict, stems: set[str], file_stems: dict[Path, str],
-           with_method: bool = False) -> Entry:
+           with_method: bool = False) -> AnalysedFile:
     name = Path(path).stem + (f"_{stats.method['kind']}{stats.method.get('order', '')}" if with_method else "")
     stem = _unique(file_name(name), stems)
     runs = f"partial: {stats.completed} of {stats.runs} runs" if stats.partial else f"{stats.runs} runs"
     label = f"{stats.campaign_name or stem}: {stats.estimator_label}, {runs}"
     taken: set[str] = set()
     output_files = {name: _unique(file_name(name), taken) for name in stats.outputs}
-    return Entry(stats, stem, label, str(attrs.get("campaign_hash", "")), dict(attrs), str(path), output_files,
+    return AnalysedFile(stats, stem, label, str(attrs.get("campaign_hash", "")), dict(attrs), str(path), output_files,
                  file_stems[Path(path).resolve()])
 
 
@@ -134,7 +134,7 @@ def file_name(name: str) -> str:
 NAME_BYTES = 255  # the longest name of one file or folder (ext4, XFS, Btrfs: bytes; APFS, NTFS: 255 characters)
 
 
-def bounded(name: str, limit: int = NAME_BYTES) -> str:
+def file_name_within(name: str, limit: int = NAME_BYTES) -> str:
     """`name` (a file name, its extension kept) as it is when its UTF-8 takes at most `limit` bytes; else cut
     and given "-" and 16 hex digits of the whole name's SHA-256 before its extension, so that names sharing
     a long start stay apart."""
@@ -149,7 +149,7 @@ def bounded(name: str, limit: int = NAME_BYTES) -> str:
     return keep + tag + ext
 
 
-def one_per_file(entries: list[Entry]) -> list[Entry]:
+def one_per_file(entries: list[AnalysedFile]) -> list[AnalysedFile]:
     """One entry per results file (several --method give several entries of one file)."""
     seen, unique = set(), []
     for e in entries:

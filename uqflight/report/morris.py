@@ -9,7 +9,7 @@ import numpy as np
 
 from . import plots
 from .blocks import Figure, Section, Table, _rel
-from .loading import Entry, bounded
+from .loading import AnalysedFile, file_name_within
 from ..text.labels import shown_time
 
 
@@ -37,7 +37,7 @@ def _number(value) -> str:
     return "null" if value is None or not np.isfinite(value) else f"{value:.3g}"
 
 
-def _panels_of(entry: Entry, times: list[float]) -> list[tuple[str, dict, int]]:
+def _panels_of(entry: AnalysedFile, times: list[float]) -> list[tuple[str, dict, int]]:
     """(panel title, measures, time index) for each quantity and each output at the selected times."""
     panels = [(f"quantity {name}", q.output.morris, 0) for name, q in entry.stats.quantities.items()
               if q.output is not None and q.output.morris]
@@ -80,14 +80,14 @@ def plot_morris(panels: list[tuple[str, dict, int]], path: Path, title: str) -> 
     return plots._save(fig, path, (handles, names), legend_columns=6)
 
 
-def morris_section(entries: list[Entry], times: list[float], out_dir: Path) -> Section:
+def morris_section(entries: list[AnalysedFile], times: list[float], out_dir: Path) -> Section:
     """The Morris screening of the entries whose statistics carry it (OutputStatistics.morris)."""
     blocks, rows, page = [], [], []
     for entry in entries:
         panels = _panels_of(entry, times)
         if not panels:
             continue
-        path = plot_morris(panels, out_dir / "plots" / bounded(f"morris_{entry.stem}.png"),
+        path = plot_morris(panels, out_dir / "plots" / file_name_within(f"morris_{entry.stem}.png"),
                            f"Morris screening: {entry.label}")
         blocks.append(Figure(_rel(path, out_dir), f"μ* against σ of the elementary effects per input, for each "
                              f"quantity and each output at the selected times, of {entry.label}; the bars are μ*'s "

@@ -10,7 +10,7 @@ from matplotlib.patches import Patch
 from ..analysis.sobol import unresolved
 from . import plots
 from .sensitivity import N_TOO_SMALL, UNRESOLVED
-from .loading import Entry, bounded
+from .loading import AnalysedFile, file_name_within
 from .blocks import Figure, Section, Table, _rel
 from .headline import interval_text, probability_text
 
@@ -91,7 +91,7 @@ def plot_quantity_sobol(quantities: dict, path: Path, title: str) -> Path:
                                              "outside [0, 1]: n too small"]), legend_columns=3)
 
 
-def quantities_section(entries: list[Entry], out_dir: Path) -> Section:
+def quantities_section(entries: list[AnalysedFile], out_dir: Path) -> Section:
     """The quantities of every file: statistics table, PDFs, Sobol' bars, exceedance table."""
     blocks, statistics, exceedance = [], [], []
     for entry in entries:
@@ -111,7 +111,7 @@ def quantities_section(entries: list[Entry], out_dir: Path) -> Section:
         defined = {name: q.output for name, q in quantities.items() if q.output is not None}
         if defined:
             thresholds = {name: q.exceedance for name, q in quantities.items() if q.exceedance}
-            path = plot_quantity_pdfs(defined, out_dir / "plots" / bounded(f"quantity_pdfs_{entry.stem}.png"),
+            path = plot_quantity_pdfs(defined, out_dir / "plots" / file_name_within(f"quantity_pdfs_{entry.stem}.png"),
                                       f"Quantities of interest: {entry.label}", thresholds)
             blocks.append(Figure(_rel(path, out_dir), f"PDFs of the quantities of {entry.label} (kernel density "
                                                       "estimate), the mean solid, the 99 % band dashed"
@@ -119,7 +119,7 @@ def quantities_section(entries: list[Entry], out_dir: Path) -> Section:
                                     else ".")))
         with_sobol = {name: out for name, out in defined.items() if out.sobol_first}
         if with_sobol:
-            path = plot_quantity_sobol(with_sobol, out_dir / "plots" / bounded(f"quantity_sobol_{entry.stem}.png"),
+            path = plot_quantity_sobol(with_sobol, out_dir / "plots" / file_name_within(f"quantity_sobol_{entry.stem}.png"),
                                        f"Sobol' indices of the quantities: {entry.label}")
             blocks.append(Figure(_rel(path, out_dir), f"First-order and total Sobol' indices of the quantities of "
                                                       f"{entry.label}, with their 95 % bootstrap intervals (pick-freeze) drawn "

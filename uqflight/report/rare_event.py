@@ -10,7 +10,7 @@ import numpy as np
 
 from . import plots
 from .blocks import Figure, Section, Table, _rel
-from .loading import Entry, bounded
+from .loading import AnalysedFile, file_name_within
 
 
 def _g(value, digits: int = 3) -> str:
@@ -23,7 +23,7 @@ def estimate_text(record: dict, event: str) -> str:
             f"c.o.v. {_g(record['cov'], 2)}, {record['runs']} runs, β = {_g(record['beta'])}")
 
 
-def headline_rows(entry: Entry) -> tuple[list, list] | None:
+def headline_rows(entry: AnalysedFile) -> tuple[list, list] | None:
     """(CSV rows, page rows) of the estimate for the headline, or None for another design."""
     runs = getattr(entry.stats, "rare_runs", None)
     if not runs:
@@ -42,7 +42,7 @@ HEADLINE_HEADER = (["file", "method", "event", "probability", "lower (95 %)", "u
                    ["method", "event", "probability", "95 % interval", "c.o.v.", "runs", "β", "stopped by"])
 
 
-def headline_table(entry: Entry) -> Table | None:
+def headline_table(entry: AnalysedFile) -> Table | None:
     """The headline's table of a rare-event design's estimate (tables/rare_event.csv), None for another design."""
     rows = headline_rows(entry)
     if rows is None:
@@ -140,7 +140,7 @@ def plot_runs(runs: dict, names: list[str], path: Path, title: str) -> Path:
     return plots._save(fig, path)
 
 
-def rare_event_section(entries: list[Entry], out_dir: Path) -> Section | None:
+def rare_event_section(entries: list[AnalysedFile], out_dir: Path) -> Section | None:
     """Per file of a rare-event design: the estimate, its rounds (table and figure) and the runs in the inputs."""
     blocks, facts, rounds = [], [], []
     for entry in entries:
@@ -152,12 +152,12 @@ def rare_event_section(entries: list[Entry], out_dir: Path) -> Section | None:
                      f"{record['stopped']}, {record['failed']} failed runs")
         rounds += [[entry.label, k + 1, int(r), p, c] for k, (r, p, c) in
                    enumerate(zip(record["round_runs"], record["round_probability"], record["round_cov"]))]
-        path = plot_convergence(record, event, out_dir / "plots" / bounded(f"rare_convergence_{entry.stem}.png"),
+        path = plot_convergence(record, event, out_dir / "plots" / file_name_within(f"rare_convergence_{entry.stem}.png"),
                                 f"{record['method']}: the estimate round by round, {entry.label}")
         blocks.append(Figure(_rel(path, out_dir), f"The estimate of P({event}) after each round of the "
                                                   f"{record['method']} against the runs so far, with ± 1.96 times its "
                                                   "c.o.v. where known, and the final 95 % interval (square)."))
-        path = plot_runs(runs, names, out_dir / "plots" / bounded(f"rare_runs_{entry.stem}.png"),
+        path = plot_runs(runs, names, out_dir / "plots" / file_name_within(f"rare_runs_{entry.stem}.png"),
                          f"The runs in the inputs, {entry.label}")
         point = record["design_point"]
         where = ("; the design point (star): " + ", ".join(f"{n} = {_g(v, 5)}" for n, v in zip(names, point))

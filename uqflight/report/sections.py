@@ -14,12 +14,12 @@ from ..analysis.sobol import unresolved
 from ..running.forking import ChildFailed, share_work
 from ..text.console import one_line
 from .sensitivity import N_TOO_SMALL, NEGLIGIBLE, index_text, plot_sensitivity
-from .loading import Entry, _same_file, bounded, one_per_file
+from .loading import AnalysedFile, _same_file, file_name_within, one_per_file
 
 BELOW_FLOOR = "below reference resolution"
 UNRESOLVED = "unresolved"
 
-def build_sections(entries: list[Entry], ref: Entry | None, times: list[float], out_dir: Path,
+def build_sections(entries: list[AnalysedFile], ref: AnalysedFile | None, times: list[float], out_dir: Path,
                    on_message: Callable[[tuple], None] | None = None) -> list[Section]:
     """The report's sections, drawing their plots into out_dir/plots. The sections are built by this
     process and a forked child per further core (forking.share_work), the costliest first: each
@@ -49,7 +49,7 @@ def _named(stage: str, build: Callable[[], Section | None]) -> Callable[[], Sect
     return run
 
 
-def section_jobs(entries: list[Entry], ref: Entry | None, times: list[float],
+def section_jobs(entries: list[AnalysedFile], ref: AnalysedFile | None, times: list[float],
                  out_dir: Path) -> list[tuple[int, str, Callable[[], Section | None]]]:
     """The report's sections in page order as (cost, stage, build): `cost` the panels it draws, roughly
     (what sets how long it takes), `stage` what the progress says while it is drawn, `build` what
@@ -110,7 +110,7 @@ def section_jobs(entries: list[Entry], ref: Entry | None, times: list[float],
     return jobs
 
 
-def notes_section(entries: list[Entry]) -> Section | None:
+def notes_section(entries: list[AnalysedFile]) -> Section | None:
     """What the reader must see before any number (Statistics.notes), per file; None without notes."""
     lines = [f"{e.label}: {note}" for e in entries for note in (getattr(e.stats, "notes", None) or [])]
     if not lines:
@@ -118,7 +118,7 @@ def notes_section(entries: list[Entry]) -> Section | None:
     return Section("Notes", "notes", "\n".join(f"- {line}" for line in dict.fromkeys(lines)), notes=True)
 
 
-def run_section(entries: list[Entry], out_dir: Path) -> Section:
+def run_section(entries: list[AnalysedFile], out_dir: Path) -> Section:
     """What was run: per results file its parameters, flight condition, excitation, design, method,
     seed, versions, aircraft hash and date; its campaign text; the design scatter (Fig. 9)."""
     blocks = []
@@ -156,7 +156,7 @@ def run_section(entries: list[Entry], out_dir: Path) -> Section:
                         parameter_rows, "tables/parameters.csv"))
     for e in one_per_file(entries):
         path = plots.plot_design_pairs(e.stats.drawn,
-                                       out_dir / "plots" / bounded(f"design_{e.file_stem}.png"),
+                                       out_dir / "plots" / file_name_within(f"design_{e.file_stem}.png"),
                                        f"Design: {e.stats.design_kind}, "
                                        f"{e.stats.runs} points ({e.file_stem})")
         if path is not None:
@@ -168,7 +168,7 @@ def run_section(entries: list[Entry], out_dir: Path) -> Section:
     return Section("What was run", "run", texts, blocks, preformatted=True)
 
 
-def failures_section(entries: list[Entry]) -> Section | None:
+def failures_section(entries: list[AnalysedFile]) -> Section | None:
     """Each failed run's parameters and reason (Statistics.failures), when any."""
     rows, parameters = [], []
     for e in one_per_file(entries):
@@ -202,7 +202,7 @@ def _finite(value) -> float | None:
     return None if value is None or not np.isfinite(value) else float(value)
 
 
-def inputs_section(entries: list[Entry], ref: Entry | None) -> Section:
+def inputs_section(entries: list[AnalysedFile], ref: AnalysedFile | None) -> Section:
     rows = [[e.label, e.stats.path, e.stats.design_kind, e.stats.method_label, e.inputs, e.stats.runs,
              e.stats.failed, e.campaign_hash[:12]] for e in entries]
     text = (f"Errors and KLD are against the reference {ref.label} ({ref.stats.path})." if ref
@@ -219,18 +219,18 @@ def inputs_section(entries: list[Entry], ref: Entry | None) -> Section:
         "tables/files.csv")])
 
 
-def statistics_section(entries: list[Entry], ref: Entry | None, times: list[float], out_dir: Path) -> Section:
+def statistics_section(entries: list[AnalysedFile], ref: AnalysedFile | None, times: list[float], out_dir: Path) -> Section:
     """Figs. 6-8 for every file (and method), the methods' bands overlaid, and the statistics at the
     selected times."""
     plot_dir = out_dir / "plots"
     blocks = []
     for entry in entries:
         overlay = ref.outputs if ref is not None and not _same_file(ref.stats.path, entry.stats.path) else None
-        blocks.append(Figure(_rel(plots.plot_mean_band(entry.outputs, plot_dir / bounded(f"mean_band_{entry.stem}.png"),
+        blocks.append(Figure(_rel(plots.plot_mean_band(entry.outputs, plot_dir / file_name_within(f"mean_band_{entry.stem}.png"),
                                                        f"Mean and 99 % band: {entry.label}", overlay), out_dir),
                              f"Mean and 99 % band of each output over time of {entry.label} (paper Figs. 6-7)"
                              + ("; the reference dashed." if overlay else ".")))
-        blocks.append(Figure(_rel(plots.plot_cov(entry.outputs, plot_dir / bounded(f"cov_{entry.stem}.png"),
+        blocks.append(Figure(_rel(plots.plot_cov(entry.outputs, plot_dir / file_name_within(f"cov_{entry.stem}.png"),
                                                  f"Spread over time: {entry.label}"), out_dir),
                              f"Modified coefficient of variation std(t) / max|mean| of the outputs of {entry.label} "
                              "(paper Fig. 8); outputs on an offset datum (min|mean| more than "
@@ -259,13 +259,13 @@ def statistics_section(entries: list[Entry], ref: Entry | None, times: list[floa
                    "time of every file and output are in tables/statistics_<file>_<output>.csv.", blocks)
 
 
-def pdf_figures(entry: Entry, out_dir: Path) -> dict[str, tuple]:
+def pdf_figures(entry: AnalysedFile, out_dir: Path) -> dict[str, tuple]:
     """(output, path, title) of the PDF figure of each output of `entry`, by output name."""
-    return {name: (out, out_dir / "plots" / bounded(f"pdf_{entry.stem}_{entry.output_files[name]}.png"),
+    return {name: (out, out_dir / "plots" / file_name_within(f"pdf_{entry.stem}_{entry.output_files[name]}.png"),
                    f"PDF of {plots.short_label(name)}: {entry.label}") for name, out in entry.outputs.items()}
 
 
-def draw_pdfs(entries: list[Entry], times: list[float], out_dir: Path) -> None:
+def draw_pdfs(entries: list[AnalysedFile], times: list[float], out_dir: Path) -> None:
     """The PDF figures of every file (shown by statistics_section): those over time on one figure per file."""
     for entry in entries:
         figures = pdf_figures(entry, out_dir).values()
@@ -275,7 +275,7 @@ def draw_pdfs(entries: list[Entry], times: list[float], out_dir: Path) -> None:
                 plots.plot_pdf_over_time(out, path, title, times)
 
 
-def _extra_statistics(entries: list[Entry]) -> list[tuple[str, str]]:
+def _extra_statistics(entries: list[AnalysedFile]) -> list[tuple[str, str]]:
     """(attribute or quantile key, column title) of the optional statistics some file has: skewness,
     kurtosis, leave-one-out error, quantiles."""
     found = []
@@ -321,7 +321,7 @@ def _below_floor(values: dict[str, tuple[float, float | None]]) -> str:
     return f"{BELOW_FLOOR}: {', '.join(below)}" if below else ""
 
 
-def accuracy_section(entries: list[Entry], out_dir: Path) -> Section:
+def accuracy_section(entries: list[AnalysedFile], out_dir: Path) -> Section:
     """Eq. 49 errors over time (Figs. 10-19) with the reference's floor, their table, the
     convergence against runs, and the KLD against the runs (Fig. 20)."""
     compared = [e for e in entries if e.has_errors]
@@ -372,17 +372,17 @@ def accuracy_section(entries: list[Entry], out_dir: Path) -> Section:
                    "KLD = ∫ ρ ln(ρ / ρ_ref) (Eq. 50)." + "".join(f" {n}" for n in notes), blocks)
 
 
-def sensitivity_section(entries: list[Entry], times: list[float], out_dir: Path) -> Section:
+def sensitivity_section(entries: list[AnalysedFile], times: list[float], out_dir: Path) -> Section:
     """Sobol' indices over time (Fig. 21), at the selected times (Table 3), and PCE vs MC (Table 4)."""
     with_sobol = [e for e in entries if e.has_sobol]
     blocks = []
     for entry in with_sobol:
-        path = plots.plot_sobol(entry.outputs, out_dir / "plots" / bounded(f"sobol_{entry.stem}.png"),
+        path = plots.plot_sobol(entry.outputs, out_dir / "plots" / file_name_within(f"sobol_{entry.stem}.png"),
                                 f"First-order Sobol' indices: {entry.label}")
         blocks.append(Figure(_rel(path, out_dir), f"First-order Sobol' indices over time of {entry.label} "
                                                   "(paper Fig. 21)" + (", bootstrap 95 % intervals shaded."
                                                                        if entry.pick_freeze else ".")))
-        path = plot_sensitivity(entry.outputs, out_dir / "plots" / bounded(f"sensitivity_{entry.stem}.png"),
+        path = plot_sensitivity(entry.outputs, out_dir / "plots" / file_name_within(f"sensitivity_{entry.stem}.png"),
                                 f"Partial variances and Sobol' indices: {entry.label}")
         if path is not None:
             blocks.append(Figure(_rel(path, out_dir), f"Per output of {entry.label}: the partial variances "
@@ -413,7 +413,7 @@ def sensitivity_section(entries: list[Entry], times: list[float], out_dir: Path)
                    blocks)
 
 
-def pce_vs_mc_table(entries: list[Entry], parameters: list[str]) -> Table:
+def pce_vs_mc_table(entries: list[AnalysedFile], parameters: list[str]) -> Table:
     """First-order indices at the final time per output and parameter, one column per file (Table 4)."""
     header = ["output", "time [s]", "parameter"]
     for e in entries:
@@ -452,12 +452,12 @@ def _at(indices: dict, parameter: str, i: int):
     return UNRESOLVED if value is None or not np.isfinite(value) else value
 
 
-def decay_section(entries: list[Entry], out_dir: Path) -> Section:
+def decay_section(entries: list[AnalysedFile], out_dir: Path) -> Section:
     """The PCE coefficients' root-sum-square per total degree over time (convergence of the expansion)."""
     blocks = []
     for e in entries:
         start = e.simulator.get("excitation", {}).get("start_s")
-        path = plots.plot_coefficient_decay(e.outputs, out_dir / "plots" / bounded(f"coefficient_decay_{e.stem}.png"),
+        path = plots.plot_coefficient_decay(e.outputs, out_dir / "plots" / file_name_within(f"coefficient_decay_{e.stem}.png"),
                                             f"PCE coefficients by total degree: {e.label}", start_s=start)
         blocks.append(Figure(_rel(path, out_dir), f"Root-sum-square of the PCE coefficients of each total degree "
                              f"from 1 on over time, {e.label}, from the excitation's start on: a fast decay "
@@ -466,7 +466,7 @@ def decay_section(entries: list[Entry], out_dir: Path) -> Section:
                    "degree p-1 mean the expansion has converged at that time.", blocks)
 
 
-def monte_carlo_section(entries: list[Entry], out_dir: Path) -> Section:
+def monte_carlo_section(entries: list[AnalysedFile], out_dir: Path) -> Section:
     """Several Monte Carlo files (the reference too) overlaid, e.g. normal against uniform inputs (Figs. 4-5)."""
     labelled = [(f"{e.label} (inputs {e.inputs})", e.outputs) for e in entries]
     bands = plots.plot_band_comparison(labelled, out_dir / "plots" / "mc_bands.png",

@@ -113,7 +113,7 @@ def trajectories_section(entries: list, times: list[float], out_dir: Path):
     """Per results file: the spaghetti plot and the scatter of the outputs at the last of `times` and of the
     quantities against the inputs, seeded by the campaign's seed (the same runs on every report); None
     when there is nothing to draw (no output and no quantity)."""
-    from .loading import bounded, one_per_file
+    from .loading import file_name_within, one_per_file
     from .blocks import Figure, Section, _rel
 
     blocks = []
@@ -123,7 +123,7 @@ def trajectories_section(entries: list, times: list[float], out_dir: Path):
                  f" The points are the {e.stats.design_kind}'s nodes, not random draws: how they spread says "
                  "nothing of the inputs' distribution.")
         if any(out.time.size > 1 for out in e.outputs.values()):
-            path, count = plot_spaghetti(drawn, e.outputs, out_dir / "plots" / bounded(f"spaghetti_{stem}.png"),
+            path, count = plot_spaghetti(drawn, e.outputs, out_dir / "plots" / file_name_within(f"spaghetti_{stem}.png"),
                                          f"Runs, mean and 99 % band: {e.label}")
             blocks.append(Figure(_rel(path, out_dir), f"{count} of the {e.stats.completed} successful runs of {stem} "
                                  f"(drawn with the campaign's seed {seed}, at most {SPAGHETTI_RUNS}), thin, with "
@@ -136,7 +136,7 @@ def trajectories_section(entries: list, times: list[float], out_dir: Path):
             "the other input most correlated with it (squared correlation; the file has no Sobol' indices)")
             + ", low to high")
         path = plot_scatter(rows["kappa"], rows["names"], {**rows["outputs"], **rows["quantities"]},
-                            out_dir / "plots" / bounded(f"scatter_{stem}.png"), f"Outputs and quantities against the "
+                            out_dir / "plots" / file_name_within(f"scatter_{stem}.png"), f"Outputs and quantities against the "
                             f"inputs: {e.label}")
         if path is not None:
             blocks.append(Figure(_rel(path, out_dir), "Each output (at the last selected time)"

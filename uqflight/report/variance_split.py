@@ -9,7 +9,7 @@ import numpy as np
 from ..analysis.sobol import unresolved
 from ..analysis.statistics import variance_split
 from .sensitivity import N_TOO_SMALL, index_text
-from .loading import Entry
+from .loading import AnalysedFile
 from .blocks import Section, Table
 
 
@@ -28,7 +28,7 @@ def _row(label: str, name: str, out, seed: str, at: int) -> tuple[list, list]:
     return [value if not (isinstance(value, float) and np.isnan(value)) else "unresolved" for value in row], page
 
 
-def variance_split_section(entries: list[Entry], times: list[float]) -> Section | None:
+def variance_split_section(entries: list[AnalysedFile], times: list[float]) -> Section | None:
     """None when no file has a seed parameter with pick-freeze indices."""
     rows, page = [], []
     for entry in entries:

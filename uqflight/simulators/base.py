@@ -198,7 +198,7 @@ class SimulatorKind(Kind):
     def check_source(self, check, name, path: str, config: dict, aircraft) -> None:
         """Refuse (check.fail at `path`) a name a quantity reads that the simulator does not record."""
 
-    def facts(self, config: dict) -> dict[str, str]:
+    def flight_summary(self, config: dict) -> dict[str, str]:
         """{"flight": text, "excitation": text}: what is flown, defaults resolved (the report; {} for a model)."""
         return {}
 
@@ -286,5 +286,5 @@ class ScenarioKind(Kind):
         return None
 
     @abstractmethod
-    def facts(self, config: dict) -> dict[str, str]:
+    def flight_summary(self, config: dict) -> dict[str, str]:
         """{"flight": text, "excitation": text}: what is flown, defaults resolved (the report)."""

@@ -157,8 +157,8 @@ class JSBSim(SimulatorKind):
     def trims_level(self, config: dict) -> bool:
         return scenario_entry(config).level_trim
 
-    def facts(self, config: dict) -> dict[str, str]:
-        return scenario_entry(config).facts(config)
+    def flight_summary(self, config: dict) -> dict[str, str]:
+        return scenario_entry(config).flight_summary(config)
 
     def check_source(self, check, name, path: str, config: dict, aircraft) -> None:
         """A named output or, when the aircraft is known, one of its properties."""

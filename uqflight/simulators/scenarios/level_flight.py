@@ -391,7 +391,7 @@ class LevelFlight(ScenarioKind):
 
     Examples
     --------
-    >>> flight = LevelFlight().facts({"aircraft": "bacm", "excitation": {"kind": "doublet"}})
+    >>> flight = LevelFlight().flight_summary({"aircraft": "bacm", "excitation": {"kind": "doublet"}})
     >>> flight["excitation"]
     'elevator doublet 1 deg at 1 s for 1 s'
     """
@@ -467,7 +467,7 @@ class LevelFlight(ScenarioKind):
             trim=config.get("trim", "newton"),
         )
 
-    def facts(self, config: dict) -> dict[str, str]:
+    def flight_summary(self, config: dict) -> dict[str, str]:
         """The flight condition and excitation a campaign's `simulator:` mapping flies, defaults resolved
         (the report's campaign table), without locating the aircraft."""
         from ..aircraft import default_condition

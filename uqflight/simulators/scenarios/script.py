@@ -438,7 +438,7 @@ class Script(ScenarioKind):
 
     Examples
     --------
-    >>> Script().facts({"kind": "jsbsim", "scenario": {"kind": "script", "script": "c172_cruise_8K", "end_s": 20}})
+    >>> Script().flight_summary({"kind": "jsbsim", "scenario": {"kind": "script", "script": "c172_cruise_8K", "end_s": 20}})
     {'flight': 'script c172_cruise_8K, cut at 20 s', 'excitation': "the script's events"}
     """
 
@@ -567,7 +567,7 @@ class Script(ScenarioKind):
         return {"scenario": json.dumps({"kind": "script", "script": Path(config["script_path"]).name,
                                         "sha256": AircraftFiles("", self.files(config)).hash()})}
 
-    def facts(self, config: dict) -> dict[str, str]:
+    def flight_summary(self, config: dict) -> dict[str, str]:
         """The script flown, as the campaign names it (the report's campaign table)."""
         scenario = config.get("scenario") or {}
         end = f", cut at {scenario['end_s']:g} s" if isinstance(scenario.get("end_s"), (int, float)) else ""
