@@ -172,8 +172,6 @@ def build_campaign(check: Checker, data: dict, simulator: dict, parameters: list
     method = schema.method(check, data.get("method", {"kind": default_method}))
     schema.check_seeds(check, parameters, design_kind, method)
     seeds = seed_names(parameters)
-    if seeds and simulator_entry(simulator).integer_seeds:
-        simulator["seed_parameters"] = seeds
     execution = Execution.checked(check, data.get("execution", {}))
     storage = Storage.checked(check, data.get("storage", {}), name)
     if quantities is None:  # read from a results file: checked as written, no aircraft to name properties

@@ -187,11 +187,15 @@ def nominal_kappa(campaign: Campaign) -> np.ndarray:
 
 
 def worker_spec(campaign: Campaign) -> WorkerSpec:
-    from ..simulators.kinds import make_bundle
+    from ..parameters import seed_names
+    from ..simulators.kinds import make_bundle, simulator_entry
 
     properties = tuple(p.property for p in campaign.parameters)
     base = str(Path(campaign.source).resolve().parent)
-    return WorkerSpec(simulator=campaign.simulator,
+    simulator, seeds = campaign.simulator, seed_names(campaign.parameters)
+    if seeds and simulator_entry(simulator).integer_seeds:  # a python model is given its seeds as Python ints
+        simulator = {**simulator, "seed_parameters": seeds}
+    return WorkerSpec(simulator=simulator,
                       parameter_names=tuple(p.name for p in campaign.parameters),
                       properties=properties, base=base,
                       bundle=make_bundle(campaign.simulator, properties, base),  # files travel with the task
