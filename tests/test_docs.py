@@ -70,6 +70,13 @@ def test_the_api_docstring_examples_run():
     assert result.attempted >= 15 and result.failed == 0
 
 
+def test_the_api_functions_have_numpydoc_parameters_returns_and_raises():
+    for name in uqflight.__all__:
+        doc = getattr(uqflight, name).__doc__
+        for section in ("Parameters", "Returns", "Raises"):
+            assert f"\n    {section}\n    {'-' * len(section)}\n" in doc, (name, section)
+
+
 def test_import_uqflight_imports_nothing_else():
     code = "import sys, uqflight; print(sorted(m for m in sys.modules if m.startswith('uqflight')))"
     loaded = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout

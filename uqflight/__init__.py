@@ -37,11 +37,27 @@ __all__ = ["analyse", "calibrate", "export_surrogate", "load_campaign", "load_su
 
 
 def load_campaign(path, check_aircraft: bool = True):
-    """The validated campaign (`uqflight.campaign.Campaign`) of a campaign file, checked as `uqflight plan`
-    checks it. `check_aircraft`: a JSBSim campaign's property and output names are checked against its aircraft and
-    the nominal values read from it (JSBSim loads the aircraft); False skips that, and nominal values must
-    then be given. A python simulator's module is imported: its code runs. Raises
-    `uqflight.campaign.CampaignError` naming the file, the field and what was expected."""
+    """The validated campaign of a campaign file, checked as `uqflight plan` checks it.
+
+    Parameters
+    ----------
+    path : str or Path
+        The campaign file (YAML).
+    check_aircraft : bool
+        Check a JSBSim campaign's property and output names against its aircraft and read the nominal values
+        from it (JSBSim loads the aircraft); False skips that, and nominal values must then be given.
+
+    Returns
+    -------
+    uqflight.campaign.Campaign
+        The campaign, frozen: its parameters, design, method and settings (`execution`, `storage`, `analysis`,
+        `limits`), and `runs`, the design's size.
+
+    Raises
+    ------
+    uqflight.campaign.CampaignError
+        Naming the file, the field and what was expected. A python simulator's module is imported: its code runs.
+    """
     from .campaign import load_campaign as load
     from .simulators.validation_view import validation_view
 
@@ -50,12 +66,34 @@ def load_campaign(path, check_aircraft: bool = True):
 
 def run(campaign, out=None, workers: int | None = None, executor: str | None = None,
         scheduler: str | None = None, force: bool = False, restart: bool = False, progress: bool = False):
-    """Run a campaign (a Campaign, or a campaign file loaded with `load_campaign`) into its results file
-    (`out`, default `storage.path`), resuming a file of this campaign begun before, as `uqflight run` does;
-    returns the `uqflight.running.runner.RunSummary` (`.path`, `.ran`, `.skipped`, `.failures`). The other
-    arguments are `run`'s options. Raises CampaignError, LockHeld, FileExistsError, DiskFull, WorkerError
-    (`uqflight.running.runner`). With `executor="dask"` and no scheduler, call it under
-    `if __name__ == "__main__":` (a LocalCluster starts processes)."""
+    """Run a campaign into its results file, resuming a file of this campaign begun before, as `uqflight run` does.
+
+    Parameters
+    ----------
+    campaign : Campaign, str or Path
+        A campaign (`load_campaign`), or a campaign file, which is loaded first.
+    out : str or Path, optional
+        The results file; default the campaign's `storage.path`.
+    workers, executor, scheduler : optional
+        `run`'s options: worker processes, `local` or `dask`, a Dask scheduler's address. With `executor="dask"`
+        and no scheduler, call it under `if __name__ == "__main__":` (a LocalCluster starts processes).
+    force : bool
+        Replace a results file of another campaign.
+    restart : bool
+        Start a results file of this same campaign over.
+    progress : bool
+        Print the progress line.
+
+    Returns
+    -------
+    uqflight.running.runner.RunSummary
+        `.path`, `.ran`, `.skipped`, `.failures` (reason: count).
+
+    Raises
+    ------
+    CampaignError, LockHeld, FileExistsError, DiskFull, WorkerError
+        See `uqflight.running.runner.run_campaign`.
+    """
     from .running.runner import run_campaign
 
     if not hasattr(campaign, "design_spec"):
@@ -85,14 +123,33 @@ def _thresholds(exceedance) -> dict | None:
 
 def analyse(results, method=None, reference=None, partial: bool = False, allow_aliasing: bool = False,
             exceedance=None):
-    """The statistics (`uqflight.analysis.statistics.Statistics`) of a results file, as `uqflight report` computes
-    them: `.outputs[NAME]` (mean, variance, std, band99, quantiles, sobol_first, sobol_total, ... over
-    time), `.quantities[NAME]`, `.notes`, `.failure_probability`. `method`: "KIND[:ORDER]" or
-    {"kind", "order"} instead of the campaign's; `reference`: a results file for the errors ε_m, ε_v and
-    the KLD; `partial`, `allow_aliasing`: as `report --partial`, `--allow-aliasing`; `exceedance`: "NAME>X" /
-    "NAME<X" strings (or {NAME: [{above: X}]}) replacing the campaign's thresholds of NAME, as `report
-    --exceedance`. Never runs campaign code. Raises `uqflight.analysis.statistics.BadInput` (one line naming the file
-    and what to do) when the file cannot give right numbers."""
+    """The statistics of a results file, as `uqflight report` computes them. Never runs campaign code.
+
+    Parameters
+    ----------
+    results : str or Path
+        The results file.
+    method : str or dict, optional
+        "KIND[:ORDER]" or {"kind", "order"} instead of the campaign's method.
+    reference : str or Path, optional
+        A results file to take the errors ε_m, ε_v and the KLD against.
+    partial, allow_aliasing : bool
+        As `report --partial` and `--allow-aliasing`.
+    exceedance : str, list of str or dict, optional
+        "NAME>X" / "NAME<X" strings, or {NAME: [{above: X}]}, replacing the campaign's thresholds of NAME, as
+        `report --exceedance`.
+
+    Returns
+    -------
+    uqflight.analysis.statistics.Statistics
+        `.outputs[NAME]` (mean, variance, std, band99, quantiles, sobol_first, sobol_total, ... over time),
+        `.quantities[NAME]`, `.notes`, `.failure_probability`, `.record` (the campaign the file records).
+
+    Raises
+    ------
+    uqflight.analysis.statistics.BadInput
+        One line naming the file and what to do, when the file cannot give right numbers.
+    """
     from .analysis.statistics import BadInput
     from .analysis.statistics import analyse as statistics
 
@@ -110,12 +167,37 @@ def analyse(results, method=None, reference=None, partial: bool = False, allow_a
 
 def write_report(results, out=None, reference=None, method=None, times=(10.0, 25.0, float("inf")),
            baseline=None, partial: bool = False, allow_aliasing: bool = False, exceedance=None) -> list:
-    """Write the report of one results file or a list of them into `out` (default RESULTS-report/ beside
-    the first), as `uqflight report` does; returns the paths written. `method`: "KIND[:ORDER]", a mapping
-    or a list of them (compared on the same runs); `times`: the tables' times (inf: the final one);
-    `baseline`: also write the baseline of `uqflight check`; `exceedance`: "NAME>X" / "NAME<X" strings (or
-    {NAME: [{above: X}]}) replacing the campaign's thresholds of NAME, as `report --exceedance`. Raises
-    BadInput as `analyse` (ValueError for a malformed threshold). An example: docs/python.md."""
+    """Write the report of one results file or several, as `uqflight report` does (an example: docs/python.md).
+
+    Parameters
+    ----------
+    results : str, Path or list of them
+        The results files; the first is the one summary.json and the baseline describe.
+    out : str or Path, optional
+        The report's folder; default RESULTS-report/ beside the first file.
+    reference : str or Path, optional
+        A Monte Carlo results file the errors are taken against.
+    method : str, dict or list of them, optional
+        "KIND[:ORDER]" or mappings, compared on the same runs.
+    times : tuple of float
+        The tables' times in seconds (inf: the final one).
+    baseline : str or Path, optional
+        Also write the baseline of `uqflight check` there.
+    partial, allow_aliasing : bool
+        As `report --partial` and `--allow-aliasing`.
+    exceedance : str, list of str or dict, optional
+        Thresholds replacing the campaign's, as in `analyse`.
+
+    Returns
+    -------
+    list of Path
+        The files written.
+
+    Raises
+    ------
+    BadInput
+        As `analyse`; ValueError for a malformed threshold.
+    """
     from pathlib import Path
 
     from .report import write_report as write
@@ -126,8 +208,27 @@ def write_report(results, out=None, reference=None, method=None, times=(10.0, 25
 
 
 def export_surrogate(results, out, method=None):
-    """Write the PCE of every output of a results file as JSON (`uqflight surrogate export`); returns the
-    path. `method`: "KIND[:ORDER]" or a mapping instead of the campaign's. Raises SurrogateError."""
+    """Write the PCE of every output of a results file as JSON, as `uqflight surrogate export` does.
+
+    Parameters
+    ----------
+    results : str or Path
+        The results file.
+    out : str or Path
+        The JSON file to write.
+    method : str or dict, optional
+        "KIND[:ORDER]" or a mapping instead of the campaign's method.
+
+    Returns
+    -------
+    Path
+        The file written.
+
+    Raises
+    ------
+    uqflight.analysis.surrogate.SurrogateError
+        Naming the file and why no surrogate can be made.
+    """
     from .analysis.surrogate import export
 
     methods = _methods(method)
@@ -135,9 +236,24 @@ def export_surrogate(results, out, method=None):
 
 
 def load_surrogate(path):
-    """The PCE surrogate of an exported JSON file (`uqflight.analysis.surrogate.Surrogate`): `.evaluate(kappa)` or
-    `.evaluate(xi=...)` gives {output: (M, T)} at M points, `.mean()`, `.variance()` {output: (T,)}. The
-    file is checked before anything is evaluated: SurrogateError names the file and the key."""
+    """The PCE surrogate of an exported JSON file, checked before anything is evaluated.
+
+    Parameters
+    ----------
+    path : str or Path
+        A file written by `export_surrogate`.
+
+    Returns
+    -------
+    uqflight.analysis.surrogate.Surrogate
+        `.evaluate(kappa)` or `.evaluate(xi=...)` gives {output: (M, T)} at M points; `.mean()`, `.variance()`
+        give {output: (T,)}.
+
+    Raises
+    ------
+    SurrogateError
+        Naming the file and the key that is wrong.
+    """
     from .analysis.surrogate import load
 
     return load(path)
@@ -147,12 +263,37 @@ def simulate(settings: dict | None = None, *, aircraft: str = "bacm", altitude_f
              airspeed_ktas: float | None = None, excitation: str = "pulse", amplitude_deg: float = 1.0,
              start_s: float = 1.0, pulse_duration_s: float = 1.0, duration_s: float = 50.0,
              output_rate_hz: float = 20.0, outputs=(), trim: str = "newton"):
-    """Fly one flight as `uqflight simulate` does: trim in level flight (default: the aircraft's
-    condition), excite the elevator and record the outputs (alpha_deg, theta_deg, h_ft, q_degps, vtas_kt
-    and the JSBSim properties in `outputs`). `settings`: {property: value} set before the trim, e.g.
-    {"aero/uq/CL0": 0.22}. Returns a FlightResult (`.time`, `.outputs[NAME]`, `.trim`, `.warnings`); raises FlightError
-    (`uqflight.simulators.base`) when the trim or the flight fails.
+    """Fly one flight as `uqflight simulate` does: trim in level flight, excite the elevator, record the outputs.
 
+    Parameters
+    ----------
+    settings : dict, optional
+        {property: value} set before the trim, e.g. {"aero/uq/CL0": 0.22}.
+    aircraft : str
+        The aircraft: a name (the project's or JSBSim's) or its folder.
+    altitude_ft, airspeed_ktas : float, optional
+        The trim condition; default the aircraft's.
+    excitation, amplitude_deg, start_s, pulse_duration_s : optional
+        The elevator's excitation (pulse, step or doublet), its amplitude, start and length.
+    duration_s, output_rate_hz : float
+        How long the flight is recorded, and how often.
+    outputs : sequence of str
+        JSBSim properties recorded beside alpha_deg, theta_deg, h_ft, q_degps and vtas_kt.
+    trim : str
+        "newton" or "jsbsim".
+
+    Returns
+    -------
+    FlightResult
+        `.time`, `.outputs[NAME]`, `.trim`, `.warnings`.
+
+    Raises
+    ------
+    uqflight.simulators.base.FlightError
+        When the trim or the flight fails.
+
+    Examples
+    --------
     >>> flight = simulate({"aero/uq/CL0": 0.22}, duration_s=2.0)
     >>> float(flight.time[-1]), sorted(flight.outputs)[:2]
     (2.0, ['alpha_deg', 'h_ft'])
@@ -180,12 +321,42 @@ def simulate(settings: dict | None = None, *, aircraft: str = "bacm", altitude_f
 def calibrate(results, data, out, noise: dict | None = None, outputs: list[str] | None = None, seed: int = 0,
               walkers: int | None = None, steps: int | None = None, method: str | None = None, order: int | None = None,
               campaign=None, predictive_draws: int = 50):
-    """Calibrate the parameters of the campaign of `results` on flight data (a CSV as `uqflight simulate
-    --out` writes it), as `uqflight calibrate` does (docs/calibration.md); writes posterior.h5,
-    summary.json, calibrated.yaml and plots/ into `out` and returns the Calibration (`.summary`: the
-    summary.json mapping, `.written`). `noise`: {output: known noise std}; the others are inferred.
-    Raises DataError / SurrogateError (bad input), ValueError, NotConverged (`uqflight.calibration.run`:
-    `.diagnostics["problems"]` says what to change). An example: docs/python.md."""
+    """Calibrate the parameters of the campaign of a results file on flight data, as `uqflight calibrate` does
+    (docs/calibration.md; an example: docs/python.md).
+
+    Parameters
+    ----------
+    results : str or Path
+        The results file whose runs give the surrogate.
+    data : str or Path
+        The flight data: a CSV as `uqflight simulate --out` writes it.
+    out : str or Path
+        The folder for posterior.h5, summary.json, calibrated.yaml and plots/.
+    noise : dict, optional
+        {output: known noise std}; the others' noise is inferred.
+    outputs : list of str, optional
+        The outputs calibrated on; default every output the data and the surrogate share.
+    seed, walkers, steps : optional
+        The sampler's seed, walkers and steps.
+    method, order : optional
+        The surrogate's method and order instead of the campaign's.
+    campaign : str or Path, optional
+        The campaign file, when its python model is not beside the results file.
+    predictive_draws : int
+        Posterior draws flown for the predictive band.
+
+    Returns
+    -------
+    Calibration
+        `.summary` (the summary.json mapping) and `.written` (the files).
+
+    Raises
+    ------
+    DataError, SurrogateError, ValueError
+        Bad input, naming what is wrong.
+    NotConverged
+        `.diagnostics["problems"]` says what to change (`uqflight.calibration.run`).
+    """
     from .calibration.run import calibrate as calibration
 
     return calibration(results, data, out, outputs=outputs, noise=noise, seed=seed, walkers=walkers, steps=steps,
