@@ -329,3 +329,20 @@ def test_a_design_refuses_a_value_with_its_fields_path_not_a_parsed_string():
         with pytest.raises(FieldError) as refused:
             build_design(spec, ["normal", "normal"], 0)
         assert refused.value.field == field and str(refused.value) == f"{field}: {refused.value.message}"
+
+
+def test_every_design_kind_class_has_examples_that_run():
+    # each registered kind's class docstring shows the kind at work (numpydoc Examples), and the doctests
+    # of every module holding a kind class run without a failure
+    import doctest
+    import importlib
+
+    from uqflight.designs import REGISTRY, DesignKind
+
+    assert all(isinstance(kind, DesignKind) for kind in REGISTRY.values())  # instances: their classes hold the docs
+    without = [name for name, kind in REGISTRY.items()
+               if ">>>" not in (type(kind).__doc__ or "") or "\n    Examples\n    --------\n" not in type(kind).__doc__]
+    assert not without, f"design kinds without an Examples section: {without}"
+    for module in sorted({type(kind).__module__ for kind in REGISTRY.values()}):
+        result = doctest.testmod(importlib.import_module(module))
+        assert result.attempted >= 1 and result.failed == 0, module

@@ -240,7 +240,18 @@ def adaptive_rules(spec: dict, germs: list[str]) -> list[str]:
 
 class AdaptiveSparseGrid(DesignKind):
     """`adaptive_sparse_grid` {rule, budget, tolerance}: round 0, the centre point; the rounds that follow
-    are made by the runner from the results (`execution`); seed unused."""
+    are made by the runner from the results (`execution`); seed unused.
+
+    Examples
+    --------
+    >>> from uqflight.designs import REGISTRY, build_design
+    >>> spec = {"kind": "adaptive_sparse_grid", "budget": 50, "tolerance": 1e-4}
+    >>> design = build_design(spec, ["normal", "normal", "uniform"], seed=0)
+    >>> design.xi.tolist(), design.weights.tolist()  # round 0: the centre point alone, weight 1
+    ([[0.0, 0.0, 0.0]], [1.0])
+    >>> design.info["rule"], REGISTRY["adaptive_sparse_grid"].size(spec, ["normal"] * 3)  # nested rules; the budget
+    ('genz_keister, gauss_patterson', 50)
+    """
 
     kind = "adaptive_sparse_grid"
     keys = {"rule": Key(), "budget": count(1), "tolerance": number("a number >= 0", lambda v: 0 <= v < float("inf"))}

@@ -27,7 +27,19 @@ def sobol_points(n: int, d: int, scramble: bool, seed: int) -> np.ndarray:
 
 
 class MonteCarlo(DesignKind):
-    """`monte_carlo` {samples}: independent draws from numpy's default_rng(seed)."""
+    """`monte_carlo` {samples}: independent draws from numpy's default_rng(seed).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from uqflight.designs import build_design
+    >>> design = build_design({"kind": "monte_carlo", "samples": 8}, ["uniform", "normal"], seed=3)
+    >>> design.xi.shape, design.weights.tolist() == [1 / 8] * 8
+    ((8, 2), True)
+    >>> u = np.random.default_rng(3).random((8, 2))  # the seed's uniforms, through each germ's quantile
+    >>> bool((design.xi[:, 0] == 2 * u[:, 0] - 1).all())  # the uniform germ's: ξ = 2u − 1
+    True
+    """
 
     kind = "monte_carlo"
     keys = {"samples": count(1)}
@@ -42,7 +54,19 @@ class Sobol(DesignKind):
     """`sobol` {samples, scramble (default true), replicates (default 1)}: Sobol' points, Owen-scrambled
     with the seed. With R replicates (randomised QMC), R independent scrambles of `samples` points each
     (seeds spawned from the campaign's), stacked replicate after replicate: R × samples runs whose
-    replicate-to-replicate spread gives the standard error of every statistic."""
+    replicate-to-replicate spread gives the standard error of every statistic.
+
+    Examples
+    --------
+    >>> from uqflight.designs import REGISTRY, build_design
+    >>> spec = {"kind": "sobol", "samples": 8, "replicates": 3}
+    >>> REGISTRY["sobol"].size(spec, ["uniform"])  # replicates × samples
+    24
+    >>> design = build_design(spec, ["uniform"], seed=0)
+    >>> eighths = ((design.xi[:, 0] + 1) / 2 * 8).astype(int).reshape(3, 8)  # u = (ξ + 1)/2, by eighths
+    >>> [sorted(replicate) for replicate in eighths.tolist()]  # each scramble: one point in every eighth
+    [[0, 1, 2, 3, 4, 5, 6, 7], [0, 1, 2, 3, 4, 5, 6, 7], [0, 1, 2, 3, 4, 5, 6, 7]]
+    """
 
     kind = "sobol"
     keys = {"samples": count(1), "scramble": flag(True), "replicates": count(1, default=1)}
@@ -67,7 +91,18 @@ class Sobol(DesignKind):
 
 
 class Halton(DesignKind):
-    """`halton` {samples, scramble (default true)}: Halton points; unscrambled, the origin is skipped."""
+    """`halton` {samples, scramble (default true)}: Halton points; unscrambled, the origin is skipped.
+
+    Examples
+    --------
+    >>> from uqflight.designs import build_design
+    >>> spec = {"kind": "halton", "samples": 4, "scramble": False}
+    >>> u = (build_design(spec, ["uniform", "uniform"], seed=0).xi + 1) / 2  # back to the unit square
+    >>> u[:, 0].tolist()  # van der Corput in base 2, from 1/2: the origin is skipped
+    [0.5, 0.25, 0.75, 0.125]
+    >>> (9 * u[:, 1]).round(12).tolist()  # base 3: 1/3, 2/3, 1/9, 4/9
+    [3.0, 6.0, 1.0, 4.0]
+    """
 
     kind = "halton"
     keys = {"samples": count(1), "scramble": flag(True)}
@@ -86,7 +121,18 @@ class Halton(DesignKind):
 
 
 class LatinHypercube(DesignKind):
-    """`latin_hypercube` {samples}: one point in each of n equal-probability slices per dimension."""
+    """`latin_hypercube` {samples}: one point in each of n equal-probability slices per dimension.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from scipy.stats import norm
+    >>> from uqflight.designs import build_design
+    >>> design = build_design({"kind": "latin_hypercube", "samples": 5}, ["uniform", "normal"], seed=2)
+    >>> u = np.column_stack([(design.xi[:, 0] + 1) / 2, norm.cdf(design.xi[:, 1])])  # each germ's CDF
+    >>> [sorted(column) for column in (5 * u).astype(int).T.tolist()]  # the fifth each point falls in
+    [[0, 1, 2, 3, 4], [0, 1, 2, 3, 4]]
+    """
 
     kind = "latin_hypercube"
     keys = {"samples": count(1)}

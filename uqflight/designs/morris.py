@@ -229,7 +229,21 @@ def info_problem(info: dict, runs: int, d: int) -> tuple[str, str] | None:
 
 class Morris(DesignKind):
     """`morris` {trajectories: R >= 2, levels: p (even, >= 2, default 4)}: N = R (d + 1) runs, trajectory
-    after trajectory, equal weights (the runs' own average, not of draws of the law)."""
+    after trajectory, equal weights (the runs' own average, not of draws of the law).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from uqflight.designs import build_design
+    >>> design = build_design({"kind": "morris", "trajectories": 3}, ["uniform", "uniform"], seed=0)
+    >>> len(design.xi), design.info["jump"]  # R (d + 1) = 3 × 3 runs; Δ = p / (2 (p − 1)), p = 4
+    (9, 0.6666666666666666)
+    >>> steps = np.diff(design.xi.reshape(3, 3, 2), axis=1)  # (trajectory, step, input)
+    >>> (steps != 0).sum(axis=2).tolist()  # every step moves one input
+    [[1, 1], [1, 1], [1, 1]]
+    >>> sorted(set(np.abs(steps).max(axis=2).round(12).ravel().tolist()))  # by 2Δ on ξ = 2u − 1
+    [1.333333333333]
+    """
 
     kind = "morris"
     keys = {"trajectories": count(2), "levels": count(2, default=4)}

@@ -23,6 +23,17 @@ class PickFreeze(DesignKind):
 
     A and B are the two halves of one scrambled Sobol' sequence in 2d dimensions (seeded), mapped
     to the germs; QMC keeps the estimators' variance below that of plain Monte Carlo.
+
+    Examples
+    --------
+    >>> from uqflight.designs import REGISTRY, build_design
+    >>> spec, germs = {"kind": "pick_freeze", "samples": 4}, ["normal", "normal", "uniform"]
+    >>> REGISTRY["pick_freeze"].size(spec, germs)  # N = n (d + 2) = 4 × 5
+    20
+    >>> xi = build_design(spec, germs, seed=0).xi
+    >>> A, B, AB1 = xi[:4], xi[4:8], xi[8:12]  # rows [A; B; AB_1; AB_2; AB_3]
+    >>> len(xi), bool((AB1[:, 0] == B[:, 0]).all() and (AB1[:, 1:] == A[:, 1:]).all())  # AB_1: A, column 1 of B
+    (20, True)
     """
 
     kind = "pick_freeze"

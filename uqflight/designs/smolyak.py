@@ -107,6 +107,18 @@ class SparseGrid(DesignKind):
     With linear growth every rule's level L is exact to total degree >= 2L + 1, so nested and
     non-nested grids of one level compare at equal accuracy (the nested one has fewer points
     from level 2 on).
+
+    Examples
+    --------
+    >>> from uqflight.designs import REGISTRY, build_design
+    >>> spec = {"kind": "sparse_grid", "level": 2}  # normal germs: Gauss-Hermite, linear growth
+    >>> design = build_design(spec, ["normal"] * 7, seed=0)
+    >>> len(design.xi), design.info["degree"], round(float(design.weights.sum()), 12)
+    (113, 5, 1.0)
+    >>> REGISTRY["sparse_grid"].size(spec, ["normal"] * 7)  # before merging: the centre is in 8 tensor rules
+    120.0
+    >>> round(float(design.weights @ (design.xi[:, 0] ** 2 * design.xi[:, 1] ** 2)), 12)  # E[ξ1² ξ2²] = 1
+    1.0
     """
 
     kind = "sparse_grid"

@@ -170,7 +170,19 @@ class RareDesign(DesignKind):
 class SubsetSimulation(RareDesign):
     """Subset simulation (Au & Beck 2001): the event's probability as a product of conditional probabilities
     p0 of nested levels, each level's `samples_per_level` runs grown by Markov chains (adaptive conditional
-    sampling) from the p0 share of the runs beyond the previous level, a seed parameter redrawn at each step (keys `event`, `budget`, `samples_per_level`, `p0`)."""
+    sampling) from the p0 share of the runs beyond the previous level, a seed parameter redrawn at each step (keys `event`, `budget`, `samples_per_level`, `p0`).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from uqflight.designs import build_design
+    >>> spec = {"kind": "subset_simulation", "event": {"of": "y", "above": 3.0}, "samples_per_level": 100}
+    >>> design = build_design(spec, ["normal", "normal"], seed=7)
+    >>> design.xi.shape, design.info["event"], design.info["budget"]  # level 0; the default budget
+    ((100, 2), 'y > 3', 12000)
+    >>> bool((design.xi == np.random.default_rng(7).standard_normal((100, 2))).all())  # draws of N(0, I)
+    True
+    """
 
     kind = "subset_simulation"
     keys = {"event": EVENT, "budget": count(1, MAX_RUNS, 12000), "samples_per_level": count(2, MAX_RUNS, None),
@@ -197,7 +209,23 @@ class SubsetSimulation(RareDesign):
 class ImportanceSampling(RareDesign):
     """Adaptive importance sampling: a sampling density moved towards the event round by round (`samples`
     runs each), the probability weighted by the input law over that density (keys `event`, `budget`,
-    `samples`)."""
+    `samples`).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from uqflight.designs import build_design
+    >>> spec = {"kind": "importance_sampling", "event": {"of": "y", "below": -2.5}, "samples": 50}
+    >>> design = build_design(spec, ["normal", "normal"], seed=7)
+    >>> design.xi.shape, design.info["event"], design.info["budget"]  # round 0; the default budget
+    ((50, 2), 'y < -2.5', 5000)
+    >>> bool((design.xi == np.random.default_rng(7).standard_normal((50, 2))).all())  # draws of N(0, I)
+    True
+    >>> build_design({**spec, "budget": 40}, ["normal"], seed=7)
+    Traceback (most recent call last):
+    ...
+    uqflight.text.FieldError: design.budget: 40 runs cannot hold one round of samples = 50
+    """
 
     kind = "importance_sampling"
     keys = {"event": EVENT, "budget": count(1, MAX_RUNS, 5000), "samples": count(2, MAX_RUNS, None)}
@@ -212,7 +240,19 @@ class ImportanceSampling(RareDesign):
 class ActiveLearning(RareDesign):
     """Active learning: a Gaussian-process surrogate of the event's margin, enriched where the sign is least
     sure, then an importance-sampling correction on true runs that keeps the estimate unbiased where the
-    surrogate is wrong (keys `event`, `budget`)."""
+    surrogate is wrong (keys `event`, `budget`).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from uqflight.designs import build_design
+    >>> spec = {"kind": "active_learning", "event": {"of": "y", "above": 3.0}, "budget": 500}
+    >>> xi = build_design(spec, ["normal", "normal"], seed=7).xi
+    >>> len(xi)  # the first design: 4k + 12 points for k = 2 inputs
+    20
+    >>> bool(np.allclose(np.linalg.norm(xi, axis=1), np.linspace(0, 5.5, 20)))  # on spheres of radii 0 … 5.5
+    True
+    """
 
     kind = "active_learning"
     keys = {"event": EVENT, "budget": count(1, MAX_RUNS, 1500)}
