@@ -51,3 +51,16 @@ def test_the_method_class_example_runs():
 
     result = doctest.testmod(uqflight.methods.kind)
     assert result.attempted >= 4 and result.failed == 0
+
+
+def test_every_method_kind_class_has_an_example_and_the_examples_run():
+    import doctest
+    import importlib
+
+    from uqflight.methods import METHODS
+
+    classes = {kind: type(method) for kind, method in METHODS.items()}  # METHODS holds one instance per kind
+    results = {name: doctest.testmod(importlib.import_module(name))
+               for name in sorted({cls.__module__ for cls in classes.values()})}
+    assert {name: result for name, result in results.items() if result.failed or not result.attempted} == {}
+    assert [kind for kind, cls in classes.items() if ">>>" not in (cls.__doc__ or "")] == []

@@ -23,7 +23,19 @@ from .collocation import LeastSquares, Regression
 
 
 class MonteCarlo(Method):
-    """Sample moments of the runs; sampled designs only."""
+    """Sample moments of the runs; sampled designs only.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from uqflight.methods import Method
+    >>> xi = np.array([[-1.5], [-0.5], [0.5], [1.5]])  # 4 draws; the runs y = 2ξ + 1 are -2, 0, 2, 4
+    >>> result = Method.of("monte_carlo").fit(xi, np.array([0.7, 0.1, 0.1, 0.1]), 2 * xi + 1, ["normal"], sampled=True)
+    >>> result.from_runs, round(float(result.mean[0]), 12)  # no PCE; each run counts once, whatever its weight
+    (True, 1.0)
+    >>> round(float(result.variance[0]), 12)  # unbiased: Σ(y − 1)² / (N − 1) = 20/3
+    6.666666666667
+    """
 
     kind, label, sampled_only, runs_on_sampled, partial, weighted = "monte_carlo", "MC", True, True, True, False
     exported_as = ("least_squares", "pseudo_galerkin")

@@ -80,7 +80,20 @@ class Fit(Method):
 
 
 class Regression(Fit):
-    """Least-squares fit of the PCE, weights ignored (Eq. 35–37)."""
+    """Least-squares fit of the PCE, weights ignored (Eq. 35–37).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from uqflight.methods import Method
+    >>> fit, xi = Method.of("regression").fit, np.random.default_rng(0).standard_normal((6, 2))  # 6 random points
+    >>> result = fit(xi, np.full(6, 1 / 6), 1 + 2 * xi[:, :1] + 3 * xi[:, 1:], ["normal", "normal"], order=1)
+    >>> round(float(result.mean[0]), 12), round(float(result.variance[0]), 12)  # exact: 1 and 2² + 3² = 13
+    (1.0, 13.0)
+    >>> x = np.array([[-1.0], [0.0], [1.0]])  # x² with Simpson's weights: its constant is the plain mean of the runs
+    >>> round(float(fit(x, np.array([1, 4, 1]) / 6, x**2, ["uniform"], order=1).mean[0]), 12)  # 2/3, not E[x²] = 1/3
+    0.666666666667
+    """
 
     kind, label, weighted = "regression", "regression", False
 
@@ -89,7 +102,20 @@ class Regression(Fit):
 
 
 class LeastSquares(Fit):
-    """Weighted least-squares fit of the PCE (Eq. 43–48)."""
+    """Weighted least-squares fit of the PCE (Eq. 43–48).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from uqflight.methods import Method
+    >>> x, simpson = np.array([[-1.0], [0.0], [1.0]]), np.array([1, 4, 1]) / 6  # Simpson's rule for U(−1, 1)
+    >>> order1 = Method.of("least_squares").fit(x, simpson, x**2, ["uniform"], order=1)
+    >>> round(float(order1.mean[0]), 12), round(float(order1.variance[0]), 12)  # weighted: E[x²] = 1/3; x carries none
+    (0.333333333333, 0.0)
+    >>> order2 = Method.of("least_squares").fit(x, simpson, x**2, ["uniform"], order=2)
+    >>> round(float(order2.mean[0]), 12), round(float(order2.variance[0]), 12)  # x² in the basis: 1/5 − 1/9 = 4/45
+    (0.333333333333, 0.088888888889)
+    """
 
     kind, label = "least_squares", "least squares"
 

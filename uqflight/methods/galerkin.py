@@ -78,20 +78,59 @@ class Projection(Method):
 
 class Integration(Projection):
     """Weighted sums of the runs (Eq. 17); on a grid the PCE for bands, PDFs and Sobol' indices is the
-    projection."""
+    projection.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from uqflight.methods import Method
+    >>> xi, w = np.array([[-3**0.5], [0.0], [3**0.5]]), np.array([1, 4, 1]) / 6  # 3-point Gauss-Hermite
+    >>> result = Method.of("integration").fit(xi, w, xi**2, ["normal"], order=1)
+    >>> round(float(result.mean[0]), 12), round(float(result.variance[0]), 12)  # E[ξ²] = 1, Var[ξ²] = 2
+    (1.0, 2.0)
+    >>> round(float(result.pce.variance()[0]), 12)  # the moments are the weights', not the order-1 PCE's
+    0.0
+    """
 
     kind, label, failed_runs, runs_on_sampled, quadrature = "integration", "Int", "conditional", True, True
     exported_as = ("least_squares", "pseudo_galerkin")
 
 
 class PseudoGalerkin(Projection):
-    """Projection of the runs on the PCE (Eq. 19–21); moments from the PCE."""
+    """Projection of the runs on the PCE (Eq. 19–21); moments from the PCE.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from uqflight.methods import Method
+    >>> xi, w = np.array([[-3**0.5], [0.0], [3**0.5]]), np.array([1, 4, 1]) / 6  # 3-point Gauss-Hermite
+    >>> pce = Method.of("pseudo_galerkin").fit(xi, w, xi**2, ["normal"], order=2).pce
+    >>> [round(float(c), 12) for c in pce.coefficients[:, 0]]  # ξ² = 1 + √2 · He₂(ξ)/√2
+    [1.0, 0.0, 1.414213562373]
+    >>> round(float(pce.mean()[0]), 12), round(float(pce.variance()[0]), 12)  # E[ξ²] = 1, Var[ξ²] = (√2)² = 2
+    (1.0, 2.0)
+    >>> order1 = Method.of("pseudo_galerkin").fit(xi, w, xi**2, ["normal"], order=1)
+    >>> round(float(order1.variance[0]), 12)  # moments from the PCE: order 1 carries none of Var[ξ²]
+    0.0
+    """
 
     kind, label = "pseudo_galerkin", "PG"
 
 
 class Interpolation(Projection):
-    """Moments from the weights (Eq. 32–34), PCE by projection."""
+    """Moments from the weights (Eq. 32–34), PCE by projection.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from uqflight.methods import Method
+    >>> x, w = np.array([[-0.6**0.5], [0.0], [0.6**0.5]]), np.array([5, 8, 5]) / 18  # 3-point Gauss-Legendre
+    >>> result = Method.of("interpolation").fit(x, w, x**2, ["uniform"], order=2)
+    >>> round(float(result.mean[0]), 12), round(float(result.variance[0]), 12)  # 1/3 and 1/5 − 1/9 = 4/45
+    (0.333333333333, 0.088888888889)
+    >>> round(float(result.pce.evaluate(np.array([[0.5]]))[0, 0]), 12)  # the projection is x² itself
+    0.25
+    """
 
     kind, label, quadrature = "interpolation", "interpolation", True
     exported_as = ("pseudo_galerkin", "pseudo_galerkin")

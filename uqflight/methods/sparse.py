@@ -171,7 +171,20 @@ def sparse_pce(xi, weights, Y, germs, order: int = 3, x0=None, *, scale=None, se
 
 class Sparse(Method):
     """Sparse PCE: candidate terms up to `max_order` (q-hyperbolic), ordered by LARS or OMP, the basis and
-    order chosen by the corrected leave-one-out error; on any design (see [methods](../methods.md))."""
+    order chosen by the corrected leave-one-out error; on any design (see [methods](../methods.md)).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from uqflight.methods import Method
+    >>> xi = np.random.default_rng(0).standard_normal((20, 3))  # 20 draws of 3 normal germs
+    >>> y = 3 + 2 * xi[:, :1] + (xi[:, 1:2] ** 2 - 1)  # 3 + 2 He₁(ξ₁) + He₂(ξ₂): 3 of 10 candidates
+    >>> result = Method.of("sparse").fit(xi, np.full(20, 0.05), y, ["normal"] * 3, order=2, sampled=True)
+    >>> result.pce.selection["terms"]
+    [[0, 0, 0], [1, 0, 0], [0, 2, 0]]
+    >>> round(float(result.mean[0]), 12), round(float(result.variance[0]), 12)  # 3 and 2² + Var[ξ²] = 4 + 2
+    (3.0, 6.0)
+    """
 
     kind, label, rule, failed_runs, partial, weighted = "sparse", "sparse", "selection", "extrapolated", True, False
     order_key = "max_order"

@@ -315,7 +315,22 @@ def refitting(kind: str, xi, weights, basis, scale, germs, order: int, sampled: 
 class Auto(Method):
     """Per output and quantity, among pseudo_galerkin (grids), least_squares and sparse of `order`, the one
     with the lowest error validated on the runs; the runs' own statistics when none validates. Each output's
-    `method` in summary.json says which it took (see [methods](../methods.md))."""
+    `method` in summary.json says which it took (see [methods](../methods.md)).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from uqflight.methods import Method
+    >>> auto, xi, w = Method.of("auto"), np.random.default_rng(0).standard_normal((10, 2)), np.full(10, 0.1)
+    >>> line, step = 1 + 2 * xi[:, :1] + 3 * xi[:, 1:], np.sign(xi[:, :1])  # 10 draws of 2 normal germs
+    >>> auto.choose(xi, w, line, None, ["normal"] * 2, 1, sampled=True)[0]  # both fits exact: a tie, the first
+    'least_squares'
+    >>> auto.choose(xi, w, step, None, ["normal"] * 2, 1, sampled=True)[0]  # no fit validates: the runs' own
+    'monte_carlo'
+    >>> result = auto.fit(xi, w, line, ["normal"] * 2, order=1, sampled=True)
+    >>> round(float(result.mean[0]), 12), round(float(result.variance[0]), 12)  # 1 and 2² + 3² = 13
+    (1.0, 13.0)
+    """
 
     kind, label, failed_runs, partial, weighted = "auto", "auto", "chosen", True, False
     exported_as = ("least_squares", "pseudo_galerkin")
