@@ -266,3 +266,15 @@ def test_quantities_written_in_two_sessions_equal_one_and_a_damaged_layout_is_re
         f["quantities/q"] = np.zeros(3)
     with pytest.raises(CorruptFile, match="/quantities/q has shape"):
         ResultStore.open(tmp_path / "one.h5")
+
+
+def test_every_take_has_a_docstring_example_and_the_examples_hold():
+    # each take's Examples feed it a few steps (a mode: a system matrix of known eigenvalues) and check the
+    # value worked out by hand from its definition
+    import doctest
+
+    from uqflight.quantities import takes
+
+    result = doctest.testmod(takes)
+    assert result.attempted >= 4 * len(REGISTRY) and result.failed == 0
+    assert [name for name, take in REGISTRY.items() if ">>>" not in (take.__doc__ or "")] == []

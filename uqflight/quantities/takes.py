@@ -71,7 +71,18 @@ class Take:
 
 
 class Max(Take, name="max"):
-    """The largest value over the steps in the window."""
+    """The largest value over the steps in the window.
+
+    Examples
+    --------
+    The window ends at before_s = 2: the 9.0 at t = 3 is not seen.
+
+    >>> reduction = REGISTRY["max"]({"of": "h_ft", "take": "max", "before_s": 2.0})
+    >>> for t, x in [(0.0, 1.0), (1.0, 7.0), (2.0, 4.0), (3.0, 9.0)]:
+    ...     reduction.step(t, x, NAN)
+    >>> reduction.result()
+    7.0
+    """
 
     example = {"of": "h_ft", "take": "max"}
 
@@ -81,7 +92,18 @@ class Max(Take, name="max"):
 
 
 class Min(Take, name="min"):
-    """The smallest value over the steps in the window."""
+    """The smallest value over the steps in the window.
+
+    Examples
+    --------
+    The window starts at after_s = 1: the −5.0 at t = 0 is not seen.
+
+    >>> reduction = REGISTRY["min"]({"of": "h_ft", "take": "min", "after_s": 1.0})
+    >>> for t, x in [(0.0, -5.0), (1.0, 3.0), (2.0, 1.0), (3.0, 2.0)]:
+    ...     reduction.step(t, x, NAN)
+    >>> reduction.result()
+    1.0
+    """
 
     example = {"of": "h_ft", "take": "min"}
 
@@ -91,7 +113,18 @@ class Min(Take, name="min"):
 
 
 class Final(Take, name="final"):
-    """The last step's value."""
+    """The last step's value.
+
+    Examples
+    --------
+    The last step inside the window (before_s = 1.5), not the run's last:
+
+    >>> reduction = REGISTRY["final"]({"of": "h_ft", "take": "final", "before_s": 1.5})
+    >>> for t, x in [(0.0, 1.0), (1.0, 2.0), (2.0, 3.0)]:
+    ...     reduction.step(t, x, NAN)
+    >>> reduction.result()
+    2.0
+    """
 
     example = {"of": "h_ft", "take": "final"}
 
@@ -101,7 +134,19 @@ class Final(Take, name="final"):
 
 class Drop(Take, name="drop"):
     """How far `of` falls below its value at the window's first step (first − min, 0 if it never falls):
-    `{of: h_ft, take: drop}` is an altitude loss."""
+    `{of: h_ft, take: drop}` is an altitude loss.
+
+    Examples
+    --------
+    From 100 at the window's first step (after_s = 1) down to 85 at the lowest: 15; the 120 at t = 0 is
+    outside the window.
+
+    >>> reduction = REGISTRY["drop"]({"of": "h_ft", "take": "drop", "after_s": 1.0})
+    >>> for t, x in [(0.0, 120.0), (1.0, 100.0), (2.0, 85.0), (3.0, 95.0)]:
+    ...     reduction.step(t, x, NAN)
+    >>> reduction.result()
+    15.0
+    """
 
     example = {"of": "h_ft", "take": "drop"}
 
@@ -117,7 +162,19 @@ class Drop(Take, name="drop"):
 
 class Change(Take, name="change"):
     """The last step's value minus the window's first (last − first): `{of: attitude/psi-deg, take: change}`
-    is the heading change of a turn, continuous across 360° (an angle `of` is unwrapped along the run)."""
+    is the heading change of a turn, continuous across 360° (an angle `of` is unwrapped along the run).
+
+    Examples
+    --------
+    A heading from 350° to 370° as the recorder feeds it, unwrapped (recorder.py), for the 350° → 10° it
+    reads: a change of +20, not −340.
+
+    >>> reduction = REGISTRY["change"]({"of": "attitude/psi-deg", "take": "change"})
+    >>> for t, x in [(0.0, 350.0), (1.0, 362.0), (2.0, 370.0)]:
+    ...     reduction.step(t, x, NAN)
+    >>> reduction.result()
+    20.0
+    """
 
     example = {"of": "h_ft", "take": "change"}
 
@@ -132,7 +189,19 @@ class Change(Take, name="change"):
 
 class Mean(Take, name="mean"):
     """Time average by the trapezoid rule over the window, ∫y dt / (t_last − t_first) (a window holding one
-    step: that step's value)."""
+    step: that step's value).
+
+    Examples
+    --------
+    Steps 0, 4, 4 at t = 0, 2, 4: the trapezoids 0.5·2·(0 + 4) + 0.5·2·(4 + 4) = 12 over 4 s give 3.0
+    (the mean of the samples would be 8/3).
+
+    >>> reduction = REGISTRY["mean"]({"of": "h_ft", "take": "mean"})
+    >>> for t, x in [(0.0, 0.0), (2.0, 4.0), (4.0, 4.0)]:
+    ...     reduction.step(t, x, NAN)
+    >>> reduction.result()
+    3.0
+    """
 
     example = {"of": "h_ft", "take": "mean", "after_s": 10.0}
 
@@ -155,7 +224,19 @@ class Mean(Take, name="mean"):
 
 
 class At(Take, name="at"):
-    """Linear interpolation at `at_s` between the two steps around it (exact at a step's time)."""
+    """Linear interpolation at `at_s` between the two steps around it (exact at a step's time).
+
+    Examples
+    --------
+    at_s = 1.5 lies halfway between the steps (1, 10) and (2, 30): 10 + 0.5·(30 − 10) = 20, not the
+    nearest step's value.
+
+    >>> reduction = REGISTRY["at"]({"of": "h_ft", "take": "at", "at_s": 1.5})
+    >>> for t, x in [(0.0, 0.0), (1.0, 10.0), (2.0, 30.0), (3.0, 100.0)]:
+    ...     reduction.step(t, x, NAN)
+    >>> reduction.result()
+    20.0
+    """
 
     required = ("of", "at_s")
     windowed = False
@@ -181,7 +262,19 @@ class At(Take, name="at"):
 
 class AtFirst(Take, name="at_first"):
     """The value of `of` at the first step meeting `when`, no interpolation: the touchdown sink rate `{of:
-    velocities/h-dot-fps, take: at_first, when: {of: "gear/unit[1]/WOW", above: 0.5}}`."""
+    velocities/h-dot-fps, take: at_first, when: {of: "gear/unit[1]/WOW", above: 0.5}}`.
+
+    Examples
+    --------
+    `when.of` (the third argument of `step`) first exceeds 3.0 at t = 1, where `of` is 90:
+
+    >>> spec = {"of": "h_ft", "take": "at_first", "when": {"of": "alpha_deg", "above": 3.0}}
+    >>> reduction = REGISTRY["at_first"](spec)
+    >>> for t, x, y in [(0.0, 100.0, 1.0), (1.0, 90.0, 4.0), (2.0, 80.0, 5.0)]:
+    ...     reduction.step(t, x, y)
+    >>> reduction.result()
+    90.0
+    """
 
     required = ("of", "when")
     example = {"of": "h_ft", "take": "at_first", "when": {"of": "alpha_deg", "above": 3.0}}
@@ -201,7 +294,19 @@ class AtFirst(Take, name="at_first"):
 
 
 class TimeOfFirst(AtFirst, name="time_of_first"):
-    """The time of the first step meeting `when`."""
+    """The time of the first step meeting `when`.
+
+    Examples
+    --------
+    `when.of` first falls below 2.0 at the step t = 2 (the step's time, not an interpolated crossing):
+
+    >>> spec = {"take": "time_of_first", "when": {"of": "alpha_deg", "below": 2.0}}
+    >>> reduction = REGISTRY["time_of_first"](spec)
+    >>> for t, y in [(0.0, 5.0), (1.0, 3.0), (2.0, 1.5), (3.0, 1.0)]:
+    ...     reduction.step(t, NAN, y)
+    >>> reduction.result()
+    2.0
+    """
 
     required = ("when",)
     unit = "s"
@@ -225,24 +330,88 @@ class Mode(Take):
 
 
 class PhugoidPeriod(Mode, name="phugoid_period_s"):
-    """The phugoid's damped period 2π/Im λ [s] of JSBSim's linearised model at the level-flight trim."""
+    """The phugoid's damped period 2π/Im λ [s] of JSBSim's linearised model at the level-flight trim.
+
+    Examples
+    --------
+    `classified_modes` (modes.py: the recorder's `eigen_modes` applies it to JSBSim's linearisation) on a
+    block-diagonal matrix: −0.03 ± 0.04i on (Vt, Theta) is a phugoid (ζ = 0.03/0.05 = 0.6, period
+    2π/0.04 s), −4 ± 3i on (Alpha, Q) a short period (ω = |λ| = 5 rad/s, ζ = 4/5 = 0.8).
+
+    >>> import numpy as np
+    >>> from uqflight.quantities.modes import classified_modes
+    >>> system = np.array([[-0.03, 0.04, 0, 0], [-0.04, -0.03, 0, 0], [0, 0, -4, 3], [0, 0, -3, -4]])
+    >>> modes = classified_modes(["Vt", "Theta", "Alpha", "Q"], system, np.array([100.0, 0, 0, 0]))
+    >>> PhugoidPeriod.mode, PhugoidPeriod.required, PhugoidPeriod.unit
+    (True, (), 's')
+    >>> round(modes["phugoid_period_s"], 6), round(2 * math.pi / 0.04, 6)
+    (157.079633, 157.079633)
+    """
 
     unit = "s"
 
 
 class PhugoidDamping(Mode, name="phugoid_damping"):
-    """The phugoid's damping ratio −Re λ/|λ| at the level-flight trim."""
+    """The phugoid's damping ratio −Re λ/|λ| at the level-flight trim.
+
+    Examples
+    --------
+    `classified_modes` (modes.py: the recorder's `eigen_modes` applies it to JSBSim's linearisation) on a
+    block-diagonal matrix: −0.03 ± 0.04i on (Vt, Theta) is a phugoid (ζ = 0.03/0.05 = 0.6, period
+    2π/0.04 s), −4 ± 3i on (Alpha, Q) a short period (ω = |λ| = 5 rad/s, ζ = 4/5 = 0.8).
+
+    >>> import numpy as np
+    >>> from uqflight.quantities.modes import classified_modes
+    >>> system = np.array([[-0.03, 0.04, 0, 0], [-0.04, -0.03, 0, 0], [0, 0, -4, 3], [0, 0, -3, -4]])
+    >>> modes = classified_modes(["Vt", "Theta", "Alpha", "Q"], system, np.array([100.0, 0, 0, 0]))
+    >>> PhugoidDamping.mode, PhugoidDamping.required, PhugoidDamping.unit
+    (True, (), '-')
+    >>> round(modes["phugoid_damping"], 6)
+    0.6
+    """
 
     unit = "-"
 
 
 class ShortPeriodFrequency(Mode, name="short_period_frequency_rad_s"):
-    """The short period's natural frequency |λ| [rad/s] at the level-flight trim."""
+    """The short period's natural frequency |λ| [rad/s] at the level-flight trim.
+
+    Examples
+    --------
+    `classified_modes` (modes.py: the recorder's `eigen_modes` applies it to JSBSim's linearisation) on a
+    block-diagonal matrix: −0.03 ± 0.04i on (Vt, Theta) is a phugoid (ζ = 0.03/0.05 = 0.6, period
+    2π/0.04 s), −4 ± 3i on (Alpha, Q) a short period (ω = |λ| = 5 rad/s, ζ = 4/5 = 0.8).
+
+    >>> import numpy as np
+    >>> from uqflight.quantities.modes import classified_modes
+    >>> system = np.array([[-0.03, 0.04, 0, 0], [-0.04, -0.03, 0, 0], [0, 0, -4, 3], [0, 0, -3, -4]])
+    >>> modes = classified_modes(["Vt", "Theta", "Alpha", "Q"], system, np.array([100.0, 0, 0, 0]))
+    >>> ShortPeriodFrequency.mode, ShortPeriodFrequency.required, ShortPeriodFrequency.unit
+    (True, (), 'rad/s')
+    >>> round(modes["short_period_frequency_rad_s"], 6)
+    5.0
+    """
 
     unit = "rad/s"
 
 
 class ShortPeriodDamping(Mode, name="short_period_damping"):
-    """The short period's damping ratio at the level-flight trim."""
+    """The short period's damping ratio at the level-flight trim.
+
+    Examples
+    --------
+    `classified_modes` (modes.py: the recorder's `eigen_modes` applies it to JSBSim's linearisation) on a
+    block-diagonal matrix: −0.03 ± 0.04i on (Vt, Theta) is a phugoid (ζ = 0.03/0.05 = 0.6, period
+    2π/0.04 s), −4 ± 3i on (Alpha, Q) a short period (ω = |λ| = 5 rad/s, ζ = 4/5 = 0.8).
+
+    >>> import numpy as np
+    >>> from uqflight.quantities.modes import classified_modes
+    >>> system = np.array([[-0.03, 0.04, 0, 0], [-0.04, -0.03, 0, 0], [0, 0, -4, 3], [0, 0, -3, -4]])
+    >>> modes = classified_modes(["Vt", "Theta", "Alpha", "Q"], system, np.array([100.0, 0, 0, 0]))
+    >>> ShortPeriodDamping.mode, ShortPeriodDamping.required, ShortPeriodDamping.unit
+    (True, (), '-')
+    >>> round(modes["short_period_damping"], 6)
+    0.8
+    """
 
     unit = "-"
