@@ -188,8 +188,8 @@ class Change(Take, name="change"):
 
 
 class Mean(Take, name="mean"):
-    """Time average by the trapezoid rule over the window, ∫y dt / (t_last − t_first) (a window holding one
-    step: that step's value).
+    """Time average of `of` by the trapezoid rule over the window, ∫of dt / (t_last − t_first) (a window holding
+    one step: that step's value).
 
     Examples
     --------
