@@ -133,6 +133,7 @@ def adaptive_text(budget: int, d: int = 3) -> str:
     return ADAPTIVE.format(budget=budget, parameters=parameters)
 
 
+@pytest.mark.slow
 def test_rounds_grow_one_results_file_whose_statistics_are_the_combination_quadrature(tmp_path):
     campaign = parse_campaign(adaptive_text(budget=200), str(tmp_path / "a.yaml"))
     assert campaign.runs == design_size(campaign.design_spec, campaign.germs) == 200  # limits.max_runs' figure

@@ -26,6 +26,7 @@ def test_aircraft_lists_the_functions_without_trimming():
     assert re.search(r"reference factors at 15000 ft, 200 KTAS .*qbar·S = [0-9.]+ lbf", shown.stdout)
 
 
+@pytest.mark.slow
 def test_a_trim_too_fast_for_the_aircraft_says_its_speed_range():
     failed = cli_in_process("aircraft", "c172x", "--trim", "--altitude-ft", "15000", "--airspeed-ktas", "200")
     assert failed.returncode == 1
@@ -80,6 +81,7 @@ def test_simulate_warns_on_the_command_line():
     assert quiet.returncode == 0 and "warning" not in quiet.stderr
 
 
+@pytest.mark.slow
 def test_plan_warns_when_the_nominal_flights_pulse_leaves_the_elevator_unmoved(tmp_path):
     text = """
 name: c172x-pulse

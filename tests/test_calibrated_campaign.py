@@ -65,6 +65,7 @@ def test_a_calibrated_campaign_keeps_function_and_perturbation_and_plans(flown, 
     assert planned.returncode == 0, planned.stderr
 
 
+@pytest.mark.slow
 def test_a_calibrated_campaign_that_fails_its_check_keeps_the_calibration_and_says_so(flown, tmp_path, monkeypatch):
     # a calibrated text the campaign check refuses (here a parameter given a key no campaign takes): the
     # posterior, the summary and the plots are kept, calibrated.yaml is not written, one warning says why

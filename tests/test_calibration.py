@@ -117,6 +117,7 @@ def test_surrogate_of_a_polynomial_model_is_exact(results):
         np.testing.assert_allclose(surrogate.basis(xi) @ surrogate.coefficients[name], expected[name][None], atol=1e-12)
 
 
+@pytest.mark.slow
 def test_posterior_matches_the_closed_form(results):
     surrogate = calibration_surrogate(results)
     data = synthetic(0)
@@ -339,6 +340,7 @@ def test_the_sampler_is_reproducible_from_its_seed():
     assert not np.array_equal(runs[0], runs[2])
 
 
+@pytest.mark.slow
 def test_an_adaptive_chain_stops_at_the_second_passing_check_and_is_the_fixed_chain_of_its_length():
     # a correlated 2-D Gaussian: emcee's DE move has tau of about 8 there, so 50 tau are reached well before MAX_STEPS
     precision = np.linalg.inv(np.array([[1.0, 0.8], [0.8, 1.0]]))

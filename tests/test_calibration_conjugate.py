@@ -186,6 +186,7 @@ def check(results, tmp_path, seed, noise, steps):
     return scores
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("noise", [True, False], ids=["noise_given", "noise_inferred"])
 def test_calibrate_matches_the_exact_posterior(results, tmp_path, noise):
     scores = check(results, tmp_path, 0, noise, steps=None)  # the default: stopped where it has converged

@@ -43,6 +43,7 @@ def overlapping_ticks(fig) -> list:
     return found
 
 
+@pytest.mark.slow
 def test_corner_and_marginals_have_units_marks_and_readable_ticks():
     truth = np.array([0.201, np.nan, np.nan, np.nan, -22.01])
     fig = corner_figure(draws(), NAMES, truth, properties=PROPERTIES)

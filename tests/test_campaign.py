@@ -162,6 +162,7 @@ def test_a_python_model_from_the_package_validates():
     assert campaign.method == {"kind": "regression", "order": 6, "split": False}
 
 
+@pytest.mark.slow
 def test_a_python_file_is_found_relative_to_the_campaign_not_the_working_directory(tmp_path):
     result = cli("run", DATA / "good_python_file.yaml", "--out", tmp_path / "r.h5", cwd=tmp_path)
     assert result.returncode == 0, result.stderr

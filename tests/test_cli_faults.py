@@ -44,6 +44,7 @@ def test_plan_reports_a_model_that_kills_its_process_at_the_nominal_as_run_does(
         assert done.stderr.startswith(f"error: {campaign}: worker process died: signal 11 (SIGSEGV)"), done.stderr
 
 
+@pytest.mark.slow
 def test_plan_in_a_process_of_its_own_does_not_die_with_the_model(tmp_path):
     # as a user runs it: the uqflight process itself, not the test's (exit 139 before)
     done = subprocess.run([UQFLIGHT, "plan", str(write(tmp_path, "segfault_at_centre"))], capture_output=True,

@@ -86,6 +86,7 @@ def test_an_output_that_is_the_commands_own_input_is_refused(results, tmp_path):
 
 @pytest.mark.parametrize("command", ["simulate --out", "design --csv", "surrogate export --out",
                                      "report --write-baseline"])
+@pytest.mark.slow
 def test_an_output_that_is_a_pipe_or_device_is_refused(results, tmp_path, command):
     # surrogate export writes a temporary file and renames it: a device (/dev/full, as root) would be replaced
     args, option = writers(results, tmp_path)[command]

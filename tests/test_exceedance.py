@@ -20,6 +20,7 @@ TRUE = {("above", 5.0): 0.25, ("above", 6.0): 1 / 16, ("below", 1.1): 0.01 / 16}
 EXCEEDANCE = "{exceedance: {final_y: [{above: 5}, {above: 6}, {below: 1.1}]}}"
 
 
+@pytest.mark.slow
 def test_the_monte_carlo_interval_holds_the_true_probability(tmp_path):
     text = python_campaign(tmp_path, "{final_y: {of: y, take: final}}", "{kind: monte_carlo, samples: 2000}",
                            analysis=EXCEEDANCE)

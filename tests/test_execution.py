@@ -155,6 +155,7 @@ def test_tsvd_storage_and_property_outputs(tmp_path):
             np.testing.assert_array_equal(compressed.resolution(name), raw.resolution(name))
 
 
+@pytest.mark.slow
 @KINDS
 def test_an_unreadable_results_file_is_refused_unless_forced(tmp_path, make_campaign):
     run_campaign(make_campaign(samples=2), out=tmp_path / "whole.h5")
@@ -258,6 +259,7 @@ design: {kind: monte_carlo, samples: 4}
     assert np.isnan(flown["y"][2]).all() and np.isfinite(np.delete(flown["y"], 2, axis=0)).all()
 
 
+@pytest.mark.slow
 def test_restart_starts_a_same_campaign_file_over_and_force_keeps_its_meaning(tmp_path):
     campaign = tmp_path / "decay.yaml"
     campaign.write_text(DECAY_TWO_INPUTS)

@@ -104,6 +104,7 @@ def test_validate_on_closed_forms():
 @pytest.mark.parametrize("campaign_file", [
     pytest.param(ROOT / "tests" / "baselines" / "ci-tiny.yaml", id="ci-tiny"),
     pytest.param(ROOT / "campaigns" / "paper-pg2-l2.yaml", id="paper-pg2-l2", marks=pytest.mark.slow)])
+@pytest.mark.slow
 def test_the_shipped_flights_are_not_flagged(tmp_path, campaign_file):
     # ci-tiny, the 15-run level-1 grid on JSBSim's c172p: the largest error measured is 0.021 (q at 8.8 s), the
     # band within 1.45 ranges beyond the runs' range (0.12 beyond their linear fit's band); paper-pg2-l2, the

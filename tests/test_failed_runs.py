@@ -66,6 +66,7 @@ def test_a_projection_of_the_successful_runs_is_flagged_as_of_neither_law(runs):
     assert stats.notes[0].startswith("statistics of a projection of the successful runs, of neither law")
 
 
+@pytest.mark.slow
 def test_the_reports_notes_box_says_the_statistics_are_conditional(runs, tmp_path):
     # (the extrapolated fit's box: test_failure_probability.py, on the sparse grid)
     done = cli_in_process("report", runs["mc"], "--method", "monte_carlo", "--out", tmp_path / "r")

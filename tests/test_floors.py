@@ -113,6 +113,7 @@ def exact_grid_errors_against(tmp_path, flown, reference_design: str, tag: str):
         return errors, f["outputs/y"][()]
 
 
+@pytest.mark.slow
 def test_errors_carry_the_reference_noise_floor(tmp_path, flown):
     errors, Y = exact_grid_errors_against(tmp_path, flown, "{kind: monte_carlo, samples: 400}", "ref")
     # σ/√N of the reference's mean and the distribution-free standard error of its variance,

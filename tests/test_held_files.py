@@ -58,6 +58,7 @@ def test_a_healthy_file_another_process_writes_is_refused_as_held_and_never_repl
     assert again.returncode == 0 and f"{status.size} already done" in again.stdout, again.stderr
 
 
+@pytest.mark.slow
 def test_resuming_a_file_another_process_reads_is_one_line_naming_it(decay_results, tmp_path):
     """D20: a reader's shared lock let the campaign check pass, then opening to write raised BlockingIOError
     (a traceback)."""

@@ -266,6 +266,7 @@ def test_a_child_aircraft_is_refused(tmp_path, home):
     assert 'mother.xml: <child name="../../elsewhere/evil">' in line
 
 
+@pytest.mark.slow
 def test_a_script_setting_the_linearization_is_refused(tmp_path, home):
     """`simulation/do_linearization` makes JSBSim write NAME_lin.sce in the working directory."""
     hostile_script(tmp_path, run=RUN + '\n<event name="lin"><condition> simulation/sim-time-sec ge 0.1 </condition>'

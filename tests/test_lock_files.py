@@ -97,6 +97,7 @@ def test_a_lock_of_a_live_run_is_refused(tmp_path):
         holder.wait()
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("gone", ["dead", "pid reused"])
 def test_a_lock_of_ours_whose_holder_is_gone_is_taken_over_by_run(tmp_path, gone):
     """Dead pid; or the pid alive but another process (its start time differs from the recorded one)."""

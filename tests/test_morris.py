@@ -120,6 +120,7 @@ def test_a_trajectory_with_a_failed_run_is_dropped_and_counted(tmp_path):
             assert stats.outputs["y"].morris[name][key][2] == pytest.approx(expected[key][i], rel=1e-12)
 
 
+@pytest.mark.slow
 def test_the_same_seed_gives_the_same_bits_and_another_seed_other_trajectories(tmp_path):
     spec = {"kind": "morris", "trajectories": 5, "levels": 4}
     germs = ["uniform", "normal", "uniform"]
@@ -173,6 +174,7 @@ def test_measures_without_trajectories_are_null_and_sigma_needs_two():
     assert (one["mu_star"] == 1.0).all() and np.isnan(one["sigma"]).all()
 
 
+@pytest.mark.slow
 def test_the_report_plots_mu_star_against_sigma_and_ranks_the_inputs_in_the_headline(tmp_path):
     # y(t) = (1 + t)(2 x1 − 3 x2 + 0.5 x3) on ranges 1, 2, 4: μ* at t = 1 is 4, 12 and 4, x2 first
     from conftest import cli_in_process

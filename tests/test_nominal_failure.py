@@ -1,6 +1,7 @@
 """A failing nominal sample (the one `run` flies first, in a real worker process) of a python model stops
 the run with one message that names it, gives its values and says what to do; exit 2, no results file. A
 JSBSim flight's outputs are known without it: its runs are flown and recorded, and the summary warns."""
+import pytest
 from conftest import DATA, cli_in_process
 
 MODEL = DATA / "failure_models.py"
@@ -29,6 +30,7 @@ def test_a_failing_nominal_sample_is_named_with_its_values_and_what_to_do(tmp_pa
     assert not (tmp_path / "c.h5").exists()
 
 
+@pytest.mark.slow
 def test_plan_says_what_run_says_of_a_nominal_sample_that_fails_or_returns_no_outputs(tmp_path):
     # plan times a nominal run: a model failing there was a traceback with exit 1
     for function, said in ((f"{MODEL}:fails_at_centre", "the nominal sample failed (a = 1.5: the centre"),

@@ -101,6 +101,7 @@ def _throttle(result):
     return float(re.search(r"throttle = \[([0-9.]+)\]", result.stdout).group(1))
 
 
+@pytest.mark.slow
 def test_simulate_with_a_drag_offset_needs_clearly_more_throttle(tmp_path):
     nominal = cli_in_process("simulate", "--aircraft", "c172p", "--duration-s", "0.5", cwd=tmp_path)
     offset = cli_in_process("simulate", "--aircraft", "c172p", "--duration-s", "0.5",

@@ -37,6 +37,7 @@ def test_pending_runs_refuse_report_and_check_with_the_resume_command(tmp_path):
     assert not (tmp_path / "r").exists()
 
 
+@pytest.mark.slow
 def test_partial_monte_carlo_is_reported_on_its_completed_runs_and_labelled(tmp_path):
     results = run_python_campaign(tmp_path, closed_form_campaign("mc", "identity", UNIFORM_X, "{kind: monte_carlo, samples: 100}"))
     with h5py.File(results) as f:

@@ -152,6 +152,7 @@ def test_coefficient_decay_times_start_at_the_pulse():
     assert plots._decay_times(time, [rising], None).nonzero()[0][0] == 20  # where the variation starts
 
 
+@pytest.mark.slow
 def test_symmetric_grid_design_is_drawn_once_with_physical_values(files, tmp_path):
     path = draw_svg(plots.plot_design_pairs, drawn_runs(files["grid"]), tmp_path / "design.png", "Design: sparse_grid")
     texts = svg_texts(path)
@@ -183,6 +184,7 @@ def test_report_refuses_an_unknown_format(files, tmp_path):
     assert not (tmp_path / "r").exists()
 
 
+@pytest.mark.slow
 def test_pdfs_drawn_on_one_figure_have_the_pixels_of_a_figure_each(decay_results, tmp_path):
     # the reused figure must forget the previous output: its limits, labels, legend and title
     import dataclasses

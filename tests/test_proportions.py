@@ -41,6 +41,7 @@ def test_independent_draws_get_the_wilson_interval_that_covers():
     assert 0.912 <= _coverage({"kind": "monte_carlo", "samples": 128}, 3) <= 0.988
 
 
+@pytest.mark.slow
 def test_randomised_qmc_replicates_give_an_interval_that_covers():
     # the hull of the pooled Wilson interval and the replicates' Student-t: at p = π/8 over 512 points the
     # Wilson interval of independent draws is wider than the scrambled nets' own error, so it covers more
@@ -54,6 +55,7 @@ def test_randomised_qmc_replicates_give_an_interval_that_covers():
     assert _coverage(spec, 3) >= 0.912
 
 
+@pytest.mark.slow
 def test_randomised_qmc_covers_at_a_few_exceedances():
     # the disk of probability 6/512 (six exceedances expected over 8 replicates of 64 points): the
     # replicates' Student-t interval alone covers 0.93-0.96 there (benchmarks/rqmc_interval_coverage.py);

@@ -105,6 +105,7 @@ def test_statistics_of_quantities_are_exact_on_a_grid_with_pseudo_galerkin(tmp_p
     assert summary["outputs"]["y"]["mean"][-1] == pytest.approx(4.0, abs=1e-12)  # the rest of the report stands
 
 
+@pytest.mark.slow
 def test_a_quantity_undefined_in_some_runs_of_a_sampled_design_is_conditional_and_counted(tmp_path):
     # t_up = the first time point with a + b t > 4: closed form on the runs where a + 4b > 4
     text = python_campaign(tmp_path, "{t_up: {take: time_of_first, when: {of: y, above: 4}}, "
@@ -124,6 +125,7 @@ def test_a_quantity_undefined_in_some_runs_of_a_sampled_design_is_conditional_an
     assert any("t_up" in note and "conditional" in note for note in stats.notes)
 
 
+@pytest.mark.slow
 def test_quantities_are_bit_identical_whatever_the_workers(tmp_path):
     text = python_campaign(tmp_path, "{peak: {of: z, take: max}, t_up: {take: time_of_first, when: {of: y, above: 4}}}",
                            "{kind: monte_carlo, samples: 100}")

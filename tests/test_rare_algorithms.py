@@ -172,6 +172,7 @@ def test_importance_sampling_budget_stop_is_an_honest_upper_bound():
 
 # ---------------------------------------------------------------- active learning
 
+@pytest.mark.slow
 def test_active_learning_reaches_a_1e_minus_6_event_from_an_all_safe_first_design():
     # the false stop of AK-MCS: every point of the first design is safe (|u| <= 5.5 but the event is a
     # half-space at distance 4.75 in 7 dimensions); the trend and the enrichment still find it.
@@ -270,6 +271,7 @@ def test_another_seed_gives_another_estimate(kind):
     assert small_run(kind, seed=0)[0].probability != small_run(kind, seed=1)[0].probability
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("kind", SMALL)
 def test_failed_runs_are_counted_outside_the_event(kind):
     # about 1 run in 10 fails (NaN), chosen by a hash of the point: no crash, every one counted, a note

@@ -129,6 +129,7 @@ def test_each_kind_estimates_its_event_end_to_end_through_run_and_report(tmp_pat
         assert f["samples/status"].shape[0] == entry["runs"] and (f["samples/status"][()] == 0).all()
 
 
+@pytest.mark.slow
 def test_a_seed_parameter_is_redrawn_by_subset_simulation(tmp_path):
     out = fly(tmp_path, SEEDED.format(seed=2, threshold=THRESHOLD))
     entry, = summary_json(analyse(out))["quantities"]["peak"]["exceedance"]
@@ -223,6 +224,7 @@ KILLED = {"subset_simulation": QUICK, "importance_sampling": ", samples: 200, bu
 
 @pytest.mark.parametrize("kind", ["subset_simulation"] + [  # three campaigns through the command line each
     pytest.param(kind, marks=pytest.mark.slow) for kind in ("importance_sampling", "active_learning")])
+@pytest.mark.slow
 def test_a_sigkilled_rare_event_campaign_resumes_to_the_same_bits(tmp_path, kind):
     (tmp_path / "c.yaml").write_text(linear_text(kind, threshold=2.5, settings=KILLED[kind]))
     killed = tmp_path / "killed.h5"
@@ -295,6 +297,7 @@ def f(p):
 '''
 
 
+@pytest.mark.slow
 def test_failed_runs_are_recorded_counted_outside_the_event_and_the_campaign_goes_on(tmp_path):
     (tmp_path / "model.py").write_text(FAILING_MODEL)
     text = linear_text("subset_simulation", threshold=2.5, settings=QUICK).replace(

@@ -387,6 +387,7 @@ def test_the_reports_own_process_never_imports_matplotlib(pg, tmp_path):
     assert (tmp_path / "out" / "plots" / "mean_band_pg.png").is_file()
 
 
+@pytest.mark.slow
 @pytest.mark.skipif(not hasattr(os, "fork"), reason="the system cannot fork")
 @pytest.mark.parametrize("error", [OSError, ZeroDivisionError])
 def test_a_section_that_fails_in_the_child_sharing_the_drawing_fails_the_report_and_leaves_nothing(
@@ -423,6 +424,7 @@ def test_a_section_that_fails_in_the_child_sharing_the_drawing_fails_the_report_
     assert list(tmp_path.iterdir()) == []  # no report, no staging folder
 
 
+@pytest.mark.slow
 def test_a_figure_that_raises_is_one_line_naming_its_section_with_exit_1(pg, tmp_path, monkeypatch):
     import uqflight.report.sections as sections
 

@@ -66,6 +66,7 @@ def test_partial_variances_of_a_linear_model_are_exact(tmp_path):
     assert not negligible(out).any()
 
 
+@pytest.mark.slow
 def test_the_headline_of_a_scalar_output_is_summary_json(tmp_path):
     write_report([run_python_campaign(tmp_path, LINEAR)], tmp_path / "report")
     summary = read_summary(tmp_path / "report" / "summary.json")["outputs"]["y"]
@@ -158,6 +159,7 @@ analysis: {band_samples: 500, bootstrap: 0}
 """
 
 
+@pytest.mark.slow
 def test_one_input_is_scattered_in_one_uncoloured_panel_per_output(tmp_path):
     """With one input, the output against it is the whole response: one panel, no colouring input to name."""
     from PIL import Image

@@ -47,6 +47,7 @@ def test_outputs_whose_squares_overflow_are_refused_in_one_line(tmp_path):
     assert not (tmp_path / "rep").exists() and not (tmp_path / "s.json").exists()
 
 
+@pytest.mark.slow
 def test_large_outputs_below_the_bound_give_their_closed_form_moments(tmp_path):
     """x = 1e70 (1 + a (1 + t)), a ~ U(0.5, 1.5): E x = 1e70 (2 + t), Var x = 1e140 (1 + t)^2 / 12, skewness 0,
     kurtosis 9/5 (a uniform's). The projection of order 2 on a level-3 grid is exact for this line; tolerance
@@ -93,6 +94,7 @@ def test_a_disk_that_fills_while_the_plots_are_drawn_leaves_the_old_report(decay
             assert sorted(p.name for p in disk.iterdir()) == ["filler", "rep"]
 
 
+@pytest.mark.slow
 def test_a_quantity_whose_powers_overflow_is_null_with_a_note(tmp_path):
     """D09 for a quantity of interest (one number per run, edited to 1e200 with h5py): its statistics are null in
     summary.json and a note says why; the outputs' report goes on."""

@@ -126,6 +126,7 @@ def kill_everywhere(tmp_path, every=1, fallback=False, with_old=True):
     return total
 
 
+@pytest.mark.slow
 def test_a_sigkill_anywhere_in_the_exchange_leaves_the_old_or_the_new_report(tmp_path):
     total = kill_everywhere(tmp_path, every=7)
     assert total < 1000  # a few hundred lines: every 7th reaches each step (every line: the slow test below)

@@ -54,6 +54,7 @@ def test_a_pce_exceedance_has_a_dash_for_its_interval_never_none(campaigns):
     assert "None" not in markdown and _cell(None) == "—"  # no table cell of the page says None
 
 
+@pytest.mark.slow
 def test_report_exceedance_leads_the_headline_with_its_interval_without_flying(campaigns):
     # one report (the slow part of these tests): the thresholds given at report time replace the campaign's,
     # and the headline shows them with their Wilson intervals before the key numbers, the contents and any figure
@@ -124,6 +125,7 @@ def test_recorded_times_show_as_asked():
     assert shown_time(np.array([3.0]), 0) == 3.0
 
 
+@pytest.mark.slow
 def test_a_changed_campaign_is_refused_naming_the_first_key_and_force(tmp_path):
     text = python_campaign(tmp_path, QUANTITIES, "{kind: monte_carlo, samples: 8}", name="c",
                            analysis="{exceedance: {final_y: [{above: 5}]}}")
@@ -142,6 +144,7 @@ def test_a_changed_campaign_is_refused_naming_the_first_key_and_force(tmp_path):
     assert "finer than the stored histories" in refused.stderr
 
 
+@pytest.mark.slow
 def test_a_change_of_analysis_alone_resumes_without_flying_again(tmp_path):
     text = python_campaign(tmp_path, QUANTITIES, "{kind: monte_carlo, samples: 8}", name="c",
                            analysis="{exceedance: {final_y: [{above: 5}]}}")

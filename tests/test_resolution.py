@@ -107,6 +107,7 @@ def test_sobol_indices_are_null_where_the_variance_is_rounding_noise(tmp_path):
         np.testing.assert_allclose(y["sobol_first"][parameter][1:], 0.5, atol=1e-12)
 
 
+@pytest.mark.slow
 def test_a_zero_mean_is_reported_without_a_crash_and_its_cov_is_null(tmp_path):
     results = run_python_campaign(tmp_path, closed_form_campaign("id", "identity", NORMAL_X, "{kind: tensor_grid, points: 5}",
                                                      "method: {kind: pseudo_galerkin, order: 1}\n"))

@@ -103,6 +103,7 @@ def test_a_script_writes_and_prints_nothing(tmp_path, monkeypatch, capfd):
     assert captured.out == "" and captured.err == ""
 
 
+@pytest.mark.slow
 def test_what_a_script_prints_in_the_workers_never_reaches_the_terminal(tmp_path):
     """c3104's events <notify format="kml">, which JSBSim writes to its standard output whatever its
     logger and debug level: 20 lines per run in every worker, flooding the runner's terminal."""
@@ -203,6 +204,7 @@ def test_an_output_rate_divides_a_rounded_dt_only_within_its_rounding():
     assert c310.steps_per_output(25) == 2 and c310.steps_per_output(10) == 5
 
 
+@pytest.mark.slow
 def test_without_an_output_rate_a_script_records_at_a_divisor_of_its_own_rate(tmp_path):
     # ah1s_flight_test's dt = 0.0075 s (133.3 Hz), c3104's 0.02 s (50 Hz): 20 Hz divides neither, and a
     # campaign that names no rate was refused for the default it never chose

@@ -68,6 +68,7 @@ def test_the_seeds_share_of_the_variance_is_the_closed_form(pick_freeze):
     assert abs(summary["outputs"]["y"]["sobol_total"]["seed"][0]) < 0.02  # y(0) = x: the seed plays no part
 
 
+@pytest.mark.slow
 def test_seeds_depend_on_the_campaign_seed_and_design_index_only(tmp_path, pick_freeze):
     small = campaign(design="{kind: monte_carlo, samples: 40}", bootstrap=0)
     one = run(tmp_path, small, "one", workers=1)

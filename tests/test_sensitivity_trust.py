@@ -187,6 +187,7 @@ def test_the_737_turn_heading_is_continuous(tmp_path):
     assert stats.quantities["altitude_loss_ft"].units == "ft" and stats.quantities["peak_load_factor"].units == "g"
 
 
+@pytest.mark.slow
 def test_a_wrapped_heading_stored_as_tsvd_factors_is_unwrapped_as_the_raw_one(flown, turn):
     # the same 400 runs stored as tSVD factors (tol 1e-12: the wrapped histories rebuilt to ~1e-9 deg):
     # unwrapped from the rebuilt runs, the statistics equal the raw file's to 1e-6 deg

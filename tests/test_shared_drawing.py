@@ -38,6 +38,7 @@ def test_the_same_png_bytes_in_a_child(tmp_path):
     assert all((tmp_path / f"{name}.png").read_bytes() == here for name in names)
 
 
+@pytest.mark.slow
 def test_a_figure_that_fails_in_a_child_fails_with_its_error_printed(tmp_path, capfd):
     parent = os.getpid()
 
@@ -54,6 +55,7 @@ def test_a_figure_that_fails_in_a_child_fails_with_its_error_printed(tmp_path, c
     assert (tmp_path / "after.png").is_file()
 
 
+@pytest.mark.slow
 def test_a_file_error_in_a_child_is_raised_here_as_that_error(tmp_path):
     missing, parent = tmp_path / "no-such-folder" / "cov.png", os.getpid()
 

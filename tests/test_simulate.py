@@ -42,6 +42,7 @@ def _read(path):
     return rows[0], np.array(rows[1:], dtype=float)
 
 
+@pytest.mark.slow
 def test_simulate_writes_into_results_and_adds_seeded_noise(tmp_path):
     args = ("simulate", "--duration-s", "10", "--excitation", "none")
     done = cli_in_process(*args, cwd=tmp_path)

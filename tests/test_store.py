@@ -223,6 +223,7 @@ def test_every_storage_form_implements_every_interface_method():
             assert list(inspect.signature(ours).parameters) == list(inspect.signature(theirs).parameters), name
 
 
+@pytest.mark.slow
 def test_raw_and_tsvd_forms_hold_the_same_runs(tmp_path):
     """The two forms of one raw + tSVD file, fed the same runs out of order, half of them and then all:
     the same matrix (NaN rows where not run or failed), the same runs in design order block by block,
@@ -273,6 +274,7 @@ def kill_writer_midway(path, batches_before_kill, delay) -> None:
     assert child.wait() == -signal.SIGKILL
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("batches_before_kill, delay", [(2, 0.0), (9, 0.003), (20, 0.006)])
 def test_resume_after_sigkill_equals_an_uninterrupted_file(tmp_path, reference, batches_before_kill, delay):
     path = tmp_path / "killed.h5"
@@ -365,6 +367,7 @@ def test_a_resume_whose_first_look_at_the_file_reads_past_its_recorded_end_mends
 
 @pytest.mark.parametrize("dataset, tsvd", [("outputs/alpha_deg", False), ("outputs/alpha_deg", True),
                                            ("samples/reason", True)])
+@pytest.mark.slow
 def test_a_torn_chunk_is_rewritten_and_its_runs_rerun_on_resume(tmp_path, dataset, tsvd):
     """A kill during HDF5's write of a chunk leaves it failing its checksum: a resume reruns its runs
     (the ok runs of an output chunk, the failed runs of a reason chunk), which restores the file bit for
@@ -445,6 +448,7 @@ def test_a_file_with_variable_length_reasons_is_refused_naming_the_dataset_and_t
             "CAMPAIGN --out FILE --restart`)")
 
 
+@pytest.mark.slow
 def test_run_refuses_a_file_with_variable_length_reasons_in_one_line_and_restart_flies_it_again(tmp_path):
     from conftest import DECAY_TWO_INPUTS, cli_in_process
 

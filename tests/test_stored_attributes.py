@@ -151,6 +151,7 @@ def test_a_pick_freeze_file_needs_its_base_rows(tmp_path, n_base):
 @pytest.mark.parametrize("text", [
     DECAY_TWO_INPUTS.replace("simulator:", "simulator: 5\nwas:"), "{{{", "[1, 2]",
     DECAY_TWO_INPUTS.replace('exp_decay"}', 'exp_decay", excitation: {start_s: abc}}')])
+@pytest.mark.slow
 def test_a_stored_campaign_text_that_is_no_campaign_is_shown_not_trusted(sound, tmp_path, text):
     # the report shows the stored text and reads the excitation's start from it (where the coefficient decay
     # is drawn from): a text whose simulator or start is no mapping or number was a traceback after the analysis
