@@ -318,7 +318,25 @@ class TimeOfFirst(AtFirst, name="time_of_first"):
 
 class Mode(Take):
     """A mode of JSBSim's linearised model at the level-flight trim point (modes.py), read once per run
-    by the recorder: no reduction over the steps, no key but `take`."""
+    by the recorder: no reduction over the steps, no key but `take`.
+
+    Examples
+    --------
+    `classified_modes` (modes.py: the recorder's `eigen_modes` applies it to JSBSim's linearisation) on a
+    block-diagonal matrix: −0.03 ± 0.04i on (Vt, Theta) is a phugoid (ζ = 0.03/0.05 = 0.6, period
+    2π/0.04 s), −4 ± 3i on (Alpha, Q) a short period (ω = |λ| = 5 rad/s, ζ = 4/5 = 0.8).
+
+    >>> import numpy as np
+    >>> from uqflight.quantities.modes import classified_modes
+    >>> system = np.array([[-0.03, 0.04, 0, 0], [-0.04, -0.03, 0, 0], [0, 0, -4, 3], [0, 0, -3, -4]])
+    >>> modes = classified_modes(["Vt", "Theta", "Alpha", "Q"], system, np.array([100.0, 0, 0, 0]))
+    >>> round(modes["phugoid_period_s"], 6), round(2 * math.pi / 0.04, 6)
+    (157.079633, 157.079633)
+    >>> round(modes["phugoid_damping"], 6), round(modes["short_period_frequency_rad_s"], 6)
+    (0.6, 5.0)
+    >>> round(modes["short_period_damping"], 6)
+    0.8
+    """
 
     required = ()
     windowed = False
@@ -334,18 +352,10 @@ class PhugoidPeriod(Mode, name="phugoid_period_s"):
 
     Examples
     --------
-    `classified_modes` (modes.py: the recorder's `eigen_modes` applies it to JSBSim's linearisation) on a
-    block-diagonal matrix: −0.03 ± 0.04i on (Vt, Theta) is a phugoid (ζ = 0.03/0.05 = 0.6, period
-    2π/0.04 s), −4 ± 3i on (Alpha, Q) a short period (ω = |λ| = 5 rad/s, ζ = 4/5 = 0.8).
+    Its value on a known matrix is in `Mode`'s example.
 
-    >>> import numpy as np
-    >>> from uqflight.quantities.modes import classified_modes
-    >>> system = np.array([[-0.03, 0.04, 0, 0], [-0.04, -0.03, 0, 0], [0, 0, -4, 3], [0, 0, -3, -4]])
-    >>> modes = classified_modes(["Vt", "Theta", "Alpha", "Q"], system, np.array([100.0, 0, 0, 0]))
     >>> PhugoidPeriod.mode, PhugoidPeriod.required, PhugoidPeriod.unit
     (True, (), 's')
-    >>> round(modes["phugoid_period_s"], 6), round(2 * math.pi / 0.04, 6)
-    (157.079633, 157.079633)
     """
 
     unit = "s"
@@ -356,18 +366,10 @@ class PhugoidDamping(Mode, name="phugoid_damping"):
 
     Examples
     --------
-    `classified_modes` (modes.py: the recorder's `eigen_modes` applies it to JSBSim's linearisation) on a
-    block-diagonal matrix: −0.03 ± 0.04i on (Vt, Theta) is a phugoid (ζ = 0.03/0.05 = 0.6, period
-    2π/0.04 s), −4 ± 3i on (Alpha, Q) a short period (ω = |λ| = 5 rad/s, ζ = 4/5 = 0.8).
+    Its value on a known matrix is in `Mode`'s example.
 
-    >>> import numpy as np
-    >>> from uqflight.quantities.modes import classified_modes
-    >>> system = np.array([[-0.03, 0.04, 0, 0], [-0.04, -0.03, 0, 0], [0, 0, -4, 3], [0, 0, -3, -4]])
-    >>> modes = classified_modes(["Vt", "Theta", "Alpha", "Q"], system, np.array([100.0, 0, 0, 0]))
     >>> PhugoidDamping.mode, PhugoidDamping.required, PhugoidDamping.unit
     (True, (), '-')
-    >>> round(modes["phugoid_damping"], 6)
-    0.6
     """
 
     unit = "-"
@@ -378,18 +380,10 @@ class ShortPeriodFrequency(Mode, name="short_period_frequency_rad_s"):
 
     Examples
     --------
-    `classified_modes` (modes.py: the recorder's `eigen_modes` applies it to JSBSim's linearisation) on a
-    block-diagonal matrix: −0.03 ± 0.04i on (Vt, Theta) is a phugoid (ζ = 0.03/0.05 = 0.6, period
-    2π/0.04 s), −4 ± 3i on (Alpha, Q) a short period (ω = |λ| = 5 rad/s, ζ = 4/5 = 0.8).
+    Its value on a known matrix is in `Mode`'s example.
 
-    >>> import numpy as np
-    >>> from uqflight.quantities.modes import classified_modes
-    >>> system = np.array([[-0.03, 0.04, 0, 0], [-0.04, -0.03, 0, 0], [0, 0, -4, 3], [0, 0, -3, -4]])
-    >>> modes = classified_modes(["Vt", "Theta", "Alpha", "Q"], system, np.array([100.0, 0, 0, 0]))
     >>> ShortPeriodFrequency.mode, ShortPeriodFrequency.required, ShortPeriodFrequency.unit
     (True, (), 'rad/s')
-    >>> round(modes["short_period_frequency_rad_s"], 6)
-    5.0
     """
 
     unit = "rad/s"
@@ -400,18 +394,10 @@ class ShortPeriodDamping(Mode, name="short_period_damping"):
 
     Examples
     --------
-    `classified_modes` (modes.py: the recorder's `eigen_modes` applies it to JSBSim's linearisation) on a
-    block-diagonal matrix: −0.03 ± 0.04i on (Vt, Theta) is a phugoid (ζ = 0.03/0.05 = 0.6, period
-    2π/0.04 s), −4 ± 3i on (Alpha, Q) a short period (ω = |λ| = 5 rad/s, ζ = 4/5 = 0.8).
+    Its value on a known matrix is in `Mode`'s example.
 
-    >>> import numpy as np
-    >>> from uqflight.quantities.modes import classified_modes
-    >>> system = np.array([[-0.03, 0.04, 0, 0], [-0.04, -0.03, 0, 0], [0, 0, -4, 3], [0, 0, -3, -4]])
-    >>> modes = classified_modes(["Vt", "Theta", "Alpha", "Q"], system, np.array([100.0, 0, 0, 0]))
     >>> ShortPeriodDamping.mode, ShortPeriodDamping.required, ShortPeriodDamping.unit
     (True, (), '-')
-    >>> round(modes["short_period_damping"], 6)
-    0.8
     """
 
     unit = "-"
