@@ -162,7 +162,7 @@ def check_settings(check: Checker, written) -> tuple[Checker, dict, dict]:
 
 def build_campaign(check: Checker, data: dict, simulator: dict, parameters: list[Parameter], text: str,
                    quantities: dict | None = None, mapping: dict | None = None) -> Campaign:
-    """The Campaign of a checked mapping (`read_settings`) and its parameters, its other sections checked
+    """The Campaign of a checked mapping (`check_settings`) and its parameters, its other sections checked
     (the design is not built: `runs` stays None); `mapping`: the mapping as written (`data` before it was
     checked)."""
     name = data["name"]
