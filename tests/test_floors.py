@@ -6,8 +6,13 @@ import pytest
 from conftest import NORMAL_2D, closed_form_campaign, run_python_campaign
 
 from uqflight.analysis import kl_divergence
-from uqflight.analysis.floors import central_moments, floors_from_moments, kld_floor, reference_floors
+from uqflight.analysis.floors import central_moments, floors_from_moments, kld_floor
 from uqflight.analysis.statistics import analyse
+
+
+def reference_floors(Y) -> dict:
+    """floors_from_moments of the runs Y (N, T): the floors of a reference of all times at once."""
+    return floors_from_moments(*central_moments(Y), len(Y))
 
 
 def test_floors_from_exact_normal_moments_are_the_closed_form():

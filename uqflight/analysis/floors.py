@@ -51,12 +51,6 @@ def floors_from_moments(mean, variance, fourth_central, n: int) -> dict[str, np.
             "se_mean": se_mean, "se_variance": se_variance}
 
 
-def reference_floors(Y_ref) -> dict[str, np.ndarray]:
-    """floors_from_moments of the reference's runs Y_ref (N, T) (see there for the keys)."""
-    Y_ref = as_runs_by_time(Y_ref)
-    return floors_from_moments(*central_moments(Y_ref), len(Y_ref))
-
-
 def kld_floor(samples_ref, n_method: int | None = None, repeats: int = 5, seed=0,
               grid_points: int = 512, rule: str = "scott"):
     """The KLD of Eq. 50 that sampling noise alone produces: a float for (N,) samples, (T,) for (N, T).

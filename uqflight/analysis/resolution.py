@@ -58,27 +58,6 @@ def resolved_variance(variance, mean, scale=None, rtol: float = RESOLUTION_RTOL,
         return np.isfinite(variance) & (variance > floor)
 
 
-def _nullable(values) -> list:
-    """A float array as nested lists with None for NaN/inf (JSON null)."""
-    values = np.asarray(values, dtype=float)
-    if values.ndim == 0:
-        return float(values) if np.isfinite(values) else None
-    return [_nullable(v) for v in values]
-
-
-def sobol_or_none(indices, resolved) -> list:
-    """Sobol' indices (d, T) (or (T,)) as nested lists, None at the times where `resolved` (T,) is False.
-
-    A share of a variance that is rounding noise is a ratio of noise: undefined, not 0. Non-finite
-    indices become None as well.
-    """
-    indices = np.asarray(indices, dtype=float)
-    resolved = np.asarray(resolved, dtype=bool)
-    if indices.shape[-1:] != resolved.shape:
-        raise ValueError(f"indices of shape {indices.shape} do not end in the {resolved.shape} of resolved")
-    return _nullable(np.where(resolved, indices, np.nan))
-
-
 def cov_or_none(std, mean, rtol: float = RESOLUTION_RTOL) -> list:
     """Modified coefficient of variation std(t) / max_t|mean(t)| as a list (T,), or all None.
 
@@ -92,4 +71,4 @@ def cov_or_none(std, mean, rtol: float = RESOLUTION_RTOL) -> list:
     magnitude = np.max(np.sqrt(mean**2 + std**2), initial=0.0)
     if not peak > rtol * magnitude or not np.isfinite(peak):
         return [None] * std.size
-    return _nullable(std / peak)
+    return [float(v) if np.isfinite(v) else None for v in std / peak]

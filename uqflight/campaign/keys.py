@@ -9,7 +9,6 @@ committed copy is rewritten by `python -m uqflight.campaign.keys > docs/referenc
 from __future__ import annotations
 
 import inspect
-import re
 from dataclasses import dataclass
 
 from ..analysis import BAND_SAMPLES, BOOTSTRAP, QUANTILES
@@ -183,20 +182,6 @@ class Key:
 
 def _paths(prefix: str, keys) -> list[str]:
     return [f"{prefix}.{k}" if prefix else k for k in keys]
-
-
-def refused_keys(call) -> tuple[str, ...]:
-    """The keys a check accepts, as it lists them when it refuses an unknown key: `call()` feeds it one
-    ('... unknown key; expected one of a, b' from the schema's Checker, '... accepted keys: a, b' from
-    designs.DesignKind.settings) and must raise."""
-    try:
-        call()
-    except ValueError as exc:  # CampaignError too
-        found = re.search(r"(?:expected one of|accepted keys:) ([^;]+)$", str(exc))
-        if found:
-            return tuple(k.strip() for k in found.group(1).split(","))
-        raise RuntimeError(f"the reference cannot read the accepted keys from: {exc}") from exc
-    raise RuntimeError(f"{call} accepted an unknown key: the reference cannot list its keys")
 
 
 def accepted_keys() -> list[Key]:

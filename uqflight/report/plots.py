@@ -592,7 +592,7 @@ def plot_band_comparison(entries: list[tuple[str, dict]], path: Path, title: str
     """Each file's mean (left) and 99 % band edges (right, lower and upper alike) minus the first
     file's, over the first file's times (others interpolated), one row per output: the first file is
     the zero line, and files that agree lie on it instead of hiding each other (Figs. 4-5 as differences)."""
-    first_label, first = entries[0]
+    _, first = entries[0]
     names = list(first)
     fig, axes = plt.subplots(len(names), 2, figsize=(12.4, 2.5 * len(names) + 1.2), squeeze=False)
     for row, name in zip(axes, names):

@@ -27,7 +27,6 @@ from scipy import special
 from threadpoolctl import threadpool_limits
 
 CONFIDENCE = 0.95
-Z95 = float(special.ndtri(0.5 * (1.0 + CONFIDENCE)))
 
 
 @dataclass(frozen=True)
