@@ -136,6 +136,17 @@ class Altitude:
         self.trims += 1
 
 
+def test_a_script_that_sets_an_output_property_flies_without_the_outputs(tmp_path):
+    """c1723 sets simulation/output/log_rate_hz at about 21.9 s, a property JSBSim ties to c172x's <output>,
+    which uqflight removes: the flight declares it instead, so the event sets it and the flight goes on."""
+    assert ScriptFile.read(jsbsim_scripts() / "c1723.xml").output_properties == ("simulation/output/log_rate_hz",)
+    config = {"kind": "jsbsim", "scenario": {"kind": "script", "script": "c1723", "end_s": 23},
+              "output_rate_hz": 10, "outputs": ["h_ft"]}
+    simulator = make_simulator(config, ["CL"], ["aero/uq/scale/CLwbh"], tmp_path)
+    result = simulator.evaluate(np.array([1.0]))
+    assert simulator.setup.time[-1] > 22.9 and np.all(np.isfinite(result["h_ft"]))
+
+
 def test_a_script_observer_sees_every_step_as_plain_jsbsim_steps(tmp_path):
     config = {"kind": "jsbsim", "scenario": {"kind": "script", "script": "c172_cruise_8K", "end_s": 1.5},
               "output_rate_hz": 20, "outputs": ["h_ft"]}

@@ -25,6 +25,7 @@ import hashlib
 import json
 import math
 import os
+import re
 from dataclasses import dataclass
 from functools import cached_property
 from decimal import Decimal, InvalidOperation
@@ -42,6 +43,9 @@ from ..jsbsim import (ATMOSPHERE, DEFAULT_OUTPUTS, OUTPUT_RATE, FlightResult, Pr
 DEFAULT_OUTPUT_RATE_HZ = 20.0
 RATE_MISMATCH = 1e-4  # the most a recording interval may differ from k steps, relatively (dt = 0.0083333: 4e-6)
 MAX_SCRIPT_BYTES = 1 << 20
+# the properties JSBSim ties to each of its outputs (FGOutputType::SetIdx): without the outputs, a script's
+# event that sets one would stop the flight ("No property ... is defined"), so the flight declares them
+OUTPUT_PROPERTY = re.compile(r"simulation/output(?:\[\d+\])?/(?:log_rate_hz|enabled)")
 MAX_STEPS = 10**7  # integration steps (80 MB of step times; 23 h at 120 Hz), as many as a results file holds times
 TIME = "simulation/sim-time-sec"
 TRIM_PROPERTIES = ("simulation/do_simple_trim", "simulation/do_trim")  # an event setting one trims
@@ -104,6 +108,7 @@ class ScriptFile:
     dt_s: float
     dt_text: str
     outputs_files: tuple[str, ...]  # `<output file=...>`, relative to the script's folder (hashed; JSBSim never reads them)
+    output_properties: tuple[str, ...]  # the properties of JSBSim's outputs it names (OUTPUT_PROPERTY)
     trims: int | None = 0  # the script's trim events (each trims once); None: a persistent one trims again and again
 
     @classmethod
@@ -132,7 +137,7 @@ class ScriptFile:
         for name in files:
             _inside(path.parent, name)
         return cls(path, use.get("aircraft").strip(), use.get("initialize").strip(), start, end, dt,
-                   run.get("dt").strip(), files, _trim_events(root))
+                   run.get("dt").strip(), files, _output_properties(root), _trim_events(root))
 
     @property
     def rate_hz(self) -> float:
@@ -242,6 +247,13 @@ class ScriptFile:
         return path
 
 
+def _output_properties(root) -> tuple[str, ...]:
+    """The output properties (OUTPUT_PROPERTY) the script's elements name, in their text or an attribute."""
+    found = {match for element in root.iter() for text in (element.text or "", *element.attrib.values())
+             for match in OUTPUT_PROPERTY.findall(text)}
+    return tuple(sorted(found))
+
+
 def _trim_events(root) -> int | None:
     """The number of the script's `<event>`s that trim (set simulation/do_simple_trim); None when one of
     them is persistent or continuous (it trims whenever its condition holds again)."""
@@ -315,6 +327,9 @@ class ScriptFlight(PropertyAccess):
         if fdm.get_delta_t() != s.script.dt_s:
             raise FlightError(f"JSBSim reads the script's dt as {fdm.get_delta_t()!r}, uqflight as {s.script.dt_s!r}")
         self._bind(fdm, s.aircraft)
+        for name in s.script.output_properties:  # their outputs were removed: the names stay, inert
+            if not self.has_property(name):
+                self._pm.get_node(name, True)
         self._recorded = [self._output_source(name) for name in s.outputs]
 
     def prepare_validation_view(self) -> None:
