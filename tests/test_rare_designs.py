@@ -174,7 +174,8 @@ def test_an_active_learning_budget_too_small_for_its_rounds_is_refused_by_run_na
     # rounds of 100 in the rest: 332 runs at least (smallest_budget), so 331 is refused before a run
     (tmp_path / "r.yaml").write_text(linear_text("active_learning", settings=", budget: 331"))
     done = cli_in_process("run", tmp_path / "r.yaml", "--out", tmp_path / "r.h5")
-    assert done.returncode == 2 and "design.budget: 331 runs are too few for active learning on 2 inputs" in done.stderr
+    assert done.returncode == 2 and "r.yaml: design.budget: 331 runs are too few for active learning on 2 inputs" \
+        in done.stderr  # the field once, right after the file
     assert "at least 332" in done.stderr and len(done.stderr.strip().splitlines()) == 1, done.stderr
     assert not (tmp_path / "r.h5").exists()
     parse_campaign(linear_text("active_learning", settings=", budget: 332"), str(tmp_path / "r.yaml"))

@@ -150,7 +150,7 @@ class RareDesign(DesignKind):
         settings = rare_settings(spec)
         problem = self.input_problem(settings, len(germs), len(redrawn))
         if problem:
-            raise ValueError(": ".join(problem))
+            raise FieldError(*problem)
         xi = germs_from_normal(first_round(settings, germs, seed, redrawn), germs)
         info = {"event": settings.event.text(), "budget": settings.budget, **settings.settings,
                 "rounds": "adapted to the event from the results, up to the budget"}
@@ -163,7 +163,7 @@ class RareDesign(DesignKind):
 
     def input_problem(self, settings: RareSettings, inputs: int, redrawn: int) -> tuple[str, str] | None:
         """(field, message) when the design cannot work on `inputs` parameters of which `redrawn` are seeds
-        (`build` raises it as the ValueError 'field: message')."""
+        (`build` raises it as a FieldError)."""
         return None
 
 
