@@ -10,10 +10,10 @@ from uqflight.simulators.scenarios.level_flight import Excitation, FlightSetup, 
 from uqflight.simulators.trim import level_speed_range
 
 
-def _setup(**condition):
+def _setup(aircraft="c172x", **condition):
     from uqflight.cli.commands import _prepared
 
-    located = _prepared("c172x", [], [])
+    located = _prepared(aircraft, [], [])
     return FlightSetup(aircraft=located.name, root=located.root, duration_s=4.0, **condition)
 
 
@@ -57,7 +57,27 @@ def test_a_trim_above_the_ceiling_says_to_fly_lower():
 def test_the_speed_range_is_scanned_once_per_condition():
     setup = _setup(altitude_ft=4000.0, airspeed_ktas=100.0)
     first = level_speed_range(setup, JSBSimFlight)
-    assert first[0] < 100.0 < first[1] and level_speed_range(setup, JSBSimFlight) is first
+    (slowest, fastest), stopped = first
+    assert slowest < 100.0 < fastest and stopped == 0 and level_speed_range(setup, JSBSimFlight) is first
+
+
+@pytest.mark.slow
+def test_a_trim_whose_engine_stops_says_so_not_only_fly_lower():
+    """pa28's piston engine stops at the closed throttle JSBSim's trim tries at 5000 ft, 100 KTAS (and stays
+    stopped: FGPiston restarts above 0.8 idle rpm only): the failure names the engine, and the speed scan
+    counts the speeds where it stopped, where it said only that the altitude was too high."""
+    failed = cli_in_process("simulate", "--aircraft", "pa28", "--altitude-ft", "5000", "--airspeed-ktas", "100",
+                            "--no-files", "--duration-s", "1")
+    assert failed.returncode == 1, failed.stderr  # the flight failed: no number to give
+    assert "engine 0 stopped during the trim (JSBSim's throttle search reaches the closed throttle" in failed.stderr
+    assert re.search(r"at [0-9]+ of the speeds an engine stopped at the closed throttle the trim tries", failed.stderr)
+    assert "fly a script that sets its own throttle" in failed.stderr
+    # the state JSBSim's trim leaves, on its own: the engine is not running
+    flight = JSBSimFlight(_setup("pa28", altitude_ft=5000.0, airspeed_ktas=100.0, trim="jsbsim"))
+    flight.diagnose_trim_failures = False
+    with pytest.raises(Exception, match="Trim Failed"):
+        flight.trim({})
+    assert flight.stopped_engines() == [0]
 
 
 def test_a_pulse_that_never_moves_the_elevator_is_warned_about():

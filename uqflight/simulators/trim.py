@@ -292,42 +292,55 @@ def lift_shortfall(flight) -> str | None:
 
 
 # -- why a level trim cannot exist: the speed ---------------------------------------------------
+# what stops an engine in JSBSim's trim (FGTrimAxis sets the throttle over its whole range; FGPiston stops
+# below 0.8 of its idle rpm and restarts only above it)
+ENGINE_STOPPED = ("JSBSim's throttle search reaches the closed throttle, where the engine falls below its idle rpm "
+                  "and a windmilling propeller does not restart it")
 SPEED_SCAN_KTAS = np.arange(20.0, 601.0, 20.0)  # JSBSim's trim at each: ~60 ms a point, ~2 s in all
-_SPEED_RANGES: dict[tuple, tuple[float, float] | None] = {}
+_SPEED_RANGES: dict[tuple, tuple[tuple[float, float] | None, int]] = {}
 
 
-def level_speed_range(setup, flight_type) -> tuple[float, float] | None:
-    """(slowest, fastest) true airspeed [KTAS] of SPEED_SCAN_KTAS (every 20 kt) at which the aircraft, as
+def level_speed_range(setup, flight_type) -> tuple[tuple[float, float] | None, int]:
+    """((slowest, fastest) true airspeed [KTAS] of SPEED_SCAN_KTAS (every 20 kt) at which the aircraft, as
     loaded, trims in level flight at `setup.altitude_ft` with JSBSim's trim (flown on `flight_type`, a
-    JSBSimFlight); None when none does. Computed
-    once per process and flight condition, on fresh copies of the aircraft, so the flight that failed is
-    left as it was. (A trim near the range's edges can take a second each: no finer search.)"""
+    JSBSimFlight), None when none does; and at how many of the speeds that fail an engine stopped during the
+    trim). Computed once per process and flight condition, on fresh copies of the aircraft, so the flight
+    that failed is left as it was. (A trim near the range's edges can take a second each: no finer search.)"""
     from .base import FlightError
 
     key = (aircraft_hash(setup), str(setup.aircraft_file), setup.altitude_ft, setup.rate_hz)
     if key in _SPEED_RANGES:
         return _SPEED_RANGES[key]
-    def trims(speed: float) -> bool:
+
+    def trims(speed: float) -> str:
         flight = flight_type(replace(setup, airspeed_ktas=float(speed), trim="jsbsim"), preflight=False)
         flight.diagnose_trim_failures = False  # a failure is an answer here, not a question
         try:
             flight.trim({})
         except FlightError:
-            return False
-        return True
+            return "stopped" if flight.stopped_engines() else "failed"
+        return "trimmed"
 
-    found = [float(v) for v in SPEED_SCAN_KTAS if trims(v)]
-    _SPEED_RANGES[key] = speeds = (min(found), max(found)) if found else None
-    return speeds
+    outcomes = {float(v): trims(v) for v in SPEED_SCAN_KTAS}
+    found = [speed for speed, outcome in outcomes.items() if outcome == "trimmed"]
+    stopped = sum(outcome == "stopped" for outcome in outcomes.values())
+    _SPEED_RANGES[key] = found_range = ((min(found), max(found)) if found else None), stopped
+    return found_range
 
 
 def speed_range_shortfall(flight) -> str | None:
     """When the flight condition's airspeed lies outside the speeds the aircraft trims level at at its
     altitude (`level_speed_range`), or none trims there: the reason and what to do, else None."""
     setup = flight.setup
-    speeds = level_speed_range(setup, type(flight))
+    speeds, stopped = level_speed_range(setup, type(flight))
     scanned = (f"{SPEED_SCAN_KTAS[0]:g} to {SPEED_SCAN_KTAS[-1]:g} KTAS scanned every "
                f"{SPEED_SCAN_KTAS[1] - SPEED_SCAN_KTAS[0]:g} kt with JSBSim's trim, the aircraft as loaded")
+    if stopped:
+        scanned += f"; at {stopped} of the speeds an engine stopped at the closed throttle the trim tries"
+    if speeds is None and stopped:
+        return (f"no level trim at {setup.altitude_ft:g} ft at any airspeed ({scanned}): fly lower (simulator."
+                "altitude_ft in a campaign, --altitude-ft on the command line), or fly a script that sets its own "
+                "throttle (scenario: {kind: script, ...})")
     if speeds is None:
         return (f"no level trim at {setup.altitude_ft:g} ft at any airspeed ({scanned}): the altitude is above "
                 "what the aircraft holds level; fly lower (simulator.altitude_ft in a campaign, "

@@ -22,7 +22,7 @@ from ..base import DivergenceError, Field, FlightError, ScenarioKind, TrimError,
 from ..engines import prepare_engines
 from ..jsbsim import (ATMOSPHERE, DEFAULT_OUTPUTS, OUTPUT_RATE, FlightResult, Observer, PropertyAccess,
                       Watch, check_finite, default_root, ready_to_load)
-from ..trim import STALL_PROPERTY, LevelTrim, lift_shortfall, speed_range_shortfall
+from ..trim import ENGINE_STOPPED, STALL_PROPERTY, LevelTrim, lift_shortfall, speed_range_shortfall
 
 # Controls the trim writes: restored to their load-time values before every sample.
 TRIM_CONTROLS = (
@@ -277,10 +277,22 @@ class JSBSimFlight(PropertyAccess):
                  f"{self.setup.airspeed_ktas:g} KTAS")
         if not self.diagnose_trim_failures:
             return f"{where} ({left})"
-        stall = lift_shortfall(self) or speed_range_shortfall(self)
-        if stall:
-            return f"{where}: {stall} (JSBSim's trim left {left})"
+        stopped = self.stopped_engines()  # before the diagnoses below fly this aircraft again
+        cause = lift_shortfall(self) or speed_range_shortfall(self)
+        if stopped:
+            engines = (f"engine{'s' if len(stopped) > 1 else ''} {', '.join(map(str, stopped))} stopped during the "
+                       f"trim ({ENGINE_STOPPED})")
+            cause = f"{engines}; {cause}" if cause else (
+                f"{engines}: trim at another airspeed or altitude where the engine keeps running (`uqflight simulate "
+                "--altitude-ft H --airspeed-ktas V` tries one), or fly a script that sets its own throttle "
+                "(scenario: {kind: script, ...})")
+        if cause:
+            return f"{where}: {cause} (JSBSim's trim left {left})"
         return f"{where}: {worst.split('/')[-1].split('-')[0]} not trimmable ({left})"
+
+    def stopped_engines(self) -> list[int]:
+        """The engines that are not running (JSBSim's `propulsion/engine[i]/set-running` reads 0)."""
+        return [i for i in range(self._engines) if not self.fdm[f"propulsion/engine[{i}]/set-running"]]
 
     def _apply(self, settings: dict[str, float]) -> None:
         for name, value in settings.items():
