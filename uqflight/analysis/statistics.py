@@ -133,7 +133,7 @@ class OutputStatistics:
 @dataclass
 class Statistics:
     path: str
-    campaign_name: str
+    record: CampaignRecord  # the campaign the file records (campaign.record)
     method: MethodSpec  # the method applied (the campaign's, or the one asked for instead: MethodSpec.analysed)
     design_kind: str
     parameter_names: list[str]
@@ -149,16 +149,32 @@ class Statistics:
     reference: str | None = None
     from_runs: bool = False  # statistics of the runs themselves (a sampled design), not of a PCE
     replicates: int = 1  # independent randomised-QMC replicates of the design
-    seeds: list[str] = field(default_factory=list)  # parameters that are random streams' seeds
-    dependence: dict | None = None  # the inputs' Gaussian copula (parameters.dependence.summary), None: independent
     quantities: dict[str, QuantityStatistics] = field(default_factory=dict)
     index_set: dict | None = None  # an adaptive grid's refinement (designs.adaptive.index_set_summary)
     rare_event: dict | None = None  # a rare-event design's estimate and rounds (rare_statistics)
     rare_runs: dict | None = None  # its runs for the report's figures (not in summary.json)
     drawn: DrawnRuns | None = None  # the runs the report draws (read_statistics with a scatter time; not in summary.json)
-    design_info: dict = field(default_factory=dict)  # the design's recorded facts (replicates, n_base, ...)
     seed: int = 0  # what seeded the analysis's draws (the campaign's seed unless Options said otherwise)
-    record: CampaignRecord | None = None  # the campaign the file records (campaign.record), for the report
+
+    @property
+    def campaign_name(self) -> str:
+        """The recorded campaign's name."""
+        return self.record.campaign.name
+
+    @property
+    def design_info(self) -> dict:
+        """The design's recorded facts (replicates, n_base, ...)."""
+        return self.record.design_info
+
+    @property
+    def seeds(self) -> list[str]:
+        """The parameters that are random streams' seeds."""
+        return self.record.seeds
+
+    @property
+    def dependence(self) -> dict | None:
+        """The inputs' Gaussian copula as summary.json states it (parameters.dependence.summary); None: independent."""
+        return self.record.dependence
 
     @property
     def method_label(self) -> str:
@@ -325,10 +341,9 @@ def analyse_store(store: ResultStore, path, reference: str | None = None, option
         sampled = DESIGNS[design_kind].sampled
         ok = status == Status.OK
         pending = int(np.sum(status == Status.PENDING))
-        stats = Statistics(str(path), campaign.name, method, design_kind,
+        stats = Statistics(str(path), record, method, design_kind,
                            store.parameter_names, int(status.size), int(ok.sum()), int(np.sum(status > 0)),
-                           pending, {}, partial=pending > 0, design_info=record.design_info, seed=options.seed,
-                           record=record)
+                           pending, {}, partial=pending > 0, seed=options.seed)
         if DESIGNS[design_kind].rare:  # its runs are not draws of the input law: its event's probability only
             from .rare_statistics import rare_statistics
 
@@ -344,7 +359,6 @@ def analyse_store(store: ResultStore, path, reference: str | None = None, option
                                  missing=int(status.size - ok.sum()), allow_aliasing=allow_aliasing)
         if record.seeds and not (sampled and method.entry.runs_on_sampled):
             problem = f"parameter {record.seeds[0]} is a seed: {SEED_REFUSAL}"
-        stats.seeds, stats.dependence = record.seeds, record.dependence
         if stats.dependence:
             stats.notes.append(f"dependent inputs: {', '.join(stats.dependence['parameters'])} are correlated by a "
                                "Gaussian copula (Nataf); the mean, variance, bands and densities are those of the "
