@@ -32,6 +32,7 @@ from uqflight.calibration.size import MAX_STEPS
 from uqflight.calibration.surrogate import calibration_surrogate, load_campaign_file
 from uqflight.campaign import parse_campaign
 from uqflight.running.runner import run_campaign
+from uqflight.methods import MethodSpec
 
 MODEL = '''
 import h5py
@@ -109,7 +110,7 @@ def app():
 
 def test_surrogate_of_a_polynomial_model_is_exact(results):
     surrogate = calibration_surrogate(results)
-    assert surrogate.method == {"kind": "regression", "order": 2}
+    assert surrogate.method == MethodSpec("regression", 2)
     assert max(float(v.max()) for v in surrogate.error_variance.values()) < 1e-20
     xi = np.array([[0.5, -1.0, 0.2]])
     expected = model(1.0 + 0.1 * 0.5, -0.5 - 0.05, 0.2)

@@ -159,7 +159,7 @@ def test_a_python_model_from_the_package_validates():
     campaign = load_campaign(DATA / "good_python_ishigami.yaml", view=validation_view)
     assert campaign.simulator["function"] == "uqflight.simulators.models:ishigami"
     assert [p.property for p in campaign.parameters] == ["x1", "x2", "x3"]
-    assert campaign.method == {"kind": "regression", "order": 6, "split": False}
+    assert campaign.method.as_mapping() == {"kind": "regression", "order": 6, "split": False}
 
 
 @pytest.mark.slow

@@ -136,9 +136,9 @@ def test_report_refuses_a_bad_order_one_way_whichever_way_it_is_given(results, t
 
 
 def test_a_sparse_order_is_refused_below_its_max_order_bound():
+    from uqflight.methods import MethodSpec
     from uqflight.methods.parsing import parse_methods
 
     with pytest.raises(ValueError, match="expected an integer ORDER >= 1 after sparse:, got 'sparse:0'"):
         parse_methods(["sparse:0"])
-    assert parse_methods(["sparse", "least_squares:1"], 3) == [{"kind": "sparse", "order": 3},
-                                                               {"kind": "least_squares", "order": 1}]
+    assert parse_methods(["sparse", "least_squares:1"], 3) == [MethodSpec("sparse", 3), MethodSpec("least_squares", 1)]

@@ -13,6 +13,7 @@ from uqflight.methods.exactness import (
 )
 from uqflight.methods.basis import orthonormal_basis, total_degree_indices
 from uqflight.analysis.statistics import analyse
+from uqflight.methods import MethodSpec
 
 
 @pytest.mark.parametrize("points", [1, 2, 3, 5, 8])
@@ -112,7 +113,7 @@ def test_report_refuses_an_aliased_order_unless_allowed(tmp_path):
                                                      "{kind: sparse_grid, level: 1}"))
     refused = cli_in_process("report", results, "--method", "pseudo_galerkin", "--order", "4", "--out", tmp_path / "r")
     assert refused.returncode == 2 and "exact to degree 3" in refused.stderr
-    allowed = analyse(results, method={"kind": "pseudo_galerkin", "order": 4}, allow_aliasing=True)
+    allowed = analyse(results, method=MethodSpec("pseudo_galerkin", 4), allow_aliasing=True)
     assert any("aliasing allowed" in note for note in allowed.notes)
 
 

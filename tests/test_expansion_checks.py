@@ -13,6 +13,7 @@ from uqflight.methods.pce import PCE
 from uqflight.methods.validation import VALIDATION_THRESHOLD, flags, validate
 from uqflight.simulators.validation_view import validation_view
 from uqflight.analysis.statistics import analyse, summary_json
+from uqflight.methods import MethodSpec
 
 MODELS = DATA / "validation_models.py"
 NORMAL_3D = "".join(f"  x{k}: {{distribution: normal, lower: -3, upper: 3}}\n" for k in (1, 2, 3))
@@ -189,7 +190,7 @@ def test_the_statistics_of_sparse_say_their_cross_validated_error(tmp_path):
 def test_auto_on_a_signed_grid_with_no_valid_method_keeps_the_least_bad_flagged(files):
     # the kinked bank on a level-2 Gauss-Hermite grid (signed weights): no candidate validates its peak, and the
     # grid's runs alone give no statistics, so auto keeps the lowest error and its flag says to sample
-    stats = analyse(files["kink_grid"], method={"kind": "auto", "order": 2})
+    stats = analyse(files["kink_grid"], method=MethodSpec("auto", 2))
     peak = stats.quantities["peak"].output
     assert peak.method["kind"] in ("least_squares", "sparse") and "negative weights" in peak.method["why"]
     assert peak.flags and all("(taken by auto)" in text and "run a sampled design" in text for text in peak.flags)

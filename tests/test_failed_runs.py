@@ -9,7 +9,7 @@ import pytest
 from conftest import NORMAL_2D, cli_in_process, closed_form_campaign, run_python_campaign
 from data.failure_models import C, P_FAIL, corner_campaign
 
-from uqflight.methods import FAILED_RUNS, METHODS
+from uqflight.methods import FAILED_RUNS, METHODS, MethodSpec
 from uqflight.analysis.statistics import BadInput, analyse
 
 # E[x1 + x2 | success] = −E[(x1 + x2) 1_fail] / 0.87, with x1 + x2 = u of density (2 − |u|)/4 on [−2, 2]:
@@ -36,7 +36,7 @@ def test_every_method_says_what_its_statistics_are_with_failed_runs():
 
 
 def test_monte_carlo_statistics_are_conditional_on_success(runs):
-    stats = analyse(runs["mc"], method={"kind": "monte_carlo"})
+    stats = analyse(runs["mc"], method=MethodSpec("monte_carlo"))
     y = successful_y(runs["mc"])
     out = stats.outputs["y"]
     assert out.mean[0] == pytest.approx(y.mean(), abs=1e-13)  # the successful runs' sample mean
@@ -50,7 +50,7 @@ def test_monte_carlo_statistics_are_conditional_on_success(runs):
 def test_a_fit_is_extrapolated_over_the_failed_region(runs, name):
     # y = 1 + x1 + x2 lies in the order-1 basis, so the fit on the successful runs is exact and its
     # moments are the whole box's: mean 1, variance 1/3 + 1/3 (to rounding, 1e-12).
-    stats = analyse(runs[name], method={"kind": "least_squares", "order": 1})
+    stats = analyse(runs[name], method=MethodSpec("least_squares", 1))
     out = stats.outputs["y"]
     assert out.mean[0] == pytest.approx(1.0, abs=1e-12) and out.variance[0] == pytest.approx(2 / 3, abs=1e-12)
     assert stats.notes[0].startswith(f"statistics of a fit extrapolated over the failed region: {stats.failed} of ")
@@ -58,7 +58,7 @@ def test_a_fit_is_extrapolated_over_the_failed_region(runs, name):
 
 
 def test_a_projection_of_the_successful_runs_is_flagged_as_of_neither_law(runs):
-    stats = analyse(runs["mc"], method={"kind": "pseudo_galerkin", "order": 1})
+    stats = analyse(runs["mc"], method=MethodSpec("pseudo_galerkin", 1))
     out, y = stats.outputs["y"], successful_y(runs["mc"])
     assert out.mean[0] == pytest.approx(y.mean(), abs=1e-13)  # c₀: the conditional mean
     # its variance Σ c_α² is neither the conditional (sample) variance nor the whole law's 2/3
@@ -90,7 +90,7 @@ def test_a_grid_with_a_failed_run_refuses_projections_and_fits_the_rest_exactly(
         analyse(grid)
     refused = cli_in_process("report", grid, "--out", tmp_path / "r")
     assert refused.returncode == 2 and "pseudo_galerkin" in refused.stderr and not (tmp_path / "r").exists()
-    stats = analyse(grid, method={"kind": "least_squares", "order": 2})
+    stats = analyse(grid, method=MethodSpec("least_squares", 2))
     out = stats.outputs["y"]
     # y = 1 + x1 + x1 x2 + x2² is in the order-2 basis, which the 15 remaining points still resolve
     assert out.mean[0] == pytest.approx(2.0, abs=1e-10) and out.variance[0] == pytest.approx(4.0, abs=1e-9)
@@ -98,4 +98,4 @@ def test_a_grid_with_a_failed_run_refuses_projections_and_fits_the_rest_exactly(
     # a tensor grid: the quadrature of the failure indicator, no interval (test_failure_probability.py)
     assert stats.failure_probability["estimate"] > 0 and np.isnan(stats.failure_probability["lower"])
     with pytest.raises(BadInput, match="rank"):
-        analyse(grid, method={"kind": "regression", "order": 4})
+        analyse(grid, method=MethodSpec("regression", 4))

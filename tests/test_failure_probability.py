@@ -12,6 +12,7 @@ from data.failure_models import C, P_FAIL, corner_campaign
 from uqflight.analysis.failures import grid_failure_probability, kish_effective_runs
 from uqflight.designs import build_design
 from uqflight.analysis.statistics import analyse, summary_json
+from uqflight.methods import MethodSpec
 
 
 @pytest.fixture(scope="module")
@@ -67,7 +68,7 @@ def test_a_tensor_grid_reports_its_quadrature_of_the_indicator_without_an_interv
 
 
 def test_a_monte_carlo_design_keeps_its_wilson_interval(runs):
-    stats = analyse(runs["mc"], method={"kind": "monte_carlo"})
+    stats = analyse(runs["mc"], method=MethodSpec("monte_carlo"))
     p = stats.failure_probability
     assert p["estimate"] == stats.failed / 1000 and p["n_effective"] == 1000.0
     assert p["lower"] <= P_FAIL <= p["upper"] and "Wilson" in p["method"]

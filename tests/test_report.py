@@ -19,6 +19,7 @@ from uqflight.simulators.validation_view import validation_view
 from uqflight.running.runner import run_campaign
 from uqflight.report import write_report
 from uqflight.analysis.statistics import analyse, read_statistics
+from uqflight.methods import MethodSpec
 
 
 DECAY = """
@@ -181,7 +182,7 @@ def test_split_form_is_ignored_by_the_kinds_that_fit_their_constant_term(tmp_pat
     path = run(DECAY, tmp_path / "split.h5", name="split", distribution="normal",
                design="{kind: sparse_grid, rule: gauss_hermite, level: 3}",
                method="{kind: least_squares, order: 2, split: true}")
-    split, plain = analyse(path), analyse(path, method={"split": False})
+    split, plain = analyse(path), analyse(path, method=MethodSpec.from_checked({"kind": "least_squares", "order": 2, "split": False}))
     np.testing.assert_allclose(split.outputs["x"].mean, plain.outputs["x"].mean, rtol=1e-12)
     np.testing.assert_allclose(split.outputs["x"].variance, plain.outputs["x"].variance, rtol=1e-12)
 
@@ -193,7 +194,7 @@ def test_method_override_reports_another_method_on_the_same_runs(files, tmp_path
     assert result.returncode == 0, result.stderr
     summary = read_summary(tmp_path / "ls" / "summary.json")
     assert summary["method"]["kind"] == "least_squares" and summary["method"]["order"] == 3
-    exact = analyse(files["pg"], method={"kind": "least_squares", "order": 3}).outputs["x"].mean
+    exact = analyse(files["pg"], method=MethodSpec("least_squares", 3)).outputs["x"].mean
     np.testing.assert_allclose(summary["outputs"]["x"]["mean"], exact, rtol=1e-12)
     bad = subprocess.run([UQFLIGHT, "report", str(files["pg"]), "--method", "galerkin", "--out", str(tmp_path / "b")],
                          capture_output=True, text=True)
@@ -313,7 +314,7 @@ def test_several_methods_over_the_same_runs(decay_results, tmp_path):
     summaries = {p.name: json.loads(p.read_text()) for p in (out / "summaries").iterdir()}
     least = summaries["decay_least_squares1.json"]
     assert least["method"]["kind"] == "least_squares" and least["method"]["order"] == 1
-    exact = analyse(decay_results, method={"kind": "least_squares", "order": 1}).outputs["x"].mean
+    exact = analyse(decay_results, method=MethodSpec("least_squares", 1)).outputs["x"].mean
     np.testing.assert_allclose(least["outputs"]["x"]["mean"], exact, rtol=1e-12)
     for bad, message in ((["--method", "galerkin:2"], "expected KIND[:ORDER]"),
                          (["--method", "least_squares:two"], "integer ORDER"),

@@ -10,7 +10,7 @@ from uqflight.calibration.surrogate import calibration_surrogate
 from uqflight.campaign import CampaignError, parse_campaign
 from uqflight.designs import build_design
 from uqflight.running.runner import run_campaign
-from uqflight.methods import fit
+from uqflight.methods import MethodSpec, fit
 from uqflight.methods.basis import orthonormal_basis
 from uqflight.methods.loo import relative_loo_error
 from uqflight.methods.sparse import hyperbolic_indices
@@ -180,7 +180,7 @@ def test_a_bad_sparse_method_is_refused_naming_its_key(tmp_path, method, field):
 
 def test_the_cli_form_of_a_sparse_method():
     assert parse_methods(["sparse:4:selection=omp,q=0.75"]) == [
-        {"kind": "sparse", "order": 4, "selection": "omp", "q": 0.75}]
+        MethodSpec("sparse", 4, settings=(("selection", "omp"), ("q", 0.75)))]
     with pytest.raises(ValueError, match="selection"):
         parse_methods(["sparse:4:selection=lasso"])
     with pytest.raises(ValueError, match="KEY one of"):

@@ -102,14 +102,16 @@ def run(campaign, out=None, workers: int | None = None, executor: str | None = N
                         progress=progress, restart=restart)
 
 
-def _methods(method) -> list[dict] | None:
-    """`KIND[:ORDER]` strings or {"kind", "order"} mappings (one or a list) into method overrides."""
+def _methods(method) -> list | None:
+    """`KIND[:ORDER]` strings or {"kind", "order"} mappings (one or a list) into method overrides (MethodSpec);
+    ValueError naming a bad one."""
     from .methods.parsing import parse_methods
 
     if method is None:
         return None
     items = method if isinstance(method, (list, tuple)) else [method]
-    return [m if isinstance(m, dict) else parse_methods([m])[0] for m in items]
+    return [parse_methods([m.get("kind", "")], m.get("order"))[0] if isinstance(m, dict) else parse_methods([m])[0]
+            for m in items]
 
 
 def _thresholds(exceedance) -> dict | None:

@@ -75,7 +75,7 @@ def baseline_json(stats: Statistics, campaign_hash: str) -> dict:
     """The baseline of `stats`: per output and quantity its time grid and compared statistics, and the
     campaign hash."""
     return {"kind": BASELINE_KIND, "version": BASELINE_VERSION, "results": stats.path,
-            "campaign": stats.campaign_name, "campaign_hash": campaign_hash, "method": stats.method,
+            "campaign": stats.campaign_name, "campaign_hash": campaign_hash, "method": stats.method.summary(),
             "outputs": {name: _entry(out) for name, out in stats.outputs.items()},
             "quantities": {name: _entry(quantity.output) for name, quantity in stats.quantities.items()}}
 

@@ -53,7 +53,7 @@ from ..text.console import quoted_name
 from ..designs import REGISTRY as DESIGNS
 from ..designs.adaptive import index_set_summary
 from ..text.labels import name_unit
-from ..methods import DEFAULT_ORDER, PCE, METHODS, Auto, Method, normalised
+from ..methods import PCE, METHODS, Auto, Method, MethodSpec
 from ..methods.basis import orthonormal_basis
 from ..methods.pce_moments import pce_standardised_moments, triple_products
 from ..methods import validation
@@ -133,8 +133,8 @@ class OutputStatistics:
 @dataclass
 class Statistics:
     path: str
-    campaign_name: str
-    method: dict
+    record: CampaignRecord  # the campaign the file records (campaign.record)
+    method: MethodSpec  # the method applied (the campaign's, or the one asked for instead: MethodSpec.analysed)
     design_kind: str
     parameter_names: list[str]
     runs: int  # the design's runs
@@ -149,21 +149,37 @@ class Statistics:
     reference: str | None = None
     from_runs: bool = False  # statistics of the runs themselves (a sampled design), not of a PCE
     replicates: int = 1  # independent randomised-QMC replicates of the design
-    seeds: list[str] = field(default_factory=list)  # parameters that are random streams' seeds
-    dependence: dict | None = None  # the inputs' Gaussian copula (parameters.dependence.summary), None: independent
     quantities: dict[str, QuantityStatistics] = field(default_factory=dict)
     index_set: dict | None = None  # an adaptive grid's refinement (designs.adaptive.index_set_summary)
     rare_event: dict | None = None  # a rare-event design's estimate and rounds (rare_statistics)
     rare_runs: dict | None = None  # its runs for the report's figures (not in summary.json)
     drawn: DrawnRuns | None = None  # the runs the report draws (read_statistics with a scatter time; not in summary.json)
-    design_info: dict = field(default_factory=dict)  # the design's recorded facts (replicates, n_base, ...)
     seed: int = 0  # what seeded the analysis's draws (the campaign's seed unless Options said otherwise)
-    record: CampaignRecord | None = None  # the campaign the file records (campaign.record), for the report
+
+    @property
+    def campaign_name(self) -> str:
+        """The recorded campaign's name."""
+        return self.record.campaign.name
+
+    @property
+    def design_info(self) -> dict:
+        """The design's recorded facts (replicates, n_base, ...)."""
+        return self.record.design_info
+
+    @property
+    def seeds(self) -> list[str]:
+        """The parameters that are random streams' seeds."""
+        return self.record.seeds
+
+    @property
+    def dependence(self) -> dict | None:
+        """The inputs' Gaussian copula as summary.json states it (parameters.dependence.summary); None: independent."""
+        return self.record.dependence
 
     @property
     def method_label(self) -> str:
         """The method as in the paper's legends, e.g. "PG order 2", "MC"."""
-        return Method.label_of(self.method)
+        return self.method.label
 
     @property
     def estimator_label(self) -> str:
@@ -174,7 +190,7 @@ class Statistics:
     @property
     def expands(self) -> bool:
         """Whether the statistics are of an expansion (a PCE), not of the runs themselves."""
-        return METHODS[self.method["kind"]].expands
+        return self.method.entry.expands
 
     @property
     def sampled(self) -> bool:
@@ -259,7 +275,7 @@ def file_record(store: ResultStore, path) -> CampaignRecord:
     return record
 
 
-def read_statistics(path, method: dict | None = None, partial: bool = False,
+def read_statistics(path, method: MethodSpec | None = None, partial: bool = False,
                     allow_aliasing: bool = False, progress=None,
                     exceedance: dict | None = None, scatter_time: float | None = None) -> tuple[Statistics, dict]:
     """The statistics of a results file (`method` overriding the campaign's) and its root attributes, the
@@ -286,7 +302,7 @@ def read_statistics(path, method: dict | None = None, partial: bool = False,
         raise BadInput(f"{path}: cannot analyse the results file ({error_line(exc)})") from exc
 
 
-def analyse(path, reference: str | None = None, options: Options | None = None, method: dict | None = None,
+def analyse(path, reference: str | None = None, options: Options | None = None, method: MethodSpec | None = None,
             partial: bool = False, allow_aliasing: bool = False, progress=None,
             exceedance: dict | None = None) -> Statistics:
     """All statistics of the results file `path` (and errors against `reference`): `analyse_store` of the
@@ -296,13 +312,13 @@ def analyse(path, reference: str | None = None, options: Options | None = None, 
 
 
 def analyse_store(store: ResultStore, path, reference: str | None = None, options: Options | None = None,
-                  method: dict | None = None, partial: bool = False, allow_aliasing: bool = False, progress=None,
+                  method: MethodSpec | None = None, partial: bool = False, allow_aliasing: bool = False, progress=None,
                   exceedance: dict | None = None, record: CampaignRecord | None = None) -> Statistics:
     """All statistics of the open results file `store` read from `path` (and errors against `reference`).
     `record`: the file's checked campaign (`file_record`) when the caller has it already, so that it is checked once.
 
-    `method` ({"kind", "order", "split"}) overrides the campaign's: the runs of one grid serve every
-    method, so methods and orders are compared on the same runs. `partial` analyses a file with pending
+    `method` overrides the campaign's (`MethodSpec.analysed`): the runs of one grid serve every method, so
+    methods and orders are compared on the same runs. `partial` analyses a file with pending
     runs where a subset of the runs is valid; `allow_aliasing` lets a projection exceed the grid's degree.
     `progress` (a uqflight.running.progress.Progress) gets a stage per file and counts its outputs and quantities.
     `exceedance` ({quantity: [{above: X} | {below: X}]}) replaces the campaign's `analysis.exceedance` of the
@@ -315,22 +331,19 @@ def analyse_store(store: ResultStore, path, reference: str | None = None, option
         record = file_record(store, path) if record is None else record
         campaign = record.campaign
         germs, analysis = campaign.germs, campaign.analysis
-        method = {"order": DEFAULT_ORDER, **normalised(campaign.method), **normalised(method or {})}
-        allow_aliasing = allow_aliasing or bool(method.get("allow_aliasing"))
+        method = campaign.method.analysed(method)
+        allow_aliasing = allow_aliasing or method.allow_aliasing
         options = options or Options(analysis.band_samples, analysis.bootstrap,
                                      quantiles=analysis.quantiles or QUANTILES)
         if options.seed is None:
             options = replace(options, seed=campaign.seed)
         status, design_kind = store.status, record.design_kind
-        if method["kind"] not in METHODS:
-            raise BadInput(f"{path}: unknown method {method['kind']!r}: expected one of {', '.join(METHODS)}")
         sampled = DESIGNS[design_kind].sampled
         ok = status == Status.OK
         pending = int(np.sum(status == Status.PENDING))
-        stats = Statistics(str(path), campaign.name, method, design_kind,
+        stats = Statistics(str(path), record, method, design_kind,
                            store.parameter_names, int(status.size), int(ok.sum()), int(np.sum(status > 0)),
-                           pending, {}, partial=pending > 0, design_info=record.design_info, seed=options.seed,
-                           record=record)
+                           pending, {}, partial=pending > 0, seed=options.seed)
         if DESIGNS[design_kind].rare:  # its runs are not draws of the input law: its event's probability only
             from .rare_statistics import rare_statistics
 
@@ -342,19 +355,18 @@ def analyse_store(store: ResultStore, path, reference: str | None = None, option
         _check_runs(store, stats, sampled, partial)
         state = store.index_set()
         stats.index_set = None if state is None else index_set_summary(state, store.parameter_names)
-        problem = method_problem(method["kind"], method["order"], store.xi[ok], store.weights[ok], germs, sampled,
+        problem = method_problem(method.kind, method.order, store.xi[ok], store.weights[ok], germs, sampled,
                                  missing=int(status.size - ok.sum()), allow_aliasing=allow_aliasing)
-        if record.seeds and not (sampled and METHODS[method["kind"]].runs_on_sampled):
+        if record.seeds and not (sampled and method.entry.runs_on_sampled):
             problem = f"parameter {record.seeds[0]} is a seed: {SEED_REFUSAL}"
-        stats.seeds, stats.dependence = record.seeds, record.dependence
         if stats.dependence:
             stats.notes.append(f"dependent inputs: {', '.join(stats.dependence['parameters'])} are correlated by a "
                                "Gaussian copula (Nataf); the mean, variance, bands and densities are those of the "
                                f"dependent inputs; the Sobol' indices are of the {stats.dependence['sobol_of']}")
         if problem:
-            raise BadInput(f"{path}: method {method['kind']} order {method['order']}: {problem}")
+            raise BadInput(f"{path}: method {method.kind} order {method.order}: {problem}")
         _note_runs(store, stats, sampled, allow_aliasing)
-        stats.from_runs = METHODS[method["kind"]].runs_on_sampled and sampled
+        stats.from_runs = method.entry.runs_on_sampled and sampled
         if DESIGNS[design_kind].not_draws:
             stats.notes.append(DESIGNS[design_kind].not_draws)
         if stats.from_runs and DESIGNS[design_kind].sobol_from_runs:
@@ -365,7 +377,7 @@ def analyse_store(store: ResultStore, path, reference: str | None = None, option
         replicates = record.design_info.get("replicates", 1)
         stats.replicates = replicates if stats.from_runs and ok.all() else 1
         if progress is not None:
-            progress.stage(f"analysing {Path(path).name} ({method['kind']} order {method['order']})",
+            progress.stage(f"analysing {Path(path).name} ({method.kind} order {method.order})",
                            len(store.output_names) + len(store.quantity_names), "outputs")
         # one pool of threads for every output's time blocks: each output's serial steps (reading it, the fit,
         # the draws, the exact moments) run here while the blocks of the one before it run in the pool; at
@@ -422,8 +434,8 @@ def _check_runs(store: ResultStore, stats: Statistics, sampled: bool, partial: b
         raise BadInput(f"{path}: {stats.pending} of {n} runs are pending (interrupted, or still running): resume "
                        f"them with `uqflight run {campaign} --out {path}`, or add --partial to analyse the "
                        f"{stats.completed} completed runs (Monte Carlo, QMC, least squares and regression only)")
-    if stats.pending and not sampled and not METHODS[stats.method["kind"]].partial:
-        raise BadInput(f"{path}: --partial: {stats.method['kind']} on a {stats.design_kind} needs every run of "
+    if stats.pending and not sampled and not stats.method.entry.partial:
+        raise BadInput(f"{path}: --partial: {stats.method.kind} on a {stats.design_kind} needs every run of "
                        f"the grid ({stats.pending} of {n} pending); use --method least_squares or regression, "
                        f"or resume the campaign")
     if stats.completed == 0:
@@ -443,12 +455,12 @@ def _note_runs(store: ResultStore, stats: Statistics, sampled: bool, allow_alias
         stats.failure_probability = grid_failure_probability(failed, store.weights[done])
     if stats.failed:
         stats.failures = failed_runs(store)
-        stats.notes.append(METHODS[stats.method["kind"]].failed_runs_note(stats.failed, int(done.sum())))
+        stats.notes.append(stats.method.entry.failed_runs_note(stats.failed, int(done.sum())))
         if not sampled:
             stats.notes.append("failure probability: " + _grid_failure_note(stats.failure_probability))
     if stats.pending:
         stats.notes.append(f"partial: {stats.completed} of {stats.runs} runs")
-    if allow_aliasing and not sampled and METHODS[stats.method["kind"]].projects:
+    if allow_aliasing and not sampled and stats.method.entry.projects:
         stats.notes.append("aliasing allowed: the projection's order may exceed what the grid integrates exactly")
 
 
@@ -537,7 +549,7 @@ def _unwrapped(histories: np.ndarray, period: float | None, name: str, unwrapped
     return found
 
 
-def _output_statistics(store: ResultStore, name: str, method: dict, germs: list[str], design_kind: str,
+def _output_statistics(store: ResultStore, name: str, method: MethodSpec, germs: list[str], design_kind: str,
                        ok: np.ndarray, options: Options) -> OutputStatistics:
     """The statistics of output `name` over the `ok` runs, its time blocks in ANALYSIS_THREADS threads."""
     chosen, runs_only, record = auto_method(store, name, method, germs, design_kind, ok, options.seed)
@@ -555,17 +567,17 @@ def _with_method(record: dict | None, finish: Callable[[], OutputStatistics]) ->
     return finished
 
 
-def auto_method(store: ResultStore, name: str, method: dict, germs: list[str], design_kind: str,
-                ok: np.ndarray, seed: int = 0) -> tuple[dict, bool, dict | None]:
+def auto_method(store: ResultStore, name: str, method: MethodSpec, germs: list[str], design_kind: str,
+                ok: np.ndarray, seed: int = 0) -> tuple[MethodSpec, bool, dict | None]:
     """(the method for output `name`, whether its statistics are the runs' own, what auto took or None):
     `method` itself, or for auto what it takes on these runs (validation.Auto.choose, its draws seeded by `seed`)."""
-    if not isinstance(METHODS[method["kind"]], Auto):
+    if not isinstance(method.entry, Auto):
         return method, False, None
     basis, scale = output_basis(store, name, ok)
-    kind, runs_only, record = METHODS[method["kind"]].choose(
-        store.xi[ok], store.weights[ok], basis, scale, germs, method["order"], DESIGNS[design_kind].sampled,
+    kind, runs_only, record = method.entry.choose(
+        store.xi[ok], store.weights[ok], basis, scale, germs, method.order, DESIGNS[design_kind].sampled,
         int(ok.size - ok.sum()), seed, name)
-    return {**method, "kind": kind}, runs_only, record
+    return replace(method, kind=kind), runs_only, record
 
 
 def _note_auto(stats: Statistics) -> None:
@@ -613,7 +625,7 @@ class BasisCache:
         return self.get("triple products", key, lambda: triple_products(germs, indices, square_indices))
 
 
-def _start_output(store: ResultStore, name: str, method: dict, germs: list[str], design_kind: str,
+def _start_output(store: ResultStore, name: str, method: MethodSpec, germs: list[str], design_kind: str,
                   ok: np.ndarray, options: Options, pool: Executor, basis_cache: BasisCache,
                   runs_only: bool = False, auto: bool = False) -> Callable[[], OutputStatistics]:
     """Read and fit output `name` here and hand its time blocks to `pool`; returns what waits for them
@@ -621,8 +633,7 @@ def _start_output(store: ResultStore, name: str, method: dict, germs: list[str],
     `runs_only`: the statistics of the (weighted) runs themselves, as on a sampled design; `auto`: `method`
     is what auto took (auto_method)."""
     xi, weights = store.xi[ok], store.weights[ok]
-    kind, order = method["kind"], method["order"]
-    entry = METHODS[kind]
+    kind, order, entry = method.kind, method.order, method.entry
     unwrapped: list[str] = []
     basis, scale = output_basis(store, name, ok, unwrapped)
     truncation = _tsvd_resolution(store, scale, int(ok.sum()))
@@ -630,14 +641,14 @@ def _start_output(store: ResultStore, name: str, method: dict, germs: list[str],
     x0 = None
     # x = x0 + S with each run's initial value (needs the runs themselves); only the projections use
     # it: the other kinds fit the constant term themselves, where the split would change nothing
-    if method.get("split") and not (sampled and entry.runs_on_sampled) and entry.split:
+    if method.split and not (sampled and entry.runs_on_sampled) and entry.split:
         basis = basis if scale is None else basis @ scale
         scale, x0 = None, basis[:, :1]
 
     def expand(a):
         return a if scale is None else a @ scale
 
-    result = entry.fit(xi, weights, basis, germs, order, x0, scale=scale, sampled=sampled, settings=method)
+    result = entry.fit(xi, weights, basis, germs, order, x0, scale=scale, sampled=sampled, settings=dict(method.settings))
     mean, variance, pce, from_runs = result.mean, result.variance, result.pce, result.from_runs
     if from_runs:  # bands, PDFs and pick-freeze indices from the runs themselves
         rows, row_scale, band_weights = basis, scale, (None if entry.run_weights(weights) is None else weights / weights.sum())
@@ -680,8 +691,8 @@ def _start_output(store: ResultStore, name: str, method: dict, germs: list[str],
                 stats.loo_error = _loo_error(entry, xi, weights, expand(basis), germs, pce.indices)
             elif entry.projects and not entry.quadrature and order >= 1:
                 stats.convergence = _lower_order_difference(kind, xi, weights, basis, scale, germs, order, x0, pce)
-            refit = (validation.refitting(kind, xi, weights, basis, scale, germs, order, sampled, method)
-                     if entry.selects else None)
+            refit = (validation.refitting(kind, xi, weights, basis, scale, germs, order, sampled,
+                                          dict(method.settings)) if entry.selects else None)
             _validate(stats, entry.rule, f"{kind} order {order}" + (" (taken by auto)" if auto else ""), xi, weights,
                       expand(basis), germs, None if isinstance(store, _QuantityView) else store.time, options.seed,
                       refit, auto)
@@ -927,7 +938,7 @@ def _reference_floor(reference: Statistics, ref: OutputStatistics, out: OutputSt
                 + ("; QMC converges faster than this Monte Carlo floor, so it is an upper bound" if qmc else ""))
         return {"eps_m_floor": floors["eps_m_floor"], "eps_v_floor": floors["eps_v_floor"],
                 "kld_floor": _kld_floor(reference, ref, out), "floor_note": note + KLD_FLOOR_NOTE}
-    note = (f"reference: {reference.method['kind']} on a {reference.design_kind}, deterministic: it has no sampling "
+    note = (f"reference: {reference.method.kind} on a {reference.design_kind}, deterministic: it has no sampling "
             "floor; its own truncation error is not included (see its convergence estimate)")
     return {"eps_m_floor": None, "eps_v_floor": None, "kld_floor": None, "floor_note": note}
 
@@ -983,9 +994,9 @@ def quantity_statistics(store: ResultStore, stats: Statistics, name: str, germs:
         why = (f"quantity {name} is undefined in {missing} of {int(ok.sum())} successful runs: a projection on "
                f"a {stats.design_kind} needs every run, so its statistics are null")
     elif missing:
-        problem = method_problem(stats.method["kind"], stats.method["order"], store.xi[defined],
+        problem = method_problem(stats.method.kind, stats.method.order, store.xi[defined],
                                  store.weights[defined], germs, sampled, missing=int((~defined).sum()))
-        why = problem and f"quantity {name}: method {stats.method['kind']} on the runs where it is defined: {problem}"
+        why = problem and f"quantity {name}: method {stats.method.kind} on the runs where it is defined: {problem}"
         if not why:
             stats.notes.append(f"quantity {name} is undefined in {missing} of {int(ok.sum())} successful runs: "
                                "its statistics are conditional on the runs where it is defined")
@@ -1158,7 +1169,7 @@ def summary_json(stats: Statistics) -> dict:
                                "floor_note": errors["floor_note"]}
         outputs[name] = entry
     return json_ready({
-        "results": stats.path, "campaign": stats.campaign_name, "method": stats.method, "design": stats.design_kind,
+        "results": stats.path, "campaign": stats.campaign_name, "method": stats.method.summary(), "design": stats.design_kind,
         "runs": stats.runs, "completed": stats.completed, "failed": stats.failed, "pending": stats.pending,
         "failure_probability": stats.failure_probability, "partial": stats.partial, "notes": stats.notes,
         "failures": stats.failures, "parameters": stats.parameter_names, "reference": stats.reference,

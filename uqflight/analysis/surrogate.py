@@ -17,11 +17,12 @@ from __future__ import annotations
 
 import json
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
 
+from ..methods import MethodSpec
 from ..text.bounded import read_bounded
 from ..text.console import listed
 from ..text.console import quoted_name, quoted_value
@@ -46,7 +47,7 @@ class Surrogate:
     time: np.ndarray  # (T,)
     coefficients: dict[str, np.ndarray]  # output -> (Z, T)
     units: dict[str, str]
-    method: dict
+    method: MethodSpec
     campaign: str = ""
     dependence: dict | None = None  # the inputs' Gaussian copula {kind, parameters, correlation}, None: independent
 
@@ -86,7 +87,7 @@ class Surrogate:
         return {name: (c[self.indices[name].any(axis=1)] ** 2).sum(axis=0) for name, c in self.coefficients.items()}
 
 
-def fit_surrogate(path, method: dict | None = None, partial: bool = False, allow_aliasing: bool = False,
+def fit_surrogate(path, method: MethodSpec | None = None, partial: bool = False, allow_aliasing: bool = False,
                   options=None, progress=None) -> Surrogate:
     """The PCE of every output of the results file `path`, exactly as `uqflight.analysis.statistics.analyse`
     fits it (with `method` overriding the campaign's), after the same checks: pending or failed runs,
@@ -96,22 +97,19 @@ def fit_surrogate(path, method: dict | None = None, partial: bool = False, allow
     and the calibration both fit here. `options`: statistics.Options (default 200 band draws: the PCE
     does not depend on them, and its bands and PDFs are not exported); `progress`: see analyse."""
     from ..designs import REGISTRY as DESIGNS
-    from ..methods import METHODS, normalised
     from .statistics import BadInput, Options, analyse_store, file_record
     from ..store import ResultStore
 
     with ResultStore.open(path) as store:
         record = file_record(store, path)
-        stored, design_kind = normalised(record.campaign.method), record.design_kind
+        design_kind = record.design_kind
         if DESIGNS[design_kind].rare:
             raise BadInput(f"{path}: a {design_kind} design's runs were chosen to reach its event, they are not "
                            "draws of the input law: no expansion of the law is fitted to them; fly a sampled "
                            "design or a grid for a surrogate")
         parameters, time = record.parameter_rows, np.asarray(store.time, dtype=float)
-        override = dict(method or {})
-        kind = override.get("kind", stored.get("kind"))
-        if isinstance(kind, str) and kind in METHODS:  # else analyse_store refuses
-            override["kind"] = METHODS[kind].exported_kind(DESIGNS[design_kind].sampled)
+        override = method or MethodSpec(record.campaign.method.kind)
+        override = replace(override, kind=override.entry.exported_kind(DESIGNS[design_kind].sampled))
         stats = analyse_store(store, path, method=override, partial=partial, allow_aliasing=allow_aliasing,
                               options=options or Options(band_samples=200, bootstrap=0), progress=progress,
                               record=record)
@@ -150,8 +148,7 @@ def surrogate_json(surrogate: Surrogate, results: str = "") -> dict:
     shared = all(np.array_equal(b, bases[0]) for b in bases)
     data = {
         "format": FORMAT, "version": VERSION, "campaign": surrogate.campaign, "results": results,
-        "method": surrogate.method["kind"], "order": surrogate.method["order"],
-        "split": bool(surrogate.method.get("split", False)),
+        "method": surrogate.method.kind, "order": surrogate.method.order, "split": surrogate.method.split,
         "basis": "orthonormal polynomials of the germs (Hermite for normal, Legendre for uniform), " + (
             "total degree" if shared else "each output's own terms (outputs.NAME.multi_indices)"),
         "parameters": surrogate.parameters, "germs": surrogate.germs,
@@ -266,7 +263,7 @@ def _checked(data: dict) -> Surrogate:
             raise ValueError(f"{key}: expected a {kind.__name__}, got {quoted_value(data[key])}")
     return Surrogate(parameters, germs, indices, time, coefficients,
                      {name: o.get("units", "") for name, o in outputs.items()},
-                     {"kind": data["method"], "order": order, "split": data.get("split", False)},
+                     MethodSpec(data["method"], order, data.get("split", False)),
                      data.get("campaign", ""), data.get("dependence"))
 
 

@@ -171,9 +171,9 @@ def _method(text: str | None, order: int | None) -> tuple[str | None, int | None
         parsed = parse_methods([text], order)[0]
     except ValueError as exc:
         refuse(f"{'--method' if text else '--order'}: {exc}")
-    if order is not None and parsed.get("order", order) != order:
+    if order is not None and parsed.order != order:
         refuse(f"--method {text} and --order {order} give two orders: give one")
-    return parsed["kind"], parsed.get("order", order)
+    return parsed.kind, parsed.order
 
 
 def _interrupted(signum, frame):

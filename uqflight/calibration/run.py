@@ -94,7 +94,8 @@ def _calibrate(results, data, out, outputs, noise, seed, walkers, steps, method,
     summary = {
         "results": str(results), "data": str(data), "campaign": surrogate.campaign.name,
         "seed": seed,
-        "surrogate": {**surrogate.method, "runs": surrogate.runs, "time_handling": TIME_HANDLING,
+        "surrogate": {"kind": surrogate.method.kind, "order": surrogate.method.order, "runs": surrogate.runs,
+                      "time_handling": TIME_HANDLING,
                       "error": "mean square leave-one-out residual of the weighted least-squares fit of the same "
                                "basis (or the surrogate's own misfit at the runs, if larger), per output and time, "
                                "added to the noise variance"},

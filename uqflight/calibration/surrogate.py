@@ -22,7 +22,7 @@ from ..campaign.record import CampaignRecord
 from ..text.console import listed
 from ..designs import REGISTRY as DESIGNS
 from ..running.runner import simulate
-from ..methods import DEFAULT_ORDER, METHOD_KINDS, normalised
+from ..methods import DEFAULT_ORDER, METHOD_KINDS, MethodSpec
 from ..methods.basis import Basis, orthonormal_basis
 from ..methods.loo import loo_residuals, relative_loo_error
 from ..parameters import Parameter
@@ -57,7 +57,7 @@ class CalibrationSurrogate:
 
     campaign: Campaign
     results: str
-    method: dict
+    method: MethodSpec
     germs: list[str]
     indices: np.ndarray
     time: np.ndarray
@@ -150,10 +150,10 @@ def calibration_surrogate(results, method: str | None = None, order: int | None 
     with store:
         record = _record_of(store, results, Path(campaign_path) if campaign_path else None)
         campaign = record.campaign
-        stored, germs = normalised(campaign.method), campaign.germs
+        stored, germs = campaign.method, campaign.germs
         sampled = DESIGNS[record.design_kind].sampled
-        kind = method or stored["kind"]
-        order = stored.get("order", DEFAULT_ORDER) if order is None else order
+        kind = method or stored.kind
+        order = (DEFAULT_ORDER if stored.order is None else stored.order) if order is None else order
         if kind not in METHOD_KINDS:
             raise SurrogateError(f"--method: expected one of {', '.join(METHOD_KINDS)}, got {kind!r}")
         ok = store.status == Status.OK
@@ -163,8 +163,7 @@ def calibration_surrogate(results, method: str | None = None, order: int | None 
             raise SurrogateError(f"{results} has no output {', '.join(map(repr, missing))} "
                                  f"(it has {listed(store.output_names)})")
         try:  # the statistics' own PCE, after their checks (pending or failed runs, aliasing, rank)
-            fitted = fit_surrogate(results, {"kind": kind, "order": order},
-                                   options=Options(band_samples=200, bootstrap=0))
+            fitted = fit_surrogate(results, MethodSpec(kind, order), options=Options(band_samples=200, bootstrap=0))
         except BadInput as exc:
             raise SurrogateError(str(exc)) from exc
         xi, weights = store.xi[ok], store.weights[ok]
@@ -187,7 +186,7 @@ def calibration_surrogate(results, method: str | None = None, order: int | None 
             curves = loo if error_weights @ (loo**2).sum(axis=1) >= error_weights @ (misfit**2).sum(axis=1) else misfit
             error_factors[name] = error_factors_of(np.sqrt(error_weights)[:, None] * curves)
             error_variance[name] = (error_factors[name] ** 2).sum(axis=1)
-        return CalibrationSurrogate(campaign, str(results), {"kind": fitted.method["kind"], "order": order},
+        return CalibrationSurrogate(campaign, str(results), fitted.method,
                                     list(germs), indices, store.time, coefficients, error_variance, error_factors,
                                     store.units, int(ok.sum()), relative, own)
 

@@ -16,7 +16,7 @@ import yaml
 
 from ..designs import REGISTRY as DESIGNS
 from ..designs import Design, build_design, design_size
-from ..methods import METHODS, Method
+from ..methods import Method, MethodSpec
 from ..parameters import Parameter, germs_of, seed_names, to_physical
 from ..parameters.dependence import GaussianCopula
 from ..quantities.spec import check_quantities
@@ -40,7 +40,7 @@ class Campaign:
     simulator: dict
     parameters: list[Parameter]
     design_spec: dict
-    method: dict
+    method: MethodSpec
     execution: Execution
     storage: Storage
     analysis: Analysis = field(default_factory=Analysis)
@@ -128,11 +128,14 @@ def parse_campaign(text: str, source: str = "<campaign>", view: ValidationView |
         check_rare_campaign(check, campaign)
         return replace(campaign, runs=int(design_size(campaign.design_spec, campaign.germs)))
     if DESIGNS[design.kind].adaptive:  # its grid is made from the results: its points are checked on analysis
-        entry = METHODS[campaign.method["kind"]]
+        entry = campaign.method.entry
         if entry.sampled_only:
-            check.fail("method.kind", f"{campaign.method['kind']} needs a sampled design; an adaptive grid needs "
+            check.fail("method.kind", f"{campaign.method.kind} needs a sampled design; an adaptive grid needs "
                                       "its weights: use integration, pseudo_galerkin or interpolation")
-        method = {entry.order_key: entry.keys[entry.order_key].default, **campaign.method}
+        method = campaign.method
+        if method.order is None:  # its default, the mapping's first key
+            method = replace(method, order=entry.keys[entry.order_key].default,
+                             written=(entry.order_key, *method.written))
         return replace(campaign, method=method, runs=int(design_size(campaign.design_spec, campaign.germs)))
     method = schema.method_for_design(check, campaign.method, design, campaign.germs)
     return replace(campaign, method=method, runs=len(design.weights))

@@ -74,7 +74,7 @@ def parameter_rows(parameters: list[Parameter]) -> list[dict]:
 def record_text(campaign: Campaign, design_kind: str, design_info: dict, versions: dict) -> str:
     """The `record` attribute of a results file of `campaign` (validated for its aircraft and design)."""
     return json.dumps({"version": VERSION, "campaign": campaign.mapping,
-                       "parameters": parameter_rows(campaign.parameters), "method": campaign.method,
+                       "parameters": parameter_rows(campaign.parameters), "method": campaign.method.as_mapping(),
                        "design": {"kind": design_kind, "info": design_info}, "versions": versions}, default=str)
 
 

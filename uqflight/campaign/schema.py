@@ -6,13 +6,14 @@ import difflib
 import math
 import re
 from collections.abc import Hashable
+from dataclasses import replace
 
 import numpy as np
 import yaml
 
 from ..designs import REGISTRY as DESIGNS
 from ..designs import Design, design_size
-from ..methods import DEFAULT_ORDER, METHOD_KINDS, METHODS, Method
+from ..methods import DEFAULT_ORDER, METHOD_KINDS, METHODS, Method, MethodSpec
 from ..methods.exactness import exact_total_degree, max_projection_order
 from ..methods.validity import method_problem
 from ..parameters import DISTRIBUTIONS, Parameter, make_parameter, seed_names
@@ -200,24 +201,23 @@ def yaml_error(exc: yaml.YAMLError) -> str:
     return message
 
 
-def method_for_design(check: Checker, method: dict, design: Design, germs: list[str]) -> dict:
+def method_for_design(check: Checker, method: MethodSpec, design: Design, germs: list[str]) -> MethodSpec:
     """The checked `method` with the order the design's points carry, refused before anything runs when they
     cannot carry it (methods.validity). Without `order`, the order is 2, or the largest a grid's projection
     allows when that is lower."""
     sampled = DESIGNS[design.kind].sampled
-    entry = METHODS[method["kind"]]
-    key = entry.order_key
-    method = dict(method)
-    if key not in method:
-        method[key] = DEFAULT_ORDER
+    entry = method.entry
+    order = method.order
+    if order is None:
+        order = DEFAULT_ORDER
         if entry.projects and not sampled:
             degree = exact_total_degree(design.xi, design.weights, germs, max_degree=2 * DEFAULT_ORDER)
-            method[key] = max(0, min(DEFAULT_ORDER, max_projection_order(degree)))
-    problem = method_problem(method["kind"], method[key], design.xi, design.weights, germs, sampled,
-                             allow_aliasing=method.get("allow_aliasing", False))
+            order = max(0, min(DEFAULT_ORDER, max_projection_order(degree)))
+    problem = method_problem(method.kind, order, design.xi, design.weights, germs, sampled,
+                             allow_aliasing=method.allow_aliasing)
     if problem:
-        check.fail(f"method.{key}" if entry.expands else "method.kind", problem)
-    return method
+        check.fail(f"method.{entry.order_key}" if entry.expands else "method.kind", problem)
+    return replace(method, order=order)
 
 
 def simulator(check: Checker, value) -> dict:
@@ -336,7 +336,7 @@ def seed_parameter(check: Checker, spec: dict, path: str, name: str, kind: str, 
     return make_parameter(name, prop, "seed", SEED_COUNT // 2, lower=0.0, upper=float(SEED_COUNT))  # nominal: κ(ξ = 0)
 
 
-def check_seeds(check: Checker, parameters: list[Parameter], design_kind, method: dict) -> None:
+def check_seeds(check: Checker, parameters: list[Parameter], design_kind, method: MethodSpec) -> None:
     """A seed's random stream has no polynomial expansion: refuse grids and PCE methods over it, and more
     than one seed (the split of the variance between seeds and the other inputs needs them as one input)."""
     seeds = seed_names(parameters)
@@ -351,8 +351,8 @@ def check_seeds(check: Checker, parameters: list[Parameter], design_kind, method
         sampled = ", ".join(name for name, kind in DESIGNS.items() if kind.sampled)
         check.fail(where, f"a seed needs a sampled design ({sampled}), not {design_kind}: "
                           "a random stream has no polynomial expansion for a grid to integrate")
-    if not METHODS[method["kind"]].runs_on_sampled:  # it would fit a PCE in the seed's ξ
-        check.fail(where, f"{SEED_REFUSAL} ({method['kind']})")
+    if not method.entry.runs_on_sampled:  # it would fit a PCE in the seed's ξ
+        check.fail(where, f"{SEED_REFUSAL} ({method.kind})")
 
 
 def dependence(check: Checker, value, known: list[str], seeds: list[str], fixed=()) -> GaussianCopula | None:
@@ -459,8 +459,27 @@ def function_property(check: Checker, spec: dict, path: str, kind: str, aircraft
     return patch_property(full, perturbation, functions)
 
 
-def method(check: Checker, value) -> dict:
-    """The `method:` mapping checked against its kind's keys (`Method.keys`: an unknown kind, the shared ones)."""
+def method(check: Checker, value) -> MethodSpec:
+    """The `method:` mapping checked against its kind's keys (`Method.keys`: an unknown kind, the shared ones):
+    the one validator of a campaign's method and of a results file's record of it.
+
+    Parameters
+    ----------
+    check : Checker
+        Names the file in its CampaignError.
+    value : object
+        The `method:` value as written.
+
+    Returns
+    -------
+    MethodSpec
+        Its keys as written, `split` filled in where the kind has it.
+
+    Raises
+    ------
+    CampaignError
+        Naming the key (`method.KEY`) and what it expected.
+    """
     kind = value.get("kind") if isinstance(value, dict) else None
     entry = METHODS.get(kind) if isinstance(kind, str) else None
     keys = (entry or Method).keys
@@ -476,7 +495,7 @@ def method(check: Checker, value) -> dict:
     problem = entry.problem(method) if entry else None
     if problem:
         check.fail(f"method.{problem[0]}", problem[1])
-    return method
+    return MethodSpec.from_checked(method)
 
 
 def campaign_name(check: Checker, value) -> str:
@@ -488,7 +507,7 @@ def campaign_name(check: Checker, value) -> str:
     return name
 
 
-def check_size(check: Checker, data: dict, simulator: dict, parameters: list, method: dict, execution: Execution,
+def check_size(check: Checker, data: dict, simulator: dict, parameters: list, method: MethodSpec, execution: Execution,
                storage: Storage, limits: Limits, germs: list[str] | None = None) -> dict:
     """The design's size, its memory and disk estimate and the PCE size, from the campaign alone
     (nothing built): refused beyond `limits` (CampaignError naming the figure and the limit).
@@ -502,7 +521,7 @@ def check_size(check: Checker, data: dict, simulator: dict, parameters: list, me
     if points is not None and points > limits.max_runs:
         check.fail("design", f"{points:.4g} runs (points built), more than limits.max_runs = {limits.max_runs}; "
                              "choose a smaller design or raise limits.max_runs")
-    order = method.get(METHODS.get(method.get("kind"), Method).order_key, DEFAULT_ORDER)  # DEFAULT_ORDER at most
+    order = DEFAULT_ORDER if method.order is None else method.order  # DEFAULT_ORDER at most
     terms = math.comb(d + order, order) if order <= 10**6 else math.inf
     figures["pce_terms"] = terms
     if terms > limits.max_pce_terms:

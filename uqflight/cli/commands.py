@@ -38,7 +38,7 @@ from ..running import stopping
 from .fast_exit import exit_fast
 from ..running.progress import Progress
 
-from ..methods import METHOD_KINDS
+from ..methods import METHOD_KINDS, MethodSpec
 from ..simulators.base import FlightError
 from ..simulators.aircraft import default_condition
 from ..simulators.jsbsim import DEFAULT_OUTPUTS
@@ -262,12 +262,12 @@ def plan(campaign_file: Path = typer.Argument(..., metavar="CAMPAIGN", help="Cam
         echo(f"dependence: {campaign.dependence.kind} over {listed(campaign.dependence.names)} (standard-normal germs, "
              "Cholesky in this order)")
     echo(describe(design))
-    kind = campaign.method["kind"]
+    kind = campaign.method.kind
     if DESIGNS[design.kind].rare:  # its own estimator: the runs are not draws of the input law
         echo(f"method: none (the {design.kind} estimates the probability of its event only)")
     else:
         entry = METHODS[kind]
-        order = campaign.method.get(entry.order_key)
+        order = campaign.method.order
         echo(f"method: {kind}" + (f" ({entry.order_key.replace('_', ' ')} {order})"
                                   if entry.builds_pce(DESIGNS[design.kind].sampled) else ""))
     runs = campaign.runs or len(design.xi)  # an adaptive grid's budget: its rounds are made from the results
@@ -630,7 +630,7 @@ def surrogate_export(
     echo(f"wrote {out}")
 
 
-def parse_method_option(method: str | None) -> dict | None:
+def parse_method_option(method: str | None) -> MethodSpec | None:
     from ..methods.parsing import parse_methods
 
     return parse_methods([method])[0] if method else None

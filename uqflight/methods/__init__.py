@@ -46,17 +46,9 @@ class MonteCarlo(Method):
 
 from .sparse import Sparse  # noqa: E402  (registered after monte_carlo)
 from .validation import AUTO_CANDIDATES, Auto  # noqa: E402
+from .spec import MethodSpec  # noqa: E402
 
 METHOD_KINDS = tuple(METHODS)
-
-
-def normalised(method: dict) -> dict:
-    """A `method:` mapping with its kind's order key (`Method.order_key`) as "order"."""
-    method = dict(method)
-    key = METHODS[method["kind"]].order_key if method.get("kind") in METHODS else "order"
-    if key != "order" and key in method:
-        method["order"] = method.pop(key)
-    return method
 
 
 def fit(kind: str, *args, **kwargs) -> Result:
@@ -65,6 +57,6 @@ def fit(kind: str, *args, **kwargs) -> Result:
     return Method.of(kind).fit(*args, **kwargs)
 
 
-__all__ = ["AUTO_CANDIDATES", "DEFAULT_ORDER", "FAILED_RUNS", "METHODS", "METHOD_KINDS", "PCE", "Auto", "Integration",
-           "Interpolation", "Key", "LeastSquares", "Method", "MonteCarlo", "PseudoGalerkin", "Regression", "Result",
-           "Sparse", "fit", "normalised", "scaled"]
+__all__ = ["AUTO_CANDIDATES", "DEFAULT_ORDER", "FAILED_RUNS", "METHODS", "METHOD_KINDS", "MethodSpec", "PCE", "Auto",
+           "Integration", "Interpolation", "Key", "LeastSquares", "Method", "MonteCarlo", "PseudoGalerkin", "Regression",
+           "Result", "Sparse", "fit", "scaled"]

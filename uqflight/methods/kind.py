@@ -137,14 +137,6 @@ class Method:
         """The method whose statistics are the runs' own: monte_carlo on a sampled design, else integration."""
         return METHODS["monte_carlo" if sampled else "integration"]
 
-    @staticmethod
-    def label_of(method: dict) -> str:
-        """A method (`{kind, order, split}`) as in the paper's legends, e.g. "PG order 2", "MC"."""
-        entry = METHODS[method["kind"]]
-        if not entry.expands:
-            return entry.label
-        return f"{entry.label} order {method['order']}" + (" split" if method.get("split") else "")
-
     @property
     def settings(self) -> tuple[str, ...]:
         """Its keys its `expansion` takes by name (beyond the order and the split form)."""
@@ -174,9 +166,9 @@ class Method:
         """Whether it builds a PCE on a design (sampled or a grid), so that its order means something."""
         return self.expands and not (sampled and self.runs_on_sampled)
 
-    def settings_of(self, method: dict | None) -> dict:
-        """The settings of a `method:` mapping its expansion takes, defaults filled in."""
-        return {key: (method or {}).get(key, self.keys[key].default) for key in self.settings}
+    def settings_of(self, settings: dict | None) -> dict:
+        """The settings its expansion takes (`settings`), defaults filled in for those not given."""
+        return {key: (settings or {}).get(key, self.keys[key].default) for key in self.settings}
 
     def problem(self, method: dict) -> tuple[str, str] | None:
         """(key, why) of the first key of a `method:` mapping its Key refuses, or None."""

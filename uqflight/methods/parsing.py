@@ -2,13 +2,30 @@
 export, calibrate), with `--order N` as the ORDER of a bare KIND."""
 from __future__ import annotations
 
-from . import METHOD_KINDS, Method
+from . import METHOD_KINDS, Method, MethodSpec
 
 
-def parse_methods(methods: list[str], order: int | None = None) -> list[dict]:
+def parse_methods(methods: list[str], order: int | None = None) -> list[MethodSpec]:
     """`KIND[:ORDER[:KEY=VALUE,...]]` strings into method overrides (KEY one of the kind's settings,
-    e.g. `sparse:4:selection=omp,q=0.75`); a bare KIND takes `order` (when given). ValueError naming
-    the bad item: an ORDER, written or given, is refused in one sentence."""
+    e.g. `sparse:4:selection=omp,q=0.75`); a bare KIND takes `order` (when given).
+
+    Parameters
+    ----------
+    methods : list of str
+        The `--method` values.
+    order : int, optional
+        `--order`: the ORDER of a bare KIND.
+
+    Returns
+    -------
+    list of MethodSpec
+        One per item, its written keys those the item gives (the order under the kind's order key).
+
+    Raises
+    ------
+    ValueError
+        Naming the bad item: an ORDER, written or given, is refused in one sentence.
+    """
     parsed = []
     for text in methods:
         kind, sep, rest = text.partition(":")
@@ -19,10 +36,10 @@ def parse_methods(methods: list[str], order: int | None = None) -> list[dict]:
         method = {"kind": kind}
         entry = Method.of(kind)
         if sep or order is not None:
-            method["order"] = checked_order(number if sep else order, entry, repr(text) if sep else None)
+            method[entry.order_key] = checked_order(number if sep else order, entry, repr(text) if sep else None)
         if more:
             method.update(_settings(entry, pairs, text))
-        parsed.append(method)
+        parsed.append(MethodSpec.from_checked(method))
     return parsed
 
 

@@ -116,7 +116,7 @@ def _file_stems(paths: list[Path]) -> dict[Path, str]:
 
 def _entry(path: Path, stats: Statistics, attrs: dict, stems: set[str], file_stems: dict[Path, str],
            with_method: bool = False) -> AnalysedFile:
-    name = Path(path).stem + (f"_{stats.method['kind']}{stats.method.get('order', '')}" if with_method else "")
+    name = Path(path).stem + (f"_{stats.method.kind}{stats.method.order}" if with_method else "")
     stem = _unique(file_name(name), stems)
     runs = f"partial: {stats.completed} of {stats.runs} runs" if stats.partial else f"{stats.runs} runs"
     label = f"{stats.campaign_name or stem}: {stats.estimator_label}, {runs}"
