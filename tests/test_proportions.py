@@ -18,7 +18,7 @@ SEEDS = range(300)
 def _found(spec: dict, d: int, seed: int) -> tuple[dict, np.ndarray]:
     design = build_design(spec, ["uniform"] * d, seed)
     hits = design.xi[:, 0] ** 2 + design.xi[:, 1] ** 2 < 0.5
-    return REGISTRY[spec["kind"]].draws.proportion(hits, np.ones(hits.size, bool), design.info), hits
+    return REGISTRY[spec["kind"]].sampling.proportion(hits, np.ones(hits.size, bool), design.info), hits
 
 
 def _coverage(spec: dict, d: int) -> float:

@@ -51,16 +51,16 @@ def exceedance_entry(bound: str, threshold: float, probability, lower, upper, me
             "flags": [flag] if flag else [], "note": sentence + (f"; {flag}" if flag else "")}
 
 
-def exceedance_from_runs(values: np.ndarray, defined: np.ndarray, thresholds: list[dict], draws: Independent = Independent(),
+def exceedance_from_runs(values: np.ndarray, defined: np.ndarray, thresholds: list[dict], sampling: Independent = Independent(),
                          info: dict | None = None, units: str = "") -> list[dict]:
     """[{above|below, probability, lower, upper, method, flags, note}] over the runs where `defined` (bool (N,),
-    design order) holds; `draws`, `info`: how the design drew its points (analysis.proportions); `units`:
+    design order) holds; `sampling`, `info`: how the design drew its points (analysis.proportions); `units`:
     the quantity's, for the unit-slip flag (`unit_slip`)."""
     found = []
     for item in thresholds:
         (bound, threshold), = item.items()
         beyond = _beyond(values, bound, threshold) & defined
-        p = draws.proportion(beyond, defined, info or {}, CONFIDENCE, event=f"{bound} {threshold:g}")
+        p = sampling.proportion(beyond, defined, info or {}, CONFIDENCE, event=f"{bound} {threshold:g}")
         slip = unit_slip(values[defined], threshold, units)
         flag = slip or (f"fewer than {RARE_COUNT} runs exceed: a rare-event extrapolation from the runs, run more "
                         "to resolve it (or a rare-event design)" if int(beyond.sum()) < RARE_COUNT else None)

@@ -1,7 +1,7 @@
 """The probability that a run does something (fails; a quantity exceeds a threshold), from a sampled
 design's runs, with an interval only where one holds for how the design drew its points.
 
-How the points were drawn (`DesignKind.draws`, one of the strategies below, with the design's recorded info):
+How the points were drawn (`DesignKind.sampling`, one of the strategies below, with the design's recorded info):
 - independent (monte_carlo): k/n and the Wilson score interval.
 - pick_freeze: Saltelli's rows [A; B; AB_1 … AB_d] repeat each other's coordinates (AB_i is A with B's
   i-th column), so the proportion and its Wilson interval are those of the 2n rows A and B alone; they
@@ -29,7 +29,7 @@ from .failures import wilson_interval
 
 class Independent:
     """Independent draws (monte_carlo): how a sampled design's runs count for a proportion; each design kind
-    carries one of these strategies (`designs.DesignKind.draws`), the subclasses below being the others."""
+    carries one of these strategies (`designs.DesignKind.sampling`), the subclasses below being the others."""
 
     independent = True  # the runs are independent draws of the law
 

@@ -448,7 +448,7 @@ def _note_runs(store: ResultStore, stats: Statistics, sampled: bool, allow_alias
     done = status != Status.PENDING
     failed = status[done] > 0
     if sampled:
-        found = DESIGNS[stats.design_kind].draws.proportion(status > 0, done, stats.design_info, event="failed")
+        found = DESIGNS[stats.design_kind].sampling.proportion(status > 0, done, stats.design_info, event="failed")
         stats.failure_probability = {**{k: found[k] for k in ("estimate", "lower", "upper", "n_effective")},
                                      "method": found["sentence"]}
     else:
@@ -932,7 +932,7 @@ def _reference_floor(reference: Statistics, ref: OutputStatistics, out: OutputSt
                 "kld_floor": _kld_floor(reference, ref, out), "floor_note": note + KLD_FLOOR_NOTE}
     if reference.from_runs and ref.fourth_central is not None:
         floors = floors_from_moments(ref.mean, ref.variance, ref.fourth_central, reference.completed)
-        qmc = not getattr(DESIGNS[reference.design_kind].draws, "independent", False)  # a grid's too
+        qmc = not getattr(DESIGNS[reference.design_kind].sampling, "independent", False)  # a grid's too
         note = (f"reference: {reference.completed} {reference.design_kind} runs; floor = its standard errors "
                 "(σ/√N for the mean, the distribution-free s.e. of the variance)"
                 + ("; QMC converges faster than this Monte Carlo floor, so it is an upper bound" if qmc else ""))
@@ -1017,7 +1017,7 @@ def quantity_statistics(store: ResultStore, stats: Statistics, name: str, germs:
     if out.pce is None and not sampled:  # auto's runs' own statistics on a grid: the weighted runs
         exceedance = _grid_exceedance(values, defined, store.weights, thresholds, units)
     elif out.pce is None:
-        exceedance = exceedance_from_runs(values, defined, thresholds, DESIGNS[stats.design_kind].draws,
+        exceedance = exceedance_from_runs(values, defined, thresholds, DESIGNS[stats.design_kind].sampling,
                                           stats.design_info, units)
     else:
         exceedance = exceedance_from_pce(out.pce.sample(options.band_samples, options.seed)[:, 0],

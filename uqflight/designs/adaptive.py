@@ -256,7 +256,7 @@ class AdaptiveSparseGrid(DesignKind):
     kind = "adaptive_sparse_grid"
     keys = {"rule": Key(), "budget": count(1), "tolerance": number("a number >= 0", lambda v: 0 <= v < float("inf"))}
     example = {"kind": "adaptive_sparse_grid", "budget": 50, "tolerance": 1e-4}
-    draws = None
+    sampling = None
     adaptive = True
 
     def size(self, spec, germs):

@@ -69,11 +69,11 @@ class DesignKind:
         and the key reference lists them.
     example : dict
         A small `design:` mapping of this kind (help text and tests).
-    draws : analysis.proportions.Independent or None
-        How its random points count as draws for a proportion's interval; None for a grid (its weights hold
-        only all together) and for a rare-event design.
+    sampling : analysis.proportions.Independent or None
+        How its points were sampled, which says how they count as draws for a proportion's interval; None for
+        a grid (its weights hold only all together) and for a rare-event design.
     sampled : bool
-        `draws` is not None: its moments are sample averages, valid on any subset of runs.
+        `sampling` is not None: its moments are sample averages, valid on any subset of runs.
     sobol_from_runs : bool
         Its runs give Sobol' indices themselves (pick-freeze estimators), without a PCE.
     adaptive : bool
@@ -98,7 +98,7 @@ class DesignKind:
     kind: ClassVar[str]
     keys: ClassVar[dict[str, Key]] = {}
     example: ClassVar[dict]
-    draws: ClassVar[Independent | None] = Independent()
+    sampling: ClassVar[Independent | None] = Independent()
     sampled: ClassVar[bool] = True
     sobol_from_runs: ClassVar[bool] = False
     adaptive: ClassVar[bool] = False
@@ -107,7 +107,7 @@ class DesignKind:
 
     def __init_subclass__(cls, **kwargs):
         super().__init_subclass__(**kwargs)
-        cls.sampled = cls.draws is not None
+        cls.sampled = cls.sampling is not None
         if "kind" in vars(cls):
             REGISTRY[cls.kind] = cls()
 

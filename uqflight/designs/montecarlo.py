@@ -71,7 +71,7 @@ class Sobol(DesignKind):
     kind = "sobol"
     keys = {"samples": count(1), "scramble": flag(True), "replicates": count(1, default=1)}
     example = {"kind": "sobol", "samples": 64}
-    draws = Net()
+    sampling = Net()
 
     def size(self, spec, germs):
         n, replicates = self.given(spec, "samples"), self.given(spec, "replicates")
@@ -107,7 +107,7 @@ class Halton(DesignKind):
     kind = "halton"
     keys = {"samples": count(1), "scramble": flag(True)}
     example = {"kind": "halton", "samples": 64}
-    draws = Net()
+    sampling = Net()
 
     def points(self, settings, germs, seed):
         from scipy.stats import qmc
@@ -137,7 +137,7 @@ class LatinHypercube(DesignKind):
     kind = "latin_hypercube"
     keys = {"samples": count(1)}
     example = {"kind": "latin_hypercube", "samples": 64}
-    draws = Stratified()
+    sampling = Stratified()
 
     def points(self, settings, germs, seed):
         from scipy.stats import qmc

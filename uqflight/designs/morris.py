@@ -248,7 +248,7 @@ class Morris(DesignKind):
     kind = "morris"
     keys = {"trajectories": count(2), "levels": count(2, default=4)}
     example = {"kind": "morris", "trajectories": 4}
-    draws = Points()
+    sampling = Points()
     not_draws = NOT_DRAWS
     screening = staticmethod(morris_screening)
     info_problem = staticmethod(info_problem)

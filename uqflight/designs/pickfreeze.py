@@ -39,7 +39,7 @@ class PickFreeze(DesignKind):
     kind = "pick_freeze"
     keys = {"samples": count(1)}
     example = {"kind": "pick_freeze", "samples": 16}
-    draws = proportions.PickFreeze()
+    sampling = proportions.PickFreeze()
     sobol_from_runs = True
 
     def size(self, spec, germs):

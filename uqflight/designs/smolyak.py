@@ -124,7 +124,7 @@ class SparseGrid(DesignKind):
     kind = "sparse_grid"
     keys = {"level": count(0), "rule": Key(), "nested": flag(None), "growth": choice(rule_catalog.GROWTHS, "linear")}
     example = {"kind": "sparse_grid", "level": 2}
-    draws = None
+    sampling = None
 
     def size(self, spec, germs):
         """The points the combination technique builds before merging the tensor rules' shared points

@@ -25,7 +25,7 @@ class TensorGrid(DesignKind):
     kind = "tensor_grid"
     keys = {"rule": Key(), "points": count(1)}
     example = {"kind": "tensor_grid", "points": 4}
-    draws = None
+    sampling = None
 
     def size(self, spec, germs):
         """points^d (a float: it may be far beyond any integer a run could reach)."""

@@ -139,7 +139,7 @@ class RareDesign(DesignKind):
     exact probability on the issue's closed-form problems, issue 46). The weights are equal and mean nothing:
     the runs are not draws of the input law."""
 
-    draws = None
+    sampling = None
     adaptive = rare = True
 
     def size(self, spec, germs):
