@@ -10,6 +10,7 @@ from typing import List, Optional
 import typer
 
 from ..cli.arguments import check_campaign_file, check_output, check_results_file
+from ..text import Refusal
 from ..text.console import echo, one_line, refuse, quoted_name
 from ..running.progress import Progress
 
@@ -62,7 +63,7 @@ def calibrate_command(
 
     Exit 0: done; 2: bad input (data, options, results file, data times outside the surrogate's); 3: the chain did not converge (nothing written; the message says what to change); 130: interrupted (Ctrl-C).
     """  # noqa: E501
-    from .likelihood import DataError, parse_noise
+    from .likelihood import parse_noise
     from .size import campaign_memory_limit, check_size
 
     check_results_file(results)
@@ -80,11 +81,11 @@ def calibrate_command(
     try:  # before the sampler's and the surrogate's modules are even imported: a refusal is immediate
         sigmas = parse_noise(list(noise))
         check_size(data, list(output) or None, walkers, steps, predictive_draws, campaign_memory_limit(results))
-    except DataError as exc:
+    except Refusal as exc:
         refuse(f"{exc}")
     known = _truth(truth, results)
     from ..running.runner import WorkerError
-    from .run import NotConverged, SurrogateError, calibrate
+    from .run import NotConverged, calibrate
 
     streams, previous = (sys.stdout, sys.stderr), signal.signal(signal.SIGINT, _interrupted)
     try:
@@ -96,7 +97,7 @@ def calibrate_command(
         sys.stdout, sys.stderr = streams
         echo(f"\ninterrupted: no calibration written to {out}", err=True)
         raise typer.Exit(EXIT_INTERRUPTED)
-    except (DataError, SurrogateError, ValueError) as exc:
+    except ValueError as exc:  # a Refusal, or a setting the sampler refuses (--steps, --walkers)
         refuse(f"{exc}")
     except WorkerError as exc:  # no simulator for the predictive runs (the model cannot be built or hangs)
         refuse(f"{results}: the posterior predictive runs cannot be flown: {exc}")
@@ -145,7 +146,7 @@ def calibrate_command(
 def _truth(items: list[str], results: Path) -> dict[str, float] | None:
     """--truth NAME=VALUE items as {name: value}; exit 2 for a malformed item, a repeated or unknown name."""
     from ..store import ResultStore
-    from .likelihood import DataError, check_names, parse_pairs
+    from .likelihood import check_names, parse_pairs
 
     if not items:
         return None
@@ -157,7 +158,7 @@ def _truth(items: list[str], results: Path) -> dict[str, float] | None:
     try:
         return check_names(parse_pairs(items, "--truth", "NAME=VALUE with a finite VALUE"), "--truth", names,
                            f"the parameters of {results}")
-    except DataError as exc:
+    except Refusal as exc:
         refuse(f"{exc}")
 
 

@@ -611,8 +611,8 @@ def surrogate_export(
     """Export the PCE of every output over time as JSON: germs, multi-indices, coefficients per output
     and time, the parameters' distributions (name, distribution, lower, upper, nominal), the time
     grid, method and order. Load it in Python with uqflight.analysis.surrogate.load(path).evaluate(kappa)."""
-    from ..analysis.statistics import BadInput
-    from ..analysis.surrogate import SurrogateError, export
+    from ..analysis.surrogate import export
+    from ..text import Refusal
 
     try:
         override = parse_method_option(method)
@@ -623,7 +623,7 @@ def surrogate_export(
     try:
         with Progress(0, label="surrogate export") as progress:
             export(results, out, override, progress)
-    except (SurrogateError, BadInput) as exc:
+    except Refusal as exc:  # BadInput among them
         refuse(f"{exc}")
     except (OSError, KeyError, ValueError) as exc:
         refuse(f"{results}: cannot export the surrogate ({' '.join(str(exc).split())})")
