@@ -24,7 +24,8 @@ from conftest import CLOSED_FORMS, NORMAL_2D, UQFLIGHT, cli_in_process, closed_f
 from typer.testing import CliRunner
 
 from uqflight.calibration.command import register
-from uqflight.calibration.likelihood import (DataError, FlightData, LogPosterior, interpolate_in_time, parse_noise,
+from uqflight.text import Refusal
+from uqflight.calibration.likelihood import (FlightData, LogPosterior, interpolate_in_time, parse_noise,
                                              read_flight_csv)
 from uqflight.calibration import sampler as sampler_module
 from uqflight.calibration.sampler import CHECK_EVERY, FIRST_CHECK, sample, split_rhat
@@ -229,7 +230,7 @@ def test_time_interpolation_is_linear_and_refuses_extrapolation():
     values = np.array([[0.0, 2.0, 6.0], [1.0, 1.0, 1.0]])  # 2t and a constant
     np.testing.assert_allclose(interpolate_in_time(values, source, np.array([0.5, 2.0, 3.0])),
                                [[1.0, 4.0, 6.0], [1.0, 1.0, 1.0]])
-    with pytest.raises(DataError, match="outside"):
+    with pytest.raises(Refusal, match="outside"):
         interpolate_in_time(values, source, np.array([-0.1, 1.0]))
 
 
@@ -480,7 +481,7 @@ def test_a_byte_order_mark_is_no_part_of_the_header(tmp_path):
 
 
 def test_a_noise_given_twice_is_refused(one_output, tmp_path):
-    with pytest.raises(DataError, match=r"--noise y: given twice \(0\.01 and 5\); give it once"):
+    with pytest.raises(Refusal, match=r"--noise y: given twice \(0\.01 and 5\); give it once"):
         parse_noise(["y=0.01", "y=5"])
     data = tmp_path / "flight.csv"
     data.write_text("time_s,y\n0,15000\n0.5,15001\n1,15002\n")
@@ -499,12 +500,12 @@ def test_the_python_api_hands_the_noise_to_the_core_as_numbers(one_output, tmp_p
                            ({"y": float("nan")}, "--noise y: expected SIGMA > 0 (a finite number), got nan"),
                            ({"y": "0.5"}, "--noise y: expected SIGMA > 0 (a finite number), got '0.5'"),
                            ({"w": 0.5}, "--noise w: not one of the calibrated outputs (y)")):
-        with pytest.raises(DataError) as refused:
+        with pytest.raises(Refusal) as refused:
             check_noise(noise, ["y"])
         assert str(refused.value) == message
     data = tmp_path / "flight.csv"
     data.write_text("time_s,y\n0,15000\n0.5,15001\n1,15002\n")
-    with pytest.raises(DataError, match=r"^--noise w: not one of the calibrated outputs \(y\)$"):
+    with pytest.raises(Refusal, match=r"^--noise w: not one of the calibrated outputs \(y\)$"):
         uqflight.calibrate(one_output, data, tmp_path / "out", noise={"w": 0.5})
     assert not (tmp_path / "out").exists()
 

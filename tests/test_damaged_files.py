@@ -14,7 +14,8 @@ from uqflight.running.runner import run_campaign
 from uqflight.report.loading import load_entries
 from uqflight.analysis.statistics import BadInput, read_statistics
 from uqflight.store import CorruptFile, ResultStore
-from uqflight.analysis.surrogate import MAX_FILE_BYTES, SurrogateError, load
+from uqflight.analysis.surrogate import MAX_FILE_BYTES, load
+from uqflight.text import Refusal
 
 N, T = 12, 5000
 CAMPAIGN = f"""
@@ -216,7 +217,7 @@ def surrogate_text(tmp_path_factory):
 def test_a_damaged_surrogate_file_is_refused_naming_what_is_wrong(surrogate_text, tmp_path, name):
     import json
 
-    from uqflight.analysis.surrogate import SurrogateError, load
+    from uqflight.analysis.surrogate import load
 
     edit, message = SURROGATE_DAMAGES[name]
     data = json.loads(surrogate_text)
@@ -224,10 +225,10 @@ def test_a_damaged_surrogate_file_is_refused_naming_what_is_wrong(surrogate_text
     edit(data)
     path = tmp_path / "pce.json"
     path.write_text(json.dumps(data))
-    with pytest.raises(SurrogateError, match=rf"pce\.json: malformed surrogate \(.*{message}"):
+    with pytest.raises(Refusal, match=rf"pce\.json: malformed surrogate \(.*{message}"):
         load(path)
     path.write_text('{"format": "uqflight-pce", "germs": ' + "[" * 100000)
-    with pytest.raises(SurrogateError, match="cannot read the surrogate"):
+    with pytest.raises(Refusal, match="cannot read the surrogate"):
         load(path)
 
 
@@ -297,7 +298,7 @@ def test_hostile_surrogate_files_are_refused_naming_the_key(surrogate_text, tmp_
         data = json.loads(surrogate_text)
         edit(data)
         path.write_text(json.dumps(data))
-    with pytest.raises(SurrogateError, match=rf"pce\.json: malformed surrogate \(ValueError: {message}"):
+    with pytest.raises(Refusal, match=rf"pce\.json: malformed surrogate \(ValueError: {message}"):
         load(path)
 
 
@@ -306,6 +307,6 @@ def test_a_surrogate_file_above_the_cap_is_refused_before_it_is_read(tmp_path):
     path = tmp_path / "big.json"
     with open(path, "wb") as fh:  # sparse: nothing is written, and parsing it would fail otherwise
         fh.truncate(MAX_FILE_BYTES + 1)
-    with pytest.raises(SurrogateError, match=r"big\.json: cannot read the surrogate \(64 MiB, more than the 64 MiB"):
+    with pytest.raises(Refusal, match=r"big\.json: cannot read the surrogate \(64 MiB, more than the 64 MiB"):
         load(path)
 

@@ -115,7 +115,8 @@ def test_correlated_normals_on_a_gauss_hermite_grid_are_exact(tmp_path):
     # the exported surrogate evaluates at physical values through the inverse Nataf transform
     from uqflight.campaign.record import read_record
     from uqflight.store import ResultStore
-    from uqflight.analysis.surrogate import SurrogateError, export, load
+    from uqflight.analysis.surrogate import export, load
+    from uqflight.text import Refusal
 
     pce = load(export(path, tmp_path / "pce.json"))
     kappa = to_physical(result_parameters(path), xi, GaussianCopula(("x1", "x2"), [[1, RHO], [RHO, 1]]))
@@ -123,7 +124,7 @@ def test_correlated_normals_on_a_gauss_hermite_grid_are_exact(tmp_path):
     data = json.loads((tmp_path / "pce.json").read_text())
     data["dependence"]["correlation"] = [[1.0, 0.6], [0.5, 1.0]]  # hand-edited: refused, naming the key
     (tmp_path / "bad.json").write_text(json.dumps(data))
-    with pytest.raises(SurrogateError, match=r"dependence\.correlation\[0\]\[1\]: expected a symmetric matrix"):
+    with pytest.raises(Refusal, match=r"dependence\.correlation\[0\]\[1\]: expected a symmetric matrix"):
         load(tmp_path / "bad.json")
     # reading the results rebuilds the transform from the stored campaign text, running no campaign code
     with ResultStore.open(path) as store:

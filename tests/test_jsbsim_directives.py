@@ -19,7 +19,8 @@ from test_path_safety import home  # noqa: F401 - the sentinel folder holding on
 
 from uqflight.simulators import make_simulator
 from uqflight.simulators.aircraft import AircraftFiles, AircraftUnsafe, jsbsim_root, locate
-from uqflight.simulators.scenarios.script import ScriptError, ScriptFile, jsbsim_scripts
+from uqflight.simulators.base import SimulatorSettingError
+from uqflight.simulators.scenarios.script import ScriptFile, jsbsim_scripts
 
 CRUISE = jsbsim_scripts() / "c172_cruise_8K.xml"  # c172x, its reset01 from the aircraft folder
 RUN = '<run start="0.0" end="40" dt="0.0083333">'
@@ -294,7 +295,7 @@ def test_the_step_count_is_bounded_where_it_is_computed(tmp_path):
 
     hostile_script(tmp_path, run='<run start="0" end="100000" dt="0.000001">')
     script = ScriptFile.read(tmp_path / "hostile.xml")
-    with pytest.raises(ScriptError, match=f"more than {MAX_STEPS}"):
+    with pytest.raises(SimulatorSettingError, match=f"more than {MAX_STEPS}"):
         script.times()
     assert len(ScriptFile.read(jsbsim_scripts() / "ball_orbit.xml").times(10.0)) == 2001  # 10 s at dt = 0.005
 

@@ -14,7 +14,8 @@ from uqflight.running.runner import run_campaign
 from uqflight.simulators.aircraft import AircraftFiles
 from uqflight.simulators.jsbsim import REPO_ROOT, quiet_jsbsim
 from uqflight.simulators.validation_view import validation_view
-from uqflight.simulators.patch import PatchError, PreparedAircraft
+from uqflight.simulators.base import SimulatorSettingError
+from uqflight.simulators.patch import PreparedAircraft
 from uqflight.simulators.aero_factors import AeroFactor, aero_factors, axis_factor
 
 # Floating point: the patched function is fl(fl(ΔC·qbar·S[·l]) + f), so (patched - f) differs from
@@ -117,7 +118,7 @@ def test_offset_on_a_function_outside_the_axes_is_refused_naming_it(tmp_path):
     refused = cli_in_process("simulate", "--aircraft", "c172p", "--offset", "kCLge=0.01", cwd=tmp_path)
     assert refused.returncode == 2
     assert "aero/function/kCLge" in refused.stderr and "offset_value" in refused.stderr
-    with pytest.raises(PatchError, match=r"aero/function/kCLge.*outside the <axis> elements"):
+    with pytest.raises(SimulatorSettingError, match=r"aero/function/kCLge.*outside the <axis> elements"):
         PreparedAircraft("c172p", patches=[("kCLge", "offset")])
     path = _campaign(tmp_path, "  G: {function: aero/function/kCLge, perturbation: offset, distribution: normal, "
                                "lower: -0.01, upper: 0.01}\n")

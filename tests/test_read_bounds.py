@@ -141,8 +141,9 @@ def test_flight_data_is_bounded_in_bytes_and_a_regular_file(decay_results, tmp_p
 def test_a_surrogate_is_loaded_only_from_a_bounded_regular_file(tmp_path):
     """The sibling in `uqflight.analysis.surrogate.load`: a FIFO made its open wait for a writer for ever, /dev/zero was
     read up to the bound. Each is refused before a byte is read, naming the file."""
-    from uqflight.analysis.surrogate import SurrogateError, load
+    from uqflight.analysis.surrogate import load
+    from uqflight.text import Refusal
 
     for path, said in unbounded_inputs(tmp_path).items():
-        with pytest.raises(SurrogateError, match=re.escape(f"{path}: cannot read the surrogate (") + ".*" + re.escape(said)):
+        with pytest.raises(Refusal, match=re.escape(f"{path}: cannot read the surrogate (") + ".*" + re.escape(said)):
             load(path)

@@ -228,7 +228,7 @@ def export_surrogate(results, out, method=None):
 
     Raises
     ------
-    uqflight.analysis.surrogate.SurrogateError
+    uqflight.text.Refusal
         Naming the file and why no surrogate can be made.
     """
     from .analysis.surrogate import export
@@ -253,7 +253,7 @@ def load_surrogate(path):
 
     Raises
     ------
-    SurrogateError
+    uqflight.text.Refusal
         Naming the file and the key that is wrong.
     """
     from .analysis.surrogate import load
@@ -354,7 +354,7 @@ def calibrate(results, data, out, noise: dict | None = None, outputs: list[str] 
 
     Raises
     ------
-    DataError, SurrogateError, ValueError
+    uqflight.text.Refusal, ValueError
         Bad input, naming what is wrong.
     NotConverged
         `.diagnostics["problems"]` says what to change (`uqflight.calibration.run`).

@@ -49,6 +49,7 @@ from .sobol import NEGLIGIBLE, UNRESOLVED_WIDTH, complete_rows, pick_freeze_indi
 from ..campaign.record import CampaignRecord, check_design_info, read_record
 from ..campaign.schema import CampaignError
 from ..quantities import quantity_unit
+from ..text import Refusal
 from ..text.console import quoted_name
 from ..designs import REGISTRY as DESIGNS
 from ..designs.adaptive import index_set_summary
@@ -74,7 +75,7 @@ BAND_LEVEL = 0.99
 JSBSIM_RESOLUTION = 1e-9
 
 
-class BadInput(ValueError):
+class BadInput(Refusal):
     """A results file, baseline or request that cannot give right numbers; the message is one line that
     names the file and says what to do."""
 

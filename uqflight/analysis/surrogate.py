@@ -23,6 +23,7 @@ from pathlib import Path
 import numpy as np
 
 from ..methods import MethodSpec
+from ..text import Refusal
 from ..text.bounded import read_bounded
 from ..text.console import listed
 from ..text.console import quoted_name, quoted_value
@@ -30,11 +31,6 @@ from ..text.console import quoted_name, quoted_value
 FORMAT = "uqflight-pce"
 VERSION = 1
 MAX_FILE_BYTES = 64 << 20  # 64 MiB of JSON (about 3 million coefficients); parsing takes about 10 times that
-
-
-class SurrogateError(ValueError):
-    """A results file or method that gives no usable surrogate, or a malformed surrogate file; the message
-    names the file (and the key) and says what to do."""
 
 
 @dataclass
@@ -172,8 +168,8 @@ def export(results, out, method: dict | None = None, progress=None) -> Path:
         progress.stage(f"writing {out}")
     text = json.dumps(data, allow_nan=False) + "\n"
     if len(text) > MAX_FILE_BYTES:
-        raise SurrogateError(f"{results}: the surrogate takes {len(text) / 2**20:.0f} MiB of JSON, more than the "
-                             f"{MAX_FILE_BYTES >> 20} MiB that load() reads; export a lower order (--method KIND:ORDER)")
+        raise Refusal(f"{results}: the surrogate takes {len(text) / 2**20:.0f} MiB of JSON, more than the "
+                      f"{MAX_FILE_BYTES >> 20} MiB that load() reads; export a lower order (--method KIND:ORDER)")
     out = Path(out)
     tmp = out.with_name(out.name + ".part")
     try:
@@ -186,7 +182,7 @@ def export(results, out, method: dict | None = None, progress=None) -> Path:
 
 
 def load(path) -> Surrogate:
-    """The surrogate written by `export` (or `uqflight surrogate export`); SurrogateError, naming the
+    """The surrogate written by `export` (or `uqflight surrogate export`); Refusal, naming the
     file and the key, for anything else (a damaged or hand-edited file is never evaluated): a file
     above MAX_FILE_BYTES (refused before it is read), numbers that are strings, booleans or out of
     range, multi-indices that are not integers in [0, MAX_DEGREE] or repeat a row, laws whose germ is
@@ -194,13 +190,13 @@ def load(path) -> Surrogate:
     try:
         data = json.loads(read_bounded(path, MAX_FILE_BYTES, "a surrogate"))
     except (OSError, ValueError, RecursionError) as exc:
-        raise SurrogateError(f"{path}: cannot read the surrogate ({exc})") from exc
+        raise Refusal(f"{path}: cannot read the surrogate ({exc})") from exc
     if not isinstance(data, dict) or data.get("format") != FORMAT:
-        raise SurrogateError(f"{path}: not a uqflight PCE surrogate (format {FORMAT!r})")
+        raise Refusal(f"{path}: not a uqflight PCE surrogate (format {FORMAT!r})")
     try:
         return _checked(data)
     except (KeyError, TypeError, ValueError, AttributeError) as exc:
-        raise SurrogateError(f"{path}: malformed surrogate ({type(exc).__name__}: {exc})") from exc
+        raise Refusal(f"{path}: malformed surrogate ({type(exc).__name__}: {exc})") from exc
 
 
 def _checked(data: dict) -> Surrogate:

@@ -9,8 +9,9 @@ from typing import List, Optional
 
 import typer
 
-from ..cli.arguments import check_campaign_file, check_output, check_results_file
-from ..text.console import echo, one_line, refuse, quoted_name
+from ..cli.arguments import RefusingGroup, check_campaign_file, check_output, check_results_file
+from ..text import Refusal
+from ..text.console import echo, one_line, quoted_name
 from ..running.progress import Progress
 
 EXIT_NOT_CONVERGED = 3
@@ -62,7 +63,7 @@ def calibrate_command(
 
     Exit 0: done; 2: bad input (data, options, results file, data times outside the surrogate's); 3: the chain did not converge (nothing written; the message says what to change); 130: interrupted (Ctrl-C).
     """  # noqa: E501
-    from .likelihood import DataError, parse_noise
+    from .likelihood import parse_noise
     from .size import campaign_memory_limit, check_size
 
     check_results_file(results)
@@ -71,20 +72,18 @@ def calibrate_command(
     check_output(out, "--out", folder=True, create=True)
     overwritten = foreign_outputs(out)
     if overwritten:
-        refuse(f"--out {out}: holds {', '.join(overwritten)}, which a calibration would replace and which "
-             "an earlier calibration did not write (no posterior.h5 of one there); choose another --out, or move "
-             "them away")
+        raise Refusal(f"--out {out}: holds {', '.join(overwritten)}, which a calibration would replace and which "
+                      "an earlier calibration did not write (no posterior.h5 of one there); choose another --out, or "
+                      "move them away")
     method, order = _method(method, order)
     if predictive_draws < 1:
-        refuse(f"--predictive-draws: expected an integer >= 1, got {predictive_draws}")
-    try:  # before the sampler's and the surrogate's modules are even imported: a refusal is immediate
-        sigmas = parse_noise(list(noise))
-        check_size(data, list(output) or None, walkers, steps, predictive_draws, campaign_memory_limit(results))
-    except DataError as exc:
-        refuse(f"{exc}")
+        raise Refusal(f"--predictive-draws: expected an integer >= 1, got {predictive_draws}")
+    # before the sampler's and the surrogate's modules are even imported: a refusal is immediate
+    sigmas = parse_noise(list(noise))
+    check_size(data, list(output) or None, walkers, steps, predictive_draws, campaign_memory_limit(results))
     known = _truth(truth, results)
     from ..running.runner import WorkerError
-    from .run import NotConverged, SurrogateError, calibrate
+    from .run import NotConverged, calibrate
 
     streams, previous = (sys.stdout, sys.stderr), signal.signal(signal.SIGINT, _interrupted)
     try:
@@ -96,10 +95,12 @@ def calibrate_command(
         sys.stdout, sys.stderr = streams
         echo(f"\ninterrupted: no calibration written to {out}", err=True)
         raise typer.Exit(EXIT_INTERRUPTED)
-    except (DataError, SurrogateError, ValueError) as exc:
-        refuse(f"{exc}")
+    except Refusal:  # its message names the file or option
+        raise
+    except ValueError as exc:  # a setting the sampler refuses (--steps, --walkers)
+        raise Refusal(str(exc)) from exc
     except WorkerError as exc:  # no simulator for the predictive runs (the model cannot be built or hangs)
-        refuse(f"{results}: the posterior predictive runs cannot be flown: {exc}")
+        raise Refusal(f"{results}: the posterior predictive runs cannot be flown: {exc}") from exc
     except NotConverged as exc:
         echo("not converged: no posterior is reported.", err=True)
         for problem in exc.diagnostics["problems"]:
@@ -143,9 +144,9 @@ def calibrate_command(
 
 
 def _truth(items: list[str], results: Path) -> dict[str, float] | None:
-    """--truth NAME=VALUE items as {name: value}; exit 2 for a malformed item, a repeated or unknown name."""
+    """--truth NAME=VALUE items as {name: value}; a Refusal for a malformed item, a repeated or unknown name."""
     from ..store import ResultStore
-    from .likelihood import DataError, check_names, parse_pairs
+    from .likelihood import check_names, parse_pairs
 
     if not items:
         return None
@@ -153,16 +154,13 @@ def _truth(items: list[str], results: Path) -> dict[str, float] | None:
         with ResultStore.open(results) as store:
             names = list(store.parameter_names)
     except (OSError, ValueError) as exc:  # damaged, or held by another process (the message names it)
-        refuse(str(exc) if str(exc).startswith(str(results)) else f"{results}: {exc}")
-    try:
-        return check_names(parse_pairs(items, "--truth", "NAME=VALUE with a finite VALUE"), "--truth", names,
-                           f"the parameters of {results}")
-    except DataError as exc:
-        refuse(f"{exc}")
+        raise Refusal(str(exc) if str(exc).startswith(str(results)) else f"{results}: {exc}") from exc
+    return check_names(parse_pairs(items, "--truth", "NAME=VALUE with a finite VALUE"), "--truth", names,
+                       f"the parameters of {results}")
 
 
 def _method(text: str | None, order: int | None) -> tuple[str | None, int | None]:
-    """--method KIND[:ORDER] (the report's parser) and --order into (kind, order); exit 2 naming the option."""
+    """--method KIND[:ORDER] (the report's parser) and --order into (kind, order); a Refusal naming the option."""
     from ..methods.parsing import checked_order, parse_methods
 
     try:
@@ -170,9 +168,9 @@ def _method(text: str | None, order: int | None) -> tuple[str | None, int | None
             return None, None if order is None else checked_order(order)
         parsed = parse_methods([text], order)[0]
     except ValueError as exc:
-        refuse(f"{'--method' if text else '--order'}: {exc}")
+        raise Refusal(f"{'--method' if text else '--order'}: {exc}") from exc
     if order is not None and parsed.order != order:
-        refuse(f"--method {text} and --order {order} give two orders: give one")
+        raise Refusal(f"--method {text} and --order {order} give two orders: give one")
     return parsed.kind, parsed.order
 
 
@@ -188,8 +186,10 @@ _page = [None]  # writes OUT/report.html after a calibration (`register`'s page)
 
 
 def register(app: typer.Typer, page=None) -> None:
-    """Add the `calibrate` command to `app`; `page(out) -> Path`, when given, writes the calibration's
-    page into OUT (report.calibration_page, a layer above this one); without it, an earlier one stays."""
+    """Add the `calibrate` command to `app`, whose group becomes a `RefusingGroup` (the command's refusals
+    exit 2); `page(out) -> Path`, when given, writes the calibration's page into OUT
+    (report.calibration_page, a layer above this one); without it, an earlier one stays."""
     if page is not None:
         _page[0] = page
+    app.info.cls = RefusingGroup
     app.command("calibrate")(calibrate_command)

@@ -23,12 +23,9 @@ from typing import Callable
 import numpy as np
 
 from ..text.bounded import Refused, read_bounded
+from ..text import Refusal
 from ..text.console import listed, quoted_name
 from ..parameters.germs import GERMS, germ_columns
-
-
-class DataError(ValueError):
-    """Flight data or a noise setting that cannot be used; the message names the file or option."""
 
 
 MAX_DATA_BYTES = 64 << 20  # a flight data CSV (about 4 million cells): refused beyond, before it is read
@@ -56,67 +53,67 @@ def read_flight_csv(path, outputs: list[str] | None, available: list[str]) -> Fl
         text = read_bounded(path, MAX_DATA_BYTES, "flight data").decode("utf-8-sig")
         rows = list(csv.reader(io.StringIO(text, newline="")))
     except Refused as exc:
-        raise DataError(f"{path}: {exc}: {DATA_FORM}") from exc
+        raise Refusal(f"{path}: {exc}: {DATA_FORM}") from exc
     except (OSError, UnicodeDecodeError, csv.Error) as exc:
-        raise DataError(f"{path}: cannot read the file ({exc})") from exc
+        raise Refusal(f"{path}: cannot read the file ({exc})") from exc
     rows = [row for row in rows if any(cell.strip() for cell in row)]
     if len(rows) < 2:
-        raise DataError(f"{path}: expected a header (time_s, outputs...) and at least one row of data")
+        raise Refusal(f"{path}: expected a header (time_s, outputs...) and at least one row of data")
     header = [cell.strip() for cell in rows[0]]
     if "time_s" not in header:
-        raise DataError(f"{path}: no time_s column (header: {listed(header)})")
+        raise Refusal(f"{path}: no time_s column (header: {listed(header)})")
     if outputs is None:
         outputs = [name for name in header if name in available]
         if not outputs:
-            raise DataError(f"{path}: none of the columns {listed(h for h in header if h != 'time_s')} is an "
-                            f"output of the campaign ({listed(available)})")
+            raise Refusal(f"{path}: none of the columns {listed(h for h in header if h != 'time_s')} is an "
+                          f"output of the campaign ({listed(available)})")
     for name in outputs:
         if name not in available:
-            raise DataError(f"--output {quoted_name(name)}: not an output of the campaign ({listed(available)})")
+            raise Refusal(f"--output {quoted_name(name)}: not an output of the campaign ({listed(available)})")
         if name not in header:
-            raise DataError(f"{path}: no column {name!r} (header: {listed(header)})")
+            raise Refusal(f"{path}: no column {name!r} (header: {listed(header)})")
     table = np.full((len(rows) - 1, len(header)), np.nan)
     for i, row in enumerate(rows[1:], start=2):
         if len(row) != len(header):
-            raise DataError(f"{path}: line {i} has {len(row)} cells, the header {len(header)}")
+            raise Refusal(f"{path}: line {i} has {len(row)} cells, the header {len(header)}")
         for j, cell in enumerate(row):
             cell = cell.strip()
             if cell:
                 try:
                     table[i - 2, j] = float(cell)
                 except ValueError:
-                    raise DataError(f"{path}: line {i}, column {quoted_name(header[j])}: expected a number, "
-                                    f"got {cell!r}") from None
+                    raise Refusal(f"{path}: line {i}, column {quoted_name(header[j])}: expected a number, "
+                                  f"got {cell!r}") from None
     time = table[:, header.index("time_s")]
     if not np.all(np.isfinite(time)) or np.any(np.diff(time) <= 0):
-        raise DataError(f"{path}: time_s must be finite and strictly increasing")
+        raise Refusal(f"{path}: time_s must be finite and strictly increasing")
     values = {name: table[:, header.index(name)] for name in outputs}
     for name, column in values.items():
         if np.any(np.isinf(column)):
-            raise DataError(f"{path}: column {name!r} holds an infinite value")
+            raise Refusal(f"{path}: column {name!r} holds an infinite value")
         if not np.isfinite(column).any():
-            raise DataError(f"{path}: column {name!r} holds no value")
+            raise Refusal(f"{path}: column {name!r} holds no value")
     return FlightData(str(path), time, values)
 
 
 def parse_noise(pairs: list[str]) -> dict[str, float]:
-    """`--noise OUTPUT=SIGMA` items as {output: sigma} (SIGMA > 0, in the output's unit); DataError otherwise."""
+    """`--noise OUTPUT=SIGMA` items as {output: sigma} (SIGMA > 0, in the output's unit); Refusal otherwise."""
     return parse_pairs(pairs, "--noise", "OUTPUT=SIGMA with SIGMA > 0", positive=True)
 
 
 def check_noise(noise: dict, outputs: list[str]) -> dict[str, float]:
     """The known noise {output: sigma}: each output one of `outputs`, each sigma a finite number > 0;
-    DataError naming the output otherwise."""
+    Refusal naming the output otherwise."""
     for name, sigma in noise.items():
         if isinstance(sigma, bool) or not isinstance(sigma, (int, float)) or not math.isfinite(sigma) or sigma <= 0:
-            raise DataError(f"--noise {quoted_name(name)}: expected SIGMA > 0 (a finite number), got {sigma!r}")
+            raise Refusal(f"--noise {quoted_name(name)}: expected SIGMA > 0 (a finite number), got {sigma!r}")
     return check_names({str(name): float(sigma) for name, sigma in noise.items()}, "--noise", outputs,
                        "the calibrated outputs")
 
 
 def parse_pairs(pairs: list[str], option: str, form: str, positive: bool = False) -> dict[str, float]:
     """`NAME=VALUE` items of `option` as {name: value}: VALUE finite (and > 0 when `positive`), each NAME
-    once; DataError (naming `option` and `form`, what the items take) otherwise."""
+    once; Refusal (naming `option` and `form`, what the items take) otherwise."""
     values = {}
     for pair in pairs:
         name, sep, text = pair.partition("=")
@@ -126,18 +123,18 @@ def parse_pairs(pairs: list[str], option: str, form: str, positive: bool = False
         except ValueError:
             value = float("nan")
         if not sep or not name or not math.isfinite(value) or (positive and not value > 0):
-            raise DataError(f"{option}: expected {form}, got {pair!r}")
+            raise Refusal(f"{option}: expected {form}, got {pair!r}")
         if name in values:
-            raise DataError(f"{option} {quoted_name(name)}: given twice ({values[name]:g} and {value:g}); give it once")
+            raise Refusal(f"{option} {quoted_name(name)}: given twice ({values[name]:g} and {value:g}); give it once")
         values[name] = value
     return values
 
 
 def check_names(values: dict[str, float], option: str, names: list[str], among: str) -> dict[str, float]:
-    """`values` when every name is one of `names` (`among` says what they are); DataError otherwise."""
+    """`values` when every name is one of `names` (`among` says what they are); Refusal otherwise."""
     for name in values:
         if name not in names:
-            raise DataError(f"{option} {quoted_name(name)}: not one of {among} ({listed(names)})")
+            raise Refusal(f"{option} {quoted_name(name)}: not one of {among} ({listed(names)})")
     return values
 
 
@@ -148,8 +145,8 @@ def interpolate_in_time(values: np.ndarray, source: np.ndarray, target: np.ndarr
     span = source[-1] - source[0]
     slack = 1e-9 * max(span, 1.0)
     if target.min() < source[0] - slack or target.max() > source[-1] + slack:
-        raise DataError(f"data times {target.min():g} to {target.max():g} s reach outside the surrogate's "
-                        f"{source[0]:g} to {source[-1]:g} s: crop the data or run a longer campaign")
+        raise Refusal(f"data times {target.min():g} to {target.max():g} s reach outside the surrogate's "
+                      f"{source[0]:g} to {source[-1]:g} s: crop the data or run a longer campaign")
     t = np.clip(target, source[0], source[-1])
     if source.size == 1:
         return np.repeat(values[..., :1], t.size, axis=-1)

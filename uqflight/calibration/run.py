@@ -15,12 +15,12 @@ from threadpoolctl import threadpool_limits
 
 from ..parameters.germs import GERMS
 
-from .likelihood import DataError, LogPosterior, check_noise, interpolate_in_time, read_flight_csv
+from .likelihood import LogPosterior, check_noise, interpolate_in_time, read_flight_csv
 from .outputs import (OUTPUT_FILES, calibrated_campaign, corner_plot, draw_all, informed, marginal, marginals_plot,
                       predictive_plot, pyplot, write_json, write_posterior)
 from .sampler import sample
 from .size import MAX_STEPS, PREDICTIVE_NOISE_DRAWS, campaign_memory_limit, check_size
-from .surrogate import (CampaignError, SurrogateError, calibration_surrogate, check_campaign_text, portable_mapping,
+from .surrogate import (CampaignError, calibration_surrogate, check_campaign_text, portable_mapping,
                         parameter_specs, prior_summaries, simulate, to_physical, to_standard)
 
 TIME_HANDLING = ("PCE coefficients (and the surrogate's error variance) interpolated linearly in time "
@@ -56,8 +56,8 @@ def calibrate(results, data, out, outputs: list[str] | None = None, noise: dict[
     uqflight.running.progress.Progress) is told the stages and counts the sampler's steps. `steps`: exactly that
     many per walker, or None: until converged (calibration.sampler, at most MAX_STEPS).
 
-    Raises DataError / SurrogateError (bad input, data too large for memory: calibration.size),
-    ValueError (bad settings), NotConverged.
+    Raises a Refusal (bad input, data too large for memory: calibration.size), ValueError (bad settings),
+    NotConverged.
     One BLAS thread: the matrices are small (a few hundred rows), where several threads on a shared
     machine make the SVDs 10-100x slower."""
     check_size(data, outputs, walkers, steps, predictive_draws, campaign_memory_limit(results))  # before any work
@@ -402,4 +402,4 @@ def _full_rows(values: np.ndarray, kept_rows: np.ndarray) -> np.ndarray:
     return full
 
 
-__all__ = ["Calibration", "DataError", "NotConverged", "SurrogateError", "calibrate"]
+__all__ = ["Calibration", "NotConverged", "calibrate"]

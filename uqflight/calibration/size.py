@@ -15,7 +15,8 @@ from pathlib import Path
 
 from ..text.bounded import Refused, open_bounded
 from ..campaign.sections import Limits
-from .likelihood import DATA_FORM, MAX_DATA_BYTES, DataError
+from ..text import Refusal
+from .likelihood import DATA_FORM, MAX_DATA_BYTES
 
 DEFAULT_WALKERS = 32  # the fewest `calibrate` uses when --walkers is not given
 MAX_STEPS = 6000  # the longest an adaptive chain (no --steps) runs (calibration.sampler)
@@ -44,15 +45,15 @@ def campaign_memory_limit(results) -> float:
 
 def check_size(data, outputs: list[str] | None, walkers: int | None, steps: int | None, predictive_draws: int,
                max_memory_gb: float) -> None:
-    """DataError when the calibration of `data` would need more than `max_memory_gb`; reads the
+    """Refusal when the calibration of `data` would need more than `max_memory_gb`; reads the
     header and counts lines, nothing more."""
     path = Path(data)
     walkers, steps = walkers or DEFAULT_WALKERS, steps or MAX_STEPS  # an adaptive chain may take MAX_STEPS
     budget = max_memory_gb * 1e9
     chain = 8.0 * walkers * steps * 3  # the chain (and emcee's copy) of at least one parameter, its log-probability
     if chain > budget:
-        raise DataError(f"--walkers {walkers} x --steps {steps} keep a chain of about {chain / 1e9:.3g} GB, more than "
-                        f"the {max_memory_gb:g} GB memory limit (limits.max_memory_gb): run fewer --steps")
+        raise Refusal(f"--walkers {walkers} x --steps {steps} keep a chain of about {chain / 1e9:.3g} GB, more than "
+                      f"the {max_memory_gb:g} GB memory limit (limits.max_memory_gb): run fewer --steps")
     try:
         with open_bounded(path, MAX_DATA_BYTES, "flight data") as fh:
             header = fh.readline(1 << 20).decode("utf-8-sig", "replace")
@@ -67,10 +68,10 @@ def check_size(data, outputs: list[str] | None, walkers: int | None, steps: int 
                     return
                 rows += block.count(b"\n")
     except Refused as exc:
-        raise DataError(f"{path}: {exc}: {DATA_FORM}") from exc
+        raise Refusal(f"{path}: {exc}: {DATA_FORM}") from exc
     except OSError as exc:
-        raise DataError(f"{path}: cannot read the file ({exc.strerror or exc})") from exc
-    raise DataError(f"{path}: more than {most} rows of data: calibrating {count} output(s) with {walkers} walkers "
-                    f"and {predictive_draws} predictive draws takes about {per_row / 1e3:.0f} kB a row, more than the "
-                    f"{max_memory_gb:g} GB memory limit (limits.max_memory_gb) allows; thin the data to fewer "
-                    "times, calibrate fewer --output or take fewer --predictive-draws")
+        raise Refusal(f"{path}: cannot read the file ({exc.strerror or exc})") from exc
+    raise Refusal(f"{path}: more than {most} rows of data: calibrating {count} output(s) with {walkers} walkers "
+                  f"and {predictive_draws} predictive draws takes about {per_row / 1e3:.0f} kB a row, more than the "
+                  f"{max_memory_gb:g} GB memory limit (limits.max_memory_gb) allows; thin the data to fewer "
+                  "times, calibrate fewer --output or take fewer --predictive-draws")

@@ -30,12 +30,13 @@ from ..parameters import to_physical as _to_physical
 from ..parameters import to_standard as _to_standard
 from ..parameters.summaries import parameter_specs, prior_summaries
 from ..simulators.validation_view import validation_view
-from ..analysis.statistics import BadInput, Options, file_record, output_basis
+from ..analysis.statistics import Options, file_record, output_basis
 from ..store import ResultStore, Status
-from ..analysis.surrogate import SurrogateError, fit_surrogate
+from ..analysis.surrogate import fit_surrogate
+from ..text import Refusal
 from .likelihood import error_factors_of
 
-__all__ = ["CalibrationSurrogate", "CampaignError", "SurrogateError", "calibration_surrogate", "campaign_folder",
+__all__ = ["CalibrationSurrogate", "CampaignError", "calibration_surrogate", "campaign_folder",
            "check_campaign_text", "portable_mapping", "load_campaign_file", "parameter_specs", "prior_summaries",
            "simulate", "to_physical", "to_standard"]
 
@@ -112,26 +113,23 @@ def _record_of(store: ResultStore, results: Path, campaign_path: Path | None) ->
         try:
             text = read_bounded(campaign_path, MAX_FILE_BYTES, "a campaign").decode("utf-8")
         except (OSError, UnicodeDecodeError, Refused) as exc:
-            raise SurrogateError(f"--campaign: cannot read {campaign_path} ({exc})") from exc
+            raise Refusal(f"--campaign: cannot read {campaign_path} ({exc})") from exc
         if text != store.campaign_text:
-            raise SurrogateError(f"{campaign_path} is not the campaign {results} was run from (the texts differ)")
+            raise Refusal(f"{campaign_path} is not the campaign {results} was run from (the texts differ)")
         source = str(campaign_path)
-    try:
-        record = file_record(store, source)
-    except BadInput as exc:
-        raise SurrogateError(str(exc)) from exc
+    record = file_record(store, source)
     campaign = record.campaign
     module, _, _ = campaign.simulator.get("function", "").partition(":")
     if module.endswith(".py"):  # looked for, not imported
         folder = campaign_folder(campaign)
         if campaign_path is None and not (folder / module).resolve().is_relative_to(folder):
-            raise SurrogateError(f"{results}: simulator.function: the python model {module} is outside the results "
-                                 "file's folder, and a results file names only a model beside it; pass the campaign "
-                                 "file with --campaign to fly a model elsewhere")
+            raise Refusal(f"{results}: simulator.function: the python model {module} is outside the results "
+                          "file's folder, and a results file names only a model beside it; pass the campaign "
+                          "file with --campaign to fly a model elsewhere")
         if not (folder / module).is_file():
-            raise SurrogateError(f"the python model {module} that the posterior-predictive runs call is not beside "
-                                 f"{source}; pass the campaign file with --campaign (its model file is looked up "
-                                 "beside it)")
+            raise Refusal(f"the python model {module} that the posterior-predictive runs call is not beside "
+                          f"{source}; pass the campaign file with --campaign (its model file is looked up "
+                          "beside it)")
     return record
 
 
@@ -146,7 +144,7 @@ def calibration_surrogate(results, method: str | None = None, order: int | None 
     try:
         store = ResultStore.open(results)
     except (OSError, ValueError) as exc:  # CorruptFile's message names the file already
-        raise SurrogateError(str(exc) if str(exc).startswith(f"{results}:") else f"{results}: {exc}") from exc
+        raise Refusal(str(exc) if str(exc).startswith(f"{results}:") else f"{results}: {exc}") from exc
     with store:
         record = _record_of(store, results, Path(campaign_path) if campaign_path else None)
         campaign = record.campaign
@@ -155,17 +153,15 @@ def calibration_surrogate(results, method: str | None = None, order: int | None 
         kind = method or stored.kind
         order = (DEFAULT_ORDER if stored.order is None else stored.order) if order is None else order
         if kind not in METHOD_KINDS:
-            raise SurrogateError(f"--method: expected one of {', '.join(METHOD_KINDS)}, got {kind!r}")
+            raise Refusal(f"--method: expected one of {', '.join(METHOD_KINDS)}, got {kind!r}")
         ok = store.status == Status.OK
         names = store.output_names if outputs is None else outputs
         missing = [name for name in names if name not in store.output_names]
         if missing:
-            raise SurrogateError(f"{results} has no output {', '.join(map(repr, missing))} "
-                                 f"(it has {listed(store.output_names)})")
-        try:  # the statistics' own PCE, after their checks (pending or failed runs, aliasing, rank)
-            fitted = fit_surrogate(results, MethodSpec(kind, order), options=Options(band_samples=200, bootstrap=0))
-        except BadInput as exc:
-            raise SurrogateError(str(exc)) from exc
+            raise Refusal(f"{results} has no output {', '.join(map(repr, missing))} "
+                          f"(it has {listed(store.output_names)})")
+        # the statistics' own PCE, after their checks (pending or failed runs, aliasing, rank)
+        fitted = fit_surrogate(results, MethodSpec(kind, order), options=Options(band_samples=200, bootstrap=0))
         xi, weights = store.xi[ok], store.weights[ok]
         own = {name: fitted.indices[name] for name in names}
         indices = _union(list(own.values()))
@@ -180,7 +176,7 @@ def calibration_surrogate(results, method: str | None = None, order: int | None 
                 loo = loo_residuals(design, Y, error_weights)
                 relative[name] = relative_loo_error(design, Y, error_weights)
             except ValueError as exc:
-                raise SurrogateError(f"{results}: output {name!r}: {exc}") from exc
+                raise Refusal(f"{results}: output {name!r}: {exc}") from exc
             misfit = Y - design @ fitted.coefficients[name]
             coefficients[name] = _on_basis(indices, own[name], fitted.coefficients[name])
             curves = loo if error_weights @ (loo**2).sum(axis=1) >= error_weights @ (misfit**2).sum(axis=1) else misfit

@@ -417,12 +417,13 @@ def check_dependence_design(check: Checker, design_spec, copula: GaussianCopula 
 def patch_nominal(check: Checker, prop: str, path: str, aircraft) -> float:
     """The nominal of a property that asks for a patch itself (`aero/uq/offset/CDo`), checked as
     `function:` with `perturbation:` is."""
-    from ..simulators.patch import NOMINAL, PatchError, check_perturbation, patch_request
+    from ..simulators.base import SimulatorSettingError
+    from ..simulators.patch import NOMINAL, check_perturbation, patch_request
 
     try:
         function, perturbation = patch_request(prop, aircraft.functions)
         check_perturbation(function, perturbation, getattr(aircraft, "aero_factors", {}))
-    except PatchError as exc:
+    except SimulatorSettingError as exc:
         check.fail(path, f"{exc} (aircraft {aircraft.aircraft!r})")
     return NOMINAL[perturbation]
 
@@ -430,7 +431,8 @@ def patch_nominal(check: Checker, prop: str, path: str, aircraft) -> float:
 def function_property(check: Checker, spec: dict, path: str, kind: str, aircraft) -> str:
     """The property that scales or offsets `spec["function"]` (aero/uq/scale/NAME), checked
     against the aircraft's aerodynamic functions when the aircraft is known."""
-    from ..simulators.patch import PatchError, check_perturbation, patch_property, resolve_function
+    from ..simulators.base import SimulatorSettingError
+    from ..simulators.patch import check_perturbation, patch_property, resolve_function
 
     if not SIMULATORS[kind].aircraft:
         check.fail(f"{path}.function", "is for JSBSim aircraft; a python simulator's parameters have no functions")
@@ -450,11 +452,11 @@ def function_property(check: Checker, spec: dict, path: str, kind: str, aircraft
         return patch_property(function, perturbation)
     try:
         full = resolve_function(function, functions)
-    except PatchError as exc:
+    except SimulatorSettingError as exc:
         check.fail(f"{path}.function", f"{exc} (aircraft {aircraft.aircraft!r})")
     try:
         check_perturbation(full, perturbation, getattr(aircraft, "aero_factors", {}))
-    except PatchError as exc:
+    except SimulatorSettingError as exc:
         check.fail(f"{path}.perturbation", f"{exc} (aircraft {aircraft.aircraft!r})")
     return patch_property(full, perturbation, functions)
 

@@ -1,24 +1,40 @@
 """The command line's file arguments, checked before any work with one message for every command:
 an output whose folder is missing, is not a folder or cannot be written, and an input of the wrong
-kind, named for what it is ("r.h5 is a results file (HDF5), not a campaign file")."""
+kind, named for what it is ("r.h5 is a results file (HDF5), not a campaign file"); and the group every
+command runs in, which prints any refusal as that one message and exits 2 (`RefusingGroup`)."""
 from __future__ import annotations
 
 import os
 import stat
 from pathlib import Path
 
+import typer
+
+from ..text import Refusal
 from ..text.console import refuse
 
 CAMPAIGN_KEYS = ("simulator:", "parameters:", "design:")  # lines a campaign file starts
 
 
+class RefusingGroup(typer.core.TyperGroup):
+    """The group of the `uqflight` commands: a `Refusal` raised by any command or sub-command, or by an
+    option's parsing, is printed as one line, "error: MESSAGE", with exit 2 (`refuse`). The one place a
+    refusal becomes an exit code."""
+
+    def invoke(self, ctx):
+        try:
+            return super().invoke(ctx)
+        except Refusal as exc:
+            refuse(str(exc))
+
+
 def check_output(path: Path, option: str, folder: bool = False, create: bool = False, inputs=()) -> None:
-    """Exit 2 naming `option` when `path` cannot be written: a file (a folder with `folder`) whose
+    """A Refusal naming `option` when `path` cannot be written: a file (a folder with `folder`) whose
     folder exists and is writable; with `create`, missing folders are made later, under a writable one.
     `inputs`: the command's input files, which its output must not replace."""
     problem = output_problem(Path(path), folder, create, inputs)
     if problem:
-        refuse(f"{option} {path}: {problem}; choose another path")
+        raise Refusal(f"{option} {path}: {problem}; choose another path")
 
 
 def output_problem(path: Path, folder: bool = False, create: bool = False, inputs=()) -> str | None:
@@ -49,10 +65,10 @@ def output_problem(path: Path, folder: bool = False, create: bool = False, input
 
 
 def check_results_file(path: Path) -> None:
-    """Exit 2 unless `path` is an HDF5 file, naming what it is instead."""
+    """A Refusal unless `path` is an HDF5 file, naming what it is instead."""
     problem = results_problem(Path(path))
     if problem:
-        refuse(f"{problem}")
+        raise Refusal(problem)
 
 
 def results_problem(path: Path) -> str | None:
@@ -70,11 +86,11 @@ def results_problem(path: Path) -> str | None:
 
 
 def check_campaign_file(path: Path) -> None:
-    """Exit 2 when `path` is a results file given for a campaign file."""
+    """A Refusal when `path` is a results file given for a campaign file."""
     import h5py
 
     if Path(path).is_file() and h5py.is_hdf5(path):
-        refuse(f"{path} is a results file (HDF5), not a campaign file: `uqflight info {path}` describes it")
+        raise Refusal(f"{path} is a results file (HDF5), not a campaign file: `uqflight info {path}` describes it")
 
 
 def is_campaign_text(path: Path) -> bool:

@@ -31,9 +31,10 @@ from typing import List, Optional
 import numpy as np
 import typer
 
-from .arguments import check_campaign_file, check_output, check_results_file
+from .arguments import RefusingGroup, check_campaign_file, check_output, check_results_file
 from ..calibration.command import register as register_calibrate
-from ..text.console import EXIT_BAD_INPUT, echo, listed, one_line, refuse, quoted_name
+from ..text import Refusal
+from ..text.console import EXIT_BAD_INPUT, echo, listed, one_line, quoted_name
 from ..running import stopping
 from .fast_exit import exit_fast
 from ..running.progress import Progress
@@ -49,7 +50,7 @@ CONTEXT = {"help_option_names": ["-h", "--help"]}
 DEFAULT_CSV, DEFAULT_PLOT = Path("results/flight.csv"), Path("results/flight.png")
 # rich_markup_mode=None: help text is shown as written, so units such as [ft], [kt], [deg], [s] are
 # not swallowed as rich markup
-app = typer.Typer(help="Uncertainty quantification campaigns on a JSBSim flight-dynamics model.",
+app = typer.Typer(help="Uncertainty quantification campaigns on a JSBSim flight-dynamics model.", cls=RefusingGroup,
                   no_args_is_help=True, add_completion=False, context_settings=CONTEXT, rich_markup_mode=None)
 surrogate_app = typer.Typer(help="The PCE surrogate of a results file: export it as JSON.", no_args_is_help=True,
                             context_settings=CONTEXT, rich_markup_mode=None)
@@ -141,10 +142,7 @@ def simulate(
     settings = parse_settings(set_)
     sigmas = parse_settings(noise, "--noise")
     recorded = tuple(DEFAULT_OUTPUTS) + tuple(output)
-    try:
-        check_noise(recorded, sigmas, seed)
-    except ValueError as exc:
-        refuse(f"{exc}")
+    check_noise(recorded, sigmas, seed)
     files = [] if no_files else [(out, "--out"), (plot, "--plot")]
     for path, option in files:
         check_output(path, option, create=path in (DEFAULT_CSV, DEFAULT_PLOT))
@@ -167,7 +165,7 @@ def simulate(
         echo(f"flight failed: {exc}", err=True)
         raise typer.Exit(1)
     except (ValueError, KeyError, FileNotFoundError, RuntimeError) as exc:  # bad input; an aircraft JSBSim refuses
-        refuse(f"{exc.args[0]}")
+        raise Refusal(exc.args[0]) from exc
     echo(result.trim.describe())
     if flight.surface_warning:
         echo(f"warning: {flight.surface_warning}", err=True)
@@ -211,15 +209,11 @@ def _offset_lines(located, flight) -> list[str]:
 
 def _prepared(aircraft: str, scale: list[str], offset: list[str], offset_value: list[str] = ()):
     """The aircraft of `simulate`/`aircraft`, patched for --scale/--offset/--offset-value; `.settings`
-    holds the patch properties' values, `.pairs` (function, kind, property, value). Raises ValueError
-    (a bad pair or function, an aircraft file that is not XML) or FileNotFoundError."""
-    from ..simulators.aircraft import AircraftUnreadable
+    holds the patch properties' values, `.pairs` (function, kind, property, value). Raises a Refusal (a
+    bad function, an aircraft not found, an aircraft file that is not XML)."""
     from ..simulators.patch import PreparedAircraft, patch_property, resolve_function
 
-    try:
-        plain = PreparedAircraft(aircraft, Path.cwd())
-    except AircraftUnreadable as exc:
-        raise ValueError(str(exc)) from None
+    plain = PreparedAircraft(aircraft, Path.cwd())
     pairs = []
     for kind, items in (("scale", scale), ("offset", offset), ("offset_value", offset_value)):
         for name, value in parse_settings(items, "--" + kind.replace("_", "-")).items():
@@ -232,15 +226,12 @@ def _prepared(aircraft: str, scale: list[str], offset: list[str], offset_value: 
 
 
 def _load(path: Path):
-    """The validated campaign, or exit 2 with the validation message (no traceback)."""
-    from ..campaign import CampaignError, load_campaign
+    """The validated campaign; a CampaignError naming the file and the field."""
+    from ..campaign import load_campaign
     from ..simulators.validation_view import validation_view
 
     check_campaign_file(path)
-    try:
-        return load_campaign(path, view=validation_view)
-    except CampaignError as exc:
-        refuse(f"{exc}")
+    return load_campaign(path, view=validation_view)
 
 
 @app.command()
@@ -277,7 +268,7 @@ def plan(campaign_file: Path = typer.Argument(..., metavar="CAMPAIGN", help="Cam
     try:
         timed = timed_nominal(campaign)
     except WorkerError as exc:  # its message says it all (a hang, a crash, a build or nominal failure), as `run`'s
-        refuse(f"{campaign_file}: {exc}")
+        raise Refusal(f"{campaign_file}: {exc}") from exc
     for warning in timed.warnings:  # e.g. the excitation left the elevator unmoved
         echo(f"warning: the nominal flight: {one_line(warning)}", err=True)
     seconds = timed.seconds
@@ -315,9 +306,9 @@ def run(
     check_output(out or Path(campaign.storage.path), "--out" if out else "storage.path", create=True,
                  inputs=[campaign_file])
     if executor not in (None, "local", "dask"):
-        refuse(f"--executor: expected local or dask, got {executor!r}")
+        raise Refusal(f"--executor: expected local or dask, got {executor!r}")
     if workers is not None and workers < 1:
-        refuse(f"--workers: expected an integer >= 1, got {workers}")
+        raise Refusal(f"--workers: expected an integer >= 1, got {workers}")
     resume = f"uqflight run {campaign_file}" + (f" --out {out}" if out else "")
     previous = stopping.install()  # SIGINT and SIGTERM stop cleanly, even if a handler's exception is lost
     try:
@@ -327,12 +318,12 @@ def run(
         echo(f"\nerror: {exc.strerror}", err=True)
         _exit_now(2)
     except CorruptFile as exc:  # the fix named with this run's own command
-        refuse(f"{str(exc).removesuffix(': ' + REFLY)}; `{resume} --restart` starts it over")
+        raise Refusal(f"{str(exc).removesuffix(': ' + REFLY)}; `{resume} --restart` starts it over") from exc
     except IncompleteFile as exc:
         echo(f"error: {exc}", err=True)
         _exit_now(1)
     except (FileExistsError, ValueError, WorkerError) as exc:
-        refuse(f"{campaign_file}: {exc}")
+        raise Refusal(f"{campaign_file}: {exc}") from exc
     except KeyboardInterrupt as exc:
         code = 143 if isinstance(exc, stopping.Terminated) else 130
         echo(f"\n{'terminated' if code == 143 else 'interrupted'}: the finished runs are stored; "
@@ -357,7 +348,7 @@ def _exit_now(code: int):
 @app.command()
 def info(results: Path = typer.Argument(..., metavar="RESULTS", help="Results file (.h5).")):
     """Show a results file's campaign, design, done and failed runs, storage and versions."""
-    from ..store import CorruptFile, LockHeld, ResultStore, Status, read_error
+    from ..store import LockHeld, ResultStore, Status, read_error
     from ..store.lock import describe_holder, live_holder
 
     check_results_file(results)
@@ -371,30 +362,24 @@ def info(results: Path = typer.Argument(..., metavar="RESULTS", help="Results fi
             echo("locked by another process (a run writing it?): read as it is now")
             writer = {"locked": True}
             store = ResultStore.open(results, while_written=True)
-    except CorruptFile as exc:
-        refuse(f"{exc}")
+    except Refusal:  # CorruptFile: its message names the file
+        raise
     except (OSError, ValueError) as exc:
         retry = "; it is being written: try again in a moment" if writer else ""
-        refuse(f"{results}: {read_error(exc)}{retry}")
+        raise Refusal(f"{results}: {read_error(exc)}{retry}") from exc
     with store:
         try:
             _describe_results(results, store, Status)
-        except CorruptFile as exc:  # a part read on the way (an adaptive grid's state)
-            refuse(f"{exc}")
-        except OSError as exc:
-            refuse(f"{results}: {read_error(exc)}")
+        except OSError as exc:  # h5py's, on a part read on the way (CorruptFile names the file)
+            raise Refusal(f"{results}: {read_error(exc)}") from exc
 
 
 def _describe_results(results, store, Status) -> None:
-    from ..campaign import CampaignError
     from ..campaign.record import read_record
 
     status = store.status
     attrs = store.attrs
-    try:
-        recorded = read_record(attrs, str(results))
-    except CampaignError as exc:
-        refuse(f"{exc}")
+    recorded = read_record(attrs, str(results))
     echo(f"file: {results}")
     echo(f"campaign: {quoted_name(recorded.campaign.name)} (sha256 {one_line(str(store.campaign_hash[:12]))})")
     echo(f"design: {recorded.design_kind} {one_line(json.dumps(recorded.design_info))}")
@@ -475,7 +460,6 @@ def report(
     """
     from ..methods.parsing import parse_methods
     from ..report import DEFAULT_TIMES, DrawingFailed, default_out_dir, write_report
-    from ..analysis.statistics import BadInput
 
     try:
         selected = (list(DEFAULT_TIMES) if times is None else
@@ -512,10 +496,8 @@ def report(
             written = write_report(results, out, reference=reference, times=selected, baseline=write_baseline,
                                    method=overrides or None, progress=progress, partial=partial,
                                    allow_aliasing=allow_aliasing, fmt=figure_format, exceedance=thresholds or None)
-    except BadInput as exc:
-        refuse(f"{exc}")
     except OSError as exc:
-        refuse(f"cannot write the report: {exc}")
+        raise Refusal(f"cannot write the report: {exc}") from exc
     except DrawingFailed as exc:  # uqflight's own failure, not the input's: its traceback is above
         echo(f"error: {exc}; no report written ({out} unchanged)", err=True)
         raise typer.Exit(1)
@@ -529,7 +511,7 @@ def report(
 
 
 def _check_quantities(thresholds: dict, results: list[Path]) -> None:
-    """Exit 2 naming --exceedance when a threshold names a quantity some results file does not have (an
+    """A Refusal naming --exceedance when a threshold names a quantity some results file does not have (an
     unreadable file is the report's to refuse)."""
     from ..store import ResultStore
 
@@ -541,12 +523,12 @@ def _check_quantities(thresholds: dict, results: list[Path]) -> None:
             continue
         unknown = [name for name in thresholds if name not in names]
         if unknown:
-            refuse(f"--exceedance: {path} has no quantity {unknown[0]!r}; its quantities: "
-                 f"{', '.join(names) or 'none (the campaign has no quantities: mapping)'}")
+            raise Refusal(f"--exceedance: {path} has no quantity {unknown[0]!r}; its quantities: "
+                          f"{', '.join(names) or 'none (the campaign has no quantities: mapping)'}")
 
 
 def _check_times(text: str, selected: list[float], results: list[Path]) -> None:
-    """Exit 2 naming --times and the flight's time range when a time lies outside a file's recorded
+    """A Refusal naming --times and the flight's time range when a time lies outside a file's recorded
     times (more than half a recording step); 'end' is always inside. An unreadable file is the
     report's to refuse."""
     from ..text.labels import shown_time
@@ -561,9 +543,9 @@ def _check_times(text: str, selected: list[float], results: list[Path]) -> None:
         half = (time[-1] - time[0]) / max(len(time) - 1, 1) / 2
         outside = [t for t in selected if np.isfinite(t) and not time[0] - half <= t <= time[-1] + half]
         if outside:
-            refuse(f"--times {text}: {', '.join(f'{t:g}' for t in outside)} s outside the flight of {path}, "
-                 f"which records {shown_time(time, 0):g} to {shown_time(time, -1):g} s; choose times in that range "
-                 "or 'end'")
+            raise Refusal(f"--times {text}: {', '.join(f'{t:g}' for t in outside)} s outside the flight of {path}, "
+                          f"which records {shown_time(time, 0):g} to {shown_time(time, -1):g} s; choose times in that "
+                          "range or 'end'")
 
 
 @app.command()
@@ -594,7 +576,7 @@ def design(
             with open(csv_path, "w", newline="") as fh:
                 csv.writer(fh).writerows(rows)
         except OSError as exc:
-            refuse(f"cannot write {csv_path}: {exc.strerror}")
+            raise Refusal(f"cannot write {csv_path}: {exc.strerror}") from exc
     echo(f"wrote {'the design' if to_stdout else csv_path}: {len(points.xi)} points of a {points.kind} design in "
          f"{len(names)} parameters ({listed(names)})", err=to_stdout)
 
@@ -611,8 +593,7 @@ def surrogate_export(
     """Export the PCE of every output over time as JSON: germs, multi-indices, coefficients per output
     and time, the parameters' distributions (name, distribution, lower, upper, nominal), the time
     grid, method and order. Load it in Python with uqflight.analysis.surrogate.load(path).evaluate(kappa)."""
-    from ..analysis.statistics import BadInput
-    from ..analysis.surrogate import SurrogateError, export
+    from ..analysis.surrogate import export
 
     try:
         override = parse_method_option(method)
@@ -623,10 +604,10 @@ def surrogate_export(
     try:
         with Progress(0, label="surrogate export") as progress:
             export(results, out, override, progress)
-    except (SurrogateError, BadInput) as exc:
-        refuse(f"{exc}")
+    except Refusal:  # BadInput: its message names the file
+        raise
     except (OSError, KeyError, ValueError) as exc:
-        refuse(f"{results}: cannot export the surrogate ({' '.join(str(exc).split())})")
+        raise Refusal(f"{results}: cannot export the surrogate ({' '.join(str(exc).split())})") from exc
     echo(f"wrote {out}")
 
 
@@ -653,21 +634,19 @@ def check(
     outputs or time grid, unreadable results file).
     """
     from ..analysis.check import compare, drift_table, load_baseline
-    from ..analysis.statistics import BadInput, read_statistics
+    from ..analysis.statistics import read_statistics
 
     if rtol < 0 or atol < 0:
-        refuse("--rtol and --atol must be >= 0")
+        raise Refusal("--rtol and --atol must be >= 0")
     check_results_file(results)
-    try:
-        expected = load_baseline(baseline)
-        stats, attrs = read_statistics(results, partial=partial)
-        comparison = compare(stats, expected, rtol, atol)
-    except BadInput as exc:
-        refuse(f"{exc}")
+    expected = load_baseline(baseline)
+    stats, attrs = read_statistics(results, partial=partial)
+    comparison = compare(stats, expected, rtol, atol)
     if expected.get("campaign_hash") and expected["campaign_hash"] != attrs.get("campaign_hash"):
-        refuse(f"{results} comes from another campaign (sha256 {one_line(str(attrs.get('campaign_hash'))[:12])}) "
-             f"than the baseline {baseline} ({str(expected['campaign_hash'])[:12]}): compare a results file "
-             "with the baseline of its own campaign")
+        recorded_hash = one_line(str(attrs.get('campaign_hash'))[:12])
+        raise Refusal(f"{results} comes from another campaign (sha256 {recorded_hash}) "
+                      f"than the baseline {baseline} ({str(expected['campaign_hash'])[:12]}): compare a results file "
+                      "with the baseline of its own campaign")
     if comparison.drifts:
         echo(f"drift: {len(comparison.drifts)} of {comparison.compared} values outside "
              f"rtol={rtol:g}, atol={atol:g}")
@@ -696,10 +675,7 @@ def aircraft_command(
         for origin, names in known_aircraft().items():
             echo(f"{origin}: {' '.join(map(quoted_name, names))}")  # folder names: quoted when odd
         return
-    try:
-        located = _prepared(aircraft, [], [])
-    except (ValueError, FileNotFoundError) as exc:
-        refuse(f"{exc}")
+    located = _prepared(aircraft, [], [])
     files = AircraftFiles.read(located.location)
     echo(f"aircraft: {located.name} ({located.location.origin}: {located.location.folder})")
     echo(f"files: {len(files.files)} XML, sha256 {files.hash()}")
@@ -717,8 +693,8 @@ def aircraft_command(
     setup = FlightSetup(aircraft=located.name, root=located.root, excitation=Excitation(kind="none"), **condition)
     try:
         flight = JSBSimFlight(setup)
-    except (RuntimeError, FileNotFoundError) as exc:
-        refuse(f"{exc}")
+    except (RuntimeError, FileNotFoundError) as exc:  # an aircraft JSBSim cannot load
+        raise Refusal(str(exc)) from exc
     echo("engines:")
     for i, (name, kind, thruster) in enumerate(engine_kinds(flight.fdm)):
         echo(f"  {i}: {quoted_name(name):<24} {quoted_name(kind):<10} thruster: {quoted_name(thruster)}")

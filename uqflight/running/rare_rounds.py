@@ -18,10 +18,7 @@ from ..campaign import Campaign
 from ..designs.rare import RareSettings, germs_from_normal, rare_settings, run_algorithm
 from ..designs.rare.record import estimate_record
 from ..store import ResultStore, Status
-
-
-class ReplayMismatch(ValueError):
-    """The stored runs are not the rounds this campaign's algorithm asks for (another uqflight's file)."""
+from ..text import Refusal
 
 
 class Replay:
@@ -43,9 +40,9 @@ class Replay:
         rows = store.status.size
         stored = store.xi[start:min(stop, rows)]
         if not np.array_equal(stored, xi[:len(stored)]):
-            raise ReplayMismatch(f"{store._file.filename}: the stored runs {start} to {min(stop, rows) - 1} are not "
-                                 f"the points this campaign's {self.settings.kind} asks for (a file written by another "
-                                 "uqflight version): fly it again with `uqflight run CAMPAIGN --restart`")
+            raise Refusal(f"{store._file.filename}: the stored runs {start} to {min(stop, rows) - 1} are not "
+                          f"the points this campaign's {self.settings.kind} asks for (a file written by another "
+                          "uqflight version): fly it again with `uqflight run CAMPAIGN --restart`")
         if stop > rows:
             design = np.vstack([store.xi, xi[rows - start:]])
             store.set_design(design, self.campaign.to_physical(design), np.full(stop, 1.0 / stop))

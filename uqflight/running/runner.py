@@ -45,6 +45,7 @@ from threadpoolctl import threadpool_limits
 from ..campaign import Campaign
 from ..campaign.record import ATTRIBUTE, record_text
 from ..campaign.schema import WORKER_BYTES
+from ..text import Refusal
 from ..text.console import one_line
 from ..designs import REGISTRY as DESIGNS
 from ..designs import Design
@@ -70,11 +71,6 @@ class DiskFull(OSError):
 
 class IncompleteFile(OSError):
     """Runs counted as done did not reach the file (a write failed late); a resume reruns them."""
-
-
-class Unwritable(ValueError):
-    """The results file cannot be written where it was asked for (no such folder, a file in the way,
-    a read-only or virtual filesystem)."""
 
 
 class WorkerError(RuntimeError):
@@ -305,8 +301,8 @@ def run_campaign(campaign: Campaign, out: Path | None = None, workers: int | Non
         if is_disk_full(exc) and not isinstance(exc, FileExistsError):
             raise DiskFull(errno.ENOSPC, disk_full_message(out, _stored_runs(out) if out.is_file() else 0)) from exc
         where = f": {exc.filename}" if exc.filename else ""
-        raise Unwritable(f"cannot write the results file {out} ({exc.strerror or exc}{where}); choose "
-                         "another path with --out or storage.path") from exc
+        raise Refusal(f"cannot write the results file {out} ({exc.strerror or exc}{where}); choose "
+                      "another path with --out or storage.path") from exc
     pool = None
     try:
         pool = WorkerPool(spec, workers if executor == "local" else 1,

@@ -27,6 +27,7 @@ from pathlib import Path
 
 import jsbsim
 
+from ..text import Refusal
 from ..text.console import one_line
 from .directives import checked, jsbsim_tree, local_name, parsed, without_io
 from .safe_paths import is_inside, outside_links, relative_name, single_name
@@ -36,11 +37,11 @@ SOURCE_ROOT = Path(__file__).resolve().parents[2]   # the repository, when run f
 SHARED = "@root/"  # key prefix of files from the root's shared engine/ and systems/ folders
 
 
-class AircraftNotFound(FileNotFoundError):
+class AircraftNotFound(Refusal, FileNotFoundError):
     """No aircraft of that name or path; the message lists where it looked and close names."""
 
 
-class AircraftUnreadable(RuntimeError):
+class AircraftUnreadable(Refusal, RuntimeError):
     """An aircraft whose main file is not well-formed XML."""
 
 

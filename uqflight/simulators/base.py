@@ -1,4 +1,5 @@
-"""What every simulator shares: the run status codes, the errors of a failed sample, and the base classes
+"""What every simulator shares: the run status codes, the errors of a failed sample, the refusal of a
+simulator's setting, and the base classes
 of the simulator and scenario kinds (registered by subclassing) with the fields their keys are.
 
 The status codes are stored per run in `/samples/status` of a results file; they are defined here
@@ -12,6 +13,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import ClassVar
 
+from ..text import Refusal
 from ..text.console import one_line, quoted_name
 
 
@@ -43,6 +45,12 @@ class DivergenceError(FlightError):
     """The flight left the envelope or produced NaN after the trim."""
 
     status = Status.DIVERGED
+
+
+class SimulatorSettingError(Refusal):
+    """A simulator's setting that cannot be used: an aerodynamic function or perturbation to patch, a JSBSim
+    script, a python model (`simulator.function`); the message says what was expected. A campaign's checks
+    raise it again as a CampaignError naming the file and the field."""
 
 
 class NominalFailed(RuntimeError):

@@ -5,17 +5,19 @@ import zlib
 
 import numpy as np
 
+from ..text import Refusal
+
 
 def check_noise(names, sigmas: dict[str, float], seed: int) -> None:
-    """ValueError naming an output not in `names`, a sigma that is negative or not finite, or a negative seed."""
+    """A Refusal naming an output not in `names`, a sigma that is negative or not finite, or a negative seed."""
     unknown = [name for name in sigmas if name not in names]
     if unknown:
-        raise ValueError(f"--noise: no output {', '.join(map(repr, unknown))} (outputs: {', '.join(names)})")
+        raise Refusal(f"--noise: no output {', '.join(map(repr, unknown))} (outputs: {', '.join(names)})")
     bad = [f"{name}={sigma!r}" for name, sigma in sigmas.items() if not (np.isfinite(sigma) and sigma >= 0)]
     if bad:
-        raise ValueError(f"--noise: expected SIGMA >= 0 (a standard deviation in the output's unit), got {', '.join(bad)}")
+        raise Refusal(f"--noise: expected SIGMA >= 0 (a standard deviation in the output's unit), got {', '.join(bad)}")
     if seed < 0:
-        raise ValueError(f"--seed: expected an integer >= 0, got {seed}")
+        raise Refusal(f"--seed: expected an integer >= 0, got {seed}")
 
 
 def add_noise(outputs: dict[str, np.ndarray], sigmas: dict[str, float], seed: int) -> dict[str, np.ndarray]:

@@ -27,17 +27,13 @@ import difflib
 import xml.etree.ElementTree as ET
 
 from .aircraft import AircraftFiles, aero_functions
+from .base import SimulatorSettingError
 from .directives import jsbsim_tree
 from .aero_factors import AeroFactor, aero_factors
 
 KINDS = ("scale", "offset_value", "offset")  # the order they nest in, innermost first
 NOMINAL = {"scale": 1.0, "offset_value": 0.0, "offset": 0.0}
 PREFIX = "aero/uq/"
-
-
-class PatchError(ValueError):
-    """An unknown function or kind (the message suggests the closest function names), or an
-    offset on a function without a reference factor."""
 
 
 def patch_property(function: str, kind: str, functions: list[str] | None = None) -> str:
@@ -67,21 +63,21 @@ def resolve_function(name: str, functions: list[str]) -> str:
     if len(matches) == 1:
         return matches[0]
     if len(matches) > 1:
-        raise PatchError(f"{name!r} names several functions ({', '.join(matches)}): give the full name")
-    raise PatchError(f"expected one of the aircraft's aerodynamic functions (`uqflight aircraft` lists them), "
-                     f"got {name!r}{function_hint(name, functions)}")
+        raise SimulatorSettingError(f"{name!r} names several functions ({', '.join(matches)}): give the full name")
+    raise SimulatorSettingError(f"expected one of the aircraft's aerodynamic functions (`uqflight aircraft` lists "
+                                f"them), got {name!r}{function_hint(name, functions)}")
 
 
 def check_perturbation(function: str, kind: str, refs: dict[str, AeroFactor]) -> None:
     """Refuse an unknown kind, and `offset` on a function without a reference factor (naming it)."""
     if kind not in KINDS:
-        raise PatchError(f"perturbation: expected one of {', '.join(KINDS)}, got {kind!r}")
+        raise SimulatorSettingError(f"perturbation: expected one of {', '.join(KINDS)}, got {kind!r}")
     ref = refs.get(function)
     if kind == "offset" and ref is not None and ref.refusal:
         unit = f" ({ref.unit})" if ref.unit else ""
-        raise PatchError(f"an offset is a coefficient increment, added times the function's reference factor, "
-                         f"and {function!r} has none: {ref.refusal}; give perturbation: offset_value "
-                         f"(--offset-value on the command line) to add a value in its own unit{unit}")
+        raise SimulatorSettingError(f"an offset is a coefficient increment, added times the function's reference "
+                                    f"factor, and {function!r} has none: {ref.refusal}; give perturbation: offset_value "
+                                    f"(--offset-value on the command line) to add a value in its own unit{unit}")
 
 
 def _wrapper(kind: str, prop: str, ref: AeroFactor) -> ET.Element:
@@ -113,7 +109,7 @@ def patch_xml(xml: bytes, patches: list[tuple[str, str]]) -> bytes:
         keep = [c for c in element if c.tag == "description"]
         body = [c for c in element if c.tag != "description"]
         if len(body) != 1:
-            raise PatchError(f"function {name!r} has {len(body)} top-level elements, expected 1")
+            raise SimulatorSettingError(f"function {name!r} has {len(body)} top-level elements, expected 1")
         node = body[0]
         for kind in KINDS:  # the product inside the sums: o·qbar·S + (v + s * f)
             if kind in wanted[name]:
@@ -158,7 +154,7 @@ def patch_kind(prop: str) -> str | None:
 
 def patch_request(prop: str, functions: list[str]) -> tuple[str, str] | None:
     """(function, kind) when `prop` is a patch property `aero/uq/KIND/NAME`, else None; raises
-    PatchError when NAME is none of `functions`."""
+    SimulatorSettingError when NAME is none of `functions`."""
     kind = patch_kind(prop)
     if kind is None:
         return None

@@ -15,18 +15,14 @@ from typing import Callable
 
 import numpy as np
 
-from .base import DivergenceError, FlightError, nominal_failed
-
-
-class PluginError(ValueError):
-    """A `simulator.function` that cannot be loaded; the message says what was expected."""
+from .base import DivergenceError, FlightError, SimulatorSettingError, nominal_failed
 
 
 def split_spec(spec) -> tuple[str, str]:
     """(module or file, attribute) of `module:attribute` or `path/to/file.py:attribute`, nothing imported."""
     if not isinstance(spec, str) or spec.count(":") != 1:
         shown = repr(spec) if isinstance(spec, str) and len(repr(spec)) <= 60 else type(spec).__name__
-        raise PluginError(f"expected 'package.module:callable' or 'file.py:callable', got {shown}")
+        raise SimulatorSettingError(f"expected 'package.module:callable' or 'file.py:callable', got {shown}")
     module_name, attribute = spec.split(":")
     return module_name, attribute
 
@@ -39,8 +35,8 @@ def load_function(spec: str, base: Path) -> Callable:
         if module_name.endswith(".py"):
             file = (base / module_name) if not Path(module_name).is_absolute() else Path(module_name)
             if not file.is_file():
-                raise PluginError(f"expected an existing Python file, got {str(file)!r} "
-                                  "(a relative path is read from the campaign's folder)")
+                raise SimulatorSettingError(f"expected an existing Python file, got {str(file)!r} "
+                                            "(a relative path is read from the campaign's folder)")
             unique = "uqflight_user_" + hashlib.sha256(str(file.resolve()).encode()).hexdigest()[:12]
             module = sys.modules.get(unique)
             if module is None:
@@ -50,13 +46,13 @@ def load_function(spec: str, base: Path) -> Callable:
                 sys.modules[unique] = module
         else:
             module = importlib.import_module(module_name)
-    except PluginError:
+    except SimulatorSettingError:
         raise
     except Exception as exc:  # the user's module failed to import: say which and why
-        raise PluginError(f"cannot import {module_name!r}: {type(exc).__name__}: {exc}") from exc
+        raise SimulatorSettingError(f"cannot import {module_name!r}: {type(exc).__name__}: {exc}") from exc
     function = getattr(module, attribute, None)
     if not callable(function):
-        raise PluginError(f"{module_name!r} has no callable {attribute!r}")
+        raise SimulatorSettingError(f"{module_name!r} has no callable {attribute!r}")
     return function
 
 

@@ -66,6 +66,7 @@ from .raw import RawStorage
 from .rare import read_rare_event, write_rare_event
 from .rounds import read_index_set, write_index_set
 from .storage import OutputStorage, key_of, name_of
+from ..text import Refusal
 
 STORAGES = (RawStorage, TsvdStorage)  # the storage forms, in the order they are read from
 
@@ -82,7 +83,7 @@ QUANTITY_ROWS = 8192  # quantity values per HDF5 chunk (64 KiB)
 CHECKED = {"chunks": True, "fletcher32": True}  # every fixed-size dataset: chunked and checksummed
 
 
-class CorruptFile(ValueError):
+class CorruptFile(Refusal):
     """A results file whose contents fail their checks (checksum, unknown status codes)."""
 
 

@@ -70,7 +70,8 @@ def echo(message: object = "", err: bool = False, nl: bool = True) -> None:
 
 def refuse(message: str) -> NoReturn:
     """A command's refusal of its input: "error: MESSAGE" on one line of standard error, and exit
-    EXIT_BAD_INPUT (2). Every command refuses through it."""
+    EXIT_BAD_INPUT (2). The command line's group calls it for every `uqflight.text.Refusal`
+    (uqflight.cli.arguments.RefusingGroup)."""
     import typer
 
     echo(f"error: {message}", err=True)

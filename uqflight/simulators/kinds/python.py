@@ -3,9 +3,9 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from ..base import Field, SimulatorKind
+from ..base import Field, SimulatorKind, SimulatorSettingError
 from ..bundle import python_bundle
-from ..python import PluginError, PythonSimulator, load_function, split_spec
+from ..python import PythonSimulator, load_function, split_spec
 from .outputs import KIND, OUTPUTS, check_outputs
 
 
@@ -34,7 +34,7 @@ class Python(SimulatorKind):
         sim = check.mapping(value, "simulator", self.keys, required=("function",))
         try:
             split_spec(sim["function"])
-        except PluginError as exc:
+        except SimulatorSettingError as exc:
             check.fail("simulator.function", str(exc))
         if "outputs" in sim:
             check_outputs(check, sim["outputs"])
@@ -44,7 +44,7 @@ class Python(SimulatorKind):
         """Import the function (its module's code runs), relative to the campaign file's folder."""
         try:
             load_function(sim["function"], Path(source).parent)
-        except PluginError as exc:
+        except SimulatorSettingError as exc:
             check.fail("simulator.function", str(exc))
 
     def make(self, config: dict, parameter_names: list[str], properties: list[str], base: Path) -> PythonSimulator:

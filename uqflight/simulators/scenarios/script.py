@@ -36,7 +36,7 @@ import numpy as np
 
 from ..aircraft import AircraftFiles, cache_dir
 from ..directives import checked, parsed, without_io
-from ..base import Field, FlightError, ScenarioKind, TrimError, check_fields
+from ..base import Field, FlightError, ScenarioKind, SimulatorSettingError, TrimError, check_fields
 from ..jsbsim import (ATMOSPHERE, DEFAULT_OUTPUTS, OUTPUT_RATE, FlightResult, PropertyAccess, Watch, check_finite,
                       ready_to_load)
 
@@ -63,10 +63,6 @@ WINDS = ("atmosphere/wind-north-fps", "atmosphere/wind-east-fps", "atmosphere/wi
          "atmosphere/gust-north-fps", "atmosphere/gust-east-fps", "atmosphere/gust-down-fps")
 
 
-class ScriptError(ValueError):
-    """A script that cannot be flown: not found, not a JSBSim run script, or naming files it lacks."""
-
-
 def jsbsim_scripts() -> Path:
     """The scripts shipped with JSBSim's Python package."""
     return Path(jsbsim.__file__).resolve().parent / "scripts"
@@ -84,15 +80,15 @@ def resolve(text: str, folder: Path) -> Path:
     names = sorted(p.stem for p in shipped.glob("*.xml"))
     close = difflib.get_close_matches(text, names, n=3, cutoff=0.6)
     hint = f"; did you mean {' or '.join(close)}?" if close else ""
-    raise ScriptError(f"no script {text!r}: expected a file relative to {folder} or the name of one of the "
-                      f"{len(names)} scripts shipped with JSBSim, without .xml (e.g. c172_cruise_8K){hint}")
+    raise SimulatorSettingError(f"no script {text!r}: expected a file relative to {folder} or the name of one of the "
+                                f"{len(names)} scripts shipped with JSBSim, without .xml (e.g. c172_cruise_8K){hint}")
 
 
 def _inside(folder: Path, name: str) -> Path:
     """folder/name, refused when the name leads outside the folder."""
     path = (folder / name).resolve()
     if not path.is_relative_to(folder.resolve()):
-        raise ScriptError(f"{name!r} leads outside the script's folder {folder}")
+        raise SimulatorSettingError(f"{name!r} leads outside the script's folder {folder}")
     return path
 
 
@@ -116,23 +112,25 @@ class ScriptFile:
         path = Path(path)
         data = path.read_bytes()
         if len(data) > MAX_SCRIPT_BYTES:
-            raise ScriptError(f"{path} is larger than {MAX_SCRIPT_BYTES >> 10} KiB; a run script is a few pages of XML")
-        root = parsed(data, path, ScriptError)
+            raise SimulatorSettingError(f"{path} is larger than {MAX_SCRIPT_BYTES >> 10} KiB; a run script is a few "
+                                        "pages of XML")
+        root = parsed(data, path, SimulatorSettingError)
         if root.tag != "runscript":
-            raise ScriptError(f"{path} is not a JSBSim run script (its root element is <{root.tag}>, not <runscript>)")
+            raise SimulatorSettingError(f"{path} is not a JSBSim run script (its root element is <{root.tag}>, "
+                                        "not <runscript>)")
         use, run = root.find("use"), root.find("run")
         if use is None or not use.get("aircraft") or not use.get("initialize"):
-            raise ScriptError(f"{path}: expected <use aircraft=... initialize=...>")
+            raise SimulatorSettingError(f"{path}: expected <use aircraft=... initialize=...>")
         if run is None or run.get("end") is None or run.get("dt") is None:
-            raise ScriptError(f"{path}: expected <run start=... end=... dt=...>")
+            raise SimulatorSettingError(f"{path}: expected <run start=... end=... dt=...>")
         try:
             start, end, dt = (float(run.get(key, "0").strip()) for key in ("start", "end", "dt"))
         except ValueError:
-            raise ScriptError(f"{path}: <run> start, end and dt must be numbers") from None
+            raise SimulatorSettingError(f"{path}: <run> start, end and dt must be numbers") from None
         if not all(map(math.isfinite, (start, end, dt))) or not dt > 0 or not end > start:
-            raise ScriptError(f"{path}: <run> needs finite numbers with dt > 0 and end > start, got start={start:g}, "
-                              f"end={end:g}, dt={dt:g}")
-        named = checked(root, path, ScriptError, "the script's folder")
+            raise SimulatorSettingError(f"{path}: <run> needs finite numbers with dt > 0 and end > start, got "
+                                        f"start={start:g}, end={end:g}, dt={dt:g}")
+        named = checked(root, path, SimulatorSettingError, "the script's folder")
         files = tuple(name.strip() for tag, name in named if tag == "output")
         for name in files:
             _inside(path.parent, name)
@@ -180,18 +178,18 @@ class ScriptFile:
     def initfile(self, aircraft_folder: Path) -> Path | None:
         """The initialisation file beside the script (passed to JSBSim, checked as directives.py checks
         what JSBSim reads), else None: then JSBSim reads the aircraft folder's (checked with the
-        aircraft's files); ScriptError when neither exists."""
+        aircraft's files); SimulatorSettingError when neither exists."""
         for folder in (self.path.parent, Path(aircraft_folder)):
             for name in (self.initialize, f"{self.initialize}.xml"):
                 candidate = _inside(folder, name)
                 if candidate.is_file():
                     if folder != self.path.parent:
                         return None
-                    checked(parsed(candidate.read_bytes(), candidate, ScriptError), candidate, ScriptError,
-                            "the script's folder")
+                    checked(parsed(candidate.read_bytes(), candidate, SimulatorSettingError), candidate,
+                            SimulatorSettingError, "the script's folder")
                     return candidate
-        raise ScriptError(f"{self.path}: initialize={self.initialize!r} names no file beside the script nor in the "
-                          f"aircraft folder {aircraft_folder}")
+        raise SimulatorSettingError(f"{self.path}: initialize={self.initialize!r} names no file beside the script "
+                                    f"nor in the aircraft folder {aircraft_folder}")
 
     def _end(self, end_s: float | None) -> float:
         """The last time a step may reach: the script's end (or `end_s` when earlier) plus 0.99 dt,
@@ -199,21 +197,22 @@ class ScriptFile:
         return (self.end_s if end_s is None else min(self.end_s, end_s)) + 0.99 * self.dt_s
 
     def bounded_steps(self, end_s: float | None = None) -> int:
-        """The steps before the end by the closed form, without holding any: ScriptError naming the
+        """The steps before the end by the closed form, without holding any: SimulatorSettingError naming the
         file and what to change when they are more than MAX_STEPS."""
         n = max(0, math.floor((self._end(end_s) - self.start_s) / self.dt_s))
         if n > MAX_STEPS:
             cut = "" if end_s is None else f" cut at {end_s:g} s"
-            raise ScriptError(f"{self.path}: <run start={self.start_s:g} end={self.end_s:g} dt={self.dt_text}>{cut} is "
-                              f"{n:.3g} integration steps, more than {MAX_STEPS}: cut the flight with "
-                              f"simulator.scenario.end_s (at most {self.start_s + MAX_STEPS * self.dt_s:.6g} s) "
-                              "or give the script a larger dt")
+            raise SimulatorSettingError(f"{self.path}: <run start={self.start_s:g} end={self.end_s:g} "
+                                        f"dt={self.dt_text}>{cut} is {n:.3g} integration steps, more than {MAX_STEPS}: "
+                                        "cut the flight with "
+                                        f"simulator.scenario.end_s (at most {self.start_s + MAX_STEPS * self.dt_s:.6g} s) "
+                                        "or give the script a larger dt")
         return n
 
     def steps(self, end_s: float | None = None) -> int:
         """The steps JSBSim runs before the end: the largest n whose summed time start + dt + ... + dt
         is at most the end. The closed form decides unless the sum's rounding (n additions) could
-        cross the end, then the sum itself does. ScriptError beyond MAX_STEPS (`bounded_steps`)."""
+        cross the end, then the sum itself does. SimulatorSettingError beyond MAX_STEPS (`bounded_steps`)."""
         end, dt = self._end(end_s), self.dt_s
         n = self.bounded_steps(end_s)
         slack = (n + 2) * max(abs(end), abs(self.start_s)) * 2.3e-16
@@ -478,7 +477,7 @@ class Script(ScenarioKind):
         text = check.string(scenario["script"], "simulator.scenario.script")
         try:
             script = ScriptFile.read(resolve(text, folder))
-        except (ScriptError, OSError) as exc:
+        except (SimulatorSettingError, OSError) as exc:
             check.fail("simulator.scenario.script", str(exc))
         sim["script_path"] = str(script.path)
         end = None
@@ -489,7 +488,7 @@ class Script(ScenarioKind):
                                                        f"s and at most its end {script.end_s:g} s, got {end:g}")
         try:
             script.bounded_steps(end)
-        except ScriptError as exc:
+        except SimulatorSettingError as exc:
             check.fail("simulator.scenario.end_s" if end is not None else "simulator.scenario.script", str(exc))
         check_fields(check, sim, "simulator", self.fields)
         rate = script.output_rate_hz(sim)
@@ -509,7 +508,7 @@ class Script(ScenarioKind):
                                              "name that aircraft")
         try:
             script.initfile(location.folder)
-        except ScriptError as exc:
+        except SimulatorSettingError as exc:
             check.fail("simulator.scenario.script", str(exc))
         sim["aircraft"] = named
         return sim
