@@ -36,7 +36,7 @@ from uqflight.analysis.errors import relative_errors
 from uqflight.analysis.floors import floors_from_moments
 from uqflight.campaign import load_campaign
 from uqflight.running.runner import run_campaign
-from uqflight.simulators.validation_view import validation_view
+from uqflight.simulators.aircraft_properties import AircraftProperties
 from uqflight.analysis.statistics import BadInput, Options, analyse
 from uqflight.store import ResultStore
 
@@ -73,7 +73,7 @@ def ensure_results(results: Path, levels, sparse: bool) -> None:
                     continue
         campaign = campaign or qmc_campaign(results, int(name.rsplit("-", 1)[1]))
         print(f"running {campaign} into {path} ...", flush=True)
-        run_campaign(load_campaign(campaign, validation_view), out=path)
+        run_campaign(load_campaign(campaign, AircraftProperties), out=path)
 
 
 def sparse_rows(results: Path, reference, floor_m: dict, floor_v: dict) -> None:

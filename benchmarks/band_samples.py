@@ -22,7 +22,7 @@ import numpy as np
 
 from uqflight.campaign import load_campaign
 from uqflight.running.runner import run_campaign
-from uqflight.simulators.validation_view import validation_view
+from uqflight.simulators.aircraft_properties import AircraftProperties
 from uqflight.analysis.statistics import Options, analyse
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -50,7 +50,7 @@ def main() -> None:
     args = parser.parse_args()
     if not args.results.exists():
         print(f"running campaigns/paper-pg2-l2.yaml into {args.results} ...", flush=True)
-        run_campaign(load_campaign(ROOT / "campaigns" / "paper-pg2-l2.yaml", validation_view), out=args.results)
+        run_campaign(load_campaign(ROOT / "campaigns" / "paper-pg2-l2.yaml", AircraftProperties), out=args.results)
     reference, std, _ = bands(args.results, args.reference, seed=10**6)
     print(f"{'draws':>7}  {'analysis cpu [s]':>16}  " + "  ".join(f"{name:>18}" for name in reference))
     print(f"{'':>7}  {'':>16}  " + "  ".join(f"{'rms / max [σ]':>18}" for _ in reference))

@@ -38,11 +38,11 @@ def ensure_results(path: Path) -> Path:
     if path.is_file():
         return path
     from uqflight.campaign import load_campaign
-    from uqflight.simulators.validation_view import validation_view
+    from uqflight.simulators.aircraft_properties import AircraftProperties
     from uqflight.running.runner import run_campaign
 
     print(f"running campaigns/grid-gh-l2.yaml into {path} (113 flights)")
-    run_campaign(load_campaign(ROOT / "campaigns/grid-gh-l2.yaml", view=validation_view), out=path)
+    run_campaign(load_campaign(ROOT / "campaigns/grid-gh-l2.yaml", read_aircraft=AircraftProperties), out=path)
     return path
 
 

@@ -44,10 +44,10 @@ storage: {{raw: false, tsvd: {{tol: 1.0e-8, batch: 1000}}}}
 MEASURE = textwrap.dedent("""
     import resource, sys, time
     from uqflight.campaign import load_campaign
-from uqflight.simulators.validation_view import validation_view
+from uqflight.simulators.aircraft_properties import AircraftProperties
     from uqflight.running.runner import run_campaign
     t0 = time.perf_counter()
-    summary = run_campaign(load_campaign(sys.argv[1], validation_view), out=sys.argv[2])
+    summary = run_campaign(load_campaign(sys.argv[1], AircraftProperties), out=sys.argv[2])
     print(summary.ran, time.perf_counter() - t0,
           resource.getrusage(resource.RUSAGE_SELF).ru_maxrss,
           resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss)

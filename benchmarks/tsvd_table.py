@@ -21,7 +21,7 @@ from pathlib import Path
 import numpy as np
 
 from uqflight.campaign import parse_campaign
-from uqflight.simulators.validation_view import validation_view
+from uqflight.simulators.aircraft_properties import AircraftProperties
 from uqflight.running.runner import run_campaign
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "tests"))  # the study's Table 1 (tests/paper.py)
 from paper import table1_parameters_yaml  # noqa: E402
@@ -59,7 +59,7 @@ def main():
     ran, seconds = 0, 0.0
     if not args.out.exists():  # an existing file is reused as it is (delete it to measure the runs again)
         text = CAMPAIGN.format(parameters=table1_parameters_yaml(), samples=args.samples, workers=args.workers)
-        summary = run_campaign(parse_campaign(text, "tsvd.yaml", validation_view), out=args.out)
+        summary = run_campaign(parse_campaign(text, "tsvd.yaml", AircraftProperties), out=args.out)
         ran, seconds = summary.ran, summary.seconds
     with ResultStore.open(args.out) as store:
         ok = store.status == Status.OK

@@ -248,11 +248,11 @@ def test_on_bacm_the_adaptive_grid_refines_k2_most(tmp_path):
     V_TAS's variance and is only C⁰ there (the engine tables' kinks): it is refined most; CLalpha (q) and
     CL0 (α, θ) follow, the inputs that carry the other outputs' variance."""
     from uqflight.campaign import load_campaign
-    from uqflight.simulators.validation_view import validation_view
+    from uqflight.simulators.aircraft_properties import AircraftProperties
 
     from conftest import ROOT
 
-    campaign = load_campaign(ROOT / "campaigns" / "bacm-adaptive.yaml", view=validation_view)
+    campaign = load_campaign(ROOT / "campaigns" / "bacm-adaptive.yaml", read_aircraft=AircraftProperties)
     run_campaign(campaign, out=tmp_path / "bacm.h5")
     with ResultStore.open(tmp_path / "bacm.h5") as store:
         state, names, n = store.index_set(), store.parameter_names, store.status.size

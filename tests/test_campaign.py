@@ -7,7 +7,7 @@ import pytest
 
 from conftest import ROOT, cli, cli_in_process
 from uqflight.campaign import CampaignError, load_campaign, parse_campaign
-from uqflight.simulators.validation_view import validation_view
+from uqflight.simulators.aircraft_properties import AircraftProperties
 
 DATA = Path(__file__).parent / "data" / "campaigns"
 
@@ -82,7 +82,7 @@ def test_a_bad_file_gets_one_message_naming_file_field_and_expectation(name):
     field, expected = BAD[name]
     path = DATA / name
     with pytest.raises(CampaignError) as caught:
-        load_campaign(path, view=validation_view)
+        load_campaign(path, read_aircraft=AircraftProperties)
     message = str(caught.value)
     assert message.startswith(expected_start(path, field)), message
     assert expected in message
@@ -127,14 +127,14 @@ def test_a_missing_file_is_named():
 # -- good files ---------------------------------------------------------------------------
 
 def test_the_shipped_campaign_validates():
-    campaign = load_campaign(ROOT / "campaigns" / "paper-pg2-l2.yaml", view=validation_view)
+    campaign = load_campaign(ROOT / "campaigns" / "paper-pg2-l2.yaml", read_aircraft=AircraftProperties)
     assert [p.name for p in campaign.parameters] == ["CL0", "CLalpha", "CD0", "k1", "k2", "Cm0", "Cmq"]
     assert campaign.parameters[0].nominal == pytest.approx(0.2)  # from the aircraft
     assert len(campaign.design().xi) == 113
 
 
 def test_initial_conditions_are_uncertain_parameters_with_the_flight_condition_as_nominal():
-    campaign = load_campaign(DATA / "good_jsbsim_ic.yaml", view=validation_view)
+    campaign = load_campaign(DATA / "good_jsbsim_ic.yaml", read_aircraft=AircraftProperties)
     speed, altitude, lift = campaign.parameters
     assert (speed.property, speed.lower, speed.upper) == ("ic/vt-kts", 185.0, 195.0)
     assert speed.nominal == pytest.approx(190.0)  # the campaign's airspeed, not the aircraft's 0
@@ -151,12 +151,12 @@ parameters:
   Vc: {property: ic/vc-kts, distribution: normal, interval_pct: 2}
 design: {kind: monte_carlo, samples: 4}
 """
-    (vc,) = parse_campaign(text, "vc.yaml", validation_view).parameters
+    (vc,) = parse_campaign(text, "vc.yaml", AircraftProperties).parameters
     assert 150 < vc.nominal < 170  # 200 KTAS at 15000 ft is about 160 KCAS
 
 
 def test_a_python_model_from_the_package_validates():
-    campaign = load_campaign(DATA / "good_python_ishigami.yaml", view=validation_view)
+    campaign = load_campaign(DATA / "good_python_ishigami.yaml", read_aircraft=AircraftProperties)
     assert campaign.simulator["function"] == "uqflight.simulators.models:ishigami"
     assert [p.property for p in campaign.parameters] == ["x1", "x2", "x3"]
     assert campaign.method.as_mapping() == {"kind": "regression", "order": 6, "split": False}

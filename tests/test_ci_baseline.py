@@ -13,7 +13,7 @@ from conftest import ROOT, cli_in_process
 
 from uqflight.campaign import load_campaign
 from uqflight.running.runner import run_campaign
-from uqflight.simulators.validation_view import validation_view
+from uqflight.simulators.aircraft_properties import AircraftProperties
 
 BASELINES = ROOT / "tests" / "baselines"
 
@@ -23,7 +23,7 @@ BASELINES = ROOT / "tests" / "baselines"
     pytest.param(ROOT / "campaigns" / "ci-small.yaml", BASELINES / "ci-small.json", 113, id="ci-small",
                  marks=pytest.mark.slow)])
 def test_small_campaign_matches_the_committed_baseline(tmp_path, campaign, baseline, runs):
-    summary = run_campaign(load_campaign(campaign, validation_view), out=tmp_path / "ci.h5", workers=2)
+    summary = run_campaign(load_campaign(campaign, AircraftProperties), out=tmp_path / "ci.h5", workers=2)
     assert summary.ran == runs and not summary.failures
     check = cli_in_process("check", tmp_path / "ci.h5", "--baseline", baseline)
     assert check.returncode == 0, check.stdout + check.stderr

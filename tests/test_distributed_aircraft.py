@@ -13,7 +13,7 @@ from conftest import scheduler_address
 
 from uqflight.campaign import load_campaign
 from uqflight.running.runner import run_campaign, worker_spec
-from uqflight.simulators.validation_view import validation_view
+from uqflight.simulators.aircraft_properties import AircraftProperties
 
 REPO = Path(__file__).resolve().parents[1]
 BIN = Path(sys.executable).parent
@@ -54,7 +54,7 @@ def _outputs(path):
 def test_separate_dask_workers_match_the_local_pool_and_refuse_other_aircraft(cluster, tmp_path, monkeypatch):
     monkeypatch.setenv("UQFLIGHT_CACHE", str(tmp_path / "client-cache"))
     address, worker_cache = cluster
-    campaign = load_campaign(REPO / "campaigns" / "c172p-scale-l2.yaml", view=validation_view)
+    campaign = load_campaign(REPO / "campaigns" / "c172p-scale-l2.yaml", read_aircraft=AircraftProperties)
     local = run_campaign(campaign, out=tmp_path / "local.h5", workers=2, executor="local")
     remote = run_campaign(campaign, out=tmp_path / "dask.h5", workers=1, executor="dask", scheduler=address)
     status_l, out_l, hash_l = _outputs(local.path)

@@ -9,7 +9,7 @@ import pytest
 from conftest import DATA, DECAY_TWO_INPUTS, UQFLIGHT, assert_same_results, cli_in_process, hostile_campaign
 
 from uqflight.campaign import parse_campaign
-from uqflight.simulators.validation_view import validation_view
+from uqflight.simulators.aircraft_properties import AircraftProperties
 from uqflight.running.runner import run_campaign
 from uqflight.store import ResultStore, Status
 
@@ -31,7 +31,7 @@ execution: {{workers: 1, chunk: 4}}
 
 
 def jsbsim_campaign(samples=12, duration=5):
-    return parse_campaign(JSBSIM_CAMPAIGN.format(samples=samples, duration=duration), "small.yaml", validation_view)
+    return parse_campaign(JSBSIM_CAMPAIGN.format(samples=samples, duration=duration), "small.yaml", AircraftProperties)
 
 
 def python_campaign(samples):
@@ -132,7 +132,7 @@ def test_resume_after_sigkill_equals_an_uninterrupted_run(tmp_path, storage):
                              capture_output=True, text=True)
     assert resumed.returncode == 0, resumed.stderr
     assert f"{160 - remaining} already done" in resumed.stdout
-    campaign = parse_campaign(text, str(tmp_path / "c.yaml"), validation_view)
+    campaign = parse_campaign(text, str(tmp_path / "c.yaml"), AircraftProperties)
     run_campaign(campaign, out=tmp_path / "whole.h5")
     assert_same_results(killed, tmp_path / "whole.h5")
 
@@ -142,9 +142,9 @@ def test_tsvd_storage_and_property_outputs(tmp_path):
     text = JSBSIM_CAMPAIGN.format(samples=10, duration=5).replace(
         "  output_rate_hz: 10\n", "  output_rate_hz: 10\n  outputs: [theta_deg, aero/qbar-psf]\n").replace(
         "execution:", "storage: {raw: false, tsvd: {tol: 1.0e-12, batch: 4}}\nexecution:")
-    run_campaign(parse_campaign(text, "t.yaml", validation_view), out=tmp_path / "t.h5")
+    run_campaign(parse_campaign(text, "t.yaml", AircraftProperties), out=tmp_path / "t.h5")
     raw_text = text.replace("raw: false", "raw: true")
-    run_campaign(parse_campaign(raw_text, "r.yaml", validation_view), out=tmp_path / "r.h5")
+    run_campaign(parse_campaign(raw_text, "r.yaml", AircraftProperties), out=tmp_path / "r.h5")
     with ResultStore.open(tmp_path / "t.h5") as compressed, ResultStore.open(tmp_path / "r.h5") as raw:
         assert compressed.output_names == raw.output_names == ["theta_deg", "aero/qbar-psf"]
         for name in raw.output_names:

@@ -11,7 +11,7 @@ from uqflight.methods.basis import orthonormal_basis, total_degree_indices
 from uqflight.methods.galerkin import pseudo_galerkin
 from uqflight.methods.pce import PCE
 from uqflight.methods.validation import VALIDATION_THRESHOLD, flags, validate
-from uqflight.simulators.validation_view import validation_view
+from uqflight.simulators.aircraft_properties import AircraftProperties
 from uqflight.analysis.statistics import analyse, summary_json
 from uqflight.methods import MethodSpec
 
@@ -110,7 +110,7 @@ def test_the_shipped_flights_are_not_flagged(tmp_path, campaign_file):
     # ci-tiny, the 15-run level-1 grid on JSBSim's c172p: the largest error measured is 0.021 (q at 8.8 s), the
     # band within 1.45 ranges beyond the runs' range (0.12 beyond their linear fit's band); paper-pg2-l2, the
     # paper's 113-run level-2 grid at order 2: errors below 1e-7, bands within 0.62 ranges of the runs
-    run_campaign(load_campaign(campaign_file, validation_view), out=tmp_path / "ci.h5", workers=2)
+    run_campaign(load_campaign(campaign_file, AircraftProperties), out=tmp_path / "ci.h5", workers=2)
     summary = strict_json(summary_json(analyse(tmp_path / "ci.h5")))
     assert all(entry["flags"] == [] for entry in summary["outputs"].values())
     assert all(entry["validation"]["validated"] for entry in summary["outputs"].values())

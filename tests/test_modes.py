@@ -9,7 +9,7 @@ from conftest import ROOT
 from uqflight.campaign import load_campaign
 from uqflight.quantities.modes import classified_modes
 from uqflight.quantities.recorder import QuantityRecorder
-from uqflight.simulators.validation_view import validation_view
+from uqflight.simulators.aircraft_properties import AircraftProperties
 
 NAMES = ["Vt", "Alpha", "Theta", "Q", "Rpm0", "Rpm1", "Beta", "Phi", "P", "Psi", "R", "Latitude", "Longitude",
          "Alt"]
@@ -48,7 +48,7 @@ def test_an_overdamped_short_period_is_undefined():
 def test_bacm_nominal_modes_match_the_flight_and_leave_the_flight_as_it_was():
     from uqflight.simulators import make_simulator
 
-    campaign = load_campaign(ROOT / "campaigns" / "bacm-modes.yaml", view=validation_view)
+    campaign = load_campaign(ROOT / "campaigns" / "bacm-modes.yaml", read_aircraft=AircraftProperties)
     names = [p.name for p in campaign.parameters]
     properties = [p.property for p in campaign.parameters]
     nominal = np.array([p.nominal for p in campaign.parameters])
@@ -79,7 +79,7 @@ def test_a_runs_modes_do_not_depend_on_the_run_flown_before_it_in_its_chunk():
     from uqflight.parameters import to_physical
     from uqflight.running.worker import run_chunk
 
-    campaign = load_campaign(ROOT / "campaigns" / "bacm-modes.yaml", view=validation_view)
+    campaign = load_campaign(ROOT / "campaigns" / "bacm-modes.yaml", read_aircraft=AircraftProperties)
     kappa = to_physical(campaign.parameters, campaign.design().xi)[16:18]
     spec, outputs = worker_spec(campaign), list(campaign.simulator["outputs"])
     pair = run_chunk(spec, np.arange(16, 18), kappa, 1001, outputs)[3]

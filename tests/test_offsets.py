@@ -13,7 +13,7 @@ from uqflight.campaign import CampaignError, load_campaign
 from uqflight.running.runner import run_campaign
 from uqflight.simulators.aircraft import AircraftFiles
 from uqflight.simulators.jsbsim import REPO_ROOT, quiet_jsbsim
-from uqflight.simulators.validation_view import validation_view
+from uqflight.simulators.aircraft_properties import AircraftProperties
 from uqflight.simulators.base import SimulatorSettingError
 from uqflight.simulators.patch import PreparedAircraft
 from uqflight.simulators.aero_factors import AeroFactor, aero_factors, axis_factor
@@ -123,7 +123,7 @@ def test_offset_on_a_function_outside_the_axes_is_refused_naming_it(tmp_path):
     path = _campaign(tmp_path, "  G: {function: aero/function/kCLge, perturbation: offset, distribution: normal, "
                                "lower: -0.01, upper: 0.01}\n")
     with pytest.raises(CampaignError, match=r"parameters\.G\.perturbation: .*aero/function/kCLge.*offset_value"):
-        load_campaign(path, view=validation_view)
+        load_campaign(path, read_aircraft=AircraftProperties)
 
 
 def test_offset_value_adds_in_the_function_own_unit():
@@ -143,7 +143,7 @@ def test_campaign_parameters_name_the_offset_kinds(tmp_path):
                                "lower: -0.002, upper: 0.002}\n"
                                "  Cm: {function: Cmo, perturbation: offset_value, distribution: normal, "
                                "lower: -5, upper: 5}\n")
-    campaign = load_campaign(path, view=validation_view)
+    campaign = load_campaign(path, read_aircraft=AircraftProperties)
     assert [(p.property, p.nominal) for p in campaign.parameters] == [
         ("aero/uq/offset/CDo", 0.0), ("aero/uq/offset_value/Cmo", 0.0)]
 
@@ -151,11 +151,11 @@ def test_campaign_parameters_name_the_offset_kinds(tmp_path):
 def test_a_patch_property_written_directly_is_checked_as_a_function_parameter(tmp_path):
     path = _campaign(tmp_path, "  CD: {property: aero/uq/offset/CDo, distribution: normal, lower: -0.002, upper: 0.002}\n"
                                "  CL: {property: aero/uq/scale/CLwbh, distribution: normal, lower: 0.9, upper: 1.1}\n")
-    campaign = load_campaign(path, view=validation_view)
+    campaign = load_campaign(path, read_aircraft=AircraftProperties)
     assert [p.nominal for p in campaign.parameters] == [0.0, 1.0]
     path = _campaign(tmp_path, "  G: {property: aero/uq/offset/kCLge, distribution: normal, lower: -0.01, upper: 0.01}\n")
     with pytest.raises(CampaignError, match=r"parameters\.G\.property: .*aero/function/kCLge.*offset_value"):
-        load_campaign(path, view=validation_view)
+        load_campaign(path, read_aircraft=AircraftProperties)
 
 
 def test_a_copy_patched_to_the_old_lbf_semantics_has_another_cache_key():
@@ -207,7 +207,7 @@ def test_a_campaign_with_an_offset_records_the_patched_copy_flown(tmp_path):
                                "lower: -0.002, upper: 0.002}\n")
     text = path.read_text().replace("duration_s: 50", "duration_s: 1").replace("order: 2", "order: 1")
     path.write_text(text.replace("results/c172p-scale-l2.h5", str(tmp_path / "r.h5")))
-    campaign = load_campaign(path, view=validation_view)
+    campaign = load_campaign(path, read_aircraft=AircraftProperties)
     summary = run_campaign(campaign, workers=1)
     with h5py.File(summary.path, "r") as f:
         recorded, status = f.attrs["aircraft_hash"], f["samples/status"][:]

@@ -14,7 +14,7 @@ from uqflight.simulators.aircraft import AircraftFiles, AircraftNotFound, locate
 from uqflight.simulators.jsbsim import REPO_ROOT, quiet_jsbsim
 from uqflight.simulators.scenarios import flight_setup_from
 from uqflight.simulators.scenarios.level_flight import JSBSimFlight
-from uqflight.simulators.validation_view import validation_view
+from uqflight.simulators.aircraft_properties import AircraftProperties
 from uqflight.simulators.patch import PreparedAircraft
 
 CAMPAIGNS = REPO_ROOT / "campaigns"
@@ -83,11 +83,11 @@ def test_unknown_function_is_refused_with_suggestions(tmp_path):
     text = (CAMPAIGNS / "c172p-scale-l2.yaml").read_text().replace("aero/coefficient/CLwbh", "aero/coefficient/CLwb")
     (tmp_path / "bad.yaml").write_text(text)
     with pytest.raises(CampaignError, match=r"parameters\.CL\.function: .*did you mean aero/coefficient/CLwbh"):
-        load_campaign(tmp_path / "bad.yaml", view=validation_view)
+        load_campaign(tmp_path / "bad.yaml", read_aircraft=AircraftProperties)
 
 
 def test_function_parameters_have_nominal_one_and_set_the_patch_property():
-    campaign = load_campaign(CAMPAIGNS / "c172p-scale-l2.yaml", view=validation_view)
+    campaign = load_campaign(CAMPAIGNS / "c172p-scale-l2.yaml", read_aircraft=AircraftProperties)
     assert [p.property for p in campaign.parameters] == [
         "aero/uq/scale/CLwbh", "aero/uq/scale/CDwbh", "aero/uq/scale/Cmalpha"]
     assert all(p.nominal == 1.0 and p.lower == pytest.approx(0.9) for p in campaign.parameters)
@@ -139,7 +139,7 @@ def test_an_aircraft_that_would_kill_the_process_is_refused_with_exit_2(tmp_path
     text = (CAMPAIGNS / "c172p-scale-l2.yaml").read_text().replace("aircraft: c172p", f"aircraft: {aircraft}")
     (tmp_path / "c.yaml").write_text(text)
     with pytest.raises(CampaignError, match="simulator.aircraft: " + message):
-        load_campaign(tmp_path / "c.yaml", view=validation_view)  # in this process: it survives
+        load_campaign(tmp_path / "c.yaml", read_aircraft=AircraftProperties)  # in this process: it survives
     for command in (["plan", tmp_path / "c.yaml"], ["aircraft", aircraft]):
         result = cli_in_process(*command, cwd=tmp_path)
         assert result.returncode == 2 and re.search(message, result.stderr), result.stderr

@@ -13,7 +13,7 @@ from uqflight.campaign import parse_campaign
 from uqflight.running.runner import run_campaign
 from uqflight.quantities import REGISTRY
 from uqflight.quantities.recorder import QuantityRecorder
-from uqflight.simulators.validation_view import validation_view
+from uqflight.simulators.aircraft_properties import AircraftProperties
 from uqflight.analysis.statistics import analyse, summary_json
 from uqflight.store import ResultStore
 from uqflight.running.worker import WorkerSpec, run_chunk
@@ -175,7 +175,7 @@ def test_every_take_is_a_registered_class_whose_example_a_level_flight_campaign_
     quantities = ", ".join(f"q_{name}: {json.dumps(take.example)}" for name, take in REGISTRY.items())
     campaign = parse_campaign(BACM.format(quantity="{of: h_ft, take: max}").replace(
         "quantities: {q: {of: h_ft, take: max}}", f"quantities: {{{quantities}}}"), str(tmp_path / "q.yaml"),
-        validation_view)
+        AircraftProperties)
     assert set(campaign.quantities) == {f"q_{name}" for name in REGISTRY}
 
 

@@ -198,13 +198,13 @@ def test_a_jsbsim_run_stores_the_nominal_values_it_read_from_the_aircraft(tmp_pa
     from uqflight.campaign.record import parameter_rows, read_record
     from uqflight.campaign.schema import CampaignError
     from uqflight.running.runner import run_campaign
-    from uqflight.simulators.validation_view import validation_view
+    from uqflight.simulators.aircraft_properties import AircraftProperties
     from uqflight.store import ResultStore
 
-    campaign = parse_campaign(JSBSIM, str(tmp_path / "c.yaml"), validation_view)
+    campaign = parse_campaign(JSBSIM, str(tmp_path / "c.yaml"), AircraftProperties)
     run_campaign(campaign, out=tmp_path / "j.h5")
     expected = parameter_rows(campaign.parameters)
-    assert expected[0]["nominal"] == validation_view(campaign.simulator).value("aero/uq/CL0")  # not in the campaign
+    assert expected[0]["nominal"] == AircraftProperties(campaign.simulator).value("aero/uq/CL0")  # not in the campaign
     with ResultStore.open(tmp_path / "j.h5") as store:
         assert read_record(store.attrs, "j.h5").parameter_rows == expected
     with ResultStore.open(without_record(tmp_path / "j.h5", tmp_path / "old.h5")) as store:

@@ -255,11 +255,11 @@ class _Altitude:
 def test_a_scenario_counts_its_times_from_the_campaign_and_its_observers_see_what_it_records(kind, tmp_path):
     from uqflight.campaign import parse_campaign
     from uqflight.simulators import make_simulator
-    from uqflight.simulators.validation_view import validation_view
+    from uqflight.simulators.aircraft_properties import AircraftProperties
 
     entry = SCENARIOS[kind]
     campaign = parse_campaign(_scenario_campaign({**entry.example, "outputs": ["h_ft"]}), str(tmp_path / "x.yaml"),
-                              validation_view)
+                              AircraftProperties)
     simulator = make_simulator(campaign.simulator, ["wind"], ["atmosphere/wind-north-fps"], tmp_path)
     time = simulator.setup.time
     assert entry.times(campaign.simulator) == len(time)  # the size estimate is the flight's own grid
@@ -294,10 +294,10 @@ def test_a_simulator_kind_builds_what_it_checks_and_counts_what_it_records(kind,
     from uqflight.campaign import parse_campaign
     from uqflight.simulators import make_simulator
     from uqflight.simulators.kinds import make_bundle
-    from uqflight.simulators.validation_view import validation_view
+    from uqflight.simulators.aircraft_properties import AircraftProperties
 
     entry = SIMULATORS[kind]
-    campaign = parse_campaign(_simulator_campaign(*entry.example), str(tmp_path / "x.yaml"), validation_view)
+    campaign = parse_campaign(_simulator_campaign(*entry.example), str(tmp_path / "x.yaml"), AircraftProperties)
     names, properties = [p.name for p in campaign.parameters], [p.property for p in campaign.parameters]
     simulator = make_simulator(campaign.simulator, names, properties, tmp_path)
     kappa = np.array([p.nominal for p in campaign.parameters])
@@ -335,16 +335,16 @@ ROOT = Path(__file__).resolve().parents[1]
 ], ids=["aircraft-folder", "script-file", "model-file"])
 def test_a_relocated_simulator_reads_the_same_files_from_another_folder(simulator, parameters, folder, tmp_path):
     from uqflight.campaign import CampaignError, parse_campaign
-    from uqflight.simulators.validation_view import validation_view
+    from uqflight.simulators.aircraft_properties import AircraftProperties
 
     entry = SIMULATORS[simulator["kind"]]
     parameters = parameters or entry.example[1]
     elsewhere = str(tmp_path / "x.yaml")
     with pytest.raises(CampaignError):  # the relative names do not resolve from elsewhere
-        parse_campaign(_simulator_campaign(simulator, parameters), elsewhere, validation_view)
+        parse_campaign(_simulator_campaign(simulator, parameters), elsewhere, AircraftProperties)
     moved = entry.relocated(simulator, ROOT / folder)
-    here = parse_campaign(_simulator_campaign(simulator, parameters), str(ROOT / folder / "x.yaml"), validation_view)
-    there = parse_campaign(_simulator_campaign(moved, parameters), elsewhere, validation_view)
+    here = parse_campaign(_simulator_campaign(simulator, parameters), str(ROOT / folder / "x.yaml"), AircraftProperties)
+    there = parse_campaign(_simulator_campaign(moved, parameters), elsewhere, AircraftProperties)
     for key in ("aircraft_path", "script_path", "function"):
         assert (key in here.simulator) == (key in there.simulator)
         if key.endswith("_path") and key in here.simulator:

@@ -15,7 +15,7 @@ import pytest
 from conftest import UQFLIGHT, cli, cli_in_process, read_summary, run_python_campaign
 from uqflight.campaign import parse_campaign
 from uqflight.analysis.check import write_baseline
-from uqflight.simulators.validation_view import validation_view
+from uqflight.simulators.aircraft_properties import AircraftProperties
 from uqflight.running.runner import run_campaign
 from uqflight.report import write_report
 from uqflight.analysis.statistics import analyse, read_statistics
@@ -59,8 +59,8 @@ analysis: {band_samples: 1000}
 """
 
 
-def run(template: str, path: Path, view=None, **fields) -> Path:
-    campaign = parse_campaign(template.format(**fields) if fields else template, str(path.with_suffix(".yaml")), view)
+def run(template: str, path: Path, read_aircraft=None, **fields) -> Path:
+    campaign = parse_campaign(template.format(**fields) if fields else template, str(path.with_suffix(".yaml")), read_aircraft)
     run_campaign(campaign, out=path, workers=1)
     return path
 
@@ -158,7 +158,7 @@ def test_pce_against_pick_freeze_and_two_monte_carlo_files(files, tmp_path):
 
 @pytest.mark.slow
 def test_report_of_a_jsbsim_campaign_and_its_check(tmp_path):
-    results = run(JSBSIM, tmp_path / "jsbsim.h5", view=validation_view)
+    results = run(JSBSIM, tmp_path / "jsbsim.h5", read_aircraft=AircraftProperties)
     baseline = tmp_path / "baseline.json"
     result = cli("report", results, "--out", tmp_path / "report", "--write-baseline", baseline)
     assert result.returncode == 0, result.stderr

@@ -21,7 +21,7 @@ from uqflight.simulators.bundle import AircraftMismatch
 from uqflight.simulators.kinds import localized
 from uqflight.simulators.jsbsim import quiet_jsbsim
 from uqflight.simulators.scenarios.level_flight import FlightSetup, JSBSimFlight
-from uqflight.simulators.validation_view import validation_view
+from uqflight.simulators.aircraft_properties import AircraftProperties
 from uqflight.simulators.scenarios.script import ScriptFile, jsbsim_scripts
 
 CRUISE = jsbsim_scripts() / "c172_cruise_8K.xml"  # c172x, trims itself at 1 s, autopilot from 5 s, gust at 10 s
@@ -62,7 +62,7 @@ def plain_jsbsim(script: Path, steps: int, every: int, properties, out: Path, in
 
 
 def test_a_shipped_script_at_nominal_records_what_plain_jsbsim_records_and_a_perturbation_changes_it(tmp_path):
-    campaign = load_campaign(script_campaign(tmp_path), validation_view)
+    campaign = load_campaign(script_campaign(tmp_path), AircraftProperties)
     summary = run_campaign(campaign, out=tmp_path / "cruise.h5", workers=1)
     with h5py.File(summary.path, "r") as f:
         xi, status, time = f["samples/xi"][()], f["samples/status"][()], f["time"][()]
@@ -247,7 +247,7 @@ def test_a_script_and_its_initialisation_travel_in_the_bundle_hashed(tmp_path, m
                                          "scripts/c172p-landing.xml", "end_s": 1.0}, "output_rate_hz": 10,
                                          "outputs": ["h_ft"]},
         "parameters": {"CL": PARAMETERS["CL"]}, "design": {"kind": "sparse_grid", "level": 1}}))
-    campaign = load_campaign(path, validation_view)
+    campaign = load_campaign(path, AircraftProperties)
     spec = worker_spec(campaign)
     assert len(spec.bundle["scenario"]["hash"]) == 64
     client = spec.build().evaluate(np.array([1.02]))
@@ -278,7 +278,7 @@ SCRIPT_WITH_RESET = """<?xml version="1.0"?>
 def test_a_script_that_resets_fails_every_run_with_the_reason_and_resumes_as_done(tmp_path):
     (tmp_path / "resets.xml").write_text(SCRIPT_WITH_RESET)  # its own file; reset01 from c172x's folder
     path = script_campaign(tmp_path, scenario={"kind": "script", "script": "resets.xml"})
-    campaign = load_campaign(path, validation_view)
+    campaign = load_campaign(path, AircraftProperties)
     first = run_campaign(campaign, out=tmp_path / "resets.h5", workers=1)
     with h5py.File(first.path, "r") as f:
         assert np.all(f["samples/status"][()] == 3)
@@ -289,7 +289,7 @@ def test_a_script_that_resets_fails_every_run_with_the_reason_and_resumes_as_don
 
 @pytest.mark.slow
 def test_a_script_campaign_is_bit_identical_with_one_or_two_workers(tmp_path):
-    campaign = load_campaign(script_campaign(tmp_path), validation_view)
+    campaign = load_campaign(script_campaign(tmp_path), AircraftProperties)
     one = run_campaign(campaign, out=tmp_path / "one.h5", workers=1)
     two = run_campaign(campaign, out=tmp_path / "two.h5", workers=2)
     assert_same_results(one.path, two.path)
@@ -311,7 +311,7 @@ class FirstContact:
 
 @pytest.mark.slow
 def test_the_landing_campaign_touches_down_at_every_corner_of_its_box():
-    campaign = load_campaign(ROOT / "campaigns" / "c172p-landing.yaml", validation_view)
+    campaign = load_campaign(ROOT / "campaigns" / "c172p-landing.yaml", AircraftProperties)
     properties = [p.property for p in campaign.parameters]
     simulator = make_simulator(campaign.simulator, [p.name for p in campaign.parameters], properties,
                                ROOT / "campaigns")
@@ -332,7 +332,7 @@ def test_separate_dask_workers_fly_a_script_campaign_bit_identical_to_the_local_
     address, worker_cache = cluster
     shutil.copytree(ROOT / "campaigns" / "scripts", tmp_path / "scripts")
     path = script_campaign(tmp_path, scenario={"kind": "script", "script": "scripts/c172p-landing.xml", "end_s": 3})
-    campaign = load_campaign(path, validation_view)
+    campaign = load_campaign(path, AircraftProperties)
     local = run_campaign(campaign, out=tmp_path / "local.h5", workers=2, executor="local")
     remote = run_campaign(campaign, out=tmp_path / "dask.h5", workers=1, executor="dask", scheduler=address)
     assert_same_results(local.path, remote.path)

@@ -7,7 +7,7 @@ import pytest
 from conftest import NORMAL_2D, ROOT, closed_form_campaign, run_python_campaign, strict_json
 
 from uqflight.campaign import load_campaign
-from uqflight.simulators.validation_view import validation_view
+from uqflight.simulators.aircraft_properties import AircraftProperties
 from uqflight.running.runner import nominal_kappa, run_campaign, worker_spec
 from uqflight.analysis.statistics import analyse, summary_json
 from uqflight.store import ResultStore
@@ -32,7 +32,7 @@ def test_a_spread_below_the_recorded_resolution_is_unresolved(tmp_path):
 
 @pytest.fixture(scope="module")
 def nominal_resolution():
-    campaign = load_campaign(ROOT / "campaigns" / "ci-small.yaml", validation_view)
+    campaign = load_campaign(ROOT / "campaigns" / "ci-small.yaml", AircraftProperties)
     simulator = worker_spec(campaign).build()
     return simulator.setup.time, simulator.resolution(nominal_kappa(campaign))
 
@@ -55,7 +55,7 @@ def test_the_aircraft_file_records_it_and_q_before_the_pulse_is_unresolved(tmp_p
     """ci-small: q's spread before the pulse (~5e-8 deg/s, trim residuals) is below the trims' drift
     (~1e-6): its Sobol' indices are null there, and defined once the pulse moves q (std ~1e-2)."""
     out = tmp_path / "ci.h5"
-    run_campaign(load_campaign(ROOT / "campaigns" / "ci-small.yaml", validation_view), out=out, workers=1)
+    run_campaign(load_campaign(ROOT / "campaigns" / "ci-small.yaml", AircraftProperties), out=out, workers=1)
     time, drift = nominal_resolution
     with ResultStore.open(out) as store:
         np.testing.assert_array_equal(store.resolution("q_degps"), drift["q_degps"])

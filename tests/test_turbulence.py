@@ -7,7 +7,7 @@ from conftest import assert_same_results, cli_in_process
 from uqflight.campaign import CampaignError, load_campaign
 from uqflight.running.runner import run_campaign
 from uqflight.simulators import JSBSimSimulator
-from uqflight.simulators.validation_view import validation_view
+from uqflight.simulators.aircraft_properties import AircraftProperties
 from uqflight.analysis.statistics import analyse, summary_json
 
 MODERATE = {"atmosphere/turb-type": 3, "atmosphere/turbulence/milspec/severity": 4,
@@ -95,7 +95,7 @@ def test_turbulence_campaigns_are_reproducible_and_their_seed_matters_only_when_
     for name, seed, props, workers in (("a", 3, None, 1), ("b", 3, None, 2), ("c", 4, None, 1),
                                        ("calm", 3, {**MODERATE, "atmosphere/turbulence/milspec/severity": 0}, 2)):
         runs[name] = tmp_path / f"{name}.h5"
-        run_campaign(load_campaign(write(tmp_path, name, seed, props), validation_view), out=runs[name], workers=workers)
+        run_campaign(load_campaign(write(tmp_path, name, seed, props), AircraftProperties), out=runs[name], workers=workers)
     assert_same_results(runs["a"], runs["b"])  # 1 or 2 workers: the same bits
     import h5py
     with h5py.File(runs["a"]) as a, h5py.File(runs["c"]) as c:
@@ -112,7 +112,7 @@ def test_turbulence_campaigns_are_reproducible_and_their_seed_matters_only_when_
 def test_a_turbulence_campaign_on_dask_is_bit_identical(tmp_path):
     pytest.importorskip("dask.distributed")
     local, dask = tmp_path / "l.h5", tmp_path / "d.h5"
-    campaign = load_campaign(write(tmp_path, "t"), validation_view)
+    campaign = load_campaign(write(tmp_path, "t"), AircraftProperties)
     run_campaign(campaign, out=local, workers=1)
     run_campaign(campaign, out=dask, workers=2, executor="dask")
     assert_same_results(local, dask)
@@ -125,6 +125,6 @@ def test_a_turbulence_campaign_on_dask_is_bit_identical(tmp_path):
 def test_a_fixed_property_that_a_parameter_sets_or_the_aircraft_lacks_is_refused(tmp_path, properties, field):
     path = write(tmp_path, "bad", properties=properties)
     with pytest.raises(CampaignError, match=field):
-        load_campaign(path, validation_view)
+        load_campaign(path, AircraftProperties)
     done = cli_in_process("plan", path)
     assert done.returncode == 2 and field in done.stderr

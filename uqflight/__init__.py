@@ -59,9 +59,9 @@ def load_campaign(path, check_aircraft: bool = True):
         Naming the file, the field and what was expected. A python simulator's module is imported: its code runs.
     """
     from .campaign import load_campaign as load
-    from .simulators.validation_view import validation_view
+    from .simulators.aircraft_properties import AircraftProperties
 
-    return load(path, view=validation_view if check_aircraft else None)
+    return load(path, read_aircraft=AircraftProperties if check_aircraft else None)
 
 
 def run(campaign, out=None, workers: int | None = None, executor: str | None = None,

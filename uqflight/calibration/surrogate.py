@@ -29,7 +29,7 @@ from ..parameters import Parameter
 from ..parameters import to_physical as _to_physical
 from ..parameters import to_standard as _to_standard
 from ..parameters.summaries import parameter_specs, prior_summaries
-from ..simulators.validation_view import validation_view
+from ..simulators.aircraft_properties import AircraftProperties
 from ..analysis.statistics import Options, file_record, output_basis
 from ..store import ResultStore, Status
 from ..analysis.surrogate import fit_surrogate
@@ -101,7 +101,7 @@ def to_standard(parameters, kappa, dependence=None) -> np.ndarray:
 
 def load_campaign_file(path) -> Campaign:
     """A campaign file (for --campaign), validated against its aircraft."""
-    return load_campaign(path, view=validation_view)
+    return load_campaign(path, read_aircraft=AircraftProperties)
 
 
 def _record_of(store: ResultStore, results: Path, campaign_path: Path | None) -> CampaignRecord:

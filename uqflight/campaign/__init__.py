@@ -27,7 +27,7 @@ from ..text import FieldError
 from .schema import TOP_KEYS, CampaignError, CampaignLoader, Checker, yaml_error
 from .sections import Analysis, Execution, Limits, Storage
 
-ValidationView = Callable[[dict], object]  # simulator config -> its aircraft's properties (see validation_view)
+AircraftReader = Callable[[dict], object]  # simulator config -> its aircraft's properties (see AircraftProperties)
 
 @dataclass(frozen=True)
 class Campaign:
@@ -67,11 +67,11 @@ class Campaign:
         return build_design(self.design_spec, self.germs, self.seed, self.redrawn)
 
 
-def load_campaign(path: str | Path, view: ValidationView | None = None) -> Campaign:
+def load_campaign(path: str | Path, read_aircraft: AircraftReader | None = None) -> Campaign:
     """Read and validate a campaign file.
 
-    `view(simulator_config)` gives the aircraft's properties
-    (`uqflight.simulators.validation_view.validation_view`); it is used for
+    `read_aircraft(simulator_config)` gives the aircraft's properties
+    (`uqflight.simulators.aircraft_properties.AircraftProperties`); it is used for
     JSBSim campaigns to check property and output names and to read nominal values from the
     aircraft. Without it, those checks are skipped and nominal values must be given.
     """
@@ -88,10 +88,10 @@ def load_campaign(path: str | Path, view: ValidationView | None = None) -> Campa
     except UnicodeDecodeError as exc:
         raise CampaignError(source, "", f"expected UTF-8 text, got byte {exc.object[exc.start]:#04x} "
                                         f"at position {exc.start}") from exc
-    return parse_campaign(text, source, view)
+    return parse_campaign(text, source, read_aircraft)
 
 
-def parse_campaign(text: str, source: str = "<campaign>", view: ValidationView | None = None) -> Campaign:
+def parse_campaign(text: str, source: str = "<campaign>", read_aircraft: AircraftReader | None = None) -> Campaign:
     """Validate campaign text; see `load_campaign`. A python simulator's module is imported (its code
     runs): this is for campaigns about to be planned or run; a results file's campaign is read by
     `campaign.record.read_record`, which never resolves the simulator."""
@@ -99,9 +99,9 @@ def parse_campaign(text: str, source: str = "<campaign>", view: ValidationView |
     check, data, simulator = check_settings(Checker(source), written)
     schema.resolve_simulator(check, simulator, source)
     aircraft = None
-    if view and simulator_entry(simulator).aircraft:
+    if read_aircraft and simulator_entry(simulator).aircraft:
         try:
-            aircraft = view(simulator)
+            aircraft = read_aircraft(simulator)
         except (FileNotFoundError, RuntimeError) as exc:  # no such aircraft, or JSBSim cannot load it
             check.fail("simulator.aircraft", str(exc))
         for i, output in enumerate(simulator.get("outputs", ())):

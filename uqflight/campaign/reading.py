@@ -26,7 +26,7 @@ def campaign_folder(campaign: Campaign) -> Path:
 
 def check_campaign_text(text: str, source: str) -> None:
     """Validate campaign text as `uqflight plan` does (CampaignError when it would be refused)."""
-    from ..simulators.validation_view import validation_view
+    from ..simulators.aircraft_properties import AircraftProperties
     from . import parse_campaign
 
-    parse_campaign(text, source, view=validation_view)
+    parse_campaign(text, source, read_aircraft=AircraftProperties)

@@ -228,10 +228,10 @@ def _prepared(aircraft: str, scale: list[str], offset: list[str], offset_value: 
 def _load(path: Path):
     """The validated campaign; a CampaignError naming the file and the field."""
     from ..campaign import load_campaign
-    from ..simulators.validation_view import validation_view
+    from ..simulators.aircraft_properties import AircraftProperties
 
     check_campaign_file(path)
-    return load_campaign(path, view=validation_view)
+    return load_campaign(path, read_aircraft=AircraftProperties)
 
 
 @app.command()
@@ -709,7 +709,7 @@ def aircraft_command(
             raise typer.Exit(1)
         where = "at the trim"
     else:  # qbar = ρ V² / 2 at the condition's altitude and airspeed: the trim's, without trimming
-        flight.prepare_validation_view()
+        flight.prepare_for_validation()
         flight.fdm.run_ic()
         where = f"at {setup.altitude_ft:g} ft, {setup.airspeed_ktas:g} KTAS"
         echo(f"not trimmed: `uqflight aircraft {aircraft} --trim` trims it at {setup.altitude_ft:g} ft, "

@@ -30,7 +30,7 @@ def is_level_flight(simulator: dict) -> bool:
 
 
 def check_quantities(check, value, simulator: dict, aircraft=None) -> dict[str, dict]:
-    """The checked `quantities:` mapping {name: spec}; `aircraft` (the validation view of a JSBSim
+    """The checked `quantities:` mapping {name: spec}; `aircraft` (the `AircraftProperties` of a JSBSim
     aircraft, or None) checks the names in `of:` and `when.of:`."""
     if value is None:
         return {}

@@ -182,7 +182,7 @@ class JSBSimFlight(PropertyAccess):
             return self._touched[name]
         return self.node(name).get_double_value() if self.has_property(name) else None
 
-    def prepare_validation_view(self) -> None:
+    def prepare_for_validation(self) -> None:
         """The state campaign validation reads nominal values in: the flight condition's initial
         conditions set, as `trim` sets them (so `ic/vc-kts` reads the matching calibrated airspeed)."""
         self.fdm["ic/h-sl-ft"] = self.setup.altitude_ft

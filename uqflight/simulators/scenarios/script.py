@@ -331,7 +331,7 @@ class ScriptFlight(PropertyAccess):
                 self._pm.get_node(name, True)
         self._recorded = [self._output_source(name) for name in s.outputs]
 
-    def prepare_validation_view(self) -> None:
+    def prepare_for_validation(self) -> None:
         """The state campaign validation reads nominal values in: the script loaded, before run_ic."""
 
     def property_value(self, name: str) -> float | None:

@@ -12,7 +12,7 @@ class AircraftProperties:
     """The campaign's aircraft as a sample finds it before the flight, as its scenario prepares it
     (level flight: loaded, with the flight condition's initial conditions set, so `ic/vt-kts` reads the
     campaign's airspeed and `ic/vc-kts` the matching calibrated airspeed; a script: loaded with it).
-    Validation reads nominal values here."""
+    Validation reads nominal values here: the class is the `read_aircraft` of `campaign.load_campaign`."""
 
     def __init__(self, simulator: dict):
         from .aircraft import aero_functions
@@ -25,7 +25,7 @@ class AircraftProperties:
         self.functions = [f.name for f in aero_functions(xml)]
         self.aero_factors = aero_factors(xml)  # each function's unit and reference factor
         self._flight = scenario_entry(simulator).flight(setup)
-        self._flight.prepare_validation_view()
+        self._flight.prepare_for_validation()
 
     def value(self, name: str) -> float | None:
         """The property's value (None when the aircraft has no such property)."""
@@ -40,7 +40,3 @@ class AircraftProperties:
         """'; did you mean ...?' with the aircraft's properties closest to `name`, or ''."""
         return self._flight.property_hint(name)
 
-
-def validation_view(simulator: dict) -> AircraftProperties:
-    """The campaign aircraft's properties, for `load_campaign(..., view=validation_view)`."""
-    return AircraftProperties(simulator)
