@@ -529,3 +529,34 @@ def test_ctrl_c_in_calibrate_exits_130_with_one_line(one_output, tmp_path):
     others = [line for line in stderr.splitlines() if not line.startswith("calibrate: ")]
     assert stdout == "" and others == ["", f"interrupted: no calibration written to {tmp_path / 'out'}"], stderr
 
+
+
+def test_a_calibration_opens_the_results_file_once_and_checks_its_campaign_once(one_output, tmp_path, monkeypatch):
+    # the memory limit, the surrogate's record and the statistics' fit each opened the file and read the record
+    from collections import Counter
+
+    import uqflight
+    import uqflight.analysis.statistics as statistics
+    from uqflight.store import ResultStore
+
+    calls, open_file, read_record = Counter(), ResultStore.open.__func__, statistics.read_record
+
+    def opened(cls, path, *args, **kwargs):
+        calls["open"] += 1
+        return open_file(cls, path, *args, **kwargs)
+
+    def read(*args, **kwargs):
+        calls["read_record"] += 1
+        return read_record(*args, **kwargs)
+
+    monkeypatch.setattr(ResultStore, "open", classmethod(opened))
+    monkeypatch.setattr(statistics, "read_record", read)
+    data = tmp_path / "flight.csv"
+    data.write_text("time_s,y\n0,15000\n0.5,15001\n1,15002\n")
+    with pytest.raises(Refusal, match="--noise w"):  # refused once the surrogate is fitted, before the sampler
+        uqflight.calibrate(one_output, data, tmp_path / "out", noise={"w": 0.5})
+    assert calls == {"open": 1, "read_record": 1}
+    from uqflight.calibration.run import calibrate
+
+    with pytest.raises(Refusal, match=r"^--truth zz: not one of the parameters of .*c\.h5 \(x1, x2\)$"):
+        calibrate(one_output, data, tmp_path / "out", truth={"zz": 1.0})

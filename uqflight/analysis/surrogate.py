@@ -91,24 +91,33 @@ def fit_surrogate(path, method: MethodSpec | None = None, partial: bool = False,
     A method that builds no PCE of its own on this design is exported as its registry entry says
     (`exported_as`: monte_carlo, and integration on a sampled design, as least squares). The export
     and the calibration both fit here. `options`: statistics.Options (default 200 band draws: the PCE
-    does not depend on them, and its bands and PDFs are not exported); `progress`: see analyse."""
-    from ..designs import REGISTRY as DESIGNS
-    from .statistics import BadInput, Options, analyse_store, file_record
+    does not depend on them, and its bands and PDFs are not exported); `progress`: see analyse. The file is
+    opened once (`fit_store_surrogate`)."""
+    from .statistics import file_record
     from ..store import ResultStore
 
     with ResultStore.open(path) as store:
-        record = file_record(store, path)
-        design_kind = record.design_kind
-        if DESIGNS[design_kind].rare:
-            raise BadInput(f"{path}: a {design_kind} design's runs were chosen to reach its event, they are not "
-                           "draws of the input law: no expansion of the law is fitted to them; fly a sampled "
-                           "design or a grid for a surrogate")
-        parameters, time = record.parameter_rows, np.asarray(store.time, dtype=float)
-        override = method or MethodSpec(record.campaign.method.kind)
-        override = replace(override, kind=override.entry.exported_kind(DESIGNS[design_kind].sampled))
-        stats = analyse_store(store, path, method=override, partial=partial, allow_aliasing=allow_aliasing,
-                              options=options or Options(band_samples=200, bootstrap=0), progress=progress,
-                              record=record)
+        return fit_store_surrogate(store, path, file_record(store, path), method, partial, allow_aliasing, options,
+                                   progress)
+
+
+def fit_store_surrogate(store, path, record, method: MethodSpec | None = None, partial: bool = False,
+                        allow_aliasing: bool = False, options=None, progress=None) -> Surrogate:
+    """`fit_surrogate` of the open results file `store` read from `path`, whose checked campaign `record`
+    (statistics.file_record) the caller has read."""
+    from ..designs import REGISTRY as DESIGNS
+    from .statistics import BadInput, Options, analyse_store
+
+    design_kind = record.design_kind
+    if DESIGNS[design_kind].rare:
+        raise BadInput(f"{path}: a {design_kind} design's runs were chosen to reach its event, they are not "
+                       "draws of the input law: no expansion of the law is fitted to them; fly a sampled "
+                       "design or a grid for a surrogate")
+    parameters, time = record.parameter_rows, np.asarray(store.time, dtype=float)
+    override = method or MethodSpec(record.campaign.method.kind)
+    override = replace(override, kind=override.entry.exported_kind(DESIGNS[design_kind].sampled))
+    stats = analyse_store(store, path, method=override, partial=partial, allow_aliasing=allow_aliasing,
+                          options=options or Options(band_samples=200, bootstrap=0), progress=progress, record=record)
     pces = {name: out.pce for name, out in stats.outputs.items()}
     units = {name: out.units for name, out in stats.outputs.items()}  # the simulator's, else from the name
     dependence = {k: v for k, v in stats.dependence.items() if k != "sobol_of"} if stats.dependence else None

@@ -64,7 +64,6 @@ def calibrate_command(
     Exit 0: done; 2: bad input (data, options, results file, data times outside the surrogate's); 3: the chain did not converge (nothing written; the message says what to change); 130: interrupted (Ctrl-C).
     """  # noqa: E501
     from .likelihood import parse_noise
-    from .size import campaign_memory_limit, check_size
 
     check_results_file(results)
     if campaign is not None:
@@ -78,10 +77,9 @@ def calibrate_command(
     method, order = _method(method, order)
     if predictive_draws < 1:
         raise Refusal(f"--predictive-draws: expected an integer >= 1, got {predictive_draws}")
-    # before the sampler's and the surrogate's modules are even imported: a refusal is immediate
+    # the options parsed before the sampler's and the surrogate's modules are imported: a refusal is immediate
     sigmas = parse_noise(list(noise))
-    check_size(data, list(output) or None, walkers, steps, predictive_draws, campaign_memory_limit(results))
-    known = _truth(truth, results)
+    known = _truth(truth)
     from ..running.runner import WorkerError
     from .run import NotConverged, calibrate
 
@@ -143,20 +141,12 @@ def calibrate_command(
              "summary.json, the plots): write the campaign from summary.json's posterior", err=True)
 
 
-def _truth(items: list[str], results: Path) -> dict[str, float] | None:
-    """--truth NAME=VALUE items as {name: value}; a Refusal for a malformed item, a repeated or unknown name."""
-    from ..store import ResultStore
-    from .likelihood import check_names, parse_pairs
+def _truth(items: list[str]) -> dict[str, float] | None:
+    """--truth NAME=VALUE items as {name: value}; a Refusal for a malformed or repeated item (`calibrate` refuses
+    a name that is no parameter of the results file)."""
+    from .likelihood import parse_pairs
 
-    if not items:
-        return None
-    try:
-        with ResultStore.open(results) as store:
-            names = list(store.parameter_names)
-    except (OSError, ValueError) as exc:  # damaged, or held by another process (the message names it)
-        raise Refusal(str(exc) if str(exc).startswith(str(results)) else f"{results}: {exc}") from exc
-    return check_names(parse_pairs(items, "--truth", "NAME=VALUE with a finite VALUE"), "--truth", names,
-                       f"the parameters of {results}")
+    return parse_pairs(items, "--truth", "NAME=VALUE with a finite VALUE") if items else None
 
 
 def _method(text: str | None, order: int | None) -> tuple[str | None, int | None]:

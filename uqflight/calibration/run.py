@@ -15,13 +15,13 @@ from threadpoolctl import threadpool_limits
 
 from ..parameters.germs import GERMS
 
-from .likelihood import LogPosterior, check_noise, interpolate_in_time, read_flight_csv
+from .likelihood import LogPosterior, check_names, check_noise, interpolate_in_time, read_flight_csv
 from .outputs import (OUTPUT_FILES, calibrated_campaign, corner_plot, draw_all, informed, marginal, marginals_plot,
                       predictive_plot, pyplot, write_json, write_posterior)
 from .sampler import sample
-from .size import MAX_STEPS, PREDICTIVE_NOISE_DRAWS, campaign_memory_limit, check_size
-from .surrogate import (CampaignError, calibration_surrogate, check_campaign_text, portable_mapping,
-                        parameter_specs, prior_summaries, simulate, to_physical, to_standard)
+from .size import MAX_STEPS, PREDICTIVE_NOISE_DRAWS, check_size
+from .surrogate import (CampaignError, check_campaign_text, open_results, parameter_specs, portable_mapping,
+                        prior_summaries, results_record, simulate, surrogate_of, to_physical, to_standard)
 
 TIME_HANDLING = ("PCE coefficients (and the surrogate's error variance) interpolated linearly in time "
                  "onto the data times; data times outside the results file's time range are refused")
@@ -60,19 +60,27 @@ def calibrate(results, data, out, outputs: list[str] | None = None, noise: dict[
     NotConverged.
     One BLAS thread: the matrices are small (a few hundred rows), where several threads on a shared
     machine make the SVDs 10-100x slower."""
-    check_size(data, outputs, walkers, steps, predictive_draws, campaign_memory_limit(results))  # before any work
+    started = clock.perf_counter()
+    results = Path(results)
     with threadpool_limits(limits=1):
-        return _calibrate(results, data, out, outputs, noise, seed, walkers, steps, method, order, campaign,
+        with open_results(results) as store:  # opened once: the record, the size check, the surrogate
+            record = results_record(store, results, Path(campaign) if campaign else None)
+            check_size(data, outputs, walkers, steps, predictive_draws, record.campaign.limits.max_memory_gb)
+            if truth:
+                check_names(truth, "--truth", [p.name for p in record.campaign.parameters],
+                            f"the parameters of {results}")
+            _stage(progress, f"fitting the surrogate of {results}")
+            surrogate = surrogate_of(store, results, record, method, order)
+        return _calibrate(surrogate, started, results, data, out, outputs, noise, seed, walkers, steps,
                           predictive_draws, truth, progress)
 
 
-def _calibrate(results, data, out, outputs, noise, seed, walkers, steps, method, order, campaign,
-               predictive_draws, truth, progress) -> Calibration:
-    """The steps of `calibrate`: fit, sample (and refine), summarise, write."""
-    started = clock.perf_counter()
+def _calibrate(surrogate, started, results, data, out, outputs, noise, seed, walkers, steps, predictive_draws,
+               truth, progress) -> Calibration:
+    """The steps of `calibrate` after the surrogate (fitted from `started`): sample (and refine), summarise,
+    write."""
     out = Path(out)
-    _stage(progress, f"fitting the surrogate of {results}")
-    surrogate, flight, given, posterior = _fitted(results, data, outputs, noise, method, order, campaign)
+    flight, given, posterior = _fitted(surrogate, data, outputs, noise)
     walkers = walkers or max(32, 2 * posterior.ndim + 2)
     if steps is not None and steps < 100:
         raise ValueError(f"--steps: expected at least 100, got {steps}")
@@ -125,14 +133,13 @@ def _stage(progress, text: str, total: int = 0, unit: str = "steps") -> None:
         progress.stage(text, total, unit)
 
 
-def _fitted(results, data, outputs, noise, method, order, campaign):
-    """The surrogate of `results`, the flight data, the given noise and the log-posterior."""
-    surrogate = calibration_surrogate(results, method=method, order=order, campaign_path=campaign)
+def _fitted(surrogate, data, outputs, noise):
+    """The flight data, the given noise and the log-posterior on the `surrogate`."""
     flight = read_flight_csv(data, outputs, surrogate.outputs)
     given = check_noise(noise or {}, list(flight.values))
     posterior = LogPosterior.build(surrogate.time, surrogate.coefficients, surrogate.error_factors,
                                    surrogate.germs, surrogate.names, surrogate.basis, flight, given)
-    return surrogate, flight, given, posterior
+    return flight, given, posterior
 
 
 @dataclass

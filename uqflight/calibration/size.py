@@ -14,7 +14,6 @@ from __future__ import annotations
 from pathlib import Path
 
 from ..text.bounded import Refused, open_bounded
-from ..campaign.sections import Limits
 from ..text import Refusal
 from .likelihood import DATA_FORM, MAX_DATA_BYTES
 
@@ -27,20 +26,6 @@ def row_bytes(predictive_draws: int, walkers: int, noise_draws: int = PREDICTIVE
     """Bytes per data row and output: the predictive band (twice: its quantiles sort a copy), the runs,
     the surrogate and its error at the draws, and the walkers' residuals (float64)."""
     return 8.0 * (predictive_draws * (2 * noise_draws + 3) + 4 * walkers)
-
-
-def campaign_memory_limit(results) -> float:
-    """The results file's campaign `limits.max_memory_gb`, read without running any of its code; the
-    default when the file cannot be read (then its own checks speak)."""
-    from ..campaign.record import read_record
-    from ..store import ResultStore
-
-    try:
-        with ResultStore.open(results) as store:
-            attrs = dict(store.attrs)
-        return float(read_record(attrs, str(results)).campaign.limits.max_memory_gb)
-    except (OSError, ValueError, KeyError):
-        return Limits.max_memory_gb
 
 
 def check_size(data, outputs: list[str] | None, walkers: int | None, steps: int | None, predictive_draws: int,

@@ -32,7 +32,7 @@ from ..parameters.summaries import parameter_specs, prior_summaries
 from ..simulators.aircraft_properties import AircraftProperties
 from ..analysis.statistics import Options, file_record, output_basis
 from ..store import ResultStore, Status
-from ..analysis.surrogate import fit_surrogate
+from ..analysis.surrogate import fit_store_surrogate
 from ..text import Refusal
 from .likelihood import error_factors_of
 
@@ -104,7 +104,15 @@ def load_campaign_file(path) -> Campaign:
     return load_campaign(path, read_aircraft=AircraftProperties)
 
 
-def _record_of(store: ResultStore, results: Path, campaign_path: Path | None) -> CampaignRecord:
+def open_results(results: Path) -> ResultStore:
+    """The results file opened for reading; a Refusal naming it when it cannot be (damaged, held, not HDF5)."""
+    try:
+        return ResultStore.open(results)
+    except (OSError, ValueError) as exc:  # CorruptFile's message names the file already
+        raise Refusal(str(exc) if str(exc).startswith(f"{results}:") else f"{results}: {exc}") from exc
+
+
+def results_record(store: ResultStore, results: Path, campaign_path: Path | None) -> CampaignRecord:
     """The campaign the results file records (campaign.record), read without running any of its code (a
     python model is imported only by the predictive runs, from beside the results file), or from beside the
     campaign file given, which must be the same text."""
@@ -135,56 +143,60 @@ def _record_of(store: ResultStore, results: Path, campaign_path: Path | None) ->
 
 def calibration_surrogate(results, method: str | None = None, order: int | None = None,
                           campaign_path=None, outputs: list[str] | None = None) -> CalibrationSurrogate:
-    """The surrogate of every output (or of `outputs`) of a results file, with its error model.
+    """The surrogate of every output (or of `outputs`) of a results file, with its error model: the file
+    opened once, its record checked once (`results_record`, `surrogate_of`)."""
+    results = Path(results)
+    with open_results(results) as store:
+        record = results_record(store, results, Path(campaign_path) if campaign_path else None)
+        return surrogate_of(store, results, record, method, order, outputs)
+
+
+def surrogate_of(store: ResultStore, results: Path, record: CampaignRecord, method: str | None = None,
+                 order: int | None = None, outputs: list[str] | None = None) -> CalibrationSurrogate:
+    """The surrogate of the open results file `store` (read from `results`, its campaign `record`).
 
     Default: the file's method and order. The PCE is the export's (`uqflight.analysis.surrogate.fit_surrogate`):
     a method without a PCE of its own is fitted as its registry entry's `exported_as` says.
     """
-    results = Path(results)
-    try:
-        store = ResultStore.open(results)
-    except (OSError, ValueError) as exc:  # CorruptFile's message names the file already
-        raise Refusal(str(exc) if str(exc).startswith(f"{results}:") else f"{results}: {exc}") from exc
-    with store:
-        record = _record_of(store, results, Path(campaign_path) if campaign_path else None)
-        campaign = record.campaign
-        stored, germs = campaign.method, campaign.germs
-        sampled = DESIGNS[record.design_kind].sampled
-        kind = method or stored.kind
-        order = (DEFAULT_ORDER if stored.order is None else stored.order) if order is None else order
-        if kind not in METHOD_KINDS:
-            raise Refusal(f"--method: expected one of {', '.join(METHOD_KINDS)}, got {kind!r}")
-        ok = store.status == Status.OK
-        names = store.output_names if outputs is None else outputs
-        missing = [name for name in names if name not in store.output_names]
-        if missing:
-            raise Refusal(f"{results} has no output {', '.join(map(repr, missing))} "
-                          f"(it has {listed(store.output_names)})")
-        # the statistics' own PCE, after their checks (pending or failed runs, aliasing, rank)
-        fitted = fit_surrogate(results, MethodSpec(kind, order), options=Options(band_samples=200, bootstrap=0))
-        xi, weights = store.xi[ok], store.weights[ok]
-        own = {name: fitted.indices[name] for name in names}
-        indices = _union(list(own.values()))
-        error_weights = np.full(len(xi), 1.0) if sampled else np.abs(weights)
-        error_weights = error_weights / error_weights.sum()
-        coefficients, error_variance, error_factors, relative = {}, {}, {}, {}
-        for name in names:
-            rows, scale = output_basis(store, name, ok)
-            Y = rows if scale is None else rows @ scale
-            design = orthonormal_basis(germs, own[name], xi)  # the output's own basis (sparse: its terms)
-            try:
-                loo = loo_residuals(design, Y, error_weights)
-                relative[name] = relative_loo_error(design, Y, error_weights)
-            except ValueError as exc:
-                raise Refusal(f"{results}: output {name!r}: {exc}") from exc
-            misfit = Y - design @ fitted.coefficients[name]
-            coefficients[name] = _on_basis(indices, own[name], fitted.coefficients[name])
-            curves = loo if error_weights @ (loo**2).sum(axis=1) >= error_weights @ (misfit**2).sum(axis=1) else misfit
-            error_factors[name] = error_factors_of(np.sqrt(error_weights)[:, None] * curves)
-            error_variance[name] = (error_factors[name] ** 2).sum(axis=1)
-        return CalibrationSurrogate(campaign, str(results), fitted.method,
-                                    list(germs), indices, store.time, coefficients, error_variance, error_factors,
-                                    store.units, int(ok.sum()), relative, own)
+    campaign = record.campaign
+    stored, germs = campaign.method, campaign.germs
+    sampled = DESIGNS[record.design_kind].sampled
+    kind = method or stored.kind
+    order = (DEFAULT_ORDER if stored.order is None else stored.order) if order is None else order
+    if kind not in METHOD_KINDS:
+        raise Refusal(f"--method: expected one of {', '.join(METHOD_KINDS)}, got {kind!r}")
+    ok = store.status == Status.OK
+    names = store.output_names if outputs is None else outputs
+    missing = [name for name in names if name not in store.output_names]
+    if missing:
+        raise Refusal(f"{results} has no output {', '.join(map(repr, missing))} "
+                      f"(it has {listed(store.output_names)})")
+    # the statistics' own PCE, after their checks (pending or failed runs, aliasing, rank)
+    fitted = fit_store_surrogate(store, results, record, MethodSpec(kind, order),
+                                 options=Options(band_samples=200, bootstrap=0))
+    xi, weights = store.xi[ok], store.weights[ok]
+    own = {name: fitted.indices[name] for name in names}
+    indices = _union(list(own.values()))
+    error_weights = np.full(len(xi), 1.0) if sampled else np.abs(weights)
+    error_weights = error_weights / error_weights.sum()
+    coefficients, error_variance, error_factors, relative = {}, {}, {}, {}
+    for name in names:
+        rows, scale = output_basis(store, name, ok)
+        Y = rows if scale is None else rows @ scale
+        design = orthonormal_basis(germs, own[name], xi)  # the output's own basis (sparse: its terms)
+        try:
+            loo = loo_residuals(design, Y, error_weights)
+            relative[name] = relative_loo_error(design, Y, error_weights)
+        except ValueError as exc:
+            raise Refusal(f"{results}: output {name!r}: {exc}") from exc
+        misfit = Y - design @ fitted.coefficients[name]
+        coefficients[name] = _on_basis(indices, own[name], fitted.coefficients[name])
+        curves = loo if error_weights @ (loo**2).sum(axis=1) >= error_weights @ (misfit**2).sum(axis=1) else misfit
+        error_factors[name] = error_factors_of(np.sqrt(error_weights)[:, None] * curves)
+        error_variance[name] = (error_factors[name] ** 2).sum(axis=1)
+    return CalibrationSurrogate(campaign, str(results), fitted.method,
+                                list(germs), indices, store.time, coefficients, error_variance, error_factors,
+                                store.units, int(ok.sum()), relative, own)
 
 
 def _union(bases: list[np.ndarray]) -> np.ndarray:
