@@ -144,8 +144,9 @@ def test_a_pick_freeze_file_needs_its_base_rows(tmp_path, n_base):
     assert cli_in_process("run", tmp_path / "c.yaml", "--out", path).returncode == 0
     (tmp_path / "edited").mkdir()
     path = malformed(path, tmp_path / "edited", "record", at("design.info", {"n_base": json.loads(n_base)}))
-    refused(cli_in_process("report", path, "--out", tmp_path / "report"), path, "record",
-            "design.info.n_base: expected the base rows n of the 64 runs, n (2 parameters + 2)")
+    for command in (["report", path, "--out", tmp_path / "report"], ["info", path]):
+        refused(cli_in_process(*command), path, "record",
+                "design.info.n_base: expected the base rows n of the 64 runs, n (2 parameters + 2)")
 
 
 @pytest.mark.parametrize("text", [

@@ -375,11 +375,11 @@ def info(results: Path = typer.Argument(..., metavar="RESULTS", help="Results fi
 
 
 def _describe_results(results, store, Status) -> None:
-    from ..campaign.record import read_record
+    from ..analysis.statistics import file_record
 
     status = store.status
     attrs = store.attrs
-    recorded = read_record(attrs, str(results))
+    recorded = file_record(store, results)  # checked as every reader checks it: the design's facts too
     echo(f"file: {results}")
     echo(f"campaign: {quoted_name(recorded.campaign.name)} (sha256 {one_line(str(store.campaign_hash[:12]))})")
     echo(f"design: {recorded.design_kind} {one_line(json.dumps(recorded.design_info))}")
