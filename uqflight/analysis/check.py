@@ -16,7 +16,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..text.bounded import Refused, read_bounded
+from ..text.bounded import OutsideBounds, read_bounded
 from ..text.console import listed
 from ..text.console import quoted_name, quoted_value
 from ..text.json_text import json_text
@@ -99,7 +99,7 @@ def load_baseline(path: Path) -> dict:
     try:
         data = json.loads(read_bounded(path, MAX_BASELINE_BYTES, "a baseline").decode("utf-8"),
                           parse_constant=refuse_constant)
-    except Refused as exc:
+    except OutsideBounds as exc:
         raise BadInput(f"{path}: {exc}; a baseline holds a results file's statistics: write one with "
                        "`uqflight report RESULTS.h5 --out DIR --write-baseline FILE`") from exc
     except OSError as exc:

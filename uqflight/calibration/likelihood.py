@@ -22,7 +22,7 @@ from typing import Callable
 
 import numpy as np
 
-from ..text.bounded import Refused, read_bounded
+from ..text.bounded import OutsideBounds, read_bounded
 from ..text import Refusal
 from ..text.console import listed, quoted_name
 from ..parameters.germs import GERMS, germ_columns
@@ -45,14 +45,14 @@ def read_flight_csv(path, outputs: list[str] | None, available: list[str]) -> Fl
     """A CSV as `uqflight simulate --out` writes it: `time_s` and one column per output.
 
     `outputs` (None: every column that is one of `available`) selects the columns; an empty cell
-    or NaN is a missing value. Refused: no time_s, non-numeric cells, times not increasing, a
+    or NaN is a missing value. OutsideBounds: no time_s, non-numeric cells, times not increasing, a
     requested output missing from the file or from the campaign.
     """
     path = Path(path)
     try:  # a byte-order mark is no part of the header
         text = read_bounded(path, MAX_DATA_BYTES, "flight data").decode("utf-8-sig")
         rows = list(csv.reader(io.StringIO(text, newline="")))
-    except Refused as exc:
+    except OutsideBounds as exc:
         raise Refusal(f"{path}: {exc}: {DATA_FORM}") from exc
     except (OSError, UnicodeDecodeError, csv.Error) as exc:
         raise Refusal(f"{path}: cannot read the file ({exc})") from exc

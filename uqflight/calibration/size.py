@@ -13,7 +13,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from ..text.bounded import Refused, open_bounded
+from ..text.bounded import OutsideBounds, open_bounded
 from ..text import Refusal
 from .likelihood import DATA_FORM, MAX_DATA_BYTES
 
@@ -52,7 +52,7 @@ def check_size(data, outputs: list[str] | None, walkers: int | None, steps: int 
                 if not block:
                     return
                 rows += block.count(b"\n")
-    except Refused as exc:
+    except OutsideBounds as exc:
         raise Refusal(f"{path}: {exc}: {DATA_FORM}") from exc
     except OSError as exc:
         raise Refusal(f"{path}: cannot read the file ({exc.strerror or exc})") from exc

@@ -15,7 +15,7 @@ from pathlib import Path
 import numpy as np
 
 from ..campaign import Campaign, CampaignError, load_campaign
-from ..text.bounded import Refused, read_bounded
+from ..text.bounded import OutsideBounds, read_bounded
 from ..campaign.schema import MAX_FILE_BYTES
 from ..campaign.reading import campaign_folder, check_campaign_text, portable_mapping
 from ..campaign.record import CampaignRecord
@@ -120,7 +120,7 @@ def results_record(store: ResultStore, results: Path, campaign_path: Path | None
     if campaign_path is not None:
         try:
             text = read_bounded(campaign_path, MAX_FILE_BYTES, "a campaign").decode("utf-8")
-        except (OSError, UnicodeDecodeError, Refused) as exc:
+        except (OSError, UnicodeDecodeError, OutsideBounds) as exc:
             raise Refusal(f"--campaign: cannot read {campaign_path} ({exc})") from exc
         if text != store.campaign_text:
             raise Refusal(f"{campaign_path} is not the campaign {results} was run from (the texts differ)")

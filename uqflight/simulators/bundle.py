@@ -25,7 +25,7 @@ import zipfile
 import zlib
 from pathlib import Path
 
-from ..text.bounded import Refused, read_bounded
+from ..text.bounded import OutsideBounds, read_bounded
 from .aircraft import MAX_BYTES, MAX_FILES, AircraftFiles, AircraftUnsafe, cache_dir, unsafe_key
 from .safe_paths import relative_name, single_name
 
@@ -127,8 +127,8 @@ def python_bundle(simulator: dict, base: str | Path) -> dict | None:
     file = Path(module) if Path(module).is_absolute() else Path(base) / module
     try:  # a regular file, bounded as an aircraft's files
         data = read_bounded(file, MAX_BYTES, "a python model")
-    except Refused as exc:
-        raise Refused(f"simulator.function: {file}: {exc}") from None
+    except OutsideBounds as exc:
+        raise OutsideBounds(f"simulator.function: {file}: {exc}") from None
     return {"kind": "python", "name": file.name, "attribute": attribute,
             "hash": hashlib.sha256(data).hexdigest(), "zip": _zip({file.name: data})}
 
