@@ -209,7 +209,9 @@ def test_bad_input_exits_2(results, tmp_path):
     good = tmp_path / "good.csv"
     write_csv(good, TIME, synthetic(3))
     for extra, message in ((["--noise", "y=-1"], "SIGMA > 0"), (["--noise", "w=1"], "not one of"),
-                           (["--output", "w"], "not an output"), (["--walkers", "3"], "--walkers")):
+                           (["--output", "w"], "not an output"), (["--walkers", "3"], "--walkers"),
+                           (["--walkers", "11"], "--walkers: expected an even number, got 11"),
+                           (["--steps", "50"], "--steps: expected at least 100, got 50")):
         run = runner.invoke(app(), ["calibrate", str(results), "--data", str(good), "--out", str(tmp_path / "o"),
                                     *extra])
         assert run.exit_code == 2 and message in run.output, (extra, run.output)

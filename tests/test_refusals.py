@@ -12,7 +12,7 @@ COMMAND_MODULES = ("cli/commands.py", "calibration/command.py", "cli/arguments.p
 # the explicit translations at the commands' boundary, where a generic library error (h5py's OSError,
 # JSBSim's RuntimeError, a worker's failure) becomes a Refusal with the command's own context:
 # simulate, plan, run (2), info (2), report, design, surrogate export, aircraft; calibrate (4)
-TRANSLATIONS = {"cli/commands.py": 10, "calibration/command.py": 3, "cli/arguments.py": 0}
+TRANSLATIONS = {"cli/commands.py": 10, "calibration/command.py": 2, "cli/arguments.py": 0}
 
 
 def calls_of(name: str) -> list[tuple[str, str]]:

@@ -354,8 +354,8 @@ def calibrate(results, data, out, noise: dict | None = None, outputs: list[str] 
 
     Raises
     ------
-    uqflight.text.Refusal, ValueError
-        Bad input, naming what is wrong.
+    uqflight.text.Refusal
+        Bad input or settings, naming what is wrong.
     NotConverged
         `.diagnostics["problems"]` says what to change (`uqflight.calibration.run`).
     """

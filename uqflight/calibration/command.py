@@ -93,10 +93,6 @@ def calibrate_command(
         sys.stdout, sys.stderr = streams
         echo(f"\ninterrupted: no calibration written to {out}", err=True)
         raise typer.Exit(EXIT_INTERRUPTED)
-    except Refusal:  # its message names the file or option
-        raise
-    except ValueError as exc:  # a setting the sampler refuses (--steps, --walkers)
-        raise Refusal(str(exc)) from exc
     except WorkerError as exc:  # no simulator for the predictive runs (the model cannot be built or hangs)
         raise Refusal(f"{results}: the posterior predictive runs cannot be flown: {exc}") from exc
     except NotConverged as exc:

@@ -14,6 +14,7 @@ import numpy as np
 from threadpoolctl import threadpool_limits
 
 from ..parameters.germs import GERMS
+from ..text import Refusal
 
 from .likelihood import LogPosterior, check_names, check_noise, interpolate_in_time, read_flight_csv
 from .outputs import (OUTPUT_FILES, calibrated_campaign, corner_plot, draw_all, informed, marginal, marginals_plot,
@@ -56,8 +57,7 @@ def calibrate(results, data, out, outputs: list[str] | None = None, noise: dict[
     uqflight.running.progress.Progress) is told the stages and counts the sampler's steps. `steps`: exactly that
     many per walker, or None: until converged (calibration.sampler, at most MAX_STEPS).
 
-    Raises a Refusal (bad input, data too large for memory: calibration.size), ValueError (bad settings),
-    NotConverged.
+    Raises a Refusal (bad input or settings, data too large for memory: calibration.size), NotConverged.
     One BLAS thread: the matrices are small (a few hundred rows), where several threads on a shared
     machine make the SVDs 10-100x slower."""
     started = clock.perf_counter()
@@ -83,7 +83,7 @@ def _calibrate(surrogate, started, results, data, out, outputs, noise, seed, wal
     flight, given, posterior = _fitted(surrogate, data, outputs, noise)
     walkers = walkers or max(32, 2 * posterior.ndim + 2)
     if steps is not None and steps < 100:
-        raise ValueError(f"--steps: expected at least 100, got {steps}")
+        raise Refusal(f"--steps: expected at least 100, got {steps}")
     fitted = clock.perf_counter()
     sampling = Sampling(surrogate, flight, given, walkers, steps, seed, out, progress)
     chain, posterior, predictive, check = sampling.run(posterior, predictive_draws)

@@ -24,6 +24,7 @@ import numpy as np
 from scipy import optimize
 from threadpoolctl import threadpool_limits
 
+from ..text import Refusal
 from .size import MAX_STEPS
 
 MIN_TAU_MULTIPLE = 50.0
@@ -105,9 +106,9 @@ def sample(log_prob: Callable, ndim: int, labels: list[str], start: np.ndarray, 
     either way, so an adaptive chain that stopped at S is the fixed chain of S steps. `moves`: emcee's
     [(move, weight)] (default MOVES); `progress` (a uqflight.running.progress.Progress) counts the steps."""
     if walkers < 2 * ndim:
-        raise ValueError(f"--walkers: expected at least 2 × {ndim} parameters = {2 * ndim}, got {walkers}")
+        raise Refusal(f"--walkers: expected at least 2 × {ndim} parameters = {2 * ndim}, got {walkers}")
     if walkers % 2:
-        raise ValueError(f"--walkers: expected an even number, got {walkers}")
+        raise Refusal(f"--walkers: expected an even number, got {walkers}")
     with threadpool_limits(limits=1):  # small matrices: one BLAS thread is 5-10x faster than several
         return _sample(log_prob, ndim, labels, start, prior_draw, walkers, steps, seed, progress, moves or MOVES)
 
@@ -122,7 +123,9 @@ def _sample(log_prob, ndim, labels, start, prior_draw, walkers, steps, seed, pro
             break
         initial[bad] = mode + 0.01 * scale * rng.standard_normal((int(bad.sum()), ndim))
     else:
-        raise ValueError("cannot place the walkers where the posterior is positive around its mode")
+        raise Refusal("cannot place the walkers where the posterior is positive around its mode (it lies at "
+                      "the edge of the priors' support, or the likelihood vanishes there): check the data against "
+                      "the results file's outputs (units, times), or widen the parameters' intervals")
     sampler = emcee.EnsembleSampler(walkers, ndim, log_prob, vectorize=True, moves=moves)
     sampler.random_state = np.random.RandomState(seed).get_state()
     passed = False  # the previous check's verdict
