@@ -10,17 +10,23 @@ from uqflight.analysis import (
     modified_cov,
     pdf_over_time,
     pick_freeze_indices,
-    quantile_band,
     relative_errors,
     weighted_mean,
     weighted_std,
     weighted_variance,
 )
-from uqflight.analysis.moments import hazen_quantiles, sorted_by_time
+from uqflight.analysis.moments import hazen_quantiles, sorted_by_time, weighted_quantiles
 from uqflight.methods import fit
 from uqflight.parameters.germs import draw_germs
 
 Z_995 = 2.5758293035489
+
+
+def quantile_band(Y, weights=None, level: float = 0.99):
+    """The central `level` band per time, as the statistics take it: the (1 − level)/2 and (1 + level)/2
+    weighted quantiles (weighted_quantiles), each (T,)."""
+    lower, upper = weighted_quantiles(Y, (0.5 * (1.0 - level), 0.5 * (1.0 + level)), weights)
+    return lower, upper
 
 
 def saltelli_design(germs, n, seed):

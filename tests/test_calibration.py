@@ -30,8 +30,9 @@ from uqflight.calibration.likelihood import (FlightData, LogPosterior, interpola
 from uqflight.calibration import sampler as sampler_module
 from uqflight.calibration.sampler import CHECK_EVERY, FIRST_CHECK, sample, split_rhat
 from uqflight.calibration.size import MAX_STEPS
-from uqflight.calibration.surrogate import calibration_surrogate, load_campaign_file
-from uqflight.campaign import parse_campaign
+from conftest import calibration_surrogate
+from uqflight.campaign import load_campaign, parse_campaign
+from uqflight.simulators.aircraft_properties import AircraftProperties
 from uqflight.running.runner import run_campaign
 from uqflight.methods import MethodSpec
 
@@ -171,7 +172,7 @@ def test_calibrate_end_to_end(results, tmp_path):
     assert summary["diagnostics"]["converged"] and summary["diagnostics"]["steps_per_tau"] >= 50
     assert summary["predictive"]["failed"] == 0
     assert min(summary["predictive"]["coverage95"].values()) > 0.75  # 21 points per output
-    calibrated = load_campaign_file(out / "calibrated.yaml")  # what `uqflight plan` loads
+    calibrated = load_campaign(out / "calibrated.yaml", AircraftProperties)  # what `uqflight plan` loads
     by_name = {p.name: p for p in calibrated.parameters}
     assert by_name["a"].distribution == "normal"
     assert by_name["a"].std == pytest.approx(params["a"]["posterior"]["std"])
@@ -308,7 +309,7 @@ def test_aircraft_calibration_recovers_cl0_and_k2(tmp_path):
     from uqflight.calibration.surrogate import simulate, to_physical
 
     root = Path(__file__).resolve().parents[1]
-    campaign = load_campaign_file(root / "campaigns/grid-gh-l2.yaml")
+    campaign = load_campaign(root / "campaigns/grid-gh-l2.yaml", AircraftProperties)
     results = tmp_path / "grid-gh-l2.h5"
     run_campaign(campaign, out=results, workers=2)
     surrogate = calibration_surrogate(results)

@@ -257,12 +257,13 @@ def test_calibrated_dependence_plans_runs_and_narrows_the_band(calibrated, tmp_p
     import h5py
     import yaml
 
-    from uqflight.calibration.surrogate import load_campaign_file
+    from uqflight.campaign import load_campaign
+    from uqflight.simulators.aircraft_properties import AircraftProperties
 
     path = calibrated / "calibrated.yaml"
     text = path.read_text()
     assert "LOST" not in text
-    campaign = load_campaign_file(path)  # as `uqflight plan` loads it
+    campaign = load_campaign(path, AircraftProperties)  # as `uqflight plan` loads it
     with h5py.File(calibrated / "posterior.h5") as f:
         draws = f["draws/kappa"][()]
     r = np.corrcoef(draws, rowvar=False)[0, 1]

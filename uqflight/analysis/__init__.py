@@ -9,7 +9,7 @@ QUANTILES = (0.005, 0.995)
 from .density import kde_bandwidth, kde_on_grid, pdf_over_time
 from .divergence import kl_divergence
 from .errors import error_summary, relative_errors
-from .moments import modified_cov, quantile_band, weighted_mean, weighted_std, weighted_variance
+from .moments import modified_cov, weighted_mean, weighted_std, weighted_variance
 from .sobol import pick_freeze_indices
 
 __all__ = [
@@ -23,7 +23,6 @@ __all__ = [
     "modified_cov",
     "pdf_over_time",
     "pick_freeze_indices",
-    "quantile_band",
     "relative_errors",
     "weighted_mean",
     "weighted_std",

@@ -143,12 +143,6 @@ def hazen_quantiles(Y, probabilities, ordered=None) -> np.ndarray:
     return np.array(bounds).reshape(shape + (ordered.shape[0],))
 
 
-def quantile_band(Y, weights=None, level: float = 0.99) -> tuple[np.ndarray, np.ndarray]:
-    """Central ``level`` band per time: the (1−level)/2 and (1+level)/2 weighted quantiles, each (T,)."""
-    lower, upper = weighted_quantiles(Y, (0.5 * (1.0 - level), 0.5 * (1.0 + level)), weights)
-    return lower, upper
-
-
 def standardised_moments(Y, weights=None) -> tuple[np.ndarray, np.ndarray]:
     """Skewness and kurtosis (Pearson's, 3 for a normal law, not the excess) of each column of Y (N, T):
     each (T,), NaN where σ = 0 (a constant column) or N is too small.

@@ -14,7 +14,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..campaign import Campaign, CampaignError, load_campaign
+from ..campaign import Campaign, CampaignError
 from ..text.bounded import OutsideBounds, read_bounded
 from ..campaign.schema import MAX_FILE_BYTES
 from ..campaign.reading import campaign_folder, check_campaign_text, portable_mapping
@@ -29,16 +29,15 @@ from ..parameters import Parameter
 from ..parameters import to_physical as _to_physical
 from ..parameters import to_standard as _to_standard
 from ..parameters.summaries import parameter_specs, prior_summaries
-from ..simulators.aircraft_properties import AircraftProperties
 from ..analysis.statistics import Options, file_record, output_basis
 from ..store import ResultStore, Status
 from ..analysis.surrogate import fit_store_surrogate
 from ..text import Refusal
 from .likelihood import error_factors_of
 
-__all__ = ["CalibrationSurrogate", "CampaignError", "calibration_surrogate", "campaign_folder",
-           "check_campaign_text", "portable_mapping", "load_campaign_file", "parameter_specs", "prior_summaries",
-           "simulate", "to_physical", "to_standard"]
+__all__ = ["CalibrationSurrogate", "CampaignError", "campaign_folder", "check_campaign_text", "open_results",
+           "parameter_specs", "portable_mapping", "prior_summaries", "results_record", "simulate", "surrogate_of",
+           "to_physical", "to_standard"]
 
 
 @dataclass
@@ -99,11 +98,6 @@ def to_standard(parameters, kappa, dependence=None) -> np.ndarray:
     return _to_standard(parameters, np.atleast_2d(kappa), dependence)
 
 
-def load_campaign_file(path) -> Campaign:
-    """A campaign file (for --campaign), validated against its aircraft."""
-    return load_campaign(path, read_aircraft=AircraftProperties)
-
-
 def open_results(results: Path) -> ResultStore:
     """The results file opened for reading; a Refusal naming it when it cannot be (damaged, held, not HDF5)."""
     try:
@@ -139,16 +133,6 @@ def results_record(store: ResultStore, results: Path, campaign_path: Path | None
                           f"{source}; pass the campaign file with --campaign (its model file is looked up "
                           "beside it)")
     return record
-
-
-def calibration_surrogate(results, method: str | None = None, order: int | None = None,
-                          campaign_path=None, outputs: list[str] | None = None) -> CalibrationSurrogate:
-    """The surrogate of every output (or of `outputs`) of a results file, with its error model: the file
-    opened once, its record checked once (`results_record`, `surrogate_of`)."""
-    results = Path(results)
-    with open_results(results) as store:
-        record = results_record(store, results, Path(campaign_path) if campaign_path else None)
-        return surrogate_of(store, results, record, method, order, outputs)
 
 
 def surrogate_of(store: ResultStore, results: Path, record: CampaignRecord, method: str | None = None,
