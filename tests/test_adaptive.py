@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 from uqflight.campaign import parse_campaign
-from uqflight.designs import build_design, design_size
+from uqflight.designs import build_design
 from uqflight.designs import rules as rule_catalog
 from uqflight.designs.adaptive import Grid, IndexSet, combination_weights, grid_points, refine
 from uqflight.running.runner import run_campaign
@@ -136,7 +136,7 @@ def adaptive_text(budget: int, d: int = 3) -> str:
 @pytest.mark.slow
 def test_rounds_grow_one_results_file_whose_statistics_are_the_combination_quadrature(tmp_path):
     campaign = parse_campaign(adaptive_text(budget=200), str(tmp_path / "a.yaml"))
-    assert campaign.runs == design_size(campaign.design_spec, campaign.germs) == 200  # limits.max_runs' figure
+    assert campaign.runs == campaign.design_spec.size(campaign.germs) == 200  # limits.max_runs' figure
     run_campaign(campaign, out=tmp_path / "a.h5")
     with ResultStore.open(tmp_path / "a.h5") as store:
         state, n, weights = store.index_set(), store.status.size, store.weights

@@ -316,12 +316,13 @@ def test_failed_runs_are_recorded_counted_outside_the_event_and_the_campaign_goe
 def test_the_shipped_hard_landing_campaign_loads_against_the_c172p():
     from conftest import ROOT
     from uqflight.campaign import load_campaign
+    from uqflight.designs.rare import Event
     from uqflight.simulators.aircraft_properties import AircraftProperties
 
     campaign = load_campaign(ROOT / "campaigns" / "c172p-landing-rare.yaml", read_aircraft=AircraftProperties)
     design = campaign.design()
     assert design.kind == "subset_simulation" and campaign.runs == campaign.design_spec["budget"]
-    assert campaign.design_spec["event"] == {"of": "touchdown_sink_rate_fps", "below": -8.5}
+    assert campaign.design_spec["event"] == Event("touchdown_sink_rate_fps", "below", -8.5)
     assert [campaign.parameters[k].name for k in campaign.redrawn] == ["turbulence"]
     assert design.xi.shape == (campaign.design_spec["samples_per_level"], 5)
 

@@ -14,8 +14,7 @@ from typing import Callable
 import numpy as np
 import yaml
 
-from ..designs import REGISTRY as DESIGNS
-from ..designs import Design, build_design, design_size
+from ..designs import Design, DesignSpec
 from ..methods import Method, MethodSpec
 from ..parameters import Parameter, germs_of, seed_names, to_physical
 from ..parameters.dependence import GaussianCopula
@@ -39,7 +38,7 @@ class Campaign:
     seed: int
     simulator: dict
     parameters: list[Parameter]
-    design_spec: dict
+    design_spec: DesignSpec
     method: MethodSpec
     execution: Execution
     storage: Storage
@@ -64,7 +63,8 @@ class Campaign:
         return tuple(k for k, p in enumerate(self.parameters) if not p.law.polynomial)
 
     def design(self) -> Design:
-        return build_design(self.design_spec, self.germs, self.seed, self.redrawn)
+        """The design of `design_spec` over the parameters' germs (DesignSpec.build)."""
+        return self.design_spec.build(self.germs, self.seed, self.redrawn)
 
 
 def load_campaign(path: str | Path, read_aircraft: AircraftReader | None = None) -> Campaign:
@@ -112,22 +112,22 @@ def parse_campaign(text: str, source: str = "<campaign>", read_aircraft: Aircraf
     schema.check_fixed_properties(check, simulator, parameters, aircraft)
     quantities = check_quantities(check, data.get("quantities"), simulator, aircraft)
     campaign = build_campaign(check, data, simulator, parameters, text, quantities, written)
-    schema.check_dependence_design(check, data["design"], campaign.dependence, parameters)
-    if isinstance(data["design"], dict):  # sizes from the campaign alone, before building anything
-        schema.check_size(check, data, simulator, parameters, campaign.method, campaign.execution,
-                          campaign.storage, campaign.limits, campaign.germs)
-    try:
+    schema.check_dependence_design(check, campaign.design_spec, campaign.dependence, parameters)
+    schema.check_size(check, campaign.design_spec, simulator, parameters, campaign.method, campaign.execution,
+                      campaign.storage, campaign.limits, campaign.germs)  # from the campaign alone, nothing built
+    try:  # what the spec asks of the parameters' germs (their rules, their number)
         design = campaign.design()
     except FieldError as exc:
         raise CampaignError(source, exc.field, exc.message) from exc
     except ValueError as exc:
         raise CampaignError(source, "design", str(exc)) from exc
-    if DESIGNS[design.kind].rare:  # its rounds are made from the results; it estimates its event only
+    design_kind = campaign.design_spec.entry
+    if design_kind.rare:  # its rounds are made from the results; it estimates its event only
         from ..designs.rare import check_rare_campaign
 
         check_rare_campaign(check, campaign)
-        return replace(campaign, runs=int(design_size(campaign.design_spec, campaign.germs)))
-    if DESIGNS[design.kind].adaptive:  # its grid is made from the results: its points are checked on analysis
+        return replace(campaign, runs=int(campaign.design_spec.size(campaign.germs)))
+    if design_kind.adaptive:  # its grid is made from the results: its points are checked on analysis
         entry = campaign.method.entry
         if entry.sampled_only:
             check.fail("method.kind", f"{campaign.method.kind} needs a sampled design; an adaptive grid needs "
@@ -136,7 +136,7 @@ def parse_campaign(text: str, source: str = "<campaign>", read_aircraft: Aircraf
         if method.order is None:  # its default, the mapping's first key
             method = replace(method, order=entry.keys[entry.order_key].default,
                              written=(entry.order_key, *method.written))
-        return replace(campaign, method=method, runs=int(design_size(campaign.design_spec, campaign.germs)))
+        return replace(campaign, method=method, runs=int(campaign.design_spec.size(campaign.germs)))
     method = schema.method_for_design(check, campaign.method, design, campaign.germs)
     return replace(campaign, method=method, runs=len(design.weights))
 
@@ -166,14 +166,13 @@ def check_settings(check: Checker, written) -> tuple[Checker, dict, dict]:
 def build_campaign(check: Checker, data: dict, simulator: dict, parameters: list[Parameter], text: str,
                    quantities: dict | None = None, mapping: dict | None = None) -> Campaign:
     """The Campaign of a checked mapping (`check_settings`) and its parameters, its other sections checked
-    (the design is not built: `runs` stays None); `mapping`: the mapping as written (`data` before it was
-    checked)."""
+    (the design checked into its spec, not built: `runs` stays None); `mapping`: the mapping as written (`data`
+    before it was checked)."""
     name = data["name"]
-    design_kind = data["design"].get("kind") if isinstance(data["design"], dict) else None
-    entry = DESIGNS.get(design_kind) if isinstance(design_kind, str) else None
-    default_method = Method.of_runs(entry is not None and (entry.sampled or entry.rare)).kind
+    design = schema.design(check, data["design"])
+    default_method = Method.of_runs(design.entry.sampled or design.entry.rare).kind
     method = schema.method(check, data.get("method", {"kind": default_method}))
-    schema.check_seeds(check, parameters, design_kind, method)
+    schema.check_seeds(check, parameters, design, method)
     seeds = seed_names(parameters)
     execution = Execution.checked(check, data.get("execution", {}))
     storage = Storage.checked(check, data.get("storage", {}), name)
@@ -183,6 +182,6 @@ def build_campaign(check: Checker, data: dict, simulator: dict, parameters: list
     limits = Limits.checked(check, data.get("limits", {}))
     dependence = schema.dependence(check, data.get("dependence"), [p.name for p in parameters], seeds,
                                    simulator.get("properties", {}))
-    return Campaign(check.source, text, name, data.get("seed", 0), simulator, parameters, data["design"], method,
+    return Campaign(check.source, text, name, data.get("seed", 0), simulator, parameters, design, method,
                     execution, storage, analysis, limits, quantities=quantities, dependence=dependence,
                     mapping=mapping if mapping is not None else {})

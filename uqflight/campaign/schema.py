@@ -12,7 +12,7 @@ import numpy as np
 import yaml
 
 from ..designs import REGISTRY as DESIGNS
-from ..designs import Design, design_size
+from ..designs import Design, DesignSpec
 from ..methods import DEFAULT_ORDER, METHOD_KINDS, METHODS, Method, MethodSpec
 from ..methods.exactness import exact_total_degree, max_projection_order
 from ..methods.validity import method_problem
@@ -336,7 +336,7 @@ def seed_parameter(check: Checker, spec: dict, path: str, name: str, kind: str, 
     return make_parameter(name, prop, "seed", SEED_COUNT // 2, lower=0.0, upper=float(SEED_COUNT))  # nominal: κ(ξ = 0)
 
 
-def check_seeds(check: Checker, parameters: list[Parameter], design_kind, method: MethodSpec) -> None:
+def check_seeds(check: Checker, parameters: list[Parameter], design: DesignSpec, method: MethodSpec) -> None:
     """A seed's random stream has no polynomial expansion: refuse grids and PCE methods over it, and more
     than one seed (the split of the variance between seeds and the other inputs needs them as one input)."""
     seeds = seed_names(parameters)
@@ -346,10 +346,9 @@ def check_seeds(check: Checker, parameters: list[Parameter], design_kind, method
         check.fail(f"parameters.{seeds[1]}.distribution", f"one seed parameter per campaign, but "
                                                           f"{', '.join(seeds)} are seeds")
     where = f"parameters.{seeds[0]}.distribution"
-    entry = DESIGNS.get(design_kind) if isinstance(design_kind, str) else None
-    if entry is not None and not entry.sampled and not entry.rare:  # a rare-event design redraws a seed
+    if not design.entry.sampled and not design.entry.rare:  # a rare-event design redraws a seed
         sampled = ", ".join(name for name, kind in DESIGNS.items() if kind.sampled)
-        check.fail(where, f"a seed needs a sampled design ({sampled}), not {design_kind}: "
+        check.fail(where, f"a seed needs a sampled design ({sampled}), not {design.kind}: "
                           "a random stream has no polynomial expansion for a grid to integrate")
     if not method.entry.runs_on_sampled:  # it would fit a PCE in the seed's ξ
         check.fail(where, f"{SEED_REFUSAL} ({method.kind})")
@@ -395,11 +394,11 @@ def dependence(check: Checker, value, known: list[str], seeds: list[str], fixed=
     return GaussianCopula(tuple(names), matrix)
 
 
-def check_dependence_design(check: Checker, design_spec, copula: GaussianCopula | None,
+def check_dependence_design(check: Checker, design: DesignSpec, copula: GaussianCopula | None,
                             parameters: list[Parameter]) -> None:
     """A grid over correlated parameters integrates in their standard-normal germs: a uniform rule named
     for every dimension cannot serve them."""
-    rule = design_spec.get("rule") if isinstance(design_spec, dict) else None
+    rule = design.get("rule")
     if copula is None or not isinstance(rule, str):
         return
     from ..designs.rules import RULE_TABLE
@@ -461,6 +460,33 @@ def function_property(check: Checker, spec: dict, path: str, kind: str, aircraft
     return patch_property(full, perturbation, functions)
 
 
+def design(check: Checker, value) -> DesignSpec:
+    """The `design:` mapping checked by its kind (`DesignSpec.checked`): the one validator of a campaign's design
+    and of a results file's record of it.
+
+    Parameters
+    ----------
+    check : Checker
+        Names the file in its CampaignError.
+    value : object
+        The `design:` value as written.
+
+    Returns
+    -------
+    DesignSpec
+        Its kind and every key of the kind, checked, defaults filled in.
+
+    Raises
+    ------
+    CampaignError
+        Naming the key (`design`, `design.kind`, `design.KEY`) and what it expected.
+    """
+    try:
+        return DesignSpec.checked(value)
+    except FieldError as exc:
+        check.fail(exc.field, exc.message)
+
+
 def method(check: Checker, value) -> MethodSpec:
     """The `method:` mapping checked against its kind's keys (`Method.keys`: an unknown kind, the shared ones):
     the one validator of a campaign's method and of a results file's record of it.
@@ -509,18 +535,18 @@ def campaign_name(check: Checker, value) -> str:
     return name
 
 
-def check_size(check: Checker, data: dict, simulator: dict, parameters: list, method: MethodSpec, execution: Execution,
-               storage: Storage, limits: Limits, germs: list[str] | None = None) -> dict:
+def check_size(check: Checker, design: DesignSpec, simulator: dict, parameters: list, method: MethodSpec,
+               execution: Execution, storage: Storage, limits: Limits, germs: list[str] | None = None) -> dict:
     """The design's size, its memory and disk estimate and the PCE size, from the campaign alone
     (nothing built): refused beyond `limits` (CampaignError naming the figure and the limit).
     Returns the figures {"runs", "memory_gb", "disk_gb", "pce_terms"}."""
     d = len(parameters)
-    try:  # the design kind's own size (designs.DesignKind.size); an unknown kind is refused when built
-        points = design_size(data["design"], germs or [p.germ for p in parameters])
+    try:  # the design kind's own size (designs.DesignKind.size)
+        points = design.size(germs or [p.germ for p in parameters])
     except FieldError as exc:
         check.fail(exc.field, exc.message)
     figures = {"runs": points}
-    if points is not None and points > limits.max_runs:
+    if points > limits.max_runs:
         check.fail("design", f"{points:.4g} runs (points built), more than limits.max_runs = {limits.max_runs}; "
                              "choose a smaller design or raise limits.max_runs")
     order = DEFAULT_ORDER if method.order is None else method.order  # DEFAULT_ORDER at most
@@ -530,7 +556,7 @@ def check_size(check: Checker, data: dict, simulator: dict, parameters: list, me
         check.fail("method.order", f"a PCE of order {order} in {d} dimensions has {float(terms):.4g} "
                                    f"terms, more than limits.max_pce_terms = {limits.max_pce_terms}")
     times, n_outputs = simulator_entry(simulator).recorded(simulator)  # 1 where known once a sample has run
-    n = points or 0
+    n = points
     rank = min(times, n, 1000)
     memory = 8.0 * (n * (3 * d + 6)                                    # the design, status, merging
                     + execution.workers * execution.chunk * times * n_outputs * 3  # chunks in flight

@@ -3,54 +3,66 @@
 Each kind is a `DesignKind` subclass (designs.base) in its module, registered in REGISTRY by its name: montecarlo
 (monte_carlo, sobol, halton, latin_hypercube), smolyak (sparse_grid), tensor (tensor_grid), pickfreeze
 (pick_freeze), morris, adaptive (adaptive_sparse_grid), rare (subset_simulation, importance_sampling,
-active_learning).
+active_learning). A `design:` mapping is checked once into a `DesignSpec` (designs.spec), which builds the `Design`.
 """
 from __future__ import annotations
 
-from dataclasses import dataclass, field
-
 import numpy as np
 
-from ..parameters.germs import check_germs
 # each module registers its kinds, in this order: that of the help and the key reference
 from . import montecarlo, smolyak, tensor, pickfreeze, morris, adaptive, rare  # noqa: F401,I001
-from .base import REGISTRY, DesignKind, is_integer
-from ..text import FieldError
+from .base import REGISTRY, DesignKind
+from .spec import Design, DesignSpec
 
 DESIGN_KINDS = tuple(REGISTRY)
 
 
-@dataclass
-class Design:
-    """Where to run the model and how to weigh each run."""
+def design_size(spec: dict, germs: list[str]) -> float:
+    """The runs the `design:` mapping `spec` builds over `germs`, from the spec alone: the mapping checked once
+    (DesignSpec.checked), then its `DesignSpec.size`.
 
-    kind: str
-    xi: np.ndarray  # (N, d) standard variables, in the order the runs are made
-    weights: np.ndarray  # (N,), summing to 1 for the input distribution; may be negative
-    info: dict = field(default_factory=dict)  # facts for people: level, rule, degree, n_base, ...
+    Parameters
+    ----------
+    spec : dict
+        A `design:` mapping.
+    germs : list of str
+        As `DesignSpec.size`.
 
+    Returns
+    -------
+    float
+        As `DesignSpec.size`.
 
-def design_size(spec: dict, germs: list[str]) -> float | None:
-    """The runs the design `spec` builds, from its kind (see DesignKind.size); None for a spec
-    whose kind or keys the builder will refuse. Raises ValueError ("design.KEY: ...") beyond a kind's limit."""
-    kind = spec.get("kind") if isinstance(spec, dict) else None
-    if not isinstance(kind, str) or kind not in REGISTRY:
-        return None
-    return REGISTRY[kind].size(spec, germs)
+    Raises
+    ------
+    FieldError
+        Naming `design.KEY` when the mapping is refused or goes beyond its kind's limit.
+    """
+    return DesignSpec.checked(spec).size(germs)
 
 
 def build_design(spec: dict, germs: list[str], seed: int, redrawn: tuple[int, ...] = ()) -> Design:
-    """The design a campaign's `design:` mapping asks for, over the given germs; `redrawn`: the columns that
-    are random-stream seeds (a rare-event design treats them apart, see designs.rare)."""
-    if not isinstance(spec, dict):
-        raise FieldError("design", f"expected a mapping with a kind key, got {spec!r}")
-    kind = spec.get("kind")
-    if not isinstance(kind, str) or kind not in REGISTRY:
-        raise FieldError("design.kind", f"expected one of {', '.join(DESIGN_KINDS)}, got {kind!r}")
-    if not is_integer(seed) or seed < 0:
-        raise FieldError("seed", f"expected an integer >= 0, got {seed!r}")
-    xi, weights, info = REGISTRY[kind].build(spec, check_germs(germs), int(seed), tuple(redrawn))
-    return Design(kind, xi, weights, info)
+    """The design a campaign's `design:` mapping asks for: the mapping checked once (DesignSpec.checked), then
+    its `DesignSpec.build`.
+
+    Parameters
+    ----------
+    spec : dict
+        A `design:` mapping.
+    germs, seed, redrawn
+        As `DesignSpec.build`.
+
+    Returns
+    -------
+    Design
+        Its points ξ (N, d), weights and facts.
+
+    Raises
+    ------
+    ValueError
+        Naming the field (`design.KEY`, `seed`, `germs`) and what was expected.
+    """
+    return DesignSpec.checked(spec).build(germs, seed, redrawn)
 
 
 def describe(design: Design) -> str:

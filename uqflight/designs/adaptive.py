@@ -27,6 +27,7 @@ from ..analysis.errors import relative_errors
 from . import rules as rule_catalog
 from .base import DesignKind, Key, count, number
 from .smolyak import _indexed_nodes
+from .spec import DesignSpec
 from ..text import FieldError
 
 ADAPTIVE_RULES = ("genz_keister", "gauss_patterson", "clenshaw_curtis")
@@ -227,15 +228,16 @@ def refine(grid: Grid, state: IndexSet, points: Points, values: list[np.ndarray]
         return state
 
 
-def adaptive_rules(spec: dict, germs: list[str]) -> list[str]:
-    """The nested rule of every dimension from the spec's `rule` (a name, a mapping germ -> name, or None
-    for each germ's nested rule); ValueError naming design.rule otherwise."""
-    rules = rule_catalog.rules_by_dimension(spec.get("rule"), germs, nested=None if spec.get("rule") else True)
+def adaptive_grid(spec: DesignSpec, germs: list[str]) -> Grid:
+    """The grid of an `adaptive_sparse_grid` spec over `germs`: the nested rule of every dimension from its
+    `rule` (a name, a mapping germ -> name, or None for each germ's nested rule); FieldError naming
+    design.rule when they are not nested."""
+    rules = rule_catalog.rules_by_dimension(spec["rule"], germs, nested=None if spec["rule"] else True)
     plain = [rule for rule in rules if rule not in ADAPTIVE_RULES]
     if plain:
         raise FieldError("design.rule", f"an adaptive grid needs nested rules ({', '.join(ADAPTIVE_RULES)}), "
                          f"got {plain[0]}")
-    return rules
+    return Grid(rules)
 
 
 class AdaptiveSparseGrid(DesignKind):
@@ -244,12 +246,12 @@ class AdaptiveSparseGrid(DesignKind):
 
     Examples
     --------
-    >>> from uqflight.designs import REGISTRY, build_design
+    >>> from uqflight.designs import build_design, design_size
     >>> spec = {"kind": "adaptive_sparse_grid", "budget": 50, "tolerance": 1e-4}
     >>> design = build_design(spec, ["normal", "normal", "uniform"], seed=0)
     >>> design.xi.tolist(), design.weights.tolist()  # round 0: the centre point alone, weight 1
     ([[0.0, 0.0, 0.0]], [1.0])
-    >>> design.info["rule"], REGISTRY["adaptive_sparse_grid"].size(spec, ["normal"] * 3)  # nested rules; the budget
+    >>> design.info["rule"], design_size(spec, ["normal"] * 3)  # nested rules; the budget
     ('genz_keister, gauss_patterson', 50)
     """
 
@@ -261,20 +263,14 @@ class AdaptiveSparseGrid(DesignKind):
 
     def size(self, spec, germs):
         """At most `budget` (a refinement that would pass it is not made)."""
-        return self.given(spec, "budget")
+        return spec["budget"]
 
-    def points(self, settings, germs, seed):
-        grid = Grid(adaptive_rules(settings, germs))
+    def points(self, spec, germs, seed):
+        grid = adaptive_grid(spec, germs)
         points = grid_points(grid, IndexSet.initial(len(germs)))
-        info = {"rule": rule_catalog.rule_names(grid.rules), "budget": settings["budget"],
-                "tolerance": float(settings["tolerance"]), "rounds": "refined from the results, up to the budget"}
+        info = {"rule": rule_catalog.rule_names(grid.rules), "budget": spec["budget"],
+                "tolerance": float(spec["tolerance"]), "rounds": "refined from the results, up to the budget"}
         return points.xi, np.ones(1), info
-
-
-def adaptive_settings(spec: dict, germs: list[str]) -> tuple[Grid, int, float]:
-    """(the grid's rules, budget, tolerance) of an `adaptive_sparse_grid` spec, checked."""
-    settings = AdaptiveSparseGrid().settings(spec)
-    return Grid(adaptive_rules(settings, germs)), settings["budget"], float(settings["tolerance"])
 
 
 def index_set_summary(state: IndexSet, parameter_names: list[str]) -> dict:

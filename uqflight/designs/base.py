@@ -21,7 +21,7 @@ def is_integer(value) -> bool:
 @dataclass(frozen=True)
 class Key:
     """A design key: what it expects (for the refusal), its default (REQUIRED: none; None: absent) and its
-    test of a given value (None: the kind's builder checks it, as a rule or an event)."""
+    test of a given value (None: the kind checks it, an event in its `settings`, a rule against the germs)."""
 
     expects: str = ""
     default: object = None
@@ -66,7 +66,7 @@ class DesignKind:
         The name a campaign gives.
     keys : dict of str to Key
         Its keys besides `kind`: what each expects, its default, its test. `settings` checks a spec on them
-        and the key reference lists them.
+        (once, into a `DesignSpec`) and the key reference lists them.
     example : dict
         A small `design:` mapping of this kind (help text and tests).
     sampling : analysis.proportions.Independent or None
@@ -85,11 +85,11 @@ class DesignKind:
 
     Examples
     --------
-    >>> from uqflight.designs import REGISTRY, build_design
+    >>> from uqflight.designs import REGISTRY, DesignSpec, build_design
     >>> kind = REGISTRY["monte_carlo"]
     >>> kind.settings({"kind": "monte_carlo", "samples": 8})
     {'samples': 8}
-    >>> kind.size({"kind": "monte_carlo", "samples": 8}, ["normal", "uniform"]), kind.sampled
+    >>> kind.size(DesignSpec.checked({"kind": "monte_carlo", "samples": 8}), ["normal", "uniform"]), kind.sampled
     (8, True)
     >>> build_design(kind.example, ["normal"], seed=1).xi.shape
     (64, 1)
@@ -112,7 +112,8 @@ class DesignKind:
             REGISTRY[cls.kind] = cls()
 
     def settings(self, spec: dict) -> dict:
-        """The spec's values of `keys`, checked, defaults filled in; ValueError "design.KEY: ..." otherwise.
+        """The spec's values of `keys`, checked, defaults filled in: what `DesignSpec.checked` holds. A kind
+        with checks across its keys extends it.
 
         Parameters
         ----------
@@ -123,6 +124,11 @@ class DesignKind:
         -------
         dict
             {key: value} for every declared key.
+
+        Raises
+        ------
+        FieldError
+            Naming `design.KEY` and what was expected.
         """
         for key in spec:
             if key != "kind" and key not in self.keys:
@@ -138,23 +144,18 @@ class DesignKind:
             found[key] = value
         return found
 
-    def given(self, spec: dict, key: str) -> int | None:
-        """spec[key] (or its default) when it is an integer >= 1, else None (the builder's own checks speak)."""
-        value = spec.get(key, self.keys[key].default)
-        return value if is_integer(value) and value >= 1 else None
+    def size(self, spec, germs: list[str]) -> float:
+        """The runs `spec` (a `DesignSpec` of this kind) builds over `germs`, from the spec alone and without
+        building anything (for the campaign's limits). Here `samples`."""
+        return spec["samples"]
 
-    def size(self, spec: dict, germs: list[str]) -> float | None:
-        """The runs `spec` builds, from the spec alone and without building anything (for the campaign's
-        limits); None when the spec is malformed, so that the builder's own checks speak. Here `samples`."""
-        return self.given(spec, "samples")
+    def build(self, spec, germs: list[str], seed: int, redrawn: tuple[int, ...] = ()) -> tuple:
+        """(ξ (N, d), weights (N,), info) of `spec` (a `DesignSpec` of this kind) over `germs`; `redrawn`: the
+        columns that are random-stream seeds (a rare-event design's)."""
+        return self.points(spec, germs, seed)
 
-    def build(self, spec: dict, germs: list[str], seed: int, redrawn: tuple[int, ...] = ()) -> tuple:
-        """(ξ (N, d), weights (N,), info) of the checked `spec` over `germs`; `redrawn`: the columns that are
-        random-stream seeds (a rare-event design's)."""
-        return self.points(self.settings(spec), germs, seed)
-
-    def points(self, settings: dict, germs: list[str], seed: int) -> tuple:
-        """(ξ, weights, info) of checked `settings`."""
+    def points(self, spec, germs: list[str], seed: int) -> tuple:
+        """(ξ, weights, info) of `spec`."""
         raise NotImplementedError(f"design kind {self.kind} gives no points")
 
     def info_problem(self, info: dict, runs: int, d: int) -> tuple[str, str] | None:

@@ -45,8 +45,8 @@ class MonteCarlo(DesignKind):
     keys = {"samples": count(1)}
     example = {"kind": "monte_carlo", "samples": 64}
 
-    def points(self, settings, germs, seed):
-        n = settings["samples"]
+    def points(self, spec, germs, seed):
+        n = spec["samples"]
         return draw_germs(germs, n, seed), equal_weights(n), {"samples": n, "generator": "numpy default_rng", "seed": seed}
 
 
@@ -58,9 +58,9 @@ class Sobol(DesignKind):
 
     Examples
     --------
-    >>> from uqflight.designs import REGISTRY, build_design
+    >>> from uqflight.designs import build_design, design_size
     >>> spec = {"kind": "sobol", "samples": 8, "replicates": 3}
-    >>> REGISTRY["sobol"].size(spec, ["uniform"])  # replicates × samples
+    >>> design_size(spec, ["uniform"])  # replicates × samples
     24
     >>> design = build_design(spec, ["uniform"], seed=0)
     >>> eighths = ((design.xi[:, 0] + 1) / 2 * 8).astype(int).reshape(3, 8)  # u = (ξ + 1)/2, by eighths
@@ -73,17 +73,21 @@ class Sobol(DesignKind):
     example = {"kind": "sobol", "samples": 64}
     sampling = Net()
 
-    def size(self, spec, germs):
-        n, replicates = self.given(spec, "samples"), self.given(spec, "replicates")
-        return None if n is None or replicates is None else n * replicates
+    def settings(self, spec):
+        """Its keys, `replicates` > 1 only scrambled."""
+        found = super().settings(spec)
+        if found["replicates"] > 1 and not found["scramble"]:
+            raise FieldError("design.replicates", "replicates need scramble: true (unscrambled copies are identical)")
+        return found
 
-    def points(self, settings, germs, seed):
-        n, scramble, replicates = settings["samples"], settings["scramble"], settings["replicates"]
+    def size(self, spec, germs):
+        return spec["samples"] * spec["replicates"]
+
+    def points(self, spec, germs, seed):
+        n, scramble, replicates = spec["samples"], spec["scramble"], spec["replicates"]
         if replicates == 1:
             xi = germ_quantiles(sobol_points(n, len(germs), scramble, seed), germs)
             return xi, equal_weights(n), {"samples": n, "scramble": scramble, "seed": seed}
-        if not scramble:
-            raise FieldError("design.replicates", "replicates need scramble: true (unscrambled copies are identical)")
         children = np.random.SeedSequence(seed).spawn(replicates)
         u = np.vstack([sobol_points(n, len(germs), True, np.random.default_rng(child)) for child in children])
         return (germ_quantiles(u, germs), equal_weights(n * replicates),
@@ -109,10 +113,10 @@ class Halton(DesignKind):
     example = {"kind": "halton", "samples": 64}
     sampling = Net()
 
-    def points(self, settings, germs, seed):
+    def points(self, spec, germs, seed):
         from scipy.stats import qmc
 
-        n, scramble = settings["samples"], settings["scramble"]
+        n, scramble = spec["samples"], spec["scramble"]
         engine = qmc.Halton(len(germs), scramble=scramble, rng=seed)
         if not scramble:
             engine.fast_forward(1)
@@ -139,9 +143,9 @@ class LatinHypercube(DesignKind):
     example = {"kind": "latin_hypercube", "samples": 64}
     sampling = Stratified()
 
-    def points(self, settings, germs, seed):
+    def points(self, spec, germs, seed):
         from scipy.stats import qmc
 
-        n = settings["samples"]
+        n = spec["samples"]
         xi = germ_quantiles(qmc.LatinHypercube(len(germs), rng=seed).random(n), germs)
         return xi, equal_weights(n), {"samples": n, "seed": seed}

@@ -253,16 +253,20 @@ class Morris(DesignKind):
     screening = staticmethod(morris_screening)
     info_problem = staticmethod(info_problem)
 
+    def settings(self, spec):
+        """Its keys, `levels` even."""
+        found = super().settings(spec)
+        if found["levels"] % 2:
+            raise FieldError("design.levels", f"expected an even number of levels (the jump Δ = p/(2(p−1)) is then "
+                             f"p/2 grid steps), got {found['levels']}")
+        return found
+
     def size(self, spec, germs):
         """R (d + 1)."""
-        r = self.given(spec, "trajectories")
-        return None if r is None else r * (len(germs) + 1)
+        return spec["trajectories"] * (len(germs) + 1)
 
-    def points(self, settings, germs, seed):
-        r, levels = settings["trajectories"], settings["levels"]
-        if levels % 2:
-            raise FieldError("design.levels", f"expected an even number of levels (the jump Δ = p/(2(p−1)) is then "
-                             f"p/2 grid steps), got {levels}")
+    def points(self, spec, germs, seed):
+        r, levels = spec["trajectories"], spec["levels"]
         u = morris_unit_points(r, len(germs), levels, seed)
         info = {"trajectories": r, "levels": levels, "jump": morris_jump(levels), "samples": len(u), "seed": seed}
         return morris_germs(u, germs, levels), equal_weights(len(u)), info

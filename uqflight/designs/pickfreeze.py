@@ -26,9 +26,9 @@ class PickFreeze(DesignKind):
 
     Examples
     --------
-    >>> from uqflight.designs import REGISTRY, build_design
+    >>> from uqflight.designs import build_design, design_size
     >>> spec, germs = {"kind": "pick_freeze", "samples": 4}, ["normal", "normal", "uniform"]
-    >>> REGISTRY["pick_freeze"].size(spec, germs)  # N = n (d + 2) = 4 × 5
+    >>> design_size(spec, germs)  # N = n (d + 2) = 4 × 5
     20
     >>> xi = build_design(spec, germs, seed=0).xi
     >>> A, B, AB1 = xi[:4], xi[4:8], xi[8:12]  # rows [A; B; AB_1; AB_2; AB_3]
@@ -43,11 +43,10 @@ class PickFreeze(DesignKind):
     sobol_from_runs = True
 
     def size(self, spec, germs):
-        n = self.given(spec, "samples")
-        return None if n is None else n * (len(germs) + 2)
+        return spec["samples"] * (len(germs) + 2)
 
-    def points(self, settings, germs, seed):
-        n, d = settings["samples"], len(germs)
+    def points(self, spec, germs, seed):
+        n, d = spec["samples"], len(germs)
         ab = germ_quantiles(sobol_points(n, 2 * d, scramble=True, seed=seed), germs + germs)
         xi = pick_freeze_rows(ab[:, :d], ab[:, d:])
         info = {"n_base": n, "samples": len(xi), "base_sequence": "scrambled Sobol'", "seed": seed}

@@ -17,7 +17,7 @@ from math import comb
 import numpy as np
 
 from . import rules as rule_catalog
-from .base import DesignKind, Key, choice, count, flag, is_integer
+from .base import DesignKind, Key, choice, count, flag
 from ..text import FieldError
 
 MERGE_TOLERANCE = 1e-12  # relative: 1-D nodes closer than this are one point
@@ -110,12 +110,12 @@ class SparseGrid(DesignKind):
 
     Examples
     --------
-    >>> from uqflight.designs import REGISTRY, build_design
+    >>> from uqflight.designs import build_design, design_size
     >>> spec = {"kind": "sparse_grid", "level": 2}  # normal germs: Gauss-Hermite, linear growth
     >>> design = build_design(spec, ["normal"] * 7, seed=0)
     >>> len(design.xi), design.info["degree"], round(float(design.weights.sum()), 12)
     (113, 5, 1.0)
-    >>> REGISTRY["sparse_grid"].size(spec, ["normal"] * 7)  # before merging: the centre is in 8 tensor rules
+    >>> design_size(spec, ["normal"] * 7)  # before merging: the centre is in 8 tensor rules
     120.0
     >>> round(float(design.weights @ (design.xi[:, 0] ** 2 * design.xi[:, 1] ** 2)), 12)  # E[ξ1² ξ2²] = 1
     1.0
@@ -129,17 +129,13 @@ class SparseGrid(DesignKind):
     def size(self, spec, germs):
         """The points the combination technique builds before merging the tensor rules' shared points
         (an upper bound on the runs, and the size of the arrays built), computed without building anything:
-        Σ over the multi-indices of Π_k size_k(j_k), a polynomial product over the dimensions."""
-        level = spec.get("level")
-        if not is_integer(level) or level < 0:
-            return None
+        Σ over the multi-indices of Π_k size_k(j_k), a polynomial product over the dimensions. Refuses a
+        level beyond MAX_LEVEL, the rules that do not fit the germs and a level beyond a rule's end."""
+        level = spec["level"]
         if level > MAX_LEVEL:
             raise FieldError("design.level", f"expected at most {MAX_LEVEL}, got {level}")
-        try:
-            rules = rule_catalog.rules_by_dimension(spec.get("rule"), germs, spec.get("nested"))
-            sizes = self._sizes(rules, spec.get("growth") or "linear", level)
-        except (ValueError, KeyError, TypeError):
-            return None
+        rules = rule_catalog.rules_by_dimension(spec["rule"], germs, spec["nested"])
+        sizes = self._sizes(rules, spec["growth"], level)
         # coefficient s of the product polynomial = the points of all tensor rules with |j| = s
         total = np.array([1.0])
         for rule in rules:
@@ -158,9 +154,9 @@ class SparseGrid(DesignKind):
             sizes[rule] = rule_catalog.level_sizes(rule, growth, level + 1)
         return sizes
 
-    def points(self, settings, germs, seed):
-        level, growth = settings["level"], settings["growth"]
-        rules = rule_catalog.rules_by_dimension(settings["rule"], germs, settings["nested"])
+    def points(self, spec, germs, seed):
+        level, growth = spec["level"], spec["growth"]
+        rules = rule_catalog.rules_by_dimension(spec["rule"], germs, spec["nested"])
         sizes = self._sizes(rules, growth, level)
         one_dimensional = {rule: [rule_catalog.nodes_weights(rule, size) for size in sizes[rule]] for rule in sizes}
         points, weights = smolyak_rule([one_dimensional[rule] for rule in rules], level)

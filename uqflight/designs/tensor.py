@@ -11,9 +11,9 @@ class TensorGrid(DesignKind):
 
     Examples
     --------
-    >>> from uqflight.designs import REGISTRY, build_design
+    >>> from uqflight.designs import build_design, design_size
     >>> spec = {"kind": "tensor_grid", "points": 3}
-    >>> REGISTRY["tensor_grid"].size(spec, ["normal"] * 3)  # points ** d
+    >>> design_size(spec, ["normal"] * 3)  # points ** d
     27.0
     >>> design = build_design(spec, ["normal", "uniform"], seed=0)
     >>> design.xi.shape, design.info["degree"]  # 3 Gauss points are exact to degree 2 × 3 − 1
@@ -29,12 +29,11 @@ class TensorGrid(DesignKind):
 
     def size(self, spec, germs):
         """points^d (a float: it may be far beyond any integer a run could reach)."""
-        n = self.given(spec, "points")
-        return None if n is None else float(n) ** len(germs)
+        return float(spec["points"]) ** len(germs)
 
-    def points(self, settings, germs, seed):
-        size = settings["points"]
-        rules = rule_catalog.rules_by_dimension(settings["rule"], germs, nested=None)
+    def points(self, spec, germs, seed):
+        size = spec["points"]
+        rules = rule_catalog.rules_by_dimension(spec["rule"], germs, nested=None)
         for rule in dict.fromkeys(rules):
             sizes = rule_catalog.allowed_sizes(rule)
             if sizes is not None and size not in sizes:

@@ -12,7 +12,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..campaign import Campaign
-from ..designs.adaptive import IndexSet, adaptive_settings, combination_weights, grid_points, refine
+from ..designs.adaptive import IndexSet, adaptive_grid, combination_weights, grid_points, refine
 from ..parameters import to_physical
 from ..store import ResultStore, Status
 
@@ -31,7 +31,8 @@ def stored_values(store: ResultStore) -> list[np.ndarray]:
 def run_rounds(store: ResultStore, campaign: Campaign, fly):
     """Refine the campaign's adaptive grid until it stops (budget, tolerance, levels, a failed run);
     `fly()` runs the file's pending runs and returns their RunSummary. Returns the summary of all rounds."""
-    grid, budget, tolerance = adaptive_settings(campaign.design_spec, campaign.germs)
+    spec = campaign.design_spec
+    grid, budget, tolerance = adaptive_grid(spec, campaign.germs), spec["budget"], float(spec["tolerance"])
     state = store.index_set() or IndexSet.initial(len(campaign.germs))
     summary = None
     while True:

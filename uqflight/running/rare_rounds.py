@@ -15,7 +15,8 @@ from __future__ import annotations
 import numpy as np
 
 from ..campaign import Campaign
-from ..designs.rare import RareSettings, germs_from_normal, rare_settings, run_algorithm
+from ..designs import DesignSpec
+from ..designs.rare import germs_from_normal, run_algorithm
 from ..designs.rare.record import estimate_record
 from ..store import ResultStore, Status
 from ..text import Refusal
@@ -24,8 +25,8 @@ from ..text import Refusal
 class Replay:
     """The `evaluate` of a rare-event design over one results file (see the module docstring)."""
 
-    def __init__(self, store: ResultStore, campaign: Campaign, settings: RareSettings, fly):
-        self.store, self.campaign, self.settings, self.fly = store, campaign, settings, fly
+    def __init__(self, store: ResultStore, campaign: Campaign, spec: DesignSpec, fly):
+        self.store, self.campaign, self.spec, self.fly = store, campaign, spec, fly
         self.offset = 0  # the rows of the rounds evaluated so far
         self.ends: list[int] = []  # the row count at the end of each round
         self.summary = None
@@ -34,14 +35,14 @@ class Replay:
         u = np.asarray(u, dtype=float)
         xi = germs_from_normal(u.reshape(-1, len(self.campaign.germs)), self.campaign.germs)
         start, stop = self.offset, self.offset + len(xi)
-        if stop > self.settings.budget:
-            raise RuntimeError(f"{self.settings.kind} asked for {stop} runs, beyond its budget {self.settings.budget}")
+        if stop > self.spec["budget"]:
+            raise RuntimeError(f"{self.spec.kind} asked for {stop} runs, beyond its budget {self.spec['budget']}")
         store = self.store
         rows = store.status.size
         stored = store.xi[start:min(stop, rows)]
         if not np.array_equal(stored, xi[:len(stored)]):
             raise Refusal(f"{store._file.filename}: the stored runs {start} to {min(stop, rows) - 1} are not "
-                          f"the points this campaign's {self.settings.kind} asks for (a file written by another "
+                          f"the points this campaign's {self.spec.kind} asks for (a file written by another "
                           "uqflight version): fly it again with `uqflight run CAMPAIGN --restart`")
         if stop > rows:
             design = np.vstack([store.xi, xi[rows - start:]])
@@ -49,7 +50,8 @@ class Replay:
         if store.pending().size:
             self._fly()
         status = store.status[start:stop]
-        margin = self.settings.event.margin(store.quantity(self.settings.event.of)[start:stop])
+        event = self.spec["event"]
+        margin = event.margin(store.quantity(event.of)[start:stop])
         margin[status != Status.OK] = np.nan
         self.offset = stop
         self.ends.append(stop)
@@ -70,12 +72,12 @@ def run_rare(store: ResultStore, campaign: Campaign, fly):
     """Fly the campaign's rare-event design until its algorithm returns, and record its estimate;
     `fly()` runs the file's pending runs and returns their RunSummary. Returns the summary of all rounds
     (a finished file resumes to nothing)."""
-    settings = rare_settings(campaign.design_spec)
+    spec = campaign.design_spec
     if store.rare_event() is not None:  # finished: every round is stored with its estimate
         return fly()
-    replay = Replay(store, campaign, settings, fly)
-    estimate = run_algorithm(settings, replay, len(campaign.germs), campaign.seed, campaign.redrawn)
+    replay = Replay(store, campaign, spec, fly)
+    estimate = run_algorithm(spec, replay, len(campaign.germs), campaign.seed, campaign.redrawn)
     if estimate.runs != replay.offset:
-        raise RuntimeError(f"{settings.kind} counted {estimate.runs} runs but evaluated {replay.offset}")
-    store.write_rare_event(estimate_record(estimate, settings, replay.ends, campaign))
+        raise RuntimeError(f"{spec.kind} counted {estimate.runs} runs but evaluated {replay.offset}")
+    store.write_rare_event(estimate_record(estimate, spec, replay.ends, campaign))
     return replay.summary or fly()

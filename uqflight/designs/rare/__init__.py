@@ -10,25 +10,28 @@ optional `budget`, the most runs):
   importance-sampling correction on true runs (`active`).
 
 The algorithms (`subset`, `importance`, `active`, `estimate`) work in standard-normal space u and call
-`evaluate(u)` once per round with the whole round's points; this module reads the `design:` mapping, maps
-u to the germs ξ (each germ's `from_normal`) and gives the first round's points (the design the results
-file is created with). The runner (`uqflight.running.rare_rounds`) replays the algorithm over the stored runs.
-The runs of such a design are not draws of the input law: the analysis gives the event's probability
-and refuses every other statistic (`uqflight.analysis.rare_statistics`).
+`evaluate(u)` once per round with the whole round's points; this module checks the `design:` mapping (its
+kinds' `settings`, once, into the campaign's `DesignSpec`), maps u to the germs ξ (each germ's `from_normal`)
+and gives the first round's points (the design the results file is created with). The runner
+(`uqflight.running.rare_rounds`) replays the algorithm over the stored runs. The runs of such a design are
+not draws of the input law: the analysis gives the event's probability and refuses every other statistic
+(`uqflight.analysis.rare_statistics`).
 """
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 
 from ...parameters.germs import GERMS
 from ..base import REQUIRED, DesignKind, Key, count, number
+from ..spec import DesignSpec
 from ...text import FieldError
 
 SIDES = ("above", "below")
 EVENT_KEYS = ("of", *SIDES)
+SHARED_KEYS = ("event", "budget")  # every rare-event kind's keys; the others are its algorithm's
 @dataclass(frozen=True)
 class Event:
     """The event whose probability is estimated: quantity `of` above (or below) `threshold`."""
@@ -44,17 +47,6 @@ class Event:
 
     def text(self) -> str:
         return f"{self.of} {'>' if self.side == 'above' else '<'} {self.threshold:g}"
-
-
-@dataclass(frozen=True)
-class RareSettings:
-    """A rare-event `design:` mapping, checked: its kind, event, budget and the algorithm's own settings
-    (only those given: the algorithm's defaults hold for the others)."""
-
-    kind: str
-    event: Event
-    budget: int
-    settings: dict = field(default_factory=dict)
 
 
 def _event(value) -> Event:
@@ -77,21 +69,18 @@ def _event(value) -> Event:
     return Event(of, sides[0], float(threshold))
 
 
-def rare_settings(spec: dict) -> RareSettings:
-    """The checked settings of a rare-event `design:` mapping; ValueError naming design.KEY otherwise."""
-    design = RARE[spec.get("kind")]
-    found = design.settings(spec)
-    event = _event(found.pop("event"))
-    budget = found.pop("budget")
-    settings = {key: float(value) if key == "p0" else value for key, value in found.items() if value is not None}
-    design.check_round(settings, budget)
-    return RareSettings(design.kind, event, budget, settings)
+def algorithm_settings(settings) -> dict:
+    """The algorithm's own keys that a rare-event design gives, from its checked `settings` (`DesignSpec.settings`
+    or what its kind's `settings` returns): every key but the event and the budget whose value is given (the
+    algorithm's defaults hold for the others)."""
+    return {key: value for key, value in dict(settings).items() if key not in SHARED_KEYS and value is not None}
 
 
-def run_algorithm(settings: RareSettings, evaluate, dimension: int, seed: int, redrawn=()):
-    """The algorithm's RareEventEstimate: `evaluate(u)` (n, d) -> margins (n,) is called once per round."""
-    return RARE[settings.kind].algorithm()(evaluate, dimension, seed=int(seed), budget=settings.budget,
-                                           redrawn=tuple(int(k) for k in redrawn), **settings.settings)
+def run_algorithm(spec: DesignSpec, evaluate, dimension: int, seed: int, redrawn=()):
+    """The algorithm's RareEventEstimate of a rare-event design's `spec`: `evaluate(u)` (n, d) -> margins (n,)
+    is called once per round."""
+    return spec.entry.algorithm()(evaluate, dimension, seed=int(seed), budget=spec["budget"],
+                                  redrawn=tuple(int(k) for k in redrawn), **algorithm_settings(spec.settings))
 
 
 def germs_from_normal(u: np.ndarray, germs: list[str]) -> np.ndarray:
@@ -114,18 +103,18 @@ class _FirstRound(BaseException):
         self.u = np.array(u, dtype=float)
 
 
-def first_round(settings: RareSettings, germs: list[str], seed: int, redrawn=()) -> np.ndarray:
-    """The points u (n, d) of the algorithm's first `evaluate` call: a function of the settings and the seed
+def first_round(spec: DesignSpec, germs: list[str], seed: int, redrawn=()) -> np.ndarray:
+    """The points u (n, d) of the algorithm's first `evaluate` call: a function of the spec and the seed
     alone (the algorithm is stopped there, nothing is run)."""
 
     def stop(u):
         raise _FirstRound(u)
 
     try:
-        run_algorithm(settings, stop, len(germs), seed, redrawn)
+        run_algorithm(spec, stop, len(germs), seed, redrawn)
     except _FirstRound as first:
         return first.u
-    raise RuntimeError(f"{settings.kind} asked for no run")
+    raise RuntimeError(f"{spec.kind} asked for no run")
 
 
 MAX_RUNS = 10**8  # a budget beyond this is no rare-event design's (and limits.max_runs bounds it first)
@@ -142,26 +131,35 @@ class RareDesign(DesignKind):
     sampling = None
     adaptive = rare = True
 
+    def settings(self, spec):
+        """Its keys, the `event` parsed into an `Event`, `p0` a float; one round of the algorithm's settings
+        within the `budget` (`check_round`)."""
+        found = super().settings(spec)
+        found["event"] = _event(found["event"])
+        if found.get("p0") is not None:
+            found["p0"] = float(found["p0"])
+        self.check_round(algorithm_settings(found), found["budget"])
+        return found
+
     def size(self, spec, germs):
         """At most `budget`."""
-        return self.given(spec, "budget")
+        return spec["budget"]
 
     def build(self, spec, germs, seed, redrawn=()):
-        settings = rare_settings(spec)
-        problem = self.input_problem(settings, len(germs), len(redrawn))
+        problem = self.input_problem(spec, len(germs), len(redrawn))
         if problem:
             raise FieldError(*problem)
-        xi = germs_from_normal(first_round(settings, germs, seed, redrawn), germs)
-        info = {"event": settings.event.text(), "budget": settings.budget, **settings.settings,
+        xi = germs_from_normal(first_round(spec, germs, seed, redrawn), germs)
+        info = {"event": spec["event"].text(), "budget": spec["budget"], **algorithm_settings(spec.settings),
                 "rounds": "adapted to the event from the results, up to the budget"}
         return xi, np.full(len(xi), 1.0 / len(xi)), info
 
     def check_round(self, settings: dict, budget: int) -> None:
-        """ValueError naming design.KEY when one round of `settings` does not fit the `budget`."""
+        """FieldError naming design.KEY when one round of the algorithm's `settings` does not fit the `budget`."""
         if settings.get("samples", 0) > budget:
             raise FieldError("design.budget", f"{budget} runs cannot hold one round of samples = {settings['samples']}")
 
-    def input_problem(self, settings: RareSettings, inputs: int, redrawn: int) -> tuple[str, str] | None:
+    def input_problem(self, spec: DesignSpec, inputs: int, redrawn: int) -> tuple[str, str] | None:
         """(field, message) when the design cannot work on `inputs` parameters of which `redrawn` are seeds
         (`build` raises it as a FieldError)."""
         return None
@@ -263,7 +261,7 @@ class ActiveLearning(RareDesign):
         from .active import active_learning
         return active_learning
 
-    def input_problem(self, settings, inputs, redrawn):
+    def input_problem(self, spec, inputs, redrawn):
         from .active import smallest_budget
 
         learned = inputs - redrawn
@@ -271,26 +269,24 @@ class ActiveLearning(RareDesign):
             return ("design.kind", "active_learning learns a surrogate of the inputs that are not seeds, and every "
                                    "parameter here is a seed: use subset_simulation or importance_sampling")
         fewest = smallest_budget(learned)
-        if settings.budget < fewest:
-            return ("design.budget", f"{settings.budget} runs are too few for active learning on {learned} "
+        if spec["budget"] < fewest:
+            return ("design.budget", f"{spec['budget']} runs are too few for active learning on {learned} "
                                      f"input{'s' if learned > 1 else ''}: its first design, one enrichment and two "
                                      f"importance-sampling rounds need at least {fewest}")
         return None
-
-
-RARE = {design.kind: design() for design in (SubsetSimulation, ImportanceSampling, ActiveLearning)}
 
 
 def check_rare_campaign(check, campaign) -> None:
     """What a rare-event design asks of the rest of its campaign (a `campaign.schema.Checker` refuses):
     its event's quantity is one of the campaign's quantities, and no `analysis.exceedance` (its runs are
     not draws of the input law: it estimates its own event only)."""
-    settings = rare_settings(campaign.design_spec)
+    spec = campaign.design_spec
+    event = spec["event"]
     names = list(campaign.quantities)
-    if settings.event.of not in names:
+    if event.of not in names:
         check.fail("design.event.of", f"expected one of the campaign's quantities ({', '.join(names) or 'none: add '}"
-                                       f"{'' if names else 'one under quantities:'}), got {settings.event.of!r}")
+                                       f"{'' if names else 'one under quantities:'}), got {event.of!r}")
     if campaign.analysis.exceedance:
-        check.fail("analysis.exceedance", f"a {settings.kind} design's runs are not draws of the input law: it "
+        check.fail("analysis.exceedance", f"a {spec.kind} design's runs are not draws of the input law: it "
                                           "estimates the probability of its design.event only; give the threshold "
                                           "there, one campaign per event")

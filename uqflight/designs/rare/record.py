@@ -7,7 +7,7 @@ import numpy as np
 from .estimate import importance_shares
 
 
-def estimate_record(estimate, settings, ends, campaign) -> dict:
+def estimate_record(estimate, spec, ends, campaign) -> dict:
     """The record of an algorithm's RareEventEstimate (designs.rare.estimate) for /rare_event: the event, the
     estimate, the rounds, the runs at the end of each `evaluate` call (`ends`) and the most probable failure
     point in u, ξ and physical values with each input's share of it."""
@@ -23,8 +23,9 @@ def estimate_record(estimate, settings, ends, campaign) -> dict:
         kappa = campaign.to_physical(xi)[0]
         xi, importance = xi[0], importance_shares(u)
     rounds = estimate.rounds
-    return {"method": settings.kind, "of": settings.event.of, "side": settings.event.side,
-            "threshold": settings.event.threshold, "budget": settings.budget,
+    event = spec["event"]
+    return {"method": spec.kind, "of": event.of, "side": event.side, "threshold": event.threshold,
+            "budget": spec["budget"],
             "probability": float(estimate.probability), "lower": float(estimate.lower),
             "upper": float(estimate.upper), "cov": float(estimate.cov),
             "beta": float(estimate.beta), "runs": int(estimate.runs),
