@@ -72,7 +72,7 @@ def test_runs_times_products_are_bounded_before_any_reader_allocates(decay_resul
 
 def test_outputs_times_runs_together_are_bounded(decay_results, tmp_path):
     """D08's sibling: each output within its bound, but 100 of them over 29 runs x 10^6 times (2.9e9 values,
-    in chunks never written) would be read whole by `info`. OutsideBounds by the layout check, nothing read."""
+    in chunks never written) would be read whole by `info`. Refused by the layout check, nothing read."""
     from uqflight.store import CorruptFile, ResultStore
 
     out = declaring(decay_results, tmp_path, 10**6)

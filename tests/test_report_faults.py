@@ -35,7 +35,7 @@ def scaled_results(folder, scale: str):
 
 def test_outputs_whose_squares_overflow_are_refused_in_one_line(tmp_path):
     """D09: finite outputs near 1e200 ran fine, but the report's variance overflowed to inf and a plotting child
-    died on it (exit 1). OutsideBounds before any statistic, by report, check and surrogate export alike."""
+    died on it (exit 1). Refused before any statistic, by report, check and surrogate export alike."""
     out = scaled_results(tmp_path, "1e200")
     for args in (("report", out, "--out", tmp_path / "rep"), ("surrogate", "export", out, "--out", tmp_path / "s.json")):
         done = cli_in_process(*args)

@@ -45,7 +45,7 @@ def read_flight_csv(path, outputs: list[str] | None, available: list[str]) -> Fl
     """A CSV as `uqflight simulate --out` writes it: `time_s` and one column per output.
 
     `outputs` (None: every column that is one of `available`) selects the columns; an empty cell
-    or NaN is a missing value. OutsideBounds: no time_s, non-numeric cells, times not increasing, a
+    or NaN is a missing value. Refused: no time_s, non-numeric cells, times not increasing, a
     requested output missing from the file or from the campaign.
     """
     path = Path(path)

@@ -33,7 +33,7 @@ PARAMETER_KEYS = ("property", "function", "perturbation", "distribution", "nomin
 LAW_KEYS = ("distribution", "nominal", "interval_pct", "lower", "upper")  # a parameter's law; the rest say what it sets
 PERTURBATIONS = ("scale", "offset", "offset_value")
 DEPENDENCE_KEYS = ("kind", "parameters", "correlation")
-# OutsideBounds before anything is built (see `check_size`); a campaign raises them under `limits:`.
+# Refused before anything is built (see `check_size`); a campaign raises them under `limits:`.
 WORKER_BYTES = 60e6  # memory of one local worker process: Python, numpy, JSBSim, the aircraft (52 MB measured)
 MAX_FILE_BYTES = 1 << 20  # a campaign file is at most 1 MiB
 NAME_PATTERN = re.compile(r"[A-Za-z0-9_][A-Za-z0-9_.-]{0,99}")
