@@ -10,9 +10,11 @@ import pytest
 from conftest import DATA, assert_same_results, cli_in_process
 
 from uqflight.campaign import parse_campaign
+from uqflight.campaign.schema import Checker
 from uqflight.running.runner import run_campaign
-from uqflight.quantities import REGISTRY
+from uqflight.quantities import REGISTRY, QuantitySpec
 from uqflight.quantities.recorder import QuantityRecorder
+from uqflight.quantities.spec import check_quantities
 from uqflight.simulators.aircraft_properties import AircraftProperties
 from uqflight.analysis.statistics import analyse, summary_json
 from uqflight.store import ResultStore
@@ -62,8 +64,10 @@ execution: {{workers: 2, chunk: 16}}
 def test_every_take_is_exact_at_the_models_time_points():
     # through the worker's own path (run_chunk), at a = 0.5, b = 1; exact to rounding (1e-12)
     assert {spec["take"] for spec, _ in CASES.values()} == {t for t, e in REGISTRY.items() if not e.mode}
-    spec = WorkerSpec(simulator={"kind": "python", "function": MODEL}, parameter_names=("a", "b"),
-                      properties=("a", "b"), base=str(DATA), quantities={k: s for k, (s, _) in CASES.items()})
+    simulator = {"kind": "python", "function": MODEL}
+    quantities = check_quantities(Checker("cases"), {k: s for k, (s, _) in CASES.items()}, simulator)
+    spec = WorkerSpec(simulator=simulator, parameter_names=("a", "b"), properties=("a", "b"), base=str(DATA),
+                      quantities=quantities)
     _, status, reasons, values = run_chunk(spec, np.arange(1), np.array([[0.5, 1.0]]), 17, ["y", "z"])
     assert status.tolist() == [0], reasons
     for name, (_, expected) in CASES.items():
@@ -191,8 +195,8 @@ def test_a_jsbsim_quantity_is_taken_at_every_integration_step():
     from uqflight.simulators import JSBSimSimulator
 
     simulator = JSBSimSimulator({"kind": "jsbsim", "duration_s": 10.0}, [])
-    recorder = QuantityRecorder({"h": {"of": "h_ft", "take": "max"}, "q": {"of": "q_degps", "take": "min"}},
-                                simulator.source)
+    recorder = QuantityRecorder({"h": QuantitySpec("h", "max", of="h_ft"),
+                                 "q": QuantitySpec("q", "min", of="q_degps")}, simulator.source)
     recorded = simulator.evaluate(np.zeros(0), (recorder,))
     found = recorder.result()
 

@@ -79,19 +79,19 @@ def test_an_angle_that_does_not_wrap_is_left_to_the_bit():
 
 
 def test_units_come_from_jsbsim_property_names():
-    from uqflight.quantities import quantity_unit
+    from uqflight.quantities import QuantitySpec, When
     from uqflight.text.labels import name_unit
 
     assert [name_unit(n) for n in ("attitude/psi-deg", "velocities/vc-kts", "velocities/u-fps", "aero/qbar-psf",
                                     "position/h-sl-mt", "simulation/sim-time-sec", "inertia/weight-lbs",
                                     "fcs/aileron-pos-norm", "velocities/p-rad_sec", "accelerations/Nz", "y")] == [
         "deg", "kt", "ft/s", "psf", "m", "s", "lbs", "-", "rad/s", "g", ""]
-    assert quantity_unit({"of": "h_ft", "take": "drop"}, {}) == "ft"
-    assert quantity_unit({"of": "attitude/psi-deg", "take": "change"}, {}) == "deg"
-    assert quantity_unit({"take": "time_of_first", "when": {"of": "h_ft", "above": 1}}, {}) == "s"
-    assert quantity_unit({"take": "short_period_damping"}, {}) == "-"
-    assert quantity_unit({"take": "short_period_frequency_rad_s"}, {}) == "rad/s"
-    assert quantity_unit({"of": "y", "take": "max"}, {"y": "N"}) == "N"
+    assert QuantitySpec("q", "drop", of="h_ft").unit({}) == "ft"
+    assert QuantitySpec("q", "change", of="attitude/psi-deg").unit({}) == "deg"
+    assert QuantitySpec("q", "time_of_first", when=When("h_ft", "above", 1.0)).unit({}) == "s"
+    assert QuantitySpec("q", "short_period_damping").unit({}) == "-"
+    assert QuantitySpec("q", "short_period_frequency_rad_s").unit({}) == "rad/s"
+    assert QuantitySpec("q", "max", of="y").unit({"y": "N"}) == "N"
 
 
 def test_pick_freeze_with_n_32_says_its_indices_are_unresolved(flown):

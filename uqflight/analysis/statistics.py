@@ -48,7 +48,6 @@ from .resolution import RESOLUTION_RTOL, resolved_variance
 from .sobol import NEGLIGIBLE, UNRESOLVED_WIDTH, complete_rows, pick_freeze_indices, unresolved
 from ..campaign.record import CampaignRecord, check_design_info, read_record
 from ..campaign.schema import CampaignError
-from ..quantities import quantity_unit
 from ..text import Refusal
 from ..text.console import quoted_name
 from ..designs import REGISTRY as DESIGNS
@@ -213,7 +212,7 @@ class QuantityStatistics:
     missing: int  # successful runs where the quantity is undefined
     output: OutputStatistics | None
     exceedance: list[dict] = field(default_factory=list)
-    units: str = ""  # its take's own, or its `of`'s (quantities.quantity_unit)
+    units: str = ""  # its take's own, or its `of`'s (QuantitySpec.unit)
     flags: list[str] = field(default_factory=list)  # its statistics' (output.flags) and its thresholds' (unit slips)
 
     def _first(self, attribute: str):
@@ -966,8 +965,9 @@ class _QuantityView:
 
 
 def quantity_units(store: ResultStore, stats: Statistics, name: str) -> str:
-    """The unit of quantity `name`: its take and `of` in the recorded campaign give it (quantities.quantity_unit)."""
-    return quantity_unit(stats.record.campaign.quantities.get(name), store.units) or name_unit(name)
+    """The unit of quantity `name`: its take and `of` in the recorded campaign give it (QuantitySpec.unit)."""
+    spec = stats.record.campaign.quantities.get(name)
+    return (spec.unit(store.units) if spec is not None else "") or name_unit(name)
 
 
 def quantity_statistics(store: ResultStore, stats: Statistics, name: str, germs: list[str], ok: np.ndarray,

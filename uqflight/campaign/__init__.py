@@ -18,6 +18,7 @@ from ..designs import Design, DesignSpec
 from ..methods import Method, MethodSpec
 from ..parameters import Parameter, germs_of, seed_names, to_physical
 from ..parameters.dependence import GaussianCopula
+from ..quantities import QuantitySpec
 from ..quantities.spec import check_quantities
 from ..simulators.jsbsim import NAMED_OUTPUTS
 from ..simulators.kinds import simulator_entry
@@ -45,7 +46,7 @@ class Campaign:
     analysis: Analysis = field(default_factory=Analysis)
     limits: Limits = field(default_factory=Limits)
     runs: int | None = None  # the design's size, known once validated
-    quantities: dict = field(default_factory=dict)  # name -> checked spec (uqflight.quantities)
+    quantities: dict[str, QuantitySpec] = field(default_factory=dict)  # `quantities:` by name, checked
     dependence: GaussianCopula | None = None  # `dependence:` (parameters.dependence), None: independent
     mapping: dict = field(default_factory=dict, repr=False)  # the file's mapping as written (YAML), never changed
 
@@ -164,7 +165,7 @@ def check_settings(check: Checker, written) -> tuple[Checker, dict, dict]:
 
 
 def build_campaign(check: Checker, data: dict, simulator: dict, parameters: list[Parameter], text: str,
-                   quantities: dict | None = None, mapping: dict | None = None) -> Campaign:
+                   quantities: dict[str, QuantitySpec] | None = None, mapping: dict | None = None) -> Campaign:
     """The Campaign of a checked mapping (`check_settings`) and its parameters, its other sections checked
     (the design checked into its spec, not built: `runs` stays None); `mapping`: the mapping as written (`data`
     before it was checked)."""

@@ -7,29 +7,14 @@ Kinds of `take` (keys in braces; every one but the modes takes `after_s`/`before
 - at_first {of, when: {of, above | below}}; time_of_first {when};
 - phugoid_period_s, phugoid_damping, short_period_frequency_rad_s, short_period_damping {}: the modes
   of JSBSim's linearised model at the level-flight trim point (modes.py).
-Each kind is a class in takes.py, registered by subclassing `Take`.
+Each kind is a class in takes.py, registered by subclassing `Take`; a quantity as the campaign states it is
+a typed, frozen `QuantitySpec` (takes.py), built by the validator alone (spec.py) and read by its take.
 """
 from __future__ import annotations
 
-from ..text.labels import name_unit
-from .takes import REGISTRY, WINDOW, Take
+from .takes import REGISTRY, WINDOW, QuantitySpec, Take, When
 
 TAKES = tuple(REGISTRY)
-
-
-def quantity_unit(spec, output_units: dict[str, str]) -> str:
-    """The unit of a quantity whose campaign spec is `spec` ({take, of, ...}): its take's own (`Take.unit`:
-    time_of_first s, a damping -, a frequency rad/s), else its `of`'s (`output_units`, else from the name);
-    "" unknown."""
-    if not isinstance(spec, dict) or not isinstance(spec.get("take"), str):
-        return ""
-    take = REGISTRY.get(spec["take"])
-    if take is not None and take.unit is not None:
-        return take.unit
-    of = spec.get("of")
-    if not isinstance(of, str):
-        return ""
-    return output_units.get(of) or name_unit(of)
 
 
 def quantity_key(name: str) -> tuple[str, str]:
@@ -41,4 +26,4 @@ def is_quantity_key(key) -> bool:
     return isinstance(key, tuple) and len(key) == 2 and key[0] == "quantity"
 
 
-__all__ = ["REGISTRY", "TAKES", "WINDOW", "Take", "is_quantity_key", "quantity_key", "quantity_unit"]
+__all__ = ["REGISTRY", "TAKES", "WINDOW", "QuantitySpec", "Take", "When", "is_quantity_key", "quantity_key"]

@@ -14,17 +14,17 @@ from __future__ import annotations
 from collections.abc import Callable, Sequence
 
 from ..text.labels import ANGLE_PERIODS, name_unit
-from . import REGISTRY
 from .modes import eigen_modes
+from . import QuantitySpec
 
 Resolve = Callable[[str], tuple[str, float]]  # a name in `of:` -> (the property recorded, its scale)
 
 
 class QuantityRecorder:
-    """`specs`: the campaign's checked quantities; `resolve`: the simulator's `source` (a named output's
+    """`specs`: the campaign's quantities by name; `resolve`: the simulator's `source` (a named output's
     property and scale for JSBSim, the output itself for a Python model)."""
 
-    def __init__(self, specs: dict[str, dict], resolve: Resolve):
+    def __init__(self, specs: dict[str, QuantitySpec], resolve: Resolve):
         self.specs = dict(specs)
         self.reductions, self.modes = {}, []
         sources: dict[str, int] = {}
@@ -35,14 +35,14 @@ class QuantityRecorder:
             return sources.setdefault(prop, len(sources)), scale
 
         for name, spec in self.specs.items():
-            take = REGISTRY[spec["take"]]
+            take = spec.entry
             if take.mode:
                 self.modes.append(name)
                 continue
             reduction = self.reductions[name] = take(spec)
-            of, of_scale = index(spec["of"]) if "of" in spec else (None, 1.0)
-            when, when_scale = index(spec["when"]["of"]) if "when" in spec else (None, 1.0)
-            period = ANGLE_PERIODS.get(name_unit(spec["of"])) if "of" in spec else None
+            of, of_scale = index(spec.of) if spec.of is not None else (None, 1.0)
+            when, when_scale = index(spec.when.of) if spec.when is not None else (None, 1.0)
+            period = ANGLE_PERIODS.get(name_unit(spec.of)) if spec.of is not None else None
             self._wiring.append((reduction, of, of_scale, when, when_scale, period and Unwrapped(period)))
         self.properties: tuple[str, ...] = tuple(sources)
         self._modes: dict[str, float] = {}
@@ -71,7 +71,7 @@ class QuantityRecorder:
     def result(self) -> dict[str, float]:
         found = {name: reduction.result() for name, reduction in self.reductions.items()}
         for name in self.modes:
-            found[name] = self._modes.get(self.specs[name]["take"], float("nan"))
+            found[name] = self._modes.get(self.specs[name].take, float("nan"))
         return {name: float(found[name]) for name in self.specs}
 
 

@@ -1,4 +1,5 @@
-"""The campaign's `quantities:` and `analysis.exceedance:` mappings, checked before anything runs.
+"""The campaign's `quantities:` and `analysis.exceedance:` mappings, checked before anything runs: each quantity
+into the typed, frozen value its take reads (`QuantitySpec`), built here alone (`check_quantities`).
 
 Each problem is raised through the campaign's checker (`Checker.fail`), so it names the file and the
 field, e.g. `quantities.peak.take: expected one of max, min, ...`.
@@ -9,7 +10,7 @@ import math
 import re
 
 from ..simulators.kinds import simulator_entry
-from . import REGISTRY, TAKES, WINDOW
+from . import REGISTRY, TAKES, WINDOW, QuantitySpec, When
 
 KEYS = ("of", "take", "at_s", "when", "after_s", "before_s")
 WHEN_KEYS = ("of", "above", "below")
@@ -29,44 +30,59 @@ def is_level_flight(simulator: dict) -> bool:
     return simulator_entry(simulator).trims_level(simulator)
 
 
-def check_quantities(check, value, simulator: dict, aircraft=None) -> dict[str, dict]:
-    """The checked `quantities:` mapping {name: spec}; `aircraft` (the `AircraftProperties` of a JSBSim
-    aircraft, or None) checks the names in `of:` and `when.of:`."""
+def check_quantities(check, value, simulator: dict, aircraft=None) -> dict[str, QuantitySpec]:
+    """The campaign's quantities, from its `quantities:` mapping checked.
+
+    Parameters
+    ----------
+    check : Checker
+        The campaign's checker: its `fail` names the file and the field.
+    value : object
+        The `quantities:` mapping as written; None: the campaign has none.
+    simulator : dict
+        The checked `simulator:`: its kind knows the names `of:` and `when.of:` may give, and the flight's span.
+    aircraft : AircraftProperties, optional
+        A JSBSim aircraft's properties, which check the names in `of:` and `when.of:`; None: not checked.
+
+    Returns
+    -------
+    dict of str to QuantitySpec
+        Every quantity by name, in the mapping's order.
+
+    Raises
+    ------
+    CampaignError
+        Through `check.fail`: `quantities.NAME.KEY: ...`, naming the file.
+    """
     if value is None:
         return {}
     if not isinstance(value, dict) or not value:
         check.fail("quantities", f"expected a mapping of quantity names to {{of, take, ...}}, got {value!r:.60}")
     found = {}
-    for name, spec in value.items():
+    for name, given in value.items():
         path = f"quantities.{name}"
         if not isinstance(name, str) or not NAME.fullmatch(name):
             check.fail(path, "expected a name of 1-100 characters among A-Z a-z 0-9 _ . - "
                              "(not starting with . or -)")
-        spec = dict(check.mapping(spec, path, KEYS, required=("take",)))
-        take = check.string(spec["take"], f"{path}.take", TAKES)
+        given = check.mapping(given, path, KEYS, required=("take",))
+        take = check.string(given["take"], f"{path}.take", TAKES)
         entry = REGISTRY[take]
         allowed = set(entry.required) | (set(WINDOW) if entry.windowed else set())
-        for key in spec:
+        for key in given:
             if key != "take" and key not in allowed:
                 check.fail(f"{path}.{key}", f"has no meaning for take: {take} (it takes "
                                             f"{', '.join(sorted(allowed)) or 'no other key'})")
         for key in entry.required:
-            if key not in spec:
+            if key not in given:
                 check.fail(f"{path}.{key}", f"is required for take: {take}")
         if entry.mode and not is_level_flight(simulator):
             check.fail(f"{path}.take", f"{take} is a mode of the linearised model at a level-flight trim: it needs "
                                        "a JSBSim simulator with scenario kind level_flight")
-        if "of" in spec:
-            _source(check, spec["of"], f"{path}.of", simulator, aircraft)
-        if "when" in spec:
-            when = spec["when"] = dict(check.mapping(spec["when"], f"{path}.when", WHEN_KEYS, required=("of",)))
-            _source(check, when["of"], f"{path}.when.of", simulator, aircraft)
-            bounds = [key for key in BOUNDS if key in when]
-            if len(bounds) != 1:
-                check.fail(f"{path}.when", "expected exactly one of above or below (the threshold)")
-            check.number(when[bounds[0]], f"{path}.when.{bounds[0]}")
-        _times(check, spec, path, flight_span(simulator))
-        found[name] = spec
+        if "of" in given:
+            _source(check, given["of"], f"{path}.of", simulator, aircraft)
+        when = _when(check, given["when"], f"{path}.when", simulator, aircraft) if "when" in given else None
+        times = _times(check, given, path, flight_span(simulator))
+        found[name] = QuantitySpec(name, take, given.get("of"), when=when, **times)
     return found
 
 
@@ -75,19 +91,32 @@ def _source(check, name, path: str, simulator: dict, aircraft) -> None:
     simulator_entry(simulator).check_source(check, name, path, simulator, aircraft)
 
 
-def _times(check, spec: dict, path: str, span: float | None) -> None:
-    """at_s within the flight, and a window that holds part of it."""
+def _when(check, given, path: str, simulator: dict, aircraft) -> When:
+    """The event of a `when:` mapping as written: its `of` a name the simulator records, one threshold."""
+    given = check.mapping(given, path, WHEN_KEYS, required=("of",))
+    _source(check, given["of"], f"{path}.of", simulator, aircraft)
+    bounds = [key for key in BOUNDS if key in given]
+    if len(bounds) != 1:
+        check.fail(path, "expected exactly one of above or below (the threshold)")
+    return When(given["of"], bounds[0], check.number(given[bounds[0]], f"{path}.{bounds[0]}"))
+
+
+def _times(check, given: dict, path: str, span: float | None) -> dict[str, float]:
+    """The times a quantity's mapping gives ({at_s, after_s, before_s} as far as written), each within the
+    flight, and a window that holds part of it."""
+    times = {}
     for key in ("at_s", *WINDOW):
-        if key in spec:
-            spec[key] = check.number(spec[key], f"{path}.{key}")
-            if spec[key] < 0 or (span is not None and spec[key] > span):
+        if key in given:
+            time = times[key] = check.number(given[key], f"{path}.{key}")
+            if time < 0 or (span is not None and time > span):
                 flight = f"[0, {span:g}] s" if span is not None else "t >= 0"
-                check.fail(f"{path}.{key}", f"{spec[key]:g} s is outside the flight ({flight})")
-    if spec.get("after_s", -math.inf) >= spec.get("before_s", math.inf):
-        check.fail(f"{path}.after_s", f"expected after_s < before_s, got {spec['after_s']:g} >= {spec['before_s']:g}")
+                check.fail(f"{path}.{key}", f"{time:g} s is outside the flight ({flight})")
+    if times.get("after_s", -math.inf) >= times.get("before_s", math.inf):
+        check.fail(f"{path}.after_s", f"expected after_s < before_s, got {times['after_s']:g} >= {times['before_s']:g}")
+    return times
 
 
-def check_exceedance(check, value, quantities: dict) -> dict[str, list[dict]]:
+def check_exceedance(check, value, quantities: dict[str, QuantitySpec]) -> dict[str, list[dict]]:
     """The checked `analysis.exceedance` mapping {quantity: [{above: X} | {below: Y}, ...]}."""
     if not isinstance(value, dict) or not value:
         check.fail("analysis.exceedance", "expected a mapping of quantity names to lists of {above: X} or "

@@ -1,4 +1,5 @@
-"""The kinds of `take`: one class each, registered by subclassing `Take` with its name (`REGISTRY`).
+"""The kinds of `take`: one class each, registered by subclassing `Take` with its name (`REGISTRY`), and the
+quantity a take is made of (`QuantitySpec`: what the campaign's `quantities:` states of it, checked by spec.py).
 
 A take over the steps is a reduction fed once per integration step (or per time point of a Python model)
 with the step's time and value. Every reduction sees the steps inside its window [after_s, before_s]
@@ -9,7 +10,10 @@ instead (modes.py). A new take is a class here and a line in docs/quantities.md.
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 from typing import ClassVar
+
+from ..text.labels import name_unit
 
 NAN = float("nan")
 WINDOW_SLACK_S = 1e-9  # a step's time and a window's end written in decimal differ by rounding only
@@ -18,19 +22,107 @@ WINDOW = ("after_s", "before_s")
 REGISTRY: dict[str, type[Take]] = {}  # every take by its name, in the order the classes are defined
 
 
+@dataclass(frozen=True)
+class When:
+    """The event of a quantity's `when:`: the first step where `of` is above (or below) `threshold`.
+
+    Parameters
+    ----------
+    of : str
+        The output or property whose crossing is the event.
+    side : str
+        "above" or "below", the key the threshold was written under.
+    threshold : float
+        The value `of` crosses.
+
+    Examples
+    --------
+    >>> When("alpha_deg", "above", 3.0).side
+    'above'
+    """
+
+    of: str
+    side: str
+    threshold: float
+
+
+@dataclass(frozen=True)
+class QuantitySpec:
+    """One quantity of the campaign's `quantities:` as the validator (spec.py) checked it: the keys it was
+    written with (an absent key is None), which its take's reduction reads.
+
+    Parameters
+    ----------
+    name : str
+        The quantity's name, its key under `quantities:` (stored in /quantities/NAME).
+    take : str
+        The take's kind (`entry` is its class).
+    of : str or None
+        The output or property taken.
+    at_s : float or None
+        `at`'s time [s].
+    when : When or None
+        `at_first`'s and `time_of_first`'s event.
+    after_s, before_s : float or None
+        The window's ends [s]; None: the flight's.
+
+    Examples
+    --------
+    >>> spec = QuantitySpec("touchdown", "at_first", of="h_ft", when=When("alpha_deg", "below", 2.0))
+    >>> spec.entry.name, spec.entry.required, spec.at_s
+    ('at_first', ('of', 'when'), None)
+    >>> spec.unit({"h_ft": "ft"}), QuantitySpec("t", "time_of_first", when=spec.when).unit({})
+    ('ft', 's')
+    """
+
+    name: str
+    take: str
+    of: str | None = None
+    at_s: float | None = None
+    when: When | None = None
+    after_s: float | None = None
+    before_s: float | None = None
+
+    @property
+    def entry(self) -> type[Take]:
+        """The take's class (`REGISTRY[take]`): its keys, its unit and its reduction over the steps."""
+        return REGISTRY[self.take]
+
+    def unit(self, output_units: dict[str, str]) -> str:
+        """The quantity's unit: its take's own (`Take.unit`: time_of_first s, a damping -, a frequency rad/s),
+        else its `of`'s.
+
+        Parameters
+        ----------
+        output_units : dict of str to str
+            The units of the outputs by name; an `of` not among them: the unit its name ends in.
+
+        Returns
+        -------
+        str
+            The unit, "" when unknown.
+        """
+        if self.entry.unit is not None:
+            return self.entry.unit
+        if self.of is None:
+            return ""
+        return output_units.get(self.of) or name_unit(self.of)
+
+
 class Take:
     """A `take`: what one quantity of interest takes of a flight.
 
     A subclass registers itself under its name, `class Max(Take, name="max")`, and says which keys it
     requires (`required`), whether it takes the window keys (`windowed`), its own unit where it is not
     its `of`'s (`unit`) and a small `example` (tests); its docstring's first paragraph describes it in
-    the campaign-key reference.
+    the campaign-key reference. A reduction is made of the quantity's `QuantitySpec` and reads its keys
+    as the spec's attributes.
 
     Examples
     --------
     >>> REGISTRY["max"].required, REGISTRY["max"].windowed, REGISTRY["max"].mode
     (('of',), True, False)
-    >>> reduction = REGISTRY["max"]({"of": "h_ft", "take": "max", "after_s": 1.0})
+    >>> reduction = REGISTRY["max"](QuantitySpec("peak_h", "max", of="h_ft", after_s=1.0))
     >>> for t, x in [(0.0, 9.0), (1.0, 2.0), (2.0, 5.0)]:
     ...     reduction.step(t, x, NAN)
     >>> reduction.result()
@@ -41,7 +133,7 @@ class Take:
     required: ClassVar[tuple[str, ...]] = ("of",)
     windowed: ClassVar[bool] = True  # takes after_s and before_s
     mode: ClassVar[bool] = False  # a mode of the linearised model at the trim point, not a reduction
-    unit: ClassVar[str | None] = None  # its own unit; None: its `of`'s (quantity_unit)
+    unit: ClassVar[str | None] = None  # its own unit; None: its `of`'s (QuantitySpec.unit)
     example: ClassVar[dict]
 
     def __init_subclass__(cls, name: str | None = None, **kwargs):
@@ -50,9 +142,9 @@ class Take:
             cls.name = name
             REGISTRY[name] = cls
 
-    def __init__(self, spec: dict):
-        self.after = float(spec.get("after_s", -math.inf)) - WINDOW_SLACK_S
-        self.before = float(spec.get("before_s", math.inf)) + WINDOW_SLACK_S
+    def __init__(self, spec: QuantitySpec):
+        self.after = (-math.inf if spec.after_s is None else spec.after_s) - WINDOW_SLACK_S
+        self.before = (math.inf if spec.before_s is None else spec.before_s) + WINDOW_SLACK_S
         self.reset()
 
     def reset(self) -> None:
@@ -77,7 +169,7 @@ class Max(Take, name="max"):
     --------
     The window ends at before_s = 2: the 9.0 at t = 3 is not seen.
 
-    >>> reduction = REGISTRY["max"]({"of": "h_ft", "take": "max", "before_s": 2.0})
+    >>> reduction = REGISTRY["max"](QuantitySpec("peak_h", "max", of="h_ft", before_s=2.0))
     >>> for t, x in [(0.0, 1.0), (1.0, 7.0), (2.0, 4.0), (3.0, 9.0)]:
     ...     reduction.step(t, x, NAN)
     >>> reduction.result()
@@ -98,7 +190,7 @@ class Min(Take, name="min"):
     --------
     The window starts at after_s = 1: the −5.0 at t = 0 is not seen.
 
-    >>> reduction = REGISTRY["min"]({"of": "h_ft", "take": "min", "after_s": 1.0})
+    >>> reduction = REGISTRY["min"](QuantitySpec("lowest_h", "min", of="h_ft", after_s=1.0))
     >>> for t, x in [(0.0, -5.0), (1.0, 3.0), (2.0, 1.0), (3.0, 2.0)]:
     ...     reduction.step(t, x, NAN)
     >>> reduction.result()
@@ -119,7 +211,7 @@ class Final(Take, name="final"):
     --------
     The last step inside the window (before_s = 1.5), not the run's last:
 
-    >>> reduction = REGISTRY["final"]({"of": "h_ft", "take": "final", "before_s": 1.5})
+    >>> reduction = REGISTRY["final"](QuantitySpec("final_h", "final", of="h_ft", before_s=1.5))
     >>> for t, x in [(0.0, 1.0), (1.0, 2.0), (2.0, 3.0)]:
     ...     reduction.step(t, x, NAN)
     >>> reduction.result()
@@ -141,7 +233,7 @@ class Drop(Take, name="drop"):
     From 100 at the window's first step (after_s = 1) down to 85 at the lowest: 15; the 120 at t = 0 is
     outside the window.
 
-    >>> reduction = REGISTRY["drop"]({"of": "h_ft", "take": "drop", "after_s": 1.0})
+    >>> reduction = REGISTRY["drop"](QuantitySpec("altitude_loss", "drop", of="h_ft", after_s=1.0))
     >>> for t, x in [(0.0, 120.0), (1.0, 100.0), (2.0, 85.0), (3.0, 95.0)]:
     ...     reduction.step(t, x, NAN)
     >>> reduction.result()
@@ -169,7 +261,7 @@ class Change(Take, name="change"):
     A heading from 350° to 370° as the recorder feeds it, unwrapped (recorder.py), for the 350° → 10° it
     reads: a change of +20, not −340.
 
-    >>> reduction = REGISTRY["change"]({"of": "attitude/psi-deg", "take": "change"})
+    >>> reduction = REGISTRY["change"](QuantitySpec("heading_change", "change", of="attitude/psi-deg"))
     >>> for t, x in [(0.0, 350.0), (1.0, 362.0), (2.0, 370.0)]:
     ...     reduction.step(t, x, NAN)
     >>> reduction.result()
@@ -196,7 +288,7 @@ class Mean(Take, name="mean"):
     Steps 0, 4, 4 at t = 0, 2, 4: the trapezoids 0.5·2·(0 + 4) + 0.5·2·(4 + 4) = 12 over 4 s give 3.0
     (the mean of the samples would be 8/3).
 
-    >>> reduction = REGISTRY["mean"]({"of": "h_ft", "take": "mean"})
+    >>> reduction = REGISTRY["mean"](QuantitySpec("mean_h", "mean", of="h_ft"))
     >>> for t, x in [(0.0, 0.0), (2.0, 4.0), (4.0, 4.0)]:
     ...     reduction.step(t, x, NAN)
     >>> reduction.result()
@@ -231,7 +323,7 @@ class At(Take, name="at"):
     at_s = 1.5 lies halfway between the steps (1, 10) and (2, 30): 10 + 0.5·(30 − 10) = 20, not the
     nearest step's value.
 
-    >>> reduction = REGISTRY["at"]({"of": "h_ft", "take": "at", "at_s": 1.5})
+    >>> reduction = REGISTRY["at"](QuantitySpec("h_at", "at", of="h_ft", at_s=1.5))
     >>> for t, x in [(0.0, 0.0), (1.0, 10.0), (2.0, 30.0), (3.0, 100.0)]:
     ...     reduction.step(t, x, NAN)
     >>> reduction.result()
@@ -242,8 +334,8 @@ class At(Take, name="at"):
     windowed = False
     example = {"of": "h_ft", "take": "at", "at_s": 20.0}
 
-    def __init__(self, spec: dict):
-        self.at = float(spec["at_s"])
+    def __init__(self, spec: QuantitySpec):
+        self.at = spec.at_s
         super().__init__(spec)
 
     def reset(self):
@@ -268,7 +360,7 @@ class AtFirst(Take, name="at_first"):
     --------
     `when.of` (the third argument of `step`) first exceeds 3.0 at t = 1, where `of` is 90:
 
-    >>> spec = {"of": "h_ft", "take": "at_first", "when": {"of": "alpha_deg", "above": 3.0}}
+    >>> spec = QuantitySpec("h_at_stall", "at_first", of="h_ft", when=When("alpha_deg", "above", 3.0))
     >>> reduction = REGISTRY["at_first"](spec)
     >>> for t, x, y in [(0.0, 100.0, 1.0), (1.0, 90.0, 4.0), (2.0, 80.0, 5.0)]:
     ...     reduction.step(t, x, y)
@@ -279,10 +371,9 @@ class AtFirst(Take, name="at_first"):
     required = ("of", "when")
     example = {"of": "h_ft", "take": "at_first", "when": {"of": "alpha_deg", "above": 3.0}}
 
-    def __init__(self, spec: dict, time: bool = False):
-        when = spec["when"]
-        self.above = "above" in when
-        self.threshold = float(when["above"] if self.above else when["below"])
+    def __init__(self, spec: QuantitySpec, time: bool = False):
+        self.above = spec.when.side == "above"
+        self.threshold = spec.when.threshold
         self.time = time
         super().__init__(spec)
 
@@ -300,7 +391,7 @@ class TimeOfFirst(AtFirst, name="time_of_first"):
     --------
     `when.of` first falls below 2.0 at the step t = 2 (the step's time, not an interpolated crossing):
 
-    >>> spec = {"take": "time_of_first", "when": {"of": "alpha_deg", "below": 2.0}}
+    >>> spec = QuantitySpec("t_low_alpha", "time_of_first", when=When("alpha_deg", "below", 2.0))
     >>> reduction = REGISTRY["time_of_first"](spec)
     >>> for t, y in [(0.0, 5.0), (1.0, 3.0), (2.0, 1.5), (3.0, 1.0)]:
     ...     reduction.step(t, NAN, y)
@@ -312,7 +403,7 @@ class TimeOfFirst(AtFirst, name="time_of_first"):
     unit = "s"
     example = {"take": "time_of_first", "when": {"of": "alpha_deg", "below": 2.0}}
 
-    def __init__(self, spec: dict):
+    def __init__(self, spec: QuantitySpec):
         super().__init__(spec, time=True)
 
 

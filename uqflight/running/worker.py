@@ -25,7 +25,7 @@ import numpy as np
 
 from ..text.console import discard_output, one_line
 from .forking import die_with_parent
-from ..quantities import quantity_key
+from ..quantities import QuantitySpec, quantity_key
 from ..quantities.recorder import QuantityRecorder
 from ..simulators import FlightError, make_simulator
 from ..simulators.base import NominalFailed
@@ -41,7 +41,7 @@ class WorkerSpec:
     properties: tuple[str, ...]
     base: str
     bundle: dict | None = None  # the aircraft's (or file.py's) files as bytes + hash (simulators/bundle.py)
-    quantities: dict | None = None  # the campaign's quantities of interest, {name: spec} (uqflight.quantities)
+    quantities: dict[str, QuantitySpec] | None = None  # the campaign's quantities of interest by name
     time: tuple[float, ...] | None = None  # the nominal flight's times, which every run's values are stored against
 
     @property
