@@ -112,6 +112,8 @@ def test_a_run_and_its_rounds_do_not_check_the_design_again(tmp_path, monkeypatc
      "c.yaml: design.budget: 100 runs cannot hold one level of samples_per_level = 200"),
     ("{kind: importance_sampling, event: {of: peak}}",
      "c.yaml: design.event: expected exactly one of above or below (the threshold), got neither"),
+    ("{kind: tensor_grid, points: 12, rule: genz_keister}",
+     "c.yaml: design.points: rule genz_keister comes in 1, 3, 9, 19, 43 points, got 12"),
     ("{kind: active_learning, event: {of: peak, above: 3}, budget: 10}",
      "c.yaml: design.budget: 10 runs are too few for active learning on 2 inputs: its first design, one "
      "enrichment and two importance-sampling rounds need at least 332"),

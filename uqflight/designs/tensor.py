@@ -4,6 +4,7 @@ from __future__ import annotations
 from . import rules as rule_catalog
 from .base import DesignKind, Key, count
 from .smolyak import tensor_product
+from ..text import FieldError
 
 
 class TensorGrid(DesignKind):
@@ -37,9 +38,7 @@ class TensorGrid(DesignKind):
         for rule in dict.fromkeys(rules):
             sizes = rule_catalog.allowed_sizes(rule)
             if sizes is not None and size not in sizes:
-                raise ValueError(
-                    f"design.points: rule {rule} comes in {', '.join(map(str, sizes))} points, got {size}"
-                )
+                raise FieldError("design.points", f"rule {rule} comes in {', '.join(map(str, sizes))} points, got {size}")
         one_dimensional = {rule: rule_catalog.nodes_weights(rule, size) for rule in set(rules)}
         xi, weights = tensor_product(
             [one_dimensional[rule][0] for rule in rules], [one_dimensional[rule][1] for rule in rules]
