@@ -1,6 +1,7 @@
 """The campaign-key reference: every key the schema accepts, gathered from the code (the schema's key
 lists and the registries of scenarios, designs, methods, distributions, rules and quantities), with
-its description from KEYS (and each kind's from VALUES or its registry entry's docstring).
+its description: a simulator's, scenario's, design's or method's key from its kind's class (a design key taken by
+several kinds, by each of them), the others from KEYS; each kind's from VALUES or its registry entry's docstring.
 
 `reference_page()` is docs/reference/campaign-keys.md (the MkDocs build generates it from here; the
 committed copy is rewritten by `python -m uqflight.campaign.keys > docs/reference/campaign-keys.md`). A key or kind without a description is an error
@@ -54,41 +55,9 @@ KEYS = {
     "parameters.NAME.upper": "The interval's upper end, > `lower`. `upper: 205`",
     # design
     "design.kind": "Required. The design kind (below).",
-    "design.samples": "Number of points (`pick_freeze`: base rows n, N = n(d + 2) runs), >= 1; "
-                      "importance_sampling: runs per round, >= 2, default 500. `samples: 1024`",
-    "design.scramble": "Scramble the QMC points with the seed. Default true. `scramble: false`",
-    "design.replicates": "`sobol`: R independent scrambles of `samples` points (randomised QMC), giving every "
-                         "statistic's standard error. Default 1. `replicates: 16`",
-    "design.budget": "adaptive_sparse_grid, required: the most runs; the refinement stops before a round "
-                     "would pass it (stopped: budget). subset_simulation, importance_sampling, active_learning: the "
-                     "most runs, default 12000, 5000 and 1500 (see [rare events](../rare-events.md)). `budget: 300`",
-    "design.event": "subset_simulation, importance_sampling, active_learning, required: the event whose "
-                    "probability is estimated, `{of: QUANTITY, above: X}` or `{of: QUANTITY, below: X}`. "
-                    "`event: {of: sink_rate_fps, below: -10}`",
     "design.event.of": "The quantity (a name under `quantities:`) the event is about.",
     "design.event.above": "The event is QUANTITY > above (give above or below, not both).",
     "design.event.below": "The event is QUANTITY < below.",
-    "design.samples_per_level": "subset_simulation: runs per level, >= 2, times p0 at least 1 (the chains). "
-                                "Default 1000. `samples_per_level: 2000`",
-    "design.p0": "subset_simulation: the conditional probability of each level, in (0, 0.5]. Default 0.1. "
-                 "`p0: 0.1`",
-    "design.tolerance": "adaptive_sparse_grid only, required: stop when the sum of the active indices' "
-                        "indicators (change of mean and variance, normalised like ε_m and ε_v) is at most "
-                        "this (stopped: tolerance). `tolerance: 1e-5`",
-    "design.level": "Sparse-grid level, 0-1000. `level: 2`",
-    "design.rule": "The 1-D rule (below) for every dimension, or a mapping germ -> rule "
-                   "(`rule: {normal: gauss_hermite, uniform: clenshaw_curtis}`). Default: each germ's Gauss rule "
-                   "(Gauss–Hermite for normal inputs, Gauss–Legendre for uniform ones).",
-    "design.nested": "Sparse grids: true swaps each default rule for its germ's nested one (Hermite -> "
-                     "Genz–Keister, Legendre -> Patterson); false refuses nested rules. Default: the rules as "
-                     "named. `nested: true`",
-    "design.growth": "Sparse grids: `linear` (default; level i exact to degree 2i−1) or `exponential` (the "
-                     "rules' own nested sequences).",
-    "design.points": "Tensor grids: points per dimension, >= 1. `points: 5`",
-    "design.trajectories": "`morris` only, required: the trajectories R >= 2, of d + 1 runs each "
-                           "(N = R(d + 1) runs). `trajectories: 20`",
-    "design.levels": "`morris`: the levels p of the grid in the unit cube, even, >= 2; the jump is "
-                     "Δ = p/(2(p − 1)). Default 4. `levels: 6`",
     # method
     "method.kind": "The method (below).",
     # execution
@@ -180,6 +149,18 @@ class Key:
         return self.description or KEYS.get(self.path)
 
 
+def _by_kind(meanings: dict[str, str]) -> str:
+    """A design key's meaning in the reference: the kinds that take it, grouped by what it means for them, e.g.
+    "`sobol`, `halton`: Scramble ...". A kind without a meaning for it leaves the whole meaning empty (the
+    reference then refuses to build: `missing_descriptions`)."""
+    if not all(meanings.values()):
+        return ""
+    groups: dict[str, list[str]] = {}
+    for kind, meaning in meanings.items():
+        groups.setdefault(meaning, []).append(f"`{kind}`")
+    return " — ".join(f"{', '.join(kinds)}: {meaning}" for meaning, kinds in groups.items())
+
+
 def _paths(prefix: str, keys) -> list[str]:
     return [f"{prefix}.{k}" if prefix else k for k in keys]
 
@@ -207,9 +188,13 @@ def accepted_keys() -> list[Key]:
             **field_descriptions("simulator.scenario", scenario.scenario_fields)}.items()]
     found += [Key(p, "parameters", dict(DISTRIBUTIONS) if p.endswith(".distribution") else None)
               for p in _paths("parameters.NAME", schema.PARAMETER_KEYS)]
-    design = {"kind": dict(DESIGNS), "rule": dict(RULE_TABLE)}
-    keys = dict.fromkeys(k for entry in DESIGNS.values() for k in ("kind", *entry.keys))
-    found += [Key(f"design.{k}", "design", design.get(k)) for k in keys]
+    found.append(Key("design.kind", "design", dict(DESIGNS)))
+    meanings: dict[str, dict[str, str]] = {}  # key -> {kind: its meaning there}
+    for kind, entry in DESIGNS.items():
+        for key, declared in entry.keys.items():
+            meanings.setdefault(key, {})[kind] = declared.description
+    found += [Key(f"design.{k}", "design", dict(RULE_TABLE) if k == "rule" else None, _by_kind(by_kind))
+              for k, by_kind in meanings.items()]
     from ..designs.rare import EVENT_KEYS
 
     found += [Key(p, "design") for p in _paths("design.event", EVENT_KEYS)]
@@ -267,11 +252,12 @@ def reference_page() -> str:
     """The Markdown of docs/reference/campaign-keys.md; RuntimeError when a key has no description."""
     missing = missing_descriptions()
     if missing:
-        raise RuntimeError("campaign keys without a description in uqflight/campaign/keys.py: " + "; ".join(missing))
+        raise RuntimeError("campaign keys without a description (in their kind's class, or uqflight/campaign/keys.py): "
+                           + "; ".join(missing))
     lines = ["# Campaign keys", "",
              "Every key a campaign file accepts, generated from the code (`uqflight/campaign/schema.py` and the "
-             "registries of scenarios, designs, methods, distributions, rules and quantities; descriptions in "
-             "`uqflight/campaign/keys.py`). `NAME` is a name you choose. An unknown key is refused (exit 2) "
+             "registries of scenarios, designs, methods, distributions, rules and quantities; a kind's keys described "
+             "in its class, the others in `uqflight/campaign/keys.py`). `NAME` is a name you choose. An unknown key is refused (exit 2) "
              "with the closest known one. The guide is [campaign files](../campaigns.md)."]
     keys = accepted_keys()
     for section in dict.fromkeys(k.section for k in keys):

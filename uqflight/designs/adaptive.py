@@ -256,7 +256,15 @@ class AdaptiveSparseGrid(DesignKind):
     """
 
     kind = "adaptive_sparse_grid"
-    keys = {"rule": Key(), "budget": count(1), "tolerance": number("a number >= 0", lambda v: 0 <= v < float("inf"))}
+    keys = {"rule": Key(description="The 1-D rule (`design.rule`) for every dimension, or a mapping germ -> rule; "
+                                     "nested rules only. Default: each germ's nested rule (Genz–Keister for normal "
+                                     "inputs, Patterson for uniform ones)."),
+            "budget": count(1, description="Required: the most runs; the refinement stops before a round would "
+                                           "pass it (stopped: budget). `budget: 300`"),
+            "tolerance": number("a number >= 0", lambda v: 0 <= v < float("inf"),
+                                description="Required: stop when the sum of the active indices' indicators (change "
+                                            "of mean and variance, normalised like ε_m and ε_v) is at most this "
+                                            "(stopped: tolerance). `tolerance: 1e-5`")}
     example = {"kind": "adaptive_sparse_grid", "budget": 50, "tolerance": 1e-4}
     sampling = None
     adaptive = True

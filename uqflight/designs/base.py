@@ -20,33 +20,35 @@ def is_integer(value) -> bool:
 
 @dataclass(frozen=True)
 class Key:
-    """A design key: what it expects (for the refusal), its default (REQUIRED: none; None: absent) and its
-    test of a given value (None: the kind checks it, an event in its `settings`, a rule against the germs)."""
+    """A design key: what it expects (for the refusal), its default (REQUIRED: none; None: absent), its test of
+    a given value (None: the kind checks it, an event in its `settings`, a rule against the germs) and its
+    meaning for this kind (the campaign-key reference, `campaign.keys`)."""
 
     expects: str = ""
     default: object = None
     test: Callable | None = None
+    description: str = ""
 
 
-def count(minimum: int, maximum: int | None = None, default=REQUIRED) -> Key:
+def count(minimum: int, maximum: int | None = None, default=REQUIRED, description: str = "") -> Key:
     """An integer key >= minimum (and <= maximum when given)."""
     top = math.inf if maximum is None else maximum
     return Key(f"an integer >= {minimum}" if maximum is None else f"an integer from {minimum} to {maximum}",
-               default, lambda value: is_integer(value) and minimum <= value <= top)
+               default, lambda value: is_integer(value) and minimum <= value <= top, description)
 
 
-def number(expects: str, test: Callable, default=REQUIRED) -> Key:
+def number(expects: str, test: Callable, default=REQUIRED, description: str = "") -> Key:
     """A real-number key that `test` accepts."""
     return Key(expects, default, lambda value: isinstance(value, (int, float)) and not isinstance(value, bool)
-               and test(value))
+               and test(value), description)
 
 
-def flag(default) -> Key:
-    return Key("true or false", default, lambda value: isinstance(value, bool))
+def flag(default, description: str = "") -> Key:
+    return Key("true or false", default, lambda value: isinstance(value, bool), description)
 
 
-def choice(choices: tuple[str, ...], default) -> Key:
-    return Key(f"one of {', '.join(choices)}", default, lambda value: value in choices)
+def choice(choices: tuple[str, ...], default, description: str = "") -> Key:
+    return Key(f"one of {', '.join(choices)}", default, lambda value: value in choices, description)
 
 
 REGISTRY: dict[str, DesignKind] = {}  # kind name -> the kind (its class's one instance)
@@ -65,8 +67,9 @@ class DesignKind:
     kind : str
         The name a campaign gives.
     keys : dict of str to Key
-        Its keys besides `kind`: what each expects, its default, its test. `settings` checks a spec on them
-        (once, into a `DesignSpec`) and the key reference lists them.
+        Its keys besides `kind`: what each expects, its default, its test and its meaning for this kind.
+        `settings` checks a spec on them (once, into a `DesignSpec`) and the key reference lists them with
+        their meanings.
     example : dict
         A small `design:` mapping of this kind (help text and tests).
     sampling : analysis.proportions.Independent or None

@@ -26,6 +26,9 @@ def sobol_points(n: int, d: int, scramble: bool, seed: int) -> np.ndarray:
     return engine.random_base2((n + skip - 1).bit_length())[skip : n + skip]
 
 
+SAMPLES = "Number of points, >= 1. `samples: 1024`"
+SCRAMBLE = "Scramble the QMC points with the seed. Default true. `scramble: false`"
+
 class MonteCarlo(DesignKind):
     """`monte_carlo` {samples}: independent draws from numpy's default_rng(seed).
 
@@ -42,7 +45,7 @@ class MonteCarlo(DesignKind):
     """
 
     kind = "monte_carlo"
-    keys = {"samples": count(1)}
+    keys = {"samples": count(1, description=SAMPLES)}
     example = {"kind": "monte_carlo", "samples": 64}
 
     def points(self, spec, germs, seed):
@@ -69,7 +72,9 @@ class Sobol(DesignKind):
     """
 
     kind = "sobol"
-    keys = {"samples": count(1), "scramble": flag(True), "replicates": count(1, default=1)}
+    keys = {"samples": count(1, description=SAMPLES), "scramble": flag(True, SCRAMBLE),
+            "replicates": count(1, default=1, description="R independent scrambles of `samples` points (randomised "
+                                "QMC), giving every statistic's standard error. Default 1. `replicates: 16`")}
     example = {"kind": "sobol", "samples": 64}
     sampling = Net()
 
@@ -109,7 +114,7 @@ class Halton(DesignKind):
     """
 
     kind = "halton"
-    keys = {"samples": count(1), "scramble": flag(True)}
+    keys = {"samples": count(1, description=SAMPLES), "scramble": flag(True, SCRAMBLE)}
     example = {"kind": "halton", "samples": 64}
     sampling = Net()
 
@@ -139,7 +144,7 @@ class LatinHypercube(DesignKind):
     """
 
     kind = "latin_hypercube"
-    keys = {"samples": count(1)}
+    keys = {"samples": count(1, description=SAMPLES)}
     example = {"kind": "latin_hypercube", "samples": 64}
     sampling = Stratified()
 

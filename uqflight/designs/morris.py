@@ -246,7 +246,10 @@ class Morris(DesignKind):
     """
 
     kind = "morris"
-    keys = {"trajectories": count(2), "levels": count(2, default=4)}
+    keys = {"trajectories": count(2, description="Required: the trajectories R >= 2, of d + 1 runs each (N = R(d + 1) "
+                                                "runs). `trajectories: 20`"),
+            "levels": count(2, default=4, description="The levels p of the grid in the unit cube, even, >= 2; the "
+                                                       "jump is Δ = p/(2(p − 1)). Default 4. `levels: 6`")}
     example = {"kind": "morris", "trajectories": 4}
     sampling = Points()
     not_draws = NOT_DRAWS

@@ -37,7 +37,7 @@ class PickFreeze(DesignKind):
     """
 
     kind = "pick_freeze"
-    keys = {"samples": count(1)}
+    keys = {"samples": count(1, description="Base rows n, >= 1: N = n(d + 2) runs. `samples: 1024`")}
     example = {"kind": "pick_freeze", "samples": 16}
     sampling = proportions.PickFreeze()
     sobol_from_runs = True

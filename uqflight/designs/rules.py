@@ -21,6 +21,10 @@ from ..parameters.germs import GERMS
 from ..text import FieldError
 
 GROWTHS = ("linear", "exponential")
+# the `rule` key of the grids that take any rule (sparse_grid, tensor_grid), for the key reference
+RULE = ("The 1-D rule (below) for every dimension, or a mapping germ -> rule (`rule: {normal: gauss_hermite, "
+        "uniform: clenshaw_curtis}`). Default: each germ's Gauss rule (Gauss–Hermite for normal inputs, "
+        "Gauss–Legendre for uniform ones).")
 GENZ_KEISTER_SIZES = (1, 3, 9, 19, 43)  # all chaospy tabulates for variant 24; 43 has ~9-digit weights
 GENZ_KEISTER_DEGREES = (1, 5, 15, 29, 69)
 PATTERSON_SIZES = tuple(2**level - 1 for level in range(1, 10))  # 1, 3, 7, ..., 511

@@ -122,7 +122,13 @@ class SparseGrid(DesignKind):
     """
 
     kind = "sparse_grid"
-    keys = {"level": count(0), "rule": Key(), "nested": flag(None), "growth": choice(rule_catalog.GROWTHS, "linear")}
+    keys = {"level": count(0, description=f"Sparse-grid level, 0-{MAX_LEVEL}. `level: 2`"),
+            "rule": Key(description=rule_catalog.RULE),
+            "nested": flag(None, "True swaps each default rule for its germ's nested one (Hermite -> Genz–Keister, "
+                                 "Legendre -> Patterson); false refuses nested rules. Default: the rules as named. "
+                                 "`nested: true`"),
+            "growth": choice(rule_catalog.GROWTHS, "linear", "`linear` (default; level i exact to degree 2i−1) or "
+                                                             "`exponential` (the rules' own nested sequences).")}
     example = {"kind": "sparse_grid", "level": 2}
     sampling = None
 

@@ -3,6 +3,7 @@ from __future__ import annotations
 
 from . import rules as rule_catalog
 from .base import DesignKind, Key, count
+from .rules import RULE
 from .smolyak import tensor_product
 from ..text import FieldError
 
@@ -24,7 +25,7 @@ class TensorGrid(DesignKind):
     """
 
     kind = "tensor_grid"
-    keys = {"rule": Key(), "points": count(1)}
+    keys = {"rule": Key(description=RULE), "points": count(1, description="Points per dimension, >= 1. `points: 5`")}
     example = {"kind": "tensor_grid", "points": 4}
     sampling = None
 

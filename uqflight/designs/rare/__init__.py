@@ -118,7 +118,15 @@ def first_round(spec: DesignSpec, germs: list[str], seed: int, redrawn=()) -> np
 
 
 MAX_RUNS = 10**8  # a budget beyond this is no rare-event design's (and limits.max_runs bounds it first)
-EVENT = Key("an event {of: QUANTITY, above: X} (or below: X) whose probability it estimates", REQUIRED)
+EVENT = Key("an event {of: QUANTITY, above: X} (or below: X) whose probability it estimates", REQUIRED,
+            description="Required: the event whose probability is estimated, `{of: QUANTITY, above: X}` or "
+                        "`{of: QUANTITY, below: X}`. `event: {of: sink_rate_fps, below: -10}`")
+
+
+def budget(default: int) -> Key:
+    """The most runs of a rare-event design, `default` when not given."""
+    return count(1, MAX_RUNS, default, f"The most runs. Default {default} (see [rare events](../rare-events.md)). "
+                                       f"`budget: {2 * default}`")
 
 
 class RareDesign(DesignKind):
@@ -183,9 +191,11 @@ class SubsetSimulation(RareDesign):
     """
 
     kind = "subset_simulation"
-    keys = {"event": EVENT, "budget": count(1, MAX_RUNS, 12000), "samples_per_level": count(2, MAX_RUNS, None),
+    keys = {"event": EVENT, "budget": budget(12000),
+            "samples_per_level": count(2, MAX_RUNS, None, "Runs per level, >= 2, times p0 at least 1 (the chains). "
+                                                          "Default 1000. `samples_per_level: 2000`"),
             "p0": number("a number in (0, 0.5], the conditional probability of each level", lambda v: 0 < v <= 0.5,
-                         None)}
+                         None, "The conditional probability of each level, in (0, 0.5]. Default 0.1. `p0: 0.1`")}
     example = {"kind": "subset_simulation", "event": {"of": "y", "above": 3.0}, "samples_per_level": 100, "p0": 0.1,
                "budget": 1000}
 
@@ -226,7 +236,8 @@ class ImportanceSampling(RareDesign):
     """
 
     kind = "importance_sampling"
-    keys = {"event": EVENT, "budget": count(1, MAX_RUNS, 5000), "samples": count(2, MAX_RUNS, None)}
+    keys = {"event": EVENT, "budget": budget(5000),
+            "samples": count(2, MAX_RUNS, None, "Runs per round, >= 2. Default 500. `samples: 500`")}
     example = {"kind": "importance_sampling", "event": {"of": "y", "above": 3.0}, "samples": 100, "budget": 1000}
 
     @staticmethod
@@ -253,7 +264,7 @@ class ActiveLearning(RareDesign):
     """
 
     kind = "active_learning"
-    keys = {"event": EVENT, "budget": count(1, MAX_RUNS, 1500)}
+    keys = {"event": EVENT, "budget": budget(1500)}
     example = {"kind": "active_learning", "event": {"of": "y", "above": 3.0}, "budget": 500}
 
     @staticmethod
