@@ -28,6 +28,7 @@ BAD = {
     "bad_simulator_kind.yaml": ("simulator.kind", "expected one of jsbsim, python, got 'xplane'"),
     "bad_missing_simulator_kind.yaml": ("simulator.kind", "is required; expected one of jsbsim, python"),
     "bad_unknown_aircraft.yaml": ("simulator.aircraft", "no aircraft 'concorde'"),
+    "bad_aircraft_number.yaml": ("simulator.aircraft", 'got 737 (YAML reads 737 as a number: quote it, "737")'),
     "bad_unknown_output.yaml": ("simulator.outputs[1]", "or a JSBSim property of aircraft 'bacm', got 'aero/not-a-property'"),
     "bad_excitation_kind.yaml": ("simulator.excitation.kind", "expected one of pulse, step, doublet, none"),
     "bad_duration.yaml": ("simulator.duration_s", "expected a number > 0, got -5"),
@@ -62,6 +63,7 @@ BAD = {
     "bad_tsvd_tol.yaml": ("storage.tsvd.tol", "expected a relative tolerance in (0, 1), got 1.5"),
     "bad_raw_false_without_tsvd.yaml": ("storage.raw", "false needs storage.tsvd"),
     "bad_band_samples.yaml": ("analysis.band_samples", "expected at most 1000000 draws (a million draws of an output"),
+    "bad_take_typo.yaml": ("quantities.peak.take", "got 'maximum'; did you mean max?"),
     "bad_bootstrap.yaml": ("analysis.bootstrap", "expected at most 10000 resamplings (10^4 of a pick-freeze design"),
 }
 # A representative handful through the command line (each start costs about a second).

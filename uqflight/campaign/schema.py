@@ -94,7 +94,11 @@ class Checker:
     def string(self, value, path: str, choices: tuple[str, ...] | None = None) -> str:
         expected = f"one of {', '.join(choices)}" if choices else "a non-empty string"
         if not isinstance(value, str) or not value or (choices and value not in choices):
-            self.fail(path, f"expected {expected}, got {quoted_value(value)}")
+            number = isinstance(value, (int, float)) and not isinstance(value, bool)
+            close = difflib.get_close_matches(value, choices, n=1) if choices and isinstance(value, str) else []
+            hint = (f" (YAML reads {value} as a number: quote it, \"{value}\")" if number and not choices else
+                    f"; did you mean {close[0]}?" if close else "")
+            self.fail(path, f"expected {expected}, got {quoted_value(value)}{hint}")
         return value
 
     def boolean(self, value, path: str) -> bool:
