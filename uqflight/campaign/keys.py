@@ -151,14 +151,14 @@ class Key:
 
 def _by_kind(meanings: dict[str, str]) -> str:
     """A design key's meaning in the reference: the kinds that take it, grouped by what it means for them, e.g.
-    "`sobol`, `halton`: Scramble ...". A kind without a meaning for it leaves the whole meaning empty (the
+    "`sobol`, `halton`: Scramble ...", one line per meaning. A kind without a meaning for it leaves the whole meaning empty (the
     reference then refuses to build: `missing_descriptions`)."""
     if not all(meanings.values()):
         return ""
     groups: dict[str, list[str]] = {}
     for kind, meaning in meanings.items():
         groups.setdefault(meaning, []).append(f"`{kind}`")
-    return " — ".join(f"{', '.join(kinds)}: {meaning}" for meaning, kinds in groups.items())
+    return "<br>".join(f"{', '.join(kinds)}: {meaning}" for meaning, kinds in groups.items())
 
 
 def _paths(prefix: str, keys) -> list[str]:
