@@ -175,6 +175,9 @@ def test_report_refuses_an_unreadable_results_file(tmp_path):
     result = cli_in_process("report", tmp_path / "missing.h5", "--out", tmp_path / "report")
     assert result.returncode == 2
     assert result.stderr.strip() == f"error: {tmp_path / 'missing.h5'}: no such results file"
+    device = cli_in_process("report", "/dev/zero", "--out", tmp_path / "report")  # there, but no file to read
+    assert device.returncode == 2
+    assert device.stderr.strip() == "error: /dev/zero is not a regular file (a device, a FIFO or a socket), not a results file"
 
 
 def test_split_form_is_ignored_by_the_kinds_that_fit_their_constant_term(tmp_path):

@@ -76,6 +76,8 @@ def results_problem(path: Path) -> str | None:
 
     if path.is_dir():
         return f"{path} is a folder, not a results file"
+    if path.exists() and not path.is_file():
+        return f"{path} is not a regular file (a device, a FIFO or a socket), not a results file"
     if not path.is_file():
         return f"{path}: no such results file"
     if h5py.is_hdf5(path):
