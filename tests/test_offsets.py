@@ -126,6 +126,13 @@ def test_offset_on_a_function_outside_the_axes_is_refused_naming_it(tmp_path):
         load_campaign(path, read_aircraft=AircraftProperties)
 
 
+def test_a_function_the_aircraft_lacks_is_refused_naming_the_option_and_the_aircraft(tmp_path):
+    refused = cli_in_process("simulate", "--aircraft", "c172p", "--scale", "nonexistent=1.1", "--no-files", cwd=tmp_path)
+    assert refused.returncode == 2
+    assert refused.stderr.startswith("error: --scale nonexistent: expected one of the aircraft's aerodynamic functions")
+    assert refused.stderr.strip().endswith("got 'nonexistent' (aircraft 'c172p')")
+
+
 def test_offset_value_adds_in_the_function_own_unit():
     functions = ("aero/function/kCLge", "aero/coefficient/CDo")
     patched = PreparedAircraft("c172p", patches=[(f, "offset_value") for f in functions])

@@ -11,8 +11,10 @@ PACKAGE = Path(__file__).resolve().parents[1] / "uqflight"
 COMMAND_MODULES = ("cli/commands.py", "calibration/command.py", "cli/arguments.py")
 # the explicit translations at the commands' boundary, where a generic library error (h5py's OSError,
 # JSBSim's RuntimeError, a worker's failure) becomes a Refusal with the command's own context:
-# simulate, plan, run (2), info (2), report, design, surrogate export, aircraft; calibrate (4)
-TRANSLATIONS = {"cli/commands.py": 10, "calibration/command.py": 2, "cli/arguments.py": 0}
+# simulate, plan, run (2), info (2), report, design, surrogate export, aircraft; calibrate (2, a worker's
+# failure and the --method/--order parse); and the option a --scale/--offset function came from (simulate,
+# aircraft: one place, _prepared)
+TRANSLATIONS = {"cli/commands.py": 11, "calibration/command.py": 2, "cli/arguments.py": 0}
 
 
 def calls_of(name: str) -> list[tuple[str, str]]:

@@ -211,14 +211,19 @@ def _prepared(aircraft: str, scale: list[str], offset: list[str], offset_value: 
     """The aircraft of `simulate`/`aircraft`, patched for --scale/--offset/--offset-value; `.settings`
     holds the patch properties' values, `.pairs` (function, kind, property, value). Raises a Refusal (a
     bad function, an aircraft not found, an aircraft file that is not XML)."""
+    from ..simulators.base import SimulatorSettingError
     from ..simulators.patch import PreparedAircraft, patch_property, resolve_function
 
     plain = PreparedAircraft(aircraft, Path.cwd())
     pairs = []
     for kind, items in (("scale", scale), ("offset", offset), ("offset_value", offset_value)):
-        for name, value in parse_settings(items, "--" + kind.replace("_", "-")).items():
-            function = resolve_function(name, plain.functions)
-            pairs.append((function, kind, patch_property(function, kind, plain.functions), value))
+        option = "--" + kind.replace("_", "-")
+        for name, value in parse_settings(items, option).items():
+            try:
+                function = resolve_function(name, plain.functions)
+                pairs.append((function, kind, patch_property(function, kind, plain.functions), value))
+            except SimulatorSettingError as exc:
+                raise Refusal(f"{option} {name}: {exc} (aircraft {plain.name!r})") from exc
     prepared = PreparedAircraft(aircraft, Path.cwd(), patches=[(f, k) for f, k, _, _ in pairs]) if pairs else plain
     prepared.settings = {prop: value for _, _, prop, value in pairs}
     prepared.pairs = pairs
