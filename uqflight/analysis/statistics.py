@@ -91,6 +91,16 @@ class Options:
     quantiles: tuple[float, ...] = QUANTILES
 
 
+@dataclass(frozen=True)
+class Screening:
+    """A screening design's measures of each input's importance from its runs (DesignKind.screening): `name`
+    names them in summary.json and the report (the design kind's `screening_name`: Morris's is morris),
+    `measures` {input: {measure: (T,) or {lower, upper}}}."""
+
+    name: str
+    measures: dict
+
+
 @dataclass
 class OutputStatistics:
     name: str
@@ -123,7 +133,7 @@ class OutputStatistics:
     pce: PCE | None = None  # the expansion behind the statistics (None: statistics of the runs themselves)
     flags: list[str] = field(default_factory=list)
     unwrapped: bool = False  # an angle whose runs wrap, made continuous before any statistic (analysis.angles)
-    morris: dict | None = None  # a Morris design's measures per parameter: mu_star, mu, sigma, mu_star_ci (screen)
+    screening: Screening | None = None  # a screening design's measures of each input (screen)
 
     @property
     def std(self) -> np.ndarray:
@@ -733,7 +743,7 @@ def unresolved_flag(out: OutputStatistics) -> str | None:
 
 def screen(stats: Statistics, out: OutputStatistics, xi: np.ndarray, Y: np.ndarray, ok: np.ndarray, options: Options,
            what: str) -> None:
-    """Set `out.morris` to the screening measures of the design (DesignKind.screening), if it has one, of the
+    """Set `out.screening` to the screening measures of the design (DesignKind.screening), if it has one, of the
     values `Y` (n_ok, T) of the `ok` runs, `xi` every run's germs; its note, after `what`, in stats.notes once.
 
     Parameters
@@ -741,7 +751,7 @@ def screen(stats: Statistics, out: OutputStatistics, xi: np.ndarray, Y: np.ndarr
     stats : Statistics
         The file's statistics: its design kind and facts, parameters and notes.
     out : OutputStatistics
-        The output's or quantity's statistics, given its `morris` measures.
+        The output's or quantity's statistics, given its `screening` measures.
     xi : numpy.ndarray
         Every run's germs (N, d), in design order.
     Y : numpy.ndarray
@@ -753,13 +763,12 @@ def screen(stats: Statistics, out: OutputStatistics, xi: np.ndarray, Y: np.ndarr
     what : str
         What the note is of ("" for every output).
     """
-    screening = DESIGNS[stats.design_kind].screening
-    if screening is None:
+    kind = DESIGNS[stats.design_kind]
+    if kind.screening is None:
         return
-    found, note = screening(xi, Y, ok, stats.design_info, options.bootstrap, options.seed)
-    out.morris = {name: {"mu_star": found["mu_star"][i], "mu": found["mu"][i], "sigma": found["sigma"][i],
-                         "mu_star_ci": {"lower": found["mu_star_ci"][0][i], "upper": found["mu_star_ci"][1][i]}}
-                  for i, name in enumerate(stats.parameter_names)}
+    measures, note = kind.screening(xi, Y, ok, stats.design_info, options.bootstrap, options.seed,
+                                    stats.parameter_names)
+    out.screening = Screening(kind.screening_name, measures)
     if note and what + note not in stats.notes:
         stats.notes.append(what + note)
 
@@ -1079,8 +1088,8 @@ def _quantity_json(quantity: QuantityStatistics, seeds: list[str]) -> dict:
         entry["validation"] = out.validation
     if out.method is not None:
         entry["method"] = out.method
-    if out.morris is not None:
-        entry["morris"] = _at_first_time(out.morris)
+    if out.screening is not None:
+        entry[out.screening.name] = _at_first_time(out.screening.measures)
     return entry
 
 
@@ -1159,8 +1168,8 @@ def summary_json(stats: Statistics) -> dict:
             entry["validation"] = out.validation
         if out.method is not None:
             entry["method"] = out.method
-        if out.morris is not None:
-            entry["morris"] = out.morris
+        if out.screening is not None:
+            entry[out.screening.name] = out.screening.measures
         if out.errors:
             errors = out.errors
             entry["errors"] = {"eps_m": errors["eps_m"], "eps_v": errors["eps_v"],

@@ -166,7 +166,10 @@ class DesignKind:
         `runs` of `d` parameters, for what the analysis reads of it; None when it fits."""
         return None
 
-    screening: ClassVar[Callable | None] = None  # (xi, Y, ok, info, bootstrap, seed) -> (measures, note)
+    # a design whose runs measure each input's importance themselves (Morris): (xi, Y, ok, info, bootstrap, seed,
+    # names) -> ({input name: its measures}, note); the measures' name in summary.json and the report
+    screening: ClassVar[Callable | None] = None
+    screening_name: ClassVar[str | None] = None
 
 
 def equal_weights(n: int) -> np.ndarray:

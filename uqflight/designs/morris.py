@@ -177,8 +177,8 @@ def morris_measures(effects: np.ndarray, n_boot: int, seed: int, confidence: flo
     return {"mu_star": mu_star, "mu": effects.mean(axis=0), "sigma": sigma, "mu_star_ci": ci}
 
 
-def morris_screening(xi: np.ndarray, Y: np.ndarray, ok: np.ndarray, info: dict, n_boot: int,
-                     seed: int) -> tuple[dict, str | None]:
+def morris_screening(xi: np.ndarray, Y: np.ndarray, ok: np.ndarray, info: dict, n_boot: int, seed: int,
+                     names: list[str]) -> tuple[dict, str | None]:
     """The Morris measures of values `Y` of the `ok` runs of a Morris design, and the note of the
     trajectories dropped (None when none is); ValueError naming the fact of `info` that does not fit the runs.
 
@@ -196,11 +196,14 @@ def morris_screening(xi: np.ndarray, Y: np.ndarray, ok: np.ndarray, info: dict, 
         Bootstrap resamples of μ*'s interval.
     seed : int
         Seeds the bootstrap.
+    names : list of str
+        The inputs' names, in the columns' order.
 
     Returns
     -------
     tuple
-        (`morris_measures`' dict, the note or None).
+        ({name: {"mu_star", "mu", "sigma" (T,), "mu_star_ci": {"lower", "upper"}}} of `morris_measures`, the
+        note or None).
     """
     problem = info_problem(info, len(xi), xi.shape[1])
     if problem:
@@ -213,7 +216,10 @@ def morris_screening(xi: np.ndarray, Y: np.ndarray, ok: np.ndarray, info: dict, 
         note = (f"the Morris measures are estimated on the {kept} complete trajectories of {kept + dropped} "
                 f"(a trajectory with a failed or undefined run has no elementary effect of the inputs after it): "
                 f"{dropped} dropped" + ("; σ is undefined with fewer than 2" if kept < 2 else ""))
-    return morris_measures(effects, n_boot, seed), note
+    found = morris_measures(effects, n_boot, seed)
+    return {name: {"mu_star": found["mu_star"][i], "mu": found["mu"][i], "sigma": found["sigma"][i],
+                   "mu_star_ci": {"lower": found["mu_star_ci"][0][i], "upper": found["mu_star_ci"][1][i]}}
+            for i, name in enumerate(names)}, note
 
 
 def info_problem(info: dict, runs: int, d: int) -> tuple[str, str] | None:
@@ -254,6 +260,7 @@ class Morris(DesignKind):
     sampling = Points()
     not_draws = NOT_DRAWS
     screening = staticmethod(morris_screening)
+    screening_name = "morris"
     info_problem = staticmethod(info_problem)
 
     def settings(self, spec):

@@ -11,7 +11,7 @@ import numpy as np
 from ..text.labels import shown_time
 from . import plots
 from .loading import AnalysedFile
-from .morris import ranked_text
+from .screenings import SCREENINGS
 from .sensitivity import top_contributors
 from .blocks import Section, Table
 
@@ -53,7 +53,7 @@ def _row(name: str, out, i: int, time, flags: list[str]) -> tuple[list, list]:
     """(CSV row, page row) of one output at time index i, shown as `time` (or a quantity: time None), with
     its `flags`; the CSV keeps the recorded time."""
     mean, std, lower, upper = (float(v[i]) for v in (out.mean, out.std, *out.band99))
-    top = (ranked_text(out.morris, i) if out.morris else
+    top = (SCREENINGS[out.screening.name].ranked_text(out.screening.measures, i) if out.screening else
            top_contributors(out.sobol_first, i, out.sobol_first_ci or None) if out.sobol_first else NO_INDICES)
     csv = [name, out.units, "" if time is None else float(out.time[i]), mean, std, lower, upper, top, "; ".join(flags)]
     page = [flagged(name, flags), "" if time is None else f"{time:g}", mean_std_text(mean, std, out.units),
@@ -126,8 +126,8 @@ def headline_section(entry: AnalysedFile, times: list[float]) -> Section:
         csv_row, page_row = _row(name, quantity.output, 0, None, quantity.flags)
         rows.append([entry.label, *csv_row])
         page.append(page_row)
-    screened = any(out.morris for out in entry.outputs.values())
-    contributors = "inputs ranked by μ* (Morris)" if screened else "top contributors (first-order Sobol')"
+    screening = next((SCREENINGS[out.screening.name] for out in entry.outputs.values() if out.screening), None)
+    contributors = screening.column if screening else "top contributors (first-order Sobol')"
     header = ["file", "output or quantity", "unit", "time [s]", "mean", "std", "band99 lower", "band99 upper",
               contributors, "flags"]
     table = Table(f"Key numbers of {entry.label}", header, rows, "tables/headline.csv",
@@ -140,8 +140,7 @@ def headline_section(entry: AnalysedFile, times: list[float]) -> Section:
             "and an index whose interval is wider than 0.5 or lies outside [0, 1] reads 'unresolved (its interval, "
             "n too small)'), "
             "per output at the selected times (--times) and per quantity of interest"
-            + ("; with a Morris design, the inputs ranked by μ*, the mean absolute elementary effect, instead of "
-               "Sobol' shares" if screened else "") + ". "
+            + (screening.sentence if screening else "") + ". "
             "Rounded to two digits of the std; in full in tables/headline.csv, as in summary.json. "
             f"A row marked {FLAGGED.strip()} is flagged: its flags say what is wrong and what helps.")
     if exceedance is not None:

@@ -92,10 +92,12 @@ def section_jobs(entries: list[AnalysedFile], ref: AnalysedFile | None, times: l
         from .variance_split import variance_split_section
 
         jobs.append((0, "writing the variance split", lambda: variance_split_section(entries, times)))
-    if any(out.morris for e in entries for out in e.outputs.values()):
-        from .morris import morris_section
+    screened = dict.fromkeys(out.screening.name for e in entries for out in e.outputs.values() if out.screening)
+    for name in screened:  # a screening design's measures: its own page (report.screenings)
+        from .screenings import SCREENINGS
 
-        jobs.append((outputs * k, "drawing the Morris screening", lambda: morris_section(entries, times, out_dir)))
+        page = SCREENINGS[name]
+        jobs.append((outputs * k, page.stage, lambda page=page: page.section(entries, times, out_dir)))
     if any(e.has_sobol for e in entries):
         jobs.append((3 * outputs * k, "drawing the Sobol' indices",
                      lambda: sensitivity_section(entries, times, out_dir)))

@@ -7,10 +7,11 @@ from pathlib import Path
 
 import numpy as np
 
-from . import plots
-from .blocks import Figure, Section, Table, _rel
-from .loading import AnalysedFile, file_name_within
-from ..text.labels import shown_time
+from .. import plots
+from ..blocks import Figure, Section, Table, _rel
+from ..loading import AnalysedFile, file_name_within
+from ...text.labels import shown_time
+from . import SCREENINGS, ScreeningPage
 
 
 def ranked_text(morris: dict, i: int) -> str:
@@ -19,7 +20,7 @@ def ranked_text(morris: dict, i: int) -> str:
     Parameters
     ----------
     morris : dict
-        An output's or quantity's measures (OutputStatistics.morris).
+        An output's or quantity's Morris measures (OutputStatistics.screening.measures).
     i : int
         The time index.
 
@@ -39,11 +40,11 @@ def _number(value) -> str:
 
 def _panels_of(entry: AnalysedFile, times: list[float]) -> list[tuple[str, dict, int]]:
     """(panel title, measures, time index) for each quantity and each output at the selected times."""
-    panels = [(f"quantity {name}", q.output.morris, 0) for name, q in entry.stats.quantities.items()
-              if q.output is not None and q.output.morris]
+    panels = [(f"quantity {name}", q.output.screening.measures, 0) for name, q in entry.stats.quantities.items()
+              if q.output is not None and q.output.screening]
     for name, out in entry.outputs.items():
-        if out.morris:
-            panels += [(f"{name} at t = {shown_time(out.time, i):g} s", out.morris, i)
+        if out.screening:
+            panels += [(f"{name} at t = {shown_time(out.time, i):g} s", out.screening.measures, i)
                        for i in plots.time_indices(out.time, times)]
     return panels
 
@@ -81,7 +82,7 @@ def plot_morris(panels: list[tuple[str, dict, int]], path: Path, title: str) -> 
 
 
 def morris_section(entries: list[AnalysedFile], times: list[float], out_dir: Path) -> Section:
-    """The Morris screening of the entries whose statistics carry it (OutputStatistics.morris)."""
+    """The Morris screening of the entries whose statistics carry it (OutputStatistics.screening)."""
     blocks, rows, page = [], [], []
     for entry in entries:
         panels = _panels_of(entry, times)
@@ -108,3 +109,9 @@ def morris_section(entries: list[AnalysedFile], times: list[float], out_dir: Pat
                    "Elementary effects EE = Δy/Δ of each input's move by the grid jump Δ in its probability scale "
                    "(docs/designs.md): μ* = mean |EE| ranks the inputs, μ = mean EE keeps the sign, σ > 0 marks "
                    "interactions or nonlinearity. A Morris design gives no Sobol' indices.", blocks)
+
+
+SCREENINGS["morris"] = ScreeningPage(
+    morris_section, ranked_text, "inputs ranked by μ* (Morris)",
+    "; with a Morris design, the inputs ranked by μ*, the mean absolute elementary effect, instead of Sobol' shares",
+    "drawing the Morris screening")
