@@ -32,6 +32,8 @@ KINDS = [
      '{"kind": "integration", "split": false, "order": 2}', '{"order": 2, "kind": "integration", "split": false}'),
     ("{kind: integration}", ADAPTIVE,
      '{"order": 2, "kind": "integration", "split": false}', '{"order": 2, "kind": "integration", "split": false}'),
+    ("{kind: integration, order: 1}", ADAPTIVE,  # an adaptive grid's record puts the order first, given or not
+     '{"order": 1, "kind": "integration", "split": false}', '{"order": 1, "kind": "integration", "split": false}'),
     ("{kind: pseudo_galerkin, order: 1, split: true}", GRID,
      '{"kind": "pseudo_galerkin", "order": 1, "split": true}',
      '{"order": 1, "kind": "pseudo_galerkin", "split": true}'),

@@ -133,10 +133,9 @@ def parse_campaign(text: str, source: str = "<campaign>", read_aircraft: Aircraf
         if entry.sampled_only:
             check.fail("method.kind", f"{campaign.method.kind} needs a sampled design; an adaptive grid needs "
                                       "its weights: use integration, pseudo_galerkin or interpolation")
-        method = campaign.method
-        if method.order is None:  # its default, the mapping's first key
-            method = replace(method, order=entry.keys[entry.order_key].default,
-                             written=(entry.order_key, *method.written))
+        method = campaign.method  # its order given or its default, the mapping's first key
+        method = replace(method, order=entry.keys[entry.order_key].default if method.order is None else method.order,
+                         written=(entry.order_key, *(key for key in method.written if key != entry.order_key)))
         return replace(campaign, method=method, runs=int(campaign.design_spec.size(campaign.germs)))
     method = schema.method_for_design(check, campaign.method, design, campaign.germs)
     return replace(campaign, method=method, runs=len(design.weights))
