@@ -12,7 +12,7 @@ import uqflight
 from uqflight.calibration.command import _method
 from uqflight.campaign import parse_campaign
 from uqflight.cli.commands import _check_times
-from uqflight.simulators.kinds import simulator_entry
+from uqflight.simulators.spec import SimulatorSpec
 
 GRID = closed_form_campaign("sq", "sum_of_squares", NORMAL_2D, "{kind: tensor_grid, points: 3}",
                 "method: {kind: pseudo_galerkin, order: 2}\n")  # 9 runs, times 0, 0.25, ..., 1 s
@@ -79,7 +79,8 @@ def test_calibrate_refuses_a_bad_method_before_any_work(results, tmp_path, args,
 
 def flight_facts(simulator: dict) -> dict:
     """What the report's campaign table says a simulator flies (campaign.record.CampaignRecord.flight)."""
-    return simulator_entry(simulator).flight_summary(simulator)
+    spec = SimulatorSpec.from_checked(simulator)
+    return spec.entry.flight_summary(spec)
 
 
 def test_the_campaign_table_shows_the_flight_and_excitation_flown():

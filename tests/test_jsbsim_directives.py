@@ -21,6 +21,7 @@ from uqflight.simulators import make_simulator
 from uqflight.simulators.aircraft import AircraftFiles, AircraftUnsafe, jsbsim_root, locate
 from uqflight.simulators.base import SimulatorSettingError
 from uqflight.simulators.scenarios.script import ScriptFile, jsbsim_scripts
+from uqflight.simulators.spec import SimulatorSpec
 
 CRUISE = jsbsim_scripts() / "c172_cruise_8K.xml"  # c172x, its reset01 from the aircraft folder
 RUN = '<run start="0.0" end="40" dt="0.0083333">'
@@ -127,7 +128,8 @@ def test_a_script_flight_writes_connects_and_listens_nowhere(tmp_path, scratch, 
                              f'<output name="127.0.0.1" type="SOCKET" port="{port}" protocol="TCP" rate="10">'
                              f'{PROBE}</output>\n<input port="{inbound}"/>')
     before = sorted(os.listdir(tmp_path))
-    simulator = make_simulator(script_simulator(), ["wind"], ["atmosphere/wind-north-fps"], tmp_path)
+    simulator = make_simulator(SimulatorSpec.from_checked(script_simulator()), ["wind"], ["atmosphere/wind-north-fps"],
+                               tmp_path)
     result = simulator.evaluate(np.array([1.0]))
     assert np.all(np.isfinite(result["h_ft"]))
     assert not listening(inbound)
@@ -159,8 +161,8 @@ def test_an_aircraft_flies_without_its_output_socket_and_input_port(tmp_path, sc
         f'<output name="127.0.0.1" type="SOCKET" port="{port}" rate="10">{PROBE}</output>\n'
         f'<output name="127.0.0.1" type="FLIGHTGEAR" port="{port}" protocol="TCP" rate="10"/>\n'
         f'<input xmlns="urn:x" port="{inbound}"/>\n<input port="{free_port()}" type="QTJSBSIM"/>'))
-    simulator = make_simulator({"kind": "jsbsim", "aircraft": "planes/talky", "duration_s": 0.5, "flight": C172}, ["wind"],
-                               ["atmosphere/wind-north-fps"], tmp_path)
+    spec = SimulatorSpec("jsbsim", {"aircraft": "planes/talky", "duration_s": 0.5, "flight": C172})
+    simulator = make_simulator(spec, ["wind"], ["atmosphere/wind-north-fps"], tmp_path)
     assert np.all(np.isfinite(simulator.evaluate(np.array([1.0]))["h_ft"]))
     assert not listening(inbound)
     with pytest.raises(BlockingIOError):
@@ -175,8 +177,8 @@ def test_an_aircraft_output_file_inside_is_written_nowhere(tmp_path, scratch, ho
     the cache's root."""
     monkeypatch.chdir(tmp_path)
     package = {p.name: p.stat().st_mtime_ns for p in jsbsim_root().iterdir()}
-    simulator = make_simulator({"kind": "jsbsim", "aircraft": "c172x", "duration_s": 0.5, "flight": C172}, ["wind"],
-                               ["atmosphere/wind-north-fps"], tmp_path)
+    spec = SimulatorSpec("jsbsim", {"aircraft": "c172x", "duration_s": 0.5, "flight": C172})
+    simulator = make_simulator(spec, ["wind"], ["atmosphere/wind-north-fps"], tmp_path)
     simulator.evaluate(np.array([1.0]))
     assert {p.name: p.stat().st_mtime_ns for p in jsbsim_root().iterdir()} == package
     assert not [p for p in (home / "cache").rglob("*.csv")] and sorted(os.listdir(tmp_path)) == ["home", "tmp"]
@@ -236,8 +238,9 @@ def test_a_default_namespaced_aircraft_is_patched_and_flown_with_the_names_jsbsi
         return appended(f'<output name="out.csv" type="CSV" rate="1">{PROBE}</output>')(
             xml.replace("<fdm_config ", '<fdm_config xmlns="urn:x" ', 1))
     copied_aircraft(tmp_path, "spaced", spaced)
-    simulator = make_simulator({"kind": "jsbsim", "aircraft": "planes/spaced", "duration_s": 1.0, "flight": C172,
-                                "outputs": ["alpha_deg"]}, ["CL"], ["aero/uq/scale/CLwbh"], tmp_path)
+    spec = SimulatorSpec("jsbsim", {"aircraft": "planes/spaced", "duration_s": 1.0, "flight": C172,
+                                    "outputs": ["alpha_deg"]})
+    simulator = make_simulator(spec, ["CL"], ["aero/uq/scale/CLwbh"], tmp_path)
     nominal, scaled = (simulator.evaluate(np.array([x]))["alpha_deg"] for x in (1.0, 1.2))
     assert np.all(np.isfinite(nominal)) and scaled[0] < nominal[0] - 0.1  # more lift per alpha trims lower
     flown = [p.read_text() for p in (home / "cache").rglob("spaced.xml")]

@@ -14,6 +14,7 @@ from uqflight.simulators.aircraft import AircraftFiles, AircraftNotFound, locate
 from uqflight.simulators.jsbsim import REPO_ROOT, quiet_jsbsim
 from uqflight.simulators.scenarios import flight_setup_from
 from uqflight.simulators.scenarios.level_flight import JSBSimFlight
+from uqflight.simulators.spec import SimulatorSpec
 from uqflight.simulators.aircraft_properties import AircraftProperties
 from uqflight.simulators.patch import PreparedAircraft
 
@@ -94,13 +95,13 @@ def test_function_parameters_have_nominal_one_and_set_the_patch_property():
 
 
 def test_excitation_without_excitation_property_goes_through_the_pitch_command():
-    setup = flight_setup_from({"aircraft": "c172p", "duration_s": 5.0})
+    setup = flight_setup_from(SimulatorSpec("jsbsim", {"aircraft": "c172p", "duration_s": 5.0}))
     flight = JSBSimFlight(setup)
     assert not flight.has_property("fcs/elevator-excitation-deg")
     assert flight.elevator_travel_deg == pytest.approx((23.0, 28.0), abs=0.01)  # range x gain 0.01745
     result = flight.fly()
-    quiet = JSBSimFlight(flight_setup_from({"aircraft": "c172p", "duration_s": 5.0,
-                                            "excitation": {"kind": "none"}})).fly()
+    quiet = JSBSimFlight(flight_setup_from(SimulatorSpec("jsbsim", {"aircraft": "c172p", "duration_s": 5.0,
+                                                                "excitation": {"kind": "none"}}))).fly()
     assert np.max(np.abs(result.outputs["q_degps"] - quiet.outputs["q_degps"])) > 0.5
 
 
@@ -111,7 +112,7 @@ HOLD = {"c172p": (0.5, 0.01, 0.05), "737": (5.0, 0.03, 0.2), "f16": (25.0, 0.06,
 @pytest.mark.slow
 @pytest.mark.parametrize("aircraft", sorted(HOLD))
 def test_stock_aircraft_trim_and_hold_level_flight_for_50_s(aircraft):
-    setup = flight_setup_from({"aircraft": aircraft, "excitation": {"kind": "none"}})
+    setup = flight_setup_from(SimulatorSpec("jsbsim", {"aircraft": aircraft, "excitation": {"kind": "none"}}))
     out = JSBSimFlight(setup).fly().outputs
     drift = [np.max(np.abs(out[k] - out[k][0])) for k in ("h_ft", "theta_deg", "vtas_kt")]
     print(aircraft, drift)
@@ -146,7 +147,7 @@ def test_an_aircraft_that_would_kill_the_process_is_refused_with_exit_2(tmp_path
 
 
 def test_a_sound_aircraft_is_checked_once_per_version(tmp_path):
-    setup = flight_setup_from({"aircraft": "c172p"})
+    setup = flight_setup_from(SimulatorSpec("jsbsim", {"aircraft": "c172p"}))
     markers = tmp_path / "cache" / "loads"
     JSBSimFlight(setup)
     assert len(list(markers.iterdir())) == 1

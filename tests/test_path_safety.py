@@ -21,6 +21,7 @@ from uqflight.simulators.aircraft import (MAX_BYTES, MAX_FILES, AircraftFiles, A
 from uqflight.simulators.bundle import BundleRefused, _unzip, _zip
 from uqflight.simulators.kinds import localized, make_bundle
 from uqflight.simulators.jsbsim import quiet_jsbsim
+from uqflight.simulators.spec import SimulatorSpec
 from uqflight.running.worker import WorkerSpec
 
 BACM = Path(__file__).resolve().parents[1] / "uqflight" / "aircraft" / "bacm"
@@ -141,7 +142,7 @@ def test_a_symlink_leaving_the_aircraft_folder_is_refused_and_not_copied(link, t
     stderr = plan_refused(tmp_path, "planes/linky", "{property: aero/uq/CL0")
     assert f"{path} is a symbolic link to {target}, outside the aircraft folder" in stderr
     with pytest.raises(AircraftUnsafe, match="symbolic link"):
-        make_bundle({"kind": "jsbsim", "aircraft": "planes/linky"}, (), tmp_path)
+        make_bundle(SimulatorSpec("jsbsim", {"aircraft": "planes/linky"}), (), tmp_path)
     assert not cache_holds(home, b"secret")
 
 
@@ -164,7 +165,7 @@ def _c172p_bundle(extra: dict[str, bytes] = {}, **fields) -> dict:
 
 
 def _spec(bundle: dict, simulator=None) -> WorkerSpec:
-    return WorkerSpec(simulator=simulator or {"kind": "jsbsim", "aircraft": "c172p"}, parameter_names=(),
+    return WorkerSpec(simulator=simulator or SimulatorSpec("jsbsim", {"aircraft": "c172p"}), parameter_names=(),
                       properties=(), base="/", bundle=bundle)
 
 
@@ -280,13 +281,13 @@ def test_every_stock_jsbsim_aircraft_reads_and_passes_the_workers_checks():
 
 @pytest.mark.parametrize("aircraft", ["c172p", "737", "f16"])
 def test_stock_aircraft_unpack_on_a_worker_compressed_and_load_in_jsbsim(aircraft, tmp_path, home):
-    simulator = {"kind": "jsbsim", "aircraft": aircraft}
+    simulator = SimulatorSpec("jsbsim", {"aircraft": aircraft})
     bundle = make_bundle(simulator, ("aero/uq/scale/CLwbh",) if aircraft == "c172p" else (), tmp_path)
     with zipfile.ZipFile(io.BytesIO(bundle["zip"])) as z:
         infos = z.infolist()
     assert all(info.compress_type == zipfile.ZIP_DEFLATED for info in infos)
     assert len(bundle["zip"]) < 0.5 * sum(info.file_size for info in infos)  # XML deflates 3-10x
-    root = Path(localized(_spec(bundle, simulator)).simulator["root"])
+    root = Path(localized(_spec(bundle, simulator)).simulator.root)
     assert root.parent == home / "cache" / "aircraft"
     quiet_jsbsim()
     fdm = jsbsim.FGFDMExec(str(root))

@@ -19,6 +19,7 @@ from uqflight.simulators.aircraft_properties import AircraftProperties
 from uqflight.analysis.statistics import analyse, summary_json
 from uqflight.store import ResultStore
 from uqflight.running.worker import WorkerSpec, run_chunk
+from uqflight.simulators.spec import SimulatorSpec
 
 MODEL = f"{DATA / 'quantity_model.py'}:ramp"  # y = a + b t, z = a t², w = a − b t, t = 0, 0.25, ..., 4
 
@@ -64,7 +65,7 @@ execution: {{workers: 2, chunk: 16}}
 def test_every_take_is_exact_at_the_models_time_points():
     # through the worker's own path (run_chunk), at a = 0.5, b = 1; exact to rounding (1e-12)
     assert {spec["take"] for spec, _ in CASES.values()} == {t for t, e in REGISTRY.items() if not e.mode}
-    simulator = {"kind": "python", "function": MODEL}
+    simulator = SimulatorSpec("python", {"function": MODEL})
     quantities = check_quantities(Checker("cases"), {k: s for k, (s, _) in CASES.items()}, simulator)
     spec = WorkerSpec(simulator=simulator, parameter_names=("a", "b"), properties=("a", "b"), base=str(DATA),
                       quantities=quantities)
@@ -194,7 +195,7 @@ def test_a_jsbsim_quantity_is_taken_at_every_integration_step():
     # every 120 Hz step (exactly: the same values), which the 20 Hz recorded times can miss
     from uqflight.simulators import JSBSimSimulator
 
-    simulator = JSBSimSimulator({"kind": "jsbsim", "duration_s": 10.0}, [])
+    simulator = JSBSimSimulator(SimulatorSpec("jsbsim", {"duration_s": 10.0}), [])
     recorder = QuantityRecorder({"h": QuantitySpec("h", "max", of="h_ft"),
                                  "q": QuantitySpec("q", "min", of="q_degps")}, simulator.source)
     recorded = simulator.evaluate(np.zeros(0), (recorder,))
@@ -202,7 +203,7 @@ def test_a_jsbsim_quantity_is_taken_at_every_integration_step():
 
     # the plain loop, on a freshly loaded aircraft (a reused one differs in the 15th digit: engine state):
     # the same trim, excitation and steps
-    flight = JSBSimSimulator({"kind": "jsbsim", "duration_s": 10.0}, []).flight
+    flight = JSBSimSimulator(SimulatorSpec("jsbsim", {"duration_s": 10.0}), []).flight
     flight.trim({})
     fdm, setup = flight.fdm, flight.setup
     node, base, per_deg = flight._excitation_input()

@@ -345,7 +345,8 @@ def test_a_relocated_simulator_reads_the_same_files_from_another_folder(simulato
     moved = entry.relocated(simulator, ROOT / folder)
     here = parse_campaign(_simulator_campaign(simulator, parameters), str(ROOT / folder / "x.yaml"), AircraftProperties)
     there = parse_campaign(_simulator_campaign(moved, parameters), elsewhere, AircraftProperties)
-    for key in ("aircraft_path", "script_path", "function"):
-        assert (key in here.simulator) == (key in there.simulator)
-        if key.endswith("_path") and key in here.simulator:
-            assert Path(here.simulator[key]).resolve() == Path(there.simulator[key]).resolve()
+    assert ("function" in here.simulator) == ("function" in there.simulator)
+    for key in ("aircraft_path", "script_path"):
+        assert (getattr(here.simulator, key) is None) == (getattr(there.simulator, key) is None)
+        if getattr(here.simulator, key) is not None:
+            assert Path(getattr(here.simulator, key)).resolve() == Path(getattr(there.simulator, key)).resolve()

@@ -23,6 +23,7 @@ from uqflight.simulators.jsbsim import quiet_jsbsim
 from uqflight.simulators.scenarios.level_flight import FlightSetup, JSBSimFlight
 from uqflight.simulators.aircraft_properties import AircraftProperties
 from uqflight.simulators.scenarios.script import ScriptFile, jsbsim_scripts
+from uqflight.simulators.spec import SimulatorSpec
 
 CRUISE = jsbsim_scripts() / "c172_cruise_8K.xml"  # c172x, trims itself at 1 s, autopilot from 5 s, gust at 10 s
 PARAMETERS = {
@@ -95,7 +96,7 @@ def test_a_script_writes_and_prints_nothing(tmp_path, monkeypatch, capfd):
     before = [sorted(os.listdir(folder)) for folder in watched]
     config = {"kind": "jsbsim", "scenario": {"kind": "script", "script": "c172_head_wind", "end_s": 1.5},
               "output_rate_hz": 10, "outputs": ["h_ft"]}
-    simulator = make_simulator(config, ["w"], ["atmosphere/wind-east-fps"], tmp_path)
+    simulator = make_simulator(SimulatorSpec.from_checked(config), ["w"], ["atmosphere/wind-east-fps"], tmp_path)
     result = simulator.evaluate(np.array([2.0]))
     assert result["h_ft"].shape == (len(simulator.setup.time),) and np.all(np.isfinite(result["h_ft"]))
     assert [sorted(os.listdir(folder)) for folder in watched] == before
@@ -142,7 +143,7 @@ def test_a_script_that_sets_an_output_property_flies_without_the_outputs(tmp_pat
     assert ScriptFile.read(jsbsim_scripts() / "c1723.xml").output_properties == ("simulation/output/log_rate_hz",)
     config = {"kind": "jsbsim", "scenario": {"kind": "script", "script": "c1723", "end_s": 23},
               "output_rate_hz": 10, "outputs": ["h_ft"]}
-    simulator = make_simulator(config, ["CL"], ["aero/uq/scale/CLwbh"], tmp_path)
+    simulator = make_simulator(SimulatorSpec.from_checked(config), ["CL"], ["aero/uq/scale/CLwbh"], tmp_path)
     result = simulator.evaluate(np.array([1.0]))
     assert simulator.setup.time[-1] > 22.9 and np.all(np.isfinite(result["h_ft"]))
 
@@ -150,7 +151,7 @@ def test_a_script_that_sets_an_output_property_flies_without_the_outputs(tmp_pat
 def test_a_script_observer_sees_every_step_as_plain_jsbsim_steps(tmp_path):
     config = {"kind": "jsbsim", "scenario": {"kind": "script", "script": "c172_cruise_8K", "end_s": 1.5},
               "output_rate_hz": 20, "outputs": ["h_ft"]}
-    simulator = make_simulator(config, [], [], tmp_path)
+    simulator = make_simulator(SimulatorSpec.from_checked(config), [], [], tmp_path)
     observer = Altitude()
     result = simulator.flight.fly({}, observers=(observer,))
     steps = simulator.setup.steps
@@ -254,8 +255,8 @@ def test_a_script_and_its_initialisation_travel_in_the_bundle_hashed(tmp_path, m
     shutil.rmtree(tmp_path / "scripts")  # the worker's machine has no such folder
     monkeypatch.setenv("UQFLIGHT_CACHE", str(tmp_path / "worker-cache"))
     remote = localized(spec)
-    assert remote.simulator["script_path"].startswith(str(tmp_path / "worker-cache" / "scenario"))
-    folder = Path(remote.simulator["script_path"]).parent
+    assert remote.simulator.script_path.startswith(str(tmp_path / "worker-cache" / "scenario"))
+    folder = Path(remote.simulator.script_path).parent
     assert sorted(os.listdir(folder)) == ["c172p-landing-init.xml", "c172p-landing.xml"]
     np.testing.assert_array_equal(remote.build().evaluate(np.array([1.02]))["h_ft"], client["h_ft"])
     (folder / "c172p-landing-init.xml").write_text("<initialize/>")

@@ -8,6 +8,7 @@ import pytest
 from uqflight.simulators.jsbsim import quiet_jsbsim
 from uqflight.simulators.scenarios.script import Script, ScriptFile, ScriptFlight, jsbsim_scripts
 from uqflight.simulators.base import TrimError
+from uqflight.simulators.spec import SimulatorSpec
 
 CRUISE = jsbsim_scripts() / "c172_cruise_8K.xml"
 TRIM_AT = 1.0083293  # "Trim (Event 2) executed at time: 1.00833"
@@ -18,8 +19,8 @@ TURBULENCE = {"atmosphere/turb-type": 3.0, "atmosphere/turbulence/milspec/severi
 
 def _flight(end_s=2.0, outputs=("atmosphere/wind-north-fps", SEVERITY, "h_ft")):
     quiet_jsbsim()
-    config = {"scenario": {"kind": "script", "script": "c172_cruise_8K", "end_s": end_s}, "script_path": str(CRUISE),
-              "output_rate_hz": 120.0, "outputs": list(outputs)}
+    config = SimulatorSpec("jsbsim", {"scenario": {"kind": "script", "script": "c172_cruise_8K", "end_s": end_s},
+                                      "output_rate_hz": 120.0, "outputs": list(outputs)}, script_path=str(CRUISE))
     return ScriptFlight(Script().setup(config))
 
 
@@ -68,8 +69,8 @@ def test_a_later_trim_that_fails_says_the_campaigns_air_was_active():
     # does not in the script's own still air, and the message says where the gust came from
     quiet_jsbsim()
     script = jsbsim_scripts() / "c172_elevator_doublet.xml"
-    config = {"scenario": {"kind": "script", "script": "c172_elevator_doublet", "end_s": 21.0},
-              "script_path": str(script), "output_rate_hz": 20.0, "outputs": ["h_ft"]}
+    config = SimulatorSpec("jsbsim", {"scenario": {"kind": "script", "script": "c172_elevator_doublet", "end_s": 21.0},
+                                      "output_rate_hz": 20.0, "outputs": ["h_ft"]}, script_path=str(script))
     assert ScriptFile.read(script).trims == 2
     ScriptFlight(Script().setup(config)).fly({})  # the re-trim in still air succeeds
     with pytest.raises(TrimError) as failed:

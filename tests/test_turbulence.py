@@ -7,6 +7,7 @@ from conftest import assert_same_results, cli_in_process
 from uqflight.campaign import CampaignError, load_campaign
 from uqflight.running.runner import run_campaign
 from uqflight.simulators import JSBSimSimulator
+from uqflight.simulators.spec import SimulatorSpec
 from uqflight.simulators.aircraft_properties import AircraftProperties
 from uqflight.analysis.statistics import analyse, summary_json
 
@@ -17,7 +18,8 @@ SIMULATOR = {"kind": "jsbsim", "aircraft": "bacm", "duration_s": 5.0, "output_ra
 
 def simulator(properties=None, seeded=True):
     config = {**SIMULATOR, **({"properties": properties} if properties else {})}
-    return JSBSimSimulator(config, ["aero/uq/CL0"] + (["atmosphere/randomseed"] if seeded else []))
+    properties = ["aero/uq/CL0"] + (["atmosphere/randomseed"] if seeded else [])
+    return JSBSimSimulator(SimulatorSpec.from_checked(config), properties)
 
 
 def kappa(seed, cl0=0.2):

@@ -21,13 +21,13 @@ from ..parameters.dependence import GaussianCopula
 from ..quantities import QuantitySpec
 from ..quantities.spec import check_quantities
 from ..simulators.jsbsim import NAMED_OUTPUTS
-from ..simulators.kinds import simulator_entry
+from ..simulators.spec import SimulatorSpec
 from . import schema
 from ..text import FieldError
 from .schema import TOP_KEYS, CampaignError, CampaignLoader, Checker, yaml_error
 from .sections import Analysis, Execution, Limits, Storage
 
-AircraftReader = Callable[[dict], object]  # simulator config -> its aircraft's properties (see AircraftProperties)
+AircraftReader = Callable[[SimulatorSpec], object]  # simulator -> its aircraft's properties (see AircraftProperties)
 
 @dataclass(frozen=True)
 class Campaign:
@@ -37,7 +37,7 @@ class Campaign:
     text: str
     name: str
     seed: int
-    simulator: dict
+    simulator: SimulatorSpec  # `simulator:` checked, located when the campaign is to run
     parameters: list[Parameter]
     design_spec: DesignSpec
     method: MethodSpec
@@ -71,7 +71,7 @@ class Campaign:
 def load_campaign(path: str | Path, read_aircraft: AircraftReader | None = None) -> Campaign:
     """Read and validate a campaign file.
 
-    `read_aircraft(simulator_config)` gives the aircraft's properties
+    `read_aircraft(simulator)` gives the aircraft's properties
     (`uqflight.simulators.aircraft_properties.AircraftProperties`); it is used for
     JSBSim campaigns to check property and output names and to read nominal values from the
     aircraft. Without it, those checks are skipped and nominal values must be given.
@@ -98,9 +98,9 @@ def parse_campaign(text: str, source: str = "<campaign>", read_aircraft: Aircraf
     `campaign.record.read_record`, which never resolves the simulator."""
     written = campaign_yaml(text, source)
     check, data, simulator = check_settings(Checker(source), written)
-    schema.resolve_simulator(check, simulator, source)
+    simulator = schema.resolve_simulator(check, simulator, source)
     aircraft = None
-    if read_aircraft and simulator_entry(simulator).aircraft:
+    if read_aircraft and simulator.entry.aircraft:
         try:
             aircraft = read_aircraft(simulator)
         except (FileNotFoundError, RuntimeError) as exc:  # no such aircraft, or JSBSim cannot load it
@@ -109,7 +109,7 @@ def parse_campaign(text: str, source: str = "<campaign>", read_aircraft: Aircraf
             if output not in NAMED_OUTPUTS and aircraft.value(output) is None:
                 check.fail(f"simulator.outputs[{i}]", f"expected one of {', '.join(NAMED_OUTPUTS)} or a JSBSim "
                            f"property of aircraft {aircraft.aircraft!r}, got {output!r}{aircraft.hint(output)}")
-    parameters = schema.parameters(check, data["parameters"], simulator["kind"], aircraft)
+    parameters = schema.parameters(check, data["parameters"], simulator.kind, aircraft)
     schema.check_fixed_properties(check, simulator, parameters, aircraft)
     quantities = check_quantities(check, data.get("quantities"), simulator, aircraft)
     campaign = build_campaign(check, data, simulator, parameters, text, quantities, written)
@@ -153,7 +153,7 @@ def campaign_yaml(text: str, source: str):
         raise CampaignError(source, "", yaml_error(exc)) from exc
 
 
-def check_settings(check: Checker, written) -> tuple[Checker, dict, dict]:
+def check_settings(check: Checker, written) -> tuple[Checker, dict, SimulatorSpec]:
     """(checker, the mapping, the checked `simulator:`) of a campaign's value as written (`written`, left
     unchanged: the mapping returned is a copy that the later checks fill): the name, seed and simulator
     checked as written; nothing imported, located or built."""
@@ -163,7 +163,7 @@ def check_settings(check: Checker, written) -> tuple[Checker, dict, dict]:
     return check, data, schema.simulator(check, data["simulator"])
 
 
-def build_campaign(check: Checker, data: dict, simulator: dict, parameters: list[Parameter], text: str,
+def build_campaign(check: Checker, data: dict, simulator: SimulatorSpec, parameters: list[Parameter], text: str,
                    quantities: dict[str, QuantitySpec] | None = None, mapping: dict | None = None) -> Campaign:
     """The Campaign of a checked mapping (`check_settings`) and its parameters, its other sections checked
     (the design checked into its spec, not built: `runs` stays None); `mapping`: the mapping as written (`data`

@@ -5,7 +5,6 @@ from __future__ import annotations
 import copy
 from pathlib import Path
 
-from ..simulators.kinds import simulator_entry
 from . import Campaign
 
 
@@ -14,8 +13,7 @@ def portable_mapping(campaign: Campaign) -> dict:
     campaign's folder (a model file, an aircraft folder, a script) made absolute: the same campaign when
     written elsewhere."""
     mapping = copy.deepcopy(campaign.mapping)
-    mapping["simulator"] = simulator_entry(mapping["simulator"]).relocated(mapping["simulator"],
-                                                                          campaign_folder(campaign))
+    mapping["simulator"] = campaign.simulator.entry.relocated(mapping["simulator"], campaign_folder(campaign))
     return mapping
 
 

@@ -21,7 +21,6 @@ from ..designs import DESIGN_KINDS
 from ..designs import REGISTRY as DESIGNS
 from ..designs.base import is_integer
 from ..parameters import Parameter, seed_names
-from ..simulators.kinds import simulator_entry
 from ..text.console import quoted_value
 from . import Campaign, build_campaign, check_settings, schema
 from .schema import CampaignError, Checker
@@ -58,7 +57,7 @@ class CampaignRecord:
     def flight(self) -> dict[str, str]:
         """What the simulator flies ({"flight": ..., "excitation": ...}), defaults resolved by its kind (and
         scenario kind); {} for a python model."""
-        return simulator_entry(self.campaign.mapping["simulator"]).flight_summary(self.campaign.mapping["simulator"])
+        return self.campaign.simulator.entry.flight_summary(self.campaign.simulator)
 
     @property
     def parameter_rows(self) -> list[dict]:

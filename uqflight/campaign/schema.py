@@ -22,7 +22,8 @@ from ..parameters.dependence import GaussianCopula, correlation_problem
 from ..parameters.distributions import SEED_REFUSAL
 from ..simulators.patch import patch_kind
 from ..simulators.kinds import REGISTRY as SIMULATORS
-from ..simulators.kinds import SIMULATOR_KINDS, simulator_entry
+from ..simulators.kinds import SIMULATOR_KINDS
+from ..simulators.spec import SimulatorSpec
 from ..text import FieldError
 from ..text.console import quoted_value
 from .sections import Execution, Limits, Storage
@@ -224,18 +225,18 @@ def method_for_design(check: Checker, method: MethodSpec, design: Design, germs:
     return replace(method, order=order)
 
 
-def simulator(check: Checker, value) -> dict:
-    """The `simulator:` mapping checked as written by its kind's entry (simulators/kinds): nothing is
-    imported or located (`resolve_simulator`)."""
+def simulator(check: Checker, value) -> SimulatorSpec:
+    """The `simulator:` mapping checked as written by its kind's entry (simulators/kinds), as its spec:
+    nothing is imported or located (`resolve_simulator`)."""
     if not isinstance(value, dict):
         check.fail("simulator", f"expected a mapping with a kind key, got {quoted_value(value)}")
     if "kind" not in value:
         check.fail("simulator.kind", f"is required; expected one of {', '.join(SIMULATOR_KINDS)}")
     kind = check.string(value["kind"], "simulator.kind", SIMULATOR_KINDS)
-    return SIMULATORS[kind].check(check, value)
+    return SimulatorSpec.from_checked(SIMULATORS[kind].check(check, value))
 
 
-def check_fixed_properties(check: Checker, sim: dict, parameters: list[Parameter], aircraft) -> None:
+def check_fixed_properties(check: Checker, sim: SimulatorSpec, parameters: list[Parameter], aircraft) -> None:
     """Each fixed property is one the aircraft can set (when it is known), and no parameter sets it too."""
     by_parameter = {p.property: p.name for p in parameters}
     for name in sim.get("properties", {}):
@@ -247,12 +248,12 @@ def check_fixed_properties(check: Checker, sim: dict, parameters: list[Parameter
                              f"got {name!r}{aircraft.hint(name)}")
 
 
-def resolve_simulator(check: Checker, sim: dict, source: str) -> None:
-    """Find what the simulator `sim` (checked by `simulator`) runs, relative to the campaign file
-    `source`: a python simulator's function is imported (its module's code runs); a JSBSim aircraft
-    is located (`sim["aircraft_path"]`, the folder that travels with the simulator). Only for
-    campaigns about to be planned or run: reading results never calls this."""
-    simulator_entry(sim).resolve(check, sim, source)
+def resolve_simulator(check: Checker, sim: SimulatorSpec, source: str) -> SimulatorSpec:
+    """`sim` (checked by `simulator`) with what it runs found, relative to the campaign file `source`: a
+    python simulator's function is imported (its module's code runs); a JSBSim aircraft is located
+    (`aircraft_path`, the folder that travels with the simulator). Only for campaigns about to be planned
+    or run: reading results never calls this."""
+    return sim.entry.resolve(check, sim, source)
 
 
 def parameters(check: Checker, value, kind: str, aircraft) -> list[Parameter]:
@@ -539,7 +540,7 @@ def campaign_name(check: Checker, value) -> str:
     return name
 
 
-def check_size(check: Checker, design: DesignSpec, simulator: dict, parameters: list, method: MethodSpec,
+def check_size(check: Checker, design: DesignSpec, simulator: SimulatorSpec, parameters: list, method: MethodSpec,
                execution: Execution, storage: Storage, limits: Limits, germs: list[str] | None = None) -> dict:
     """The design's size, its memory and disk estimate and the PCE size, from the campaign alone
     (nothing built): refused beyond `limits` (CampaignError naming the figure and the limit).
@@ -559,7 +560,7 @@ def check_size(check: Checker, design: DesignSpec, simulator: dict, parameters: 
     if terms > limits.max_pce_terms:
         check.fail("method.order", f"a PCE of order {order} in {d} dimensions has {float(terms):.4g} "
                                    f"terms, more than limits.max_pce_terms = {limits.max_pce_terms}")
-    times, n_outputs = simulator_entry(simulator).recorded(simulator)  # 1 where known once a sample has run
+    times, n_outputs = simulator.entry.recorded(simulator)  # 1 where known once a sample has run
     n = points
     rank = min(times, n, 1000)
     memory = 8.0 * (n * (3 * d + 6)                                    # the design, status, merging

@@ -9,7 +9,7 @@ from __future__ import annotations
 import math
 import re
 
-from ..simulators.kinds import simulator_entry
+from ..simulators.spec import SimulatorSpec
 from . import REGISTRY, TAKES, WINDOW, QuantitySpec, When
 
 KEYS = ("of", "take", "at_s", "when", "after_s", "before_s")
@@ -18,19 +18,19 @@ BOUNDS = ("above", "below")
 NAME = re.compile(r"[A-Za-z0-9_][A-Za-z0-9_.-]{0,99}")
 
 
-def flight_span(simulator: dict) -> float | None:
+def flight_span(simulator: SimulatorSpec) -> float | None:
     """The flight's last time [s] when the campaign fixes it (a level flight's duration, a script's end_s or,
     once the script is resolved at plan, its own end), else None (a Python model's time grid: known once a
     run is made)."""
-    return simulator_entry(simulator).span(simulator)
+    return simulator.entry.span(simulator)
 
 
-def is_level_flight(simulator: dict) -> bool:
+def is_level_flight(simulator: SimulatorSpec) -> bool:
     """A JSBSim aircraft trimmed in level flight (its modes are those of that trim)."""
-    return simulator_entry(simulator).trims_level(simulator)
+    return simulator.entry.trims_level(simulator)
 
 
-def check_quantities(check, value, simulator: dict, aircraft=None) -> dict[str, QuantitySpec]:
+def check_quantities(check, value, simulator: SimulatorSpec, aircraft=None) -> dict[str, QuantitySpec]:
     """The campaign's quantities, from its `quantities:` mapping checked.
 
     Parameters
@@ -39,7 +39,7 @@ def check_quantities(check, value, simulator: dict, aircraft=None) -> dict[str, 
         The campaign's checker: its `fail` names the file and the field.
     value : object
         The `quantities:` mapping as written; None: the campaign has none.
-    simulator : dict
+    simulator : SimulatorSpec
         The checked `simulator:`: its kind knows the names `of:` and `when.of:` may give, and the flight's span.
     aircraft : AircraftProperties, optional
         A JSBSim aircraft's properties, which check the names in `of:` and `when.of:`; None: not checked.
@@ -88,7 +88,7 @@ def check_quantities(check, value, simulator: dict, aircraft=None) -> dict[str, 
 
 def _source(check, name, path: str, simulator: dict, aircraft) -> None:
     """An output or property a quantity reads, as the simulator kind knows its names."""
-    simulator_entry(simulator).check_source(check, name, path, simulator, aircraft)
+    simulator.entry.check_source(check, name, path, simulator, aircraft)
 
 
 def _when(check, given, path: str, simulator: dict, aircraft) -> When:

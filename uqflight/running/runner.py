@@ -184,13 +184,13 @@ def nominal_kappa(campaign: Campaign) -> np.ndarray:
 
 def worker_spec(campaign: Campaign) -> WorkerSpec:
     from ..parameters import seed_names
-    from ..simulators.kinds import make_bundle, simulator_entry
+    from ..simulators.kinds import make_bundle
 
     properties = tuple(p.property for p in campaign.parameters)
     base = str(Path(campaign.source).resolve().parent)
     simulator, seeds = campaign.simulator, seed_names(campaign.parameters)
-    if seeds and simulator_entry(simulator).integer_seeds:  # a python model is given its seeds as Python ints
-        simulator = {**simulator, "seed_parameters": seeds}
+    if seeds and simulator.entry.integer_seeds:  # a python model is given its seeds as Python ints
+        simulator = replace(simulator, seed_parameters=tuple(seeds))
     return WorkerSpec(simulator=simulator,
                       parameter_names=tuple(p.name for p in campaign.parameters),
                       properties=properties, base=base,

@@ -27,7 +27,7 @@ from ..text.console import discard_output, one_line
 from .forking import die_with_parent
 from ..quantities import QuantitySpec, quantity_key
 from ..quantities.recorder import QuantityRecorder
-from ..simulators import FlightError, make_simulator
+from ..simulators import FlightError, SimulatorSpec, make_simulator
 from ..simulators.base import NominalFailed
 from ..simulators.kinds import localized
 
@@ -36,7 +36,7 @@ from ..simulators.kinds import localized
 class WorkerSpec:
     """What a worker needs to build its simulator (picklable, sent with every chunk)."""
 
-    simulator: dict
+    simulator: SimulatorSpec
     parameter_names: tuple[str, ...]
     properties: tuple[str, ...]
     base: str
@@ -46,7 +46,8 @@ class WorkerSpec:
 
     @property
     def key(self) -> str:
-        return json.dumps([self.simulator, self.parameter_names, self.properties, self.base], sort_keys=True)
+        return json.dumps([self.simulator.as_mapping(), self.parameter_names, self.properties, self.base],
+                          sort_keys=True)
 
     def build(self):
         return make_simulator(self.simulator, list(self.parameter_names), list(self.properties), Path(self.base))

@@ -8,20 +8,21 @@ from __future__ import annotations
 from pathlib import Path
 
 from .base import FlightError
-from .kinds import simulator_entry
 from .kinds.jsbsim import JSBSimSimulator
 from .python import PythonSimulator
+from .spec import SimulatorSpec
 
 
-def simulator_provenance(config: dict, base: Path | None = None, properties=()) -> dict:
+def simulator_provenance(config: SimulatorSpec, base: Path | None = None, properties=()) -> dict:
     """Results-file attributes naming what the campaign's simulator runs (a JSBSim aircraft's hash, its
     scenario's files; nothing for a python model)."""
-    return simulator_entry(config).provenance(config, base, properties)
+    return config.entry.provenance(config, base, properties)
 
 
-def make_simulator(config: dict, parameter_names: list[str], properties: list[str], base: Path):
-    """The simulator a campaign's `simulator:` mapping describes."""
-    return simulator_entry(config).make(config, parameter_names, properties, base)
+def make_simulator(config: SimulatorSpec, parameter_names: list[str], properties: list[str], base: Path):
+    """The simulator a campaign's `simulator:` spec describes."""
+    return config.entry.make(config, parameter_names, properties, base)
 
 
-__all__ = ["FlightError", "JSBSimSimulator", "PythonSimulator", "make_simulator", "simulator_provenance"]
+__all__ = ["FlightError", "JSBSimSimulator", "PythonSimulator", "SimulatorSpec", "make_simulator",
+           "simulator_provenance"]

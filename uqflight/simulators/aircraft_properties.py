@@ -6,6 +6,7 @@ import jsbsim
 
 from .directives import LINEARIZATION
 from .scenarios import flight_setup_from
+from .spec import SimulatorSpec
 
 
 class AircraftProperties:
@@ -14,12 +15,12 @@ class AircraftProperties:
     campaign's airspeed and `ic/vc-kts` the matching calibrated airspeed; a script: loaded with it).
     Validation reads nominal values here: the class is the `read_aircraft` of `campaign.load_campaign`."""
 
-    def __init__(self, simulator: dict):
+    def __init__(self, simulator: SimulatorSpec):
         from .aircraft import aero_functions
         from .aero_factors import aero_factors
         from .scenarios import scenario_entry
 
-        setup = flight_setup_from({**simulator, "outputs": []})  # raises AircraftNotFound (a FileNotFoundError)
+        setup = flight_setup_from(simulator.with_settings(outputs=[]))  # raises AircraftNotFound (a FileNotFoundError)
         self.aircraft = setup.aircraft
         xml = setup.aircraft_file.read_bytes()
         self.functions = [f.name for f in aero_functions(xml)]

@@ -134,7 +134,8 @@ class SimulatorKind(Kind):
     A kind owns its `simulator:` keys (`fields`; a JSBSim scenario adds its own) and their checks, finds
     what it runs, builds the simulator a worker uses, names the files that travel to workers and the
     provenance the results file keeps, and counts what a run records from the campaign alone (for
-    `limits`).
+    `limits`). Beside `check`, which checks the mapping as written, and `relocated`, which rewrites it, its
+    methods take the campaign's `SimulatorSpec` (simulators/spec.py), `config` or `sim`.
 
     Attributes
     ----------
@@ -153,9 +154,10 @@ class SimulatorKind(Kind):
     Examples
     --------
     >>> from uqflight.simulators.kinds import REGISTRY
+    >>> from uqflight.simulators.spec import SimulatorSpec
     >>> sorted(REGISTRY)
     ['jsbsim', 'python']
-    >>> REGISTRY["python"].recorded({"kind": "python", "function": "m:f", "outputs": ["y", "z"]})
+    >>> REGISTRY["python"].recorded(SimulatorSpec("python", {"function": "m:f", "outputs": ["y", "z"]}))
     (1, 2)
     """
 
@@ -169,19 +171,19 @@ class SimulatorKind(Kind):
         """The mapping checked as written (`check` is the campaign's Checker); nothing imported or located."""
 
     @abstractmethod
-    def resolve(self, check, sim: dict, source: str) -> None:
-        """Find what it runs relative to the campaign file `source` (a python module is imported, an aircraft
-        located); only for campaigns about to be planned or run."""
+    def resolve(self, check, sim, source: str):
+        """`sim` with what it runs found relative to the campaign file `source` (a python module is imported,
+        an aircraft located); only for campaigns about to be planned or run."""
 
     @abstractmethod
-    def make(self, config: dict, parameter_names: list[str], properties: list[str], base: Path):
+    def make(self, config, parameter_names: list[str], properties: list[str], base: Path):
         """The simulator a worker flies."""
 
-    def bundle(self, config: dict, properties, base) -> dict | None:
+    def bundle(self, config, properties, base) -> dict | None:
         """The files a worker that shares no disk with the client needs, or None."""
         return None
 
-    def provenance(self, config: dict, base: Path | None = None, properties=()) -> dict:
+    def provenance(self, config, base: Path | None = None, properties=()) -> dict:
         """Results-file attributes naming what it runs."""
         return {}
 
@@ -191,22 +193,22 @@ class SimulatorKind(Kind):
         return dict(config)
 
     @abstractmethod
-    def recorded(self, config: dict) -> tuple[int, int]:
+    def recorded(self, config) -> tuple[int, int]:
         """(times, outputs) a run records, from the campaign alone (1 where known only once a sample has run)."""
 
-    def span(self, config: dict) -> float | None:
+    def span(self, config) -> float | None:
         """The flight's last time [s] when the campaign fixes it, else None."""
         return None
 
-    def trims_level(self, config: dict) -> bool:
+    def trims_level(self, config) -> bool:
         """A JSBSim aircraft trimmed in level flight (its modes are those of that trim)."""
         return False
 
     @abstractmethod
-    def check_source(self, check, name, path: str, config: dict, aircraft) -> None:
+    def check_source(self, check, name, path: str, config, aircraft) -> None:
         """Refuse (check.fail at `path`) a name a quantity reads that the simulator does not record."""
 
-    def flight_summary(self, config: dict) -> dict[str, str]:
+    def flight_summary(self, config) -> dict[str, str]:
         """{"flight": text, "excitation": text}: what is flown, defaults resolved (the report; {} for a model)."""
         return {}
 
@@ -217,7 +219,8 @@ class ScenarioKind(Kind):
 
     A scenario owns its keys and their checks, builds the setup and the flight of a campaign's
     `simulator:` mapping, counts its recorded times from the campaign alone, names the files beyond the
-    aircraft's that travel to workers, and states its provenance and resolution.
+    aircraft's that travel to workers, and states its provenance and resolution. Beside `relocated`, which
+    rewrites the mapping as written, its methods take the campaign's `SimulatorSpec` (simulators/spec.py).
 
     Attributes
     ----------
@@ -237,9 +240,11 @@ class ScenarioKind(Kind):
     Examples
     --------
     >>> from uqflight.simulators.scenarios import REGISTRY, scenario_entry
+    >>> from uqflight.simulators.spec import SimulatorSpec
     >>> sorted(REGISTRY)
     ['level_flight', 'script']
-    >>> scenario_entry({"kind": "jsbsim"}).kind, scenario_entry({"kind": "jsbsim"}).times({"duration_s": 1.0})
+    >>> spec = SimulatorSpec("jsbsim", {"duration_s": 1.0})
+    >>> scenario_entry(spec).kind, scenario_entry(spec).times(spec)
     ('level_flight', 21)
     """
 
@@ -254,11 +259,11 @@ class ScenarioKind(Kind):
         return tuple(self.scenario_fields)
 
     @abstractmethod
-    def check(self, check, sim: dict, folder: Path) -> dict:
+    def check(self, check, sim, folder: Path):
         """`sim` checked (`check.fail(field, message)` refuses), its files resolved against `folder`."""
 
     @abstractmethod
-    def setup(self, config: dict, root: Path | None = None, base: Path | None = None, properties=()):
+    def setup(self, config, root: Path | None = None, base: Path | None = None, properties=()):
         """The setup (aircraft, root, aircraft_file, time, outputs) of a checked `simulator:` mapping."""
 
     @abstractmethod
@@ -266,26 +271,26 @@ class ScenarioKind(Kind):
         """The flight: `fly(settings, observers=()) -> FlightResult`."""
 
     @abstractmethod
-    def times(self, config: dict) -> int:
+    def times(self, config) -> int:
         """The number of recorded times, from the campaign alone."""
 
     @abstractmethod
-    def span(self, config: dict) -> float | None:
+    def span(self, config) -> float | None:
         """The flight's last time [s] from the campaign alone, or None."""
 
-    def files(self, config: dict) -> dict[str, bytes]:
+    def files(self, config) -> dict[str, bytes]:
         """{name: bytes}: files beyond the aircraft's that a worker needs."""
         return {}
 
-    def localize(self, config: dict, folder: Path) -> dict:
-        """The mapping reading the files of `files` from `folder`, where a worker wrote them."""
+    def localize(self, config, folder: Path):
+        """The spec reading the files of `files` from `folder`, where a worker wrote them."""
         return config
 
     def relocated(self, config: dict, folder: Path) -> dict:
         """The mapping with the files it names relative to the campaign's `folder` made absolute."""
         return config
 
-    def provenance(self, config: dict) -> dict:
+    def provenance(self, config) -> dict:
         """Results-file attributes beyond the aircraft's hash."""
         return {}
 
@@ -294,5 +299,5 @@ class ScenarioKind(Kind):
         return None
 
     @abstractmethod
-    def flight_summary(self, config: dict) -> dict[str, str]:
+    def flight_summary(self, config) -> dict[str, str]:
         """{"flight": text, "excitation": text}: what is flown, defaults resolved (the report)."""

@@ -23,11 +23,13 @@ import re
 import shutil
 import zipfile
 import zlib
+from dataclasses import replace
 from pathlib import Path
 
 from ..text.bounded import OutsideBounds, read_bounded
 from .aircraft import MAX_BYTES, MAX_FILES, AircraftFiles, AircraftUnsafe, cache_dir, unsafe_key
 from .safe_paths import relative_name, single_name
+from .spec import SimulatorSpec
 
 SHA256 = re.compile(r"[0-9a-f]{64}")
 
@@ -102,15 +104,15 @@ def _checked(bundle) -> dict:
     return bundle
 
 
-def aircraft_bundle(simulator: dict, properties, base: str | Path, scenario_files) -> dict | None:
+def aircraft_bundle(simulator: SimulatorSpec, properties, base: str | Path, scenario_files) -> dict | None:
     """A JSBSim simulator's aircraft (the patched copy when `properties` perturb its functions) and its
     scenario's files (`scenario_files(simulator)`); None when the simulator already reads a worker's local
     copy (`root`)."""
     from .patch import PreparedAircraft
 
-    if "root" in simulator:
+    if simulator.root is not None:
         return None
-    prepared = PreparedAircraft(simulator.get("aircraft_path", simulator.get("aircraft", "bacm")), Path(base),
+    prepared = PreparedAircraft(simulator.aircraft_path or simulator.get("aircraft", "bacm"), Path(base),
                                 properties)
     bundle = {"kind": "aircraft", "name": prepared.name, "hash": prepared.hash, "zip": _zip(prepared.files.files)}
     files = scenario_files(simulator)  # a script scenario's script and initialisation
@@ -119,7 +121,7 @@ def aircraft_bundle(simulator: dict, properties, base: str | Path, scenario_file
     return bundle
 
 
-def python_bundle(simulator: dict, base: str | Path) -> dict | None:
+def python_bundle(simulator: SimulatorSpec, base: str | Path) -> dict | None:
     """A python simulator's file (`file.py:callable`); None for an installed module."""
     module, _, attribute = str(simulator.get("function", "")).partition(":")
     if not module.endswith(".py"):
@@ -133,16 +135,16 @@ def python_bundle(simulator: dict, base: str | Path) -> dict | None:
             "hash": hashlib.sha256(data).hexdigest(), "zip": _zip({file.name: data})}
 
 
-def unpacked(bundle, simulator: dict) -> tuple[dict, Path | None]:
-    """The simulator mapping reading the bundle's files from this worker's cache (unpacked on first use),
+def unpacked(bundle, simulator: SimulatorSpec) -> tuple[SimulatorSpec, Path | None]:
+    """The simulator spec reading the bundle's files from this worker's cache (unpacked on first use),
     and the folder of its scenario's files (None: none travel). Raises BundleRefused when the bundle's
     names, hash, size or file count are unsafe (before unpacking anything), AircraftMismatch when the
     files differ from its hash."""
     bundle = _checked(bundle)
-    return UNPACK[bundle["kind"]](bundle, dict(simulator))
+    return UNPACK[bundle["kind"]](bundle, simulator)
 
 
-def _unpacked_aircraft(bundle: dict, simulator: dict) -> tuple[dict, Path | None]:
+def _unpacked_aircraft(bundle: dict, simulator: SimulatorSpec) -> tuple[SimulatorSpec, Path | None]:
     name, digest = bundle["name"], bundle["hash"]
     files = AircraftFiles(name, _unzip(bundle["zip"], unsafe_key))
     if f"{name}.xml" not in files.files or files.hash() != digest:
@@ -153,8 +155,7 @@ def _unpacked_aircraft(bundle: dict, simulator: dict) -> tuple[dict, Path | None
     except AircraftUnsafe as exc:
         raise _refuse(str(exc)) from None
     check_aircraft(root, name, digest)
-    simulator.update(root=str(root), aircraft=name)
-    simulator.pop("aircraft_path", None)
+    simulator = replace(simulator.with_settings(aircraft=name), root=str(root), aircraft_path=None)
     scenario = bundle.get("scenario")
     if not scenario:
         return simulator, None
@@ -164,7 +165,7 @@ def _unpacked_aircraft(bundle: dict, simulator: dict) -> tuple[dict, Path | None
     return simulator, _unpacked(scenario, cache_dir("scenario", scenario["hash"][:24]))
 
 
-def _unpacked_python(bundle: dict, simulator: dict) -> tuple[dict, None]:
+def _unpacked_python(bundle: dict, simulator: SimulatorSpec) -> tuple[SimulatorSpec, None]:
     if not (isinstance(bundle.get("attribute"), str) and bundle["attribute"].isidentifier()):
         raise _refuse(f"attribute {bundle.get('attribute')!r}: expected a Python name")
     name, digest = bundle["name"], bundle["hash"]
@@ -179,8 +180,7 @@ def _unpacked_python(bundle: dict, simulator: dict) -> tuple[dict, None]:
     if hashlib.sha256(file.read_bytes()).hexdigest() != digest:
         raise AircraftMismatch(f"worker: {file} differs from the client's {name} "
                                f"(sha256 {digest[:12]}): refusing to run it; delete {folder}")
-    simulator["function"] = f"{file}:{bundle['attribute']}"
-    return simulator, None
+    return simulator.with_settings(function=f"{file}:{bundle['attribute']}"), None
 
 
 # the bundles' kinds: how each unpacks, and the suffix of its name

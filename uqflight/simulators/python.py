@@ -16,6 +16,7 @@ from typing import Callable
 import numpy as np
 
 from .base import DivergenceError, FlightError, SimulatorSettingError, nominal_failed
+from .spec import SimulatorSpec
 
 
 def split_spec(spec) -> tuple[str, str]:
@@ -59,10 +60,10 @@ def load_function(spec: str, base: Path) -> Callable:
 class PythonSimulator:
     """Calls `function` once per sample and checks what it returns."""
 
-    def __init__(self, config: dict, parameter_names: list[str], base: Path):
+    def __init__(self, config: SimulatorSpec, parameter_names: list[str], base: Path):
         self.function = load_function(config["function"], base)
         self.names = list(parameter_names)
-        self.seeds = set(config.get("seed_parameters", ()))  # given to the function as Python ints
+        self.seeds = set(config.seed_parameters)  # given to the function as Python ints
         self.outputs = config.get("outputs")
         self.units: dict[str, str] = {}
         self.time: np.ndarray | None = None  # the nominal run's times (`layout`), which every run must return

@@ -13,20 +13,16 @@ from pathlib import Path
 from ..base import SimulatorKind
 from ..bundle import unpacked
 from ..scenarios import scenario_entry
+from ..spec import SimulatorSpec
 from . import jsbsim, python  # noqa: F401  (defining their classes registers them)
 
 REGISTRY = SimulatorKind.registry
 SIMULATOR_KINDS = tuple(REGISTRY)
 
 
-def simulator_entry(config: dict) -> SimulatorKind:
-    """The kind of a checked `simulator:` mapping."""
-    return REGISTRY[config["kind"]]
-
-
-def make_bundle(simulator: dict, properties, base: str | Path) -> dict | None:
+def make_bundle(simulator: SimulatorSpec, properties, base: str | Path) -> dict | None:
     """{"kind", "name", "hash", "zip"} for the simulator's files, or None when there is nothing to send."""
-    return simulator_entry(simulator).bundle(simulator, properties, base)
+    return simulator.entry.bundle(simulator, properties, base)
 
 
 def localized(spec):

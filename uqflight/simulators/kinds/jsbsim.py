@@ -2,6 +2,7 @@
 scenario kind says (level flight when it names none; simulators/scenarios owns the scenario's keys)."""
 from __future__ import annotations
 
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -14,6 +15,7 @@ from ..jsbsim import DEFAULT_OUTPUTS, NAMED_OUTPUTS, UNITS, aircraft_hash
 from ..scenarios import DEFAULT as DEFAULT_SCENARIO
 from ..scenarios import REGISTRY as SCENARIOS
 from ..scenarios import SCENARIO_KINDS, scenario_entry
+from ..spec import SimulatorSpec
 from .outputs import KIND, OUTPUTS, check_outputs
 
 
@@ -21,7 +23,7 @@ class JSBSimSimulator:
     """The campaign's aircraft and flight, flown as its scenario kind says (scenarios/); parameters
     map to JSBSim properties."""
 
-    def __init__(self, config: dict, properties: list[str], base: Path | None = None):
+    def __init__(self, config: SimulatorSpec, properties: list[str], base: Path | None = None):
         # the aircraft is located (a path relative to the campaign's folder) and, when parameters
         # set aero/uq/scale/... or aero/uq/offset/... properties, patched (see patch.py)
         self.scenario = scenario_entry(config)
@@ -71,7 +73,7 @@ class JSBSim(SimulatorKind):
 
     Examples
     --------
-    >>> JSBSim().span({"kind": "jsbsim", "duration_s": 3.0})
+    >>> JSBSim().span(SimulatorSpec("jsbsim", {"duration_s": 3.0}))
     3.0
     """
 
@@ -113,22 +115,22 @@ class JSBSim(SimulatorKind):
             check_outputs(check, sim["outputs"])
         return sim
 
-    def resolve(self, check, sim: dict, source: str) -> None:
-        """The scenario's files resolved and the aircraft located (`sim["aircraft_path"]`, the folder that
-        travels with the simulator), relative to the campaign file `source`."""
-        scenario = scenario_entry(sim)
-        sim.update(scenario.check(check, sim, Path(source).resolve().parent))
-        check.string(sim.setdefault("aircraft", SCENARIOS[DEFAULT_SCENARIO].default_aircraft), "simulator.aircraft")
-        locate_aircraft(check, sim, source)
+    def resolve(self, check, sim: SimulatorSpec, source: str) -> SimulatorSpec:
+        """The scenario's files resolved and the aircraft located (`aircraft_path`, the folder that travels
+        with the simulator), relative to the campaign file `source`."""
+        sim = scenario_entry(sim).check(check, sim, Path(source).resolve().parent)
+        aircraft = check.string(sim.get("aircraft", SCENARIOS[DEFAULT_SCENARIO].default_aircraft), "simulator.aircraft")
+        return replace(sim.with_settings(aircraft=aircraft), aircraft_path=located_aircraft(check, aircraft, source))
 
-    def make(self, config: dict, parameter_names: list[str], properties: list[str], base: Path) -> JSBSimSimulator:
+    def make(self, config: SimulatorSpec, parameter_names: list[str], properties: list[str],
+             base: Path) -> JSBSimSimulator:
         return JSBSimSimulator(config, properties, base)
 
-    def bundle(self, config: dict, properties, base) -> dict | None:
+    def bundle(self, config: SimulatorSpec, properties, base) -> dict | None:
         """The aircraft (the patched copy when `properties` perturb its functions) and its scenario's files."""
         return aircraft_bundle(config, properties, base, scenario_entry(config).files)
 
-    def provenance(self, config: dict, base: Path | None = None, properties=()) -> dict:
+    def provenance(self, config: SimulatorSpec, base: Path | None = None, properties=()) -> dict:
         """The aircraft's hash (the patched copy's when `properties` scale or offset its functions), and what
         its scenario kind adds (nothing for level flight)."""
         scenario = scenario_entry(config)
@@ -148,19 +150,19 @@ class JSBSim(SimulatorKind):
                 sim["aircraft"] = str(location.folder)
         return scenario_entry(sim).relocated(sim, Path(folder))
 
-    def recorded(self, config: dict) -> tuple[int, int]:
+    def recorded(self, config: SimulatorSpec) -> tuple[int, int]:
         return scenario_entry(config).times(config), len(config.get("outputs", DEFAULT_OUTPUTS))
 
-    def span(self, config: dict) -> float | None:
+    def span(self, config: SimulatorSpec) -> float | None:
         return scenario_entry(config).span(config)
 
-    def trims_level(self, config: dict) -> bool:
+    def trims_level(self, config: SimulatorSpec) -> bool:
         return scenario_entry(config).level_trim
 
-    def flight_summary(self, config: dict) -> dict[str, str]:
+    def flight_summary(self, config: SimulatorSpec) -> dict[str, str]:
         return scenario_entry(config).flight_summary(config)
 
-    def check_source(self, check, name, path: str, config: dict, aircraft) -> None:
+    def check_source(self, check, name, path: str, config: SimulatorSpec, aircraft) -> None:
         """A named output or, when the aircraft is known, one of its properties."""
         check.string(name, path)
         if aircraft is not None and name not in NAMED_OUTPUTS and aircraft.value(name) is None:
@@ -179,11 +181,11 @@ def check_fixed_properties(check, value) -> dict:
     return value
 
 
-def locate_aircraft(check, sim: dict, source: str) -> None:
-    """sim["aircraft_path"]: the folder of the aircraft, relative to the campaign file `source` (or the
-    project's, JSBSim's; see `aircraft.locate`). Reads folders only."""
+def located_aircraft(check, aircraft: str, source: str) -> str:
+    """The folder of the aircraft `aircraft`, relative to the campaign file `source` (or the project's,
+    JSBSim's; see `aircraft.locate`). Reads folders only."""
     try:
-        sim["aircraft_path"] = str(locate(sim["aircraft"], Path(source).resolve().parent).folder)
+        return str(locate(aircraft, Path(source).resolve().parent).folder)
     except AircraftNotFound as exc:
         check.fail("simulator.aircraft", str(exc))
 

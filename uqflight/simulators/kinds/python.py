@@ -6,6 +6,7 @@ from pathlib import Path
 from ..base import Field, SimulatorKind, SimulatorSettingError
 from ..bundle import python_bundle
 from ..python import PythonSimulator, load_function, split_spec
+from ..spec import SimulatorSpec
 from .outputs import KIND, OUTPUTS, check_outputs
 
 
@@ -40,17 +41,19 @@ class Python(SimulatorKind):
             check_outputs(check, sim["outputs"])
         return dict(sim)
 
-    def resolve(self, check, sim: dict, source: str) -> None:
+    def resolve(self, check, sim: SimulatorSpec, source: str) -> SimulatorSpec:
         """Import the function (its module's code runs), relative to the campaign file's folder."""
         try:
             load_function(sim["function"], Path(source).parent)
         except SimulatorSettingError as exc:
             check.fail("simulator.function", str(exc))
+        return sim
 
-    def make(self, config: dict, parameter_names: list[str], properties: list[str], base: Path) -> PythonSimulator:
+    def make(self, config: SimulatorSpec, parameter_names: list[str], properties: list[str],
+             base: Path) -> PythonSimulator:
         return PythonSimulator(config, parameter_names, base)
 
-    def bundle(self, config: dict, properties, base) -> dict | None:
+    def bundle(self, config: SimulatorSpec, properties, base) -> dict | None:
         """A `file.py` model's file; None for an installed module."""
         return python_bundle(config, base)
 
@@ -61,11 +64,11 @@ class Python(SimulatorKind):
             return dict(config)
         return {**config, "function": f"{(Path(folder) / module).resolve()}:{attribute}"}
 
-    def recorded(self, config: dict) -> tuple[int, int]:
+    def recorded(self, config: SimulatorSpec) -> tuple[int, int]:
         """The time grid is the model's: known once a sample has run (1 until then)."""
         return 1, len(config.get("outputs", ())) or 1
 
-    def check_source(self, check, name, path: str, config: dict, aircraft) -> None:
+    def check_source(self, check, name, path: str, config: SimulatorSpec, aircraft) -> None:
         """One of the model's outputs, when the campaign lists them."""
         check.string(name, path)
         outputs = config.get("outputs")

@@ -23,6 +23,7 @@ from ..engines import prepare_engines
 from ..jsbsim import (ATMOSPHERE, DEFAULT_OUTPUTS, OUTPUT_RATE, FlightResult, Observer, PropertyAccess,
                       Watch, check_finite, default_root, ready_to_load)
 from ..trim import ENGINE_STOPPED, STALL_PROPERTY, LevelTrim, lift_shortfall, speed_range_shortfall
+from ..spec import SimulatorSpec
 
 # Controls the trim writes: restored to their load-time values before every sample.
 TRIM_CONTROLS = (
@@ -403,7 +404,8 @@ class LevelFlight(ScenarioKind):
 
     Examples
     --------
-    >>> flight = LevelFlight().flight_summary({"aircraft": "bacm", "excitation": {"kind": "doublet"}})
+    >>> spec = SimulatorSpec("jsbsim", {"aircraft": "bacm", "excitation": {"kind": "doublet"}})
+    >>> flight = LevelFlight().flight_summary(spec)
     >>> flight["excitation"]
     'elevator doublet 1 deg at 1 s for 1 s'
     """
@@ -430,9 +432,9 @@ class LevelFlight(ScenarioKind):
                       "for every sample).", choices=FlightSetup.TRIMS),
     }
 
-    def check(self, check, sim: dict, folder: Path) -> dict:
+    def check(self, check, sim: SimulatorSpec, folder: Path) -> SimulatorSpec:
         """The scenario's keys checked as their fields say, the output rate against the integration rate."""
-        check_fields(check, sim, "simulator", self.fields)
+        check_fields(check, sim.as_mapping(), "simulator", self.fields)
         rate = float(sim.get("output_rate_hz", FlightSetup.output_rate_hz))
         problem = FlightSetup.rate_problem(FlightSetup.rate_hz, rate)
         if problem:
@@ -440,30 +442,31 @@ class LevelFlight(ScenarioKind):
         return sim
 
     @staticmethod
-    def _timing(config: dict) -> FlightSetup:
+    def _timing(config: SimulatorSpec) -> FlightSetup:
         """The timing alone, FlightSetup's defaults where the campaign gives none (its own checks apply)."""
         return FlightSetup(**{key: float(config[key]) for key in ("duration_s", "rate_hz", "output_rate_hz")
                               if key in config})
 
-    def span(self, config: dict) -> float:
+    def span(self, config: SimulatorSpec) -> float:
         """The flight's last time [s]: duration_s."""
         return self._timing(config).duration_s
 
-    def times(self, config: dict) -> int:
+    def times(self, config: SimulatorSpec) -> int:
         """The number of recorded times (the trimmed state, then duration_s at output_rate_hz)."""
         return self._timing(config).n_times
 
-    def setup(self, config: dict, root: Path | None = None, base: Path | None = None, properties=()) -> FlightSetup:
-        """A FlightSetup from a campaign's `simulator:` mapping (keys already validated). The aircraft
-        is located (a path relative to `base`, the project's, JSBSim's; see `aircraft.locate`) and
-        patched when `properties` scale or offset its functions, unless `root` or config["root"] is given."""
+    def setup(self, config: SimulatorSpec, root: Path | None = None, base: Path | None = None,
+              properties=()) -> FlightSetup:
+        """A FlightSetup from a campaign's `simulator:` spec. The aircraft is located (a path relative to
+        `base`, the project's, JSBSim's; see `aircraft.locate`) and patched when `properties` scale or offset
+        its functions, unless `root` or config.root is given."""
         from ..aircraft import default_condition
         from ..patch import PreparedAircraft
 
         name = config.get("aircraft", self.default_aircraft)
-        root = config.get("root", root)
+        root = config.root or root
         if root is None:
-            prepared = PreparedAircraft(config.get("aircraft_path", name), base, properties)
+            prepared = PreparedAircraft(config.aircraft_path or name, base, properties)
             name, root = prepared.name, prepared.root
         flight = {**default_condition(name), **config.get("flight", {})}
         return FlightSetup(
@@ -479,8 +482,8 @@ class LevelFlight(ScenarioKind):
             trim=config.get("trim", "newton"),
         )
 
-    def flight_summary(self, config: dict) -> dict[str, str]:
-        """The flight condition and excitation a campaign's `simulator:` mapping flies, defaults resolved
+    def flight_summary(self, config: SimulatorSpec) -> dict[str, str]:
+        """The flight condition and excitation a campaign's `simulator:` spec flies, defaults resolved
         (the report's campaign table), without locating the aircraft."""
         from ..aircraft import default_condition
 

@@ -26,7 +26,7 @@ import json
 import math
 import os
 import re
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from functools import cached_property
 from decimal import Decimal, InvalidOperation
 from pathlib import Path
@@ -37,6 +37,7 @@ import numpy as np
 from ..aircraft import AircraftFiles, cache_dir
 from ..directives import checked, parsed, without_io
 from ..base import Field, FlightError, ScenarioKind, SimulatorSettingError, TrimError, check_fields
+from ..spec import SimulatorSpec
 from ..jsbsim import (ATMOSPHERE, DEFAULT_OUTPUTS, OUTPUT_RATE, FlightResult, PropertyAccess, Watch, check_finite,
                       ready_to_load)
 
@@ -159,8 +160,8 @@ class ScriptFile:
             return DEFAULT_OUTPUT_RATE_HZ
         return self.rate_hz / math.ceil(self.rate_hz / DEFAULT_OUTPUT_RATE_HZ)
 
-    def output_rate_hz(self, config: dict) -> float:
-        """The recording rate of a campaign's `simulator:` mapping `config` flying this script: its
+    def output_rate_hz(self, config: SimulatorSpec) -> float:
+        """The recording rate of a campaign's `simulator:` spec `config` flying this script: its
         `output_rate_hz`, else `default_output_rate_hz`."""
         return float(config["output_rate_hz"]) if "output_rate_hz" in config else self.default_output_rate_hz
 
@@ -265,8 +266,8 @@ def _trim_events(root) -> int | None:
     return count
 
 
-def _script_file(config: dict, base: Path | None) -> ScriptFile:
-    path = config.get("script_path") or resolve(config["scenario"]["script"], Path(base or Path.cwd()))
+def _script_file(config: SimulatorSpec, base: Path | None) -> ScriptFile:
+    path = config.script_path or resolve(config["scenario"]["script"], Path(base or Path.cwd()))
     return ScriptFile.read(Path(path))
 
 
@@ -452,7 +453,8 @@ class Script(ScenarioKind):
 
     Examples
     --------
-    >>> Script().flight_summary({"kind": "jsbsim", "scenario": {"kind": "script", "script": "c172_cruise_8K", "end_s": 20}})
+    >>> Script().flight_summary(SimulatorSpec("jsbsim", {"scenario": {"kind": "script", "script": "c172_cruise_8K",
+    ...                                                                "end_s": 20}}))
     {'flight': 'script c172_cruise_8K, cut at 20 s', 'excitation': "the script's events"}
     """
 
@@ -465,7 +467,7 @@ class Script(ScenarioKind):
     example = {"kind": "jsbsim", "scenario": {"kind": "script", "script": "c172_cruise_8K", "end_s": 2.0},
                "output_rate_hz": 10.0}
 
-    def check(self, check, sim: dict, folder: Path) -> dict:
+    def check(self, check, sim: SimulatorSpec, folder: Path) -> SimulatorSpec:
         """Resolve and read the script, check end_s, the output rate against the script's dt and the
         campaign's aircraft against the script's (`check` is the campaign's Checker)."""
         from ..aircraft import AircraftNotFound, locate
@@ -479,7 +481,6 @@ class Script(ScenarioKind):
             script = ScriptFile.read(resolve(text, folder))
         except (SimulatorSettingError, OSError) as exc:
             check.fail("simulator.scenario.script", str(exc))
-        sim["script_path"] = str(script.path)
         end = None
         if "end_s" in scenario:
             end = check.number(scenario["end_s"], "simulator.scenario.end_s")
@@ -490,7 +491,7 @@ class Script(ScenarioKind):
             script.bounded_steps(end)
         except SimulatorSettingError as exc:
             check.fail("simulator.scenario.end_s" if end is not None else "simulator.scenario.script", str(exc))
-        check_fields(check, sim, "simulator", self.fields)
+        check_fields(check, sim.as_mapping(), "simulator", self.fields)
         rate = script.output_rate_hz(sim)
         if script.steps_per_output(rate) is None:
             divisors = ", ".join(f"{script.rate_hz / k:.4g}" for k in range(1, 7))
@@ -510,34 +511,34 @@ class Script(ScenarioKind):
             script.initfile(location.folder)
         except SimulatorSettingError as exc:
             check.fail("simulator.scenario.script", str(exc))
-        sim["aircraft"] = named
-        return sim
+        return replace(sim.with_settings(aircraft=named), script_path=str(script.path))
 
-    def span(self, config: dict) -> float | None:
+    def span(self, config: SimulatorSpec) -> float | None:
         """end_s when given, else the script's own end once it is resolved (`script_path`), else None: no
         file is read before the campaign is resolved."""
         end = config.get("scenario", {}).get("end_s")
         if isinstance(end, (int, float)) and not isinstance(end, bool):
             return float(end)
-        return ScriptFile.read(Path(config["script_path"])).end_s if config.get("script_path") else None
+        return ScriptFile.read(Path(config.script_path)).end_s if config.script_path else None
 
-    def times(self, config: dict) -> int:
+    def times(self, config: SimulatorSpec) -> int:
         """The number of recorded times, from the script's timing and the output rate alone."""
         script = _script_file(config, None)
         end_s = config.get("scenario", {}).get("end_s")
         steps = script.steps(None if end_s is None else float(end_s))
         return steps // script.steps_per_output(script.output_rate_hz(config)) + 1
 
-    def setup(self, config: dict, root: Path | None = None, base: Path | None = None, properties=()) -> ScriptSetup:
-        """A ScriptSetup from a campaign's `simulator:` mapping (keys already validated): the script's
+    def setup(self, config: SimulatorSpec, root: Path | None = None, base: Path | None = None,
+              properties=()) -> ScriptSetup:
+        """A ScriptSetup from a campaign's `simulator:` spec: the script's
         aircraft located and patched as for level flight (see `LevelFlight.setup`)."""
         from ..patch import PreparedAircraft
 
         script = _script_file(config, base)
         name = config.get("aircraft", script.aircraft)
-        root = config.get("root", root)
+        root = config.root or root
         if root is None:
-            prepared = PreparedAircraft(config.get("aircraft_path", name), base, properties)
+            prepared = PreparedAircraft(config.aircraft_path or name, base, properties)
             name, root = prepared.name, prepared.root
         root = Path(root)
         scenario = config.get("scenario", {})
@@ -552,10 +553,10 @@ class Script(ScenarioKind):
     def flight(self, setup: ScriptSetup, preflight: bool = True) -> ScriptFlight:
         return ScriptFlight(setup, preflight=preflight)
 
-    def files(self, config: dict) -> dict[str, bytes]:
+    def files(self, config: SimulatorSpec) -> dict[str, bytes]:
         """The script, its initialisation file when beside it, and the output files it names (keys relative
         to the script's folder): what a worker needs beyond the aircraft's files."""
-        script = ScriptFile.read(Path(config["script_path"]))
+        script = ScriptFile.read(Path(config.script_path))
         folder = script.path.parent
         names = [script.path.name, *script.outputs_files]
         for name in (script.initialize, f"{script.initialize}.xml"):
@@ -564,9 +565,9 @@ class Script(ScenarioKind):
                 break
         return {name: _inside(folder, name).read_bytes() for name in dict.fromkeys(names)}
 
-    def localize(self, config: dict, folder: Path) -> dict:
-        """The mapping reading the script (and the files beside it) from `folder`, where `files` were written."""
-        return {**config, "script_path": str(Path(folder) / Path(config["script_path"]).name)}
+    def localize(self, config: SimulatorSpec, folder: Path) -> SimulatorSpec:
+        """The spec reading the script (and the files beside it) from `folder`, where `files` were written."""
+        return replace(config, script_path=str(Path(folder) / Path(config.script_path).name))
 
     def relocated(self, config: dict, folder: Path) -> dict:
         """A script given as a file relative to `folder` made absolute (a JSBSim script keeps its name)."""
@@ -576,12 +577,12 @@ class Script(ScenarioKind):
             scenario["script"] = str(candidate.resolve())
         return {**config, "scenario": scenario}
 
-    def provenance(self, config: dict) -> dict:
+    def provenance(self, config: SimulatorSpec) -> dict:
         """The scenario and the sha256 of the script's files, for the results file."""
-        return {"scenario": json.dumps({"kind": "script", "script": Path(config["script_path"]).name,
+        return {"scenario": json.dumps({"kind": "script", "script": Path(config.script_path).name,
                                         "sha256": AircraftFiles("", self.files(config)).hash()})}
 
-    def flight_summary(self, config: dict) -> dict[str, str]:
+    def flight_summary(self, config: SimulatorSpec) -> dict[str, str]:
         """The script flown, as the campaign names it (the report's campaign table)."""
         scenario = config.get("scenario") or {}
         end = f", cut at {scenario['end_s']:g} s" if isinstance(scenario.get("end_s"), (int, float)) else ""
