@@ -469,18 +469,14 @@ class LevelFlight(ScenarioKind):
             prepared = PreparedAircraft(config.aircraft_path or name, base, properties)
             name, root = prepared.name, prepared.root
         flight = {**default_condition(name), **config.get("flight", {})}
-        return FlightSetup(
-            aircraft=name,
-            root=Path(root),
-            altitude_ft=float(flight["altitude_ft"]),
-            airspeed_ktas=float(flight["airspeed_ktas"]),
-            excitation=Excitation(**config.get("excitation", {})),
-            duration_s=float(config.get("duration_s", 50.0)),
-            rate_hz=float(config.get("rate_hz", 120.0)),
-            output_rate_hz=float(config.get("output_rate_hz", 20.0)),
-            outputs=tuple(config.get("outputs", DEFAULT_OUTPUTS)),
-            trim=config.get("trim", "newton"),
-        )
+        given = {key: float(config[key]) for key in ("duration_s", "rate_hz", "output_rate_hz") if key in config}
+        if "outputs" in config:
+            given["outputs"] = tuple(config["outputs"])
+        if "trim" in config:
+            given["trim"] = config["trim"]
+        return FlightSetup(aircraft=name, root=Path(root), altitude_ft=float(flight["altitude_ft"]),
+                           airspeed_ktas=float(flight["airspeed_ktas"]),
+                           excitation=Excitation(**config.get("excitation", {})), **given)  # FlightSetup's defaults
 
     def flight_summary(self, config: SimulatorSpec) -> dict[str, str]:
         """The flight condition and excitation a campaign's `simulator:` spec flies, defaults resolved
@@ -494,7 +490,7 @@ class LevelFlight(ScenarioKind):
                  f"{excitation.kind} {excitation.amplitude_deg:g} deg at {excitation.start_s:g} s"
                  + (f" for {excitation.duration_s:g} s" if excitation.kind != "step" else ""))
         return {"flight": f"level, {condition['altitude_ft']:g} ft, {condition['airspeed_ktas']:g} KTAS, "
-                          f"trim {config.get('trim', 'newton')}",
+                          f"trim {config.get('trim', FlightSetup.trim)}",
                 "excitation": f"elevator {shape}"}
 
     def flight(self, setup: FlightSetup, preflight: bool = True) -> JSBSimFlight:
