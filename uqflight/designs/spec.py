@@ -127,8 +127,8 @@ class DesignSpec:
         Raises
         ------
         ValueError
-            Naming `seed`, `germs` or `design.KEY` (a `FieldError` but for the germs and a tensor grid's
-            points) when the seed or the germs are not a campaign's, or the spec does not fit these germs.
+            Naming `seed`, `germs` or `design.KEY` (a `FieldError` but for the germs) when the seed or the germs
+            are not a campaign's, or the spec does not fit these germs.
         """
         if not is_integer(seed) or seed < 0:
             raise FieldError("seed", f"expected an integer >= 0, got {seed!r}")
