@@ -24,8 +24,7 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
 from uqflight.analysis.failures import wilson_interval  # noqa: E402
-from uqflight.analysis.proportions import sampled_proportion  # noqa: E402
-from uqflight.designs import build_design  # noqa: E402
+from uqflight.designs import REGISTRY, build_design  # noqa: E402
 
 
 def student_t(hits: np.ndarray, replicates: int) -> tuple[float, float]:
@@ -50,7 +49,7 @@ def coverage(seeds: int, replicates: int, points: int, expected: float) -> list[
         for seed in range(seeds):
             design = build_design({"kind": "sobol", "samples": points, "replicates": replicates}, [germ] * 3, seed)
             hits = hit(design.xi)
-            found = sampled_proportion(hits, np.ones(hits.size, bool), "net", design.info)
+            found = REGISTRY["sobol"].sampling.proportion(hits, np.ones(hits.size, bool), design.info)
             intervals = (student_t(hits, replicates), wilson_interval(hits.mean(), hits.size),
                          (found["lower"], found["upper"]))
             for k, (lower, upper) in enumerate(intervals):

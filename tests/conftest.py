@@ -88,16 +88,6 @@ def _refuse_constant(name: str):
     raise ValueError(f"{name} is not JSON: summary.json must be strict")
 
 
-def calibration_surrogate(results, **kwargs):
-    """The calibration's surrogate of a results file, as `calibrate` builds it (`surrogate_of` of the file opened
-    once and its record); `kwargs`: surrogate_of's method, order, outputs."""
-    from uqflight.calibration.surrogate import open_results, results_record, surrogate_of
-
-    results = Path(results)
-    with open_results(results) as store:
-        return surrogate_of(store, results, results_record(store, results, None), **kwargs)
-
-
 def read_summary(path) -> dict:
     """A summary.json (or any JSON the tool writes), read as a strict parser would: NaN, Infinity and
     -Infinity are errors."""

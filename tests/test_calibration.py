@@ -30,7 +30,7 @@ from uqflight.calibration.likelihood import (FlightData, LogPosterior, interpola
 from uqflight.calibration import sampler as sampler_module
 from uqflight.calibration.sampler import CHECK_EVERY, FIRST_CHECK, sample, split_rhat
 from uqflight.calibration.size import MAX_STEPS
-from conftest import calibration_surrogate
+from uqflight.calibration.surrogate import calibration_surrogate
 from uqflight.campaign import load_campaign, parse_campaign
 from uqflight.simulators.aircraft_properties import AircraftProperties
 from uqflight.running.runner import run_campaign

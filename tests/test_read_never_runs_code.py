@@ -102,7 +102,7 @@ def test_info_report_check_and_surrogate_export_import_no_model(world, name, tmp
 @pytest.mark.parametrize("name", ["file", "module"])
 def test_the_calibration_surrogate_imports_no_model(world, name, monkeypatch):
     """`calibrate` before its sampling: the campaign, the parameters and the PCE surrogate of the file."""
-    from conftest import calibration_surrogate
+    from uqflight.calibration.surrogate import calibration_surrogate
 
     monkeypatch.chdir(world["cwd"])
     for folder in world["env"]["PYTHONPATH"].split(os.pathsep)[:2]:

@@ -6,7 +6,7 @@ import json
 import numpy as np
 import pytest
 
-from conftest import calibration_surrogate
+from uqflight.calibration.surrogate import calibration_surrogate
 from uqflight.campaign import CampaignError, parse_campaign
 from uqflight.designs import build_design
 from uqflight.running.runner import run_campaign

@@ -35,9 +35,9 @@ from ..analysis.surrogate import fit_store_surrogate
 from ..text import Refusal
 from .likelihood import error_factors_of
 
-__all__ = ["CalibrationSurrogate", "CampaignError", "campaign_folder", "check_campaign_text", "open_results",
-           "parameter_specs", "portable_mapping", "prior_summaries", "results_record", "simulate", "surrogate_of",
-           "to_physical", "to_standard"]
+__all__ = ["CalibrationSurrogate", "CampaignError", "calibration_surrogate", "campaign_folder", "check_campaign_text",
+           "open_results", "parameter_specs", "portable_mapping", "prior_summaries", "results_record", "simulate",
+           "surrogate_of", "to_physical", "to_standard"]
 
 
 @dataclass
@@ -133,6 +133,16 @@ def results_record(store: ResultStore, results: Path, campaign_path: Path | None
                           f"{source}; pass the campaign file with --campaign (its model file is looked up "
                           "beside it)")
     return record
+
+
+def calibration_surrogate(results, method: str | None = None, order: int | None = None,
+                          campaign_path=None, outputs: list[str] | None = None) -> CalibrationSurrogate:
+    """The surrogate of every output (or of `outputs`) of a results file, with its error model, as `calibrate`
+    builds it: the file opened once, its record checked once (`results_record`, `surrogate_of`)."""
+    results = Path(results)
+    with open_results(results) as store:
+        record = results_record(store, results, Path(campaign_path) if campaign_path else None)
+        return surrogate_of(store, results, record, method, order, outputs)
 
 
 def surrogate_of(store: ResultStore, results: Path, record: CampaignRecord, method: str | None = None,
