@@ -145,7 +145,6 @@ class Statistics:
     path: str
     record: CampaignRecord  # the campaign the file records (campaign.record)
     method: MethodSpec  # the method applied (the campaign's, or the one asked for instead: MethodSpec.analysed)
-    design_kind: str
     parameter_names: list[str]
     runs: int  # the design's runs
     completed: int
@@ -170,6 +169,11 @@ class Statistics:
     def campaign_name(self) -> str:
         """The recorded campaign's name."""
         return self.record.campaign.name
+
+    @property
+    def design_kind(self) -> str:
+        """The recorded design's kind."""
+        return self.record.design_kind
 
     @property
     def design_info(self) -> dict:
@@ -351,9 +355,8 @@ def analyse_store(store: ResultStore, path, reference: str | None = None, option
         sampled = DESIGNS[design_kind].sampled
         ok = status == Status.OK
         pending = int(np.sum(status == Status.PENDING))
-        stats = Statistics(str(path), record, method, design_kind,
-                           store.parameter_names, int(status.size), int(ok.sum()), int(np.sum(status > 0)),
-                           pending, {}, partial=pending > 0, seed=options.seed)
+        stats = Statistics(str(path), record, method, store.parameter_names, int(status.size), int(ok.sum()),
+                           int(np.sum(status > 0)), pending, {}, partial=pending > 0, seed=options.seed)
         if DESIGNS[design_kind].rare:  # its runs are not draws of the input law: its event's probability only
             from .rare_statistics import rare_statistics
 
