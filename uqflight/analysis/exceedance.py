@@ -51,8 +51,9 @@ def exceedance_entry(bound: str, threshold: float, probability, lower, upper, me
             "flags": [flag] if flag else [], "note": sentence + (f"; {flag}" if flag else "")}
 
 
-def exceedance_from_runs(values: np.ndarray, defined: np.ndarray, thresholds: list[dict], sampling: Independent = Independent(),
-                         info: dict | None = None, units: str = "") -> list[dict]:
+def exceedance_from_runs(values: np.ndarray, defined: np.ndarray, thresholds: list[dict],
+                         sampling: Independent = Independent(), info: dict | None = None,
+                         units: str = "") -> list[dict]:
     """[{above|below, probability, lower, upper, method, flags, note}] over the runs where `defined` (bool (N,),
     design order) holds; `sampling`, `info`: how the design drew its points (analysis.proportions); `units`:
     the quantity's, for the unit-slip flag (`unit_slip`)."""

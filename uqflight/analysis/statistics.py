@@ -661,7 +661,8 @@ def _start_output(store: ResultStore, name: str, method: MethodSpec, germs: list
     def expand(a):
         return a if scale is None else a @ scale
 
-    result = entry.fit(xi, weights, basis, germs, order, x0, scale=scale, sampled=sampled, settings=dict(method.settings))
+    result = entry.fit(xi, weights, basis, germs, order, x0, scale=scale, sampled=sampled,
+                       settings=dict(method.settings))
     mean, variance, pce, from_runs = result.mean, result.variance, result.pce, result.from_runs
     if from_runs:  # bands, PDFs and pick-freeze indices from the runs themselves
         rows, row_scale, band_weights = basis, scale, (None if entry.run_weights(weights) is None else weights / weights.sum())
@@ -1182,8 +1183,8 @@ def summary_json(stats: Statistics) -> dict:
                                "floor_note": errors["floor_note"]}
         outputs[name] = entry
     return json_ready({
-        "results": stats.path, "campaign": stats.campaign_name, "method": stats.method.summary(), "design": stats.design_kind,
-        "runs": stats.runs, "completed": stats.completed, "failed": stats.failed, "pending": stats.pending,
+        "results": stats.path, "campaign": stats.campaign_name, "method": stats.method.summary(),
+        "design": stats.design_kind, "runs": stats.runs, "completed": stats.completed, "failed": stats.failed, "pending": stats.pending,
         "failure_probability": stats.failure_probability, "partial": stats.partial, "notes": stats.notes,
         "failures": stats.failures, "parameters": stats.parameter_names, "reference": stats.reference,
         **({"dependence": stats.dependence} if stats.dependence else {}),

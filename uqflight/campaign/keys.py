@@ -151,8 +151,8 @@ class Key:
 
 def _by_kind(meanings: dict[str, str]) -> str:
     """A design key's meaning in the reference: the kinds that take it, grouped by what it means for them, e.g.
-    "`sobol`, `halton`: Scramble ...", one line per meaning. A kind without a meaning for it leaves the whole meaning empty (the
-    reference then refuses to build: `missing_descriptions`)."""
+    "`sobol`, `halton`: Scramble ...", one line per meaning. A kind without a meaning for it leaves the whole
+    meaning empty (the reference then refuses to build: `missing_descriptions`)."""
     if not all(meanings.values()):
         return ""
     groups: dict[str, list[str]] = {}
@@ -257,7 +257,8 @@ def reference_page() -> str:
     lines = ["# Campaign keys", "",
              "Every key a campaign file accepts, generated from the code (`uqflight/campaign/schema.py` and the "
              "registries of scenarios, designs, methods, distributions, rules and quantities; a kind's keys described "
-             "in its class, the others in `uqflight/campaign/keys.py`). `NAME` is a name you choose. An unknown key is refused (exit 2) "
+             "in its class, the others in `uqflight/campaign/keys.py`). `NAME` is a name you choose. "
+             "An unknown key is refused (exit 2) "
              "with the closest known one. The guide is [campaign files](../campaigns.md)."]
     keys = accepted_keys()
     for section in dict.fromkeys(k.section for k in keys):

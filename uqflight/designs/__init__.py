@@ -19,49 +19,13 @@ DESIGN_KINDS = tuple(REGISTRY)
 
 def design_size(spec: dict, germs: list[str]) -> float:
     """The runs the `design:` mapping `spec` builds over `germs`, from the spec alone: the mapping checked once
-    (DesignSpec.checked), then its `DesignSpec.size`.
-
-    Parameters
-    ----------
-    spec : dict
-        A `design:` mapping.
-    germs : list of str
-        As `DesignSpec.size`.
-
-    Returns
-    -------
-    float
-        As `DesignSpec.size`.
-
-    Raises
-    ------
-    FieldError
-        Naming `design.KEY` when the mapping is refused or goes beyond its kind's limit.
-    """
+    (DesignSpec.checked), then its `DesignSpec.size` (see there)."""
     return DesignSpec.checked(spec).size(germs)
 
 
 def build_design(spec: dict, germs: list[str], seed: int, redrawn: tuple[int, ...] = ()) -> Design:
     """The design a campaign's `design:` mapping asks for: the mapping checked once (DesignSpec.checked), then
-    its `DesignSpec.build`.
-
-    Parameters
-    ----------
-    spec : dict
-        A `design:` mapping.
-    germs, seed, redrawn
-        As `DesignSpec.build`.
-
-    Returns
-    -------
-    Design
-        Its points ξ (N, d), weights and facts.
-
-    Raises
-    ------
-    ValueError
-        Naming the field (`design.KEY`, `seed`, `germs`) and what was expected.
-    """
+    its `DesignSpec.build` (see there for the arguments, the result and the refusals)."""
     return DesignSpec.checked(spec).build(germs, seed, redrawn)
 
 

@@ -39,7 +39,8 @@ class TensorGrid(DesignKind):
         for rule in dict.fromkeys(rules):
             sizes = rule_catalog.allowed_sizes(rule)
             if sizes is not None and size not in sizes:
-                raise FieldError("design.points", f"rule {rule} comes in {', '.join(map(str, sizes))} points, got {size}")
+                raise FieldError("design.points",
+                                 f"rule {rule} comes in {', '.join(map(str, sizes))} points, got {size}")
         one_dimensional = {rule: rule_catalog.nodes_weights(rule, size) for rule in set(rules)}
         xi, weights = tensor_product(
             [one_dimensional[rule][0] for rule in rules], [one_dimensional[rule][1] for rule in rules]
